@@ -1,0 +1,1 @@
+"""StrideFix analyzer: reads LCM logs, scores POSE against TRUTH, writes metrics and reports."""

@@ -1,0 +1,40 @@
+"""The `stridefix` console script: one sub-command per job.
+
+Each sub-command lives in the module that does the work and contributes two functions:
+``add_parser(subparsers)`` (declares its arguments and help) and ``run(args) -> int`` (the exit status).
+Exit status: 0 success, 1 the work failed, 2 bad usage or unreadable input.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# sub-command name -> module providing add_parser() and run()
+SUBCOMMANDS = {
+    "sim": "stridefix_sim.cli",
+    "analyze": "stridefix_analyzer.analyze",
+    "report": "stridefix_analyzer.report",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="stridefix",
+        description="StrideFix tools: simulate a walk, analyze LCM logs, render reports.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, module_name in SUBCOMMANDS.items():
+        module = importlib.import_module(module_name)
+        p = module.add_parser(sub)
+        p.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return int(args._run(args) or 0)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs what StrideFix needs and is missing; safe to run again (make deps).
+#  1. Debian packages (apt-get update first, only when something is missing).
+#  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
+#     re-installed only when requirements.txt or pyproject.toml changed.
+#  3. A .pth file so the venv imports the LCM Python bindings that the build generates.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+VENV=${VENV:-.venv}
+BUILD=${BUILD:-build}
+DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev cmake g++ gcc make pkg-config)
+
+missing=()
+for p in "${DEBS[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ! python3 -c 'import venv, ensurepip' 2>/dev/null; then missing+=(python3-venv); fi
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  echo "deps: installing Debian packages: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+if [ ! -x "$VENV/bin/python" ]; then
+  echo "deps: creating virtualenv $VENV"
+  python3 -m venv "$VENV"
+fi
+stamp="$VENV/.stridefix-deps"
+want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "deps: installing Python packages into $VENV"
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+  echo "$want" > "$stamp"
+fi
+site=$("$VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+echo "$(pwd)/$BUILD/lcmtypes/python" > "$site/stridefix_lcmtypes.pth"
