@@ -1,0 +1,44 @@
+# StrideFix — the entry point. `make demo` runs the default SIL walk end to end; `make test` runs
+# every test. Both install what is missing first (make deps). Variables can be overridden:
+#   make test BUILD=build-dbg CMAKE_BUILD_TYPE=Debug
+BUILD ?= build
+VENV ?= .venv
+CMAKE_BUILD_TYPE ?= RelWithDebInfo
+JOBS ?= 2
+PY := $(VENV)/bin/python
+DEMO_OUT ?= out/demo
+STRIDEFIXD := $(BUILD)/firmware/stridefixd
+
+.PHONY: all deps build test test-c test-python demo bench clean help
+
+all: build
+
+help:
+	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
+	@echo "make test   - install what is missing, build, run every test (C, Python, end to end)"
+	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
+	@echo "make build  - CMake build into $(BUILD)/"
+	@echo "make clean  - remove $(BUILD)/ and out/"
+
+deps:
+	@BUILD=$(BUILD) VENV=$(VENV) tools/deps.sh
+
+build: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DSTRIDEFIX_PYTHON=$(abspath $(PY)) > $(BUILD).cmake.log 2>&1 \
+		|| { cat $(BUILD).cmake.log; exit 1; }
+	@cmake --build $(BUILD) -j $(JOBS)
+
+test: build
+	@$(MAKE) --no-print-directory test-c test-python
+
+test-c:
+	cd $(BUILD) && ctest --output-on-failure
+
+test-python:
+	STRIDEFIXD=$(abspath $(STRIDEFIXD)) $(PY) -m pytest -q
+
+demo: build
+	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
+
+clean:
+	rm -rf $(BUILD) $(BUILD).cmake.log out

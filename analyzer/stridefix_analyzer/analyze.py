@@ -1,0 +1,162 @@
+"""``stridefix analyze``: read LCM logs, score POSE against TRUTH, write metrics.json + analysis.npz.
+
+Outputs in ``--out DIR`` (default ``out/analyze``):
+
+- ``metrics.json``: the summary (see :meth:`stridefix_analyzer.metrics.Metrics.summary`) plus
+  ``inputs``, ``messages`` (events per channel), ``unknown_channels``, ``decode_errors``,
+  ``health`` (last HEALTH fields), ``config`` (``version``, ``dbc_sha256``, ``params``) and
+  ``warnings``. Non-finite numbers are written as ``null``.
+- ``analysis.npz``: the per-truth-sample series the report plots
+  (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
+
+Exit status: 0 success; 1 nothing could be scored (every truth sample precedes the first POSE);
+2 missing or unreadable input, or no TRUTH / no POSE in the logs.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from .logread import KNOWN_CHANNELS, LogData, LogReadError, LogTruncatedWarning, read_logs
+from .metrics import Metrics, MetricsInputError, run_metrics, scheme_code
+
+DEFAULT_OUT = os.path.join("out", "analyze")
+METRICS_FILE = "metrics.json"
+SERIES_FILE = "analysis.npz"
+
+# channels the analysis needs decoded; the rest (IMU, MAG, ...) are only counted, which is faster
+_DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG")
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Declare the ``analyze`` sub-command and its options."""
+    p = subparsers.add_parser(
+        "analyze", help="score POSE against TRUTH in LCM logs; write metrics.json and analysis.npz",
+        description="Read one or more LCM event logs (e.g. the firmware's log and the simulator's "
+                    "truth log), score every POSE scheme against TRUTH with the causal protocol of "
+                    "DESIGN.md, and write DIR/metrics.json and DIR/analysis.npz.")
+    p.add_argument("logs", nargs="+", metavar="LOG",
+                   help="LCM event log(s); events of all logs are merged")
+    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
+                   help=f"output directory, created if needed (default: {DEFAULT_OUT})")
+    p.add_argument("--scheme", default=None, metavar="NAME",
+                   help="pose scheme reported at the top level when POSE holds several "
+                        "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
+                        "default: the one with most POSE messages)")
+    p.add_argument("--all-channels", action="store_true",
+                   help=f"decode every known channel ({', '.join(KNOWN_CHANNELS)}) to check their "
+                        "payloads, not only those the analysis needs (slower on long logs)")
+    return p
+
+
+def _json_ready(value):
+    """Recursively convert numpy scalars/arrays to Python, and non-finite floats to None."""
+    if isinstance(value, dict):
+        return {str(k): _json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_ready(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def build_summary(data: LogData, metrics: Metrics) -> dict:
+    """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
+    doc = {"inputs": data.inputs}
+    doc.update(metrics.summary())
+    doc.update(messages=dict(sorted(data.messages.items())),
+               unknown_channels=data.unknown_channels,
+               decode_errors=data.decode_errors,
+               health=data.health,
+               config={**data.versions, "params": data.config},
+               warnings=data.warnings)
+    return _json_ready(doc)
+
+
+def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, str]:
+    """Write metrics.json and analysis.npz into ``out_dir``; return their paths."""
+    os.makedirs(out_dir, exist_ok=True)
+    json_path = os.path.join(out_dir, METRICS_FILE)
+    npz_path = os.path.join(out_dir, SERIES_FILE)
+    with open(json_path, "w", encoding="utf-8") as f:
+        json.dump(summary, f, indent=2, allow_nan=False)
+        f.write("\n")
+    np.savez_compressed(npz_path, **metrics.series())
+    return json_path, npz_path
+
+
+def _fmt(value, digits: int = 2) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}f}"
+    return str(value)
+
+
+def format_summary(summary: dict) -> str:
+    """A compact plain-text table of the per-scheme scores, for the terminal."""
+    cols = ["n", "mean", "median", "p75", "p90", "p95", "max", "rmse"]
+    lines = [f"{'scheme':<11}" + "".join(f"{c:>8}" for c in cols)
+             + f"{'floor%':>8}{'final':>8}{'steps':>8}"]
+    for name, s in summary["per_scheme"].items():
+        e = s["position_error_m"]
+        mark = "*" if name == summary["primary_scheme"] else " "
+        floor = s["floor_hit_rate"]
+        lines.append(f"{mark}{name:<10}" + "".join(f"{_fmt(e[c]):>8}" for c in cols)
+                     + f"{_fmt(None if floor is None else 100 * floor, 1):>8}"
+                     + f"{_fmt(s['final_error_m']):>8}" + f"{_fmt(s['steps']['error']):>8}")
+    st = summary["steps"]
+    lines.append(f"(errors in m; * primary scheme; steps = detected - truth)  "
+                 f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
+                 f"walked {summary['distance_walked_m']:.1f} m, "
+                 f"steps detected {st['detected']} / truth {_fmt(st['truth'])}")
+    return "\n".join(lines)
+
+
+def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None = None,
+                all_channels: bool = False) -> tuple[dict, Metrics]:
+    """Read ``logs``, score them and write the outputs; return (summary, metrics).
+
+    Raises
+    ------
+    LogReadError
+        A log is missing or unreadable.
+    MetricsInputError
+        No TRUTH or no POSE, or the requested scheme is absent.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LogTruncatedWarning)   # kept in data.warnings instead
+        data = read_logs(logs, decode=None if all_channels else _DECODE)
+    code = scheme_code(scheme) if scheme is not None else None
+    metrics = run_metrics(data, scheme=code)
+    summary = build_summary(data, metrics)
+    write_outputs(out_dir, summary, metrics)
+    return summary, metrics
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``stridefix analyze``; returns the exit status."""
+    try:
+        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels)
+    except (LogReadError, MetricsInputError) as exc:
+        print(f"stridefix analyze: error: {exc}", file=sys.stderr)
+        return 2
+    for note in summary["warnings"]:
+        print(f"stridefix analyze: warning: {note}", file=sys.stderr)
+    print(format_summary(summary))
+    print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
+    if summary["position_error_m"]["n"] == 0:
+        print("stridefix analyze: error: no truth sample could be scored (all precede the first "
+              "POSE of the primary scheme)", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,345 @@
+"""Score the published POSE stream against TRUTH: the evaluation protocol of DESIGN.md.
+
+Protocol (causal, nothing looks ahead): for each truth time t the estimate is the latest ``POSE``
+with ``t_us ≤ t`` (of the same fusion scheme); the position error is the horizontal distance
+between the two [m]. Truth samples before the scheme's first POSE are not scored but counted as
+``unscored``. Statistics: n, mean, median, 75th/90th/95th percentile (numpy's default linear
+interpolation), max and RMSE, plus the empirical CDF. Also floor hit rate, step count against the
+truth, distance walked along the truth, and the final error.
+
+When a log holds POSE messages of several schemes (``pose_t.scheme``), each is scored on its own
+and reported under its name; one of them is the *primary* scheme whose numbers are repeated at the
+top level of the summary (see :func:`choose_primary`).
+
+No plotting here: :mod:`stridefix_analyzer.plots` draws what this module computes.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+import stridefix
+from .logread import LogData, Table
+
+#: pose_t.scheme code → name used in reports and JSON keys
+SCHEME_NAMES = {
+    stridefix.pose_t.SCHEME_PDR_ONLY: "pdr_only",
+    stridefix.pose_t.SCHEME_WIFI_ONLY: "wifi_only",
+    stridefix.pose_t.SCHEME_OVERWRITE: "overwrite",
+    stridefix.pose_t.SCHEME_STATIC: "static",
+    stridefix.pose_t.SCHEME_ADAPTIVE: "adaptive",
+    stridefix.pose_t.SCHEME_KALMAN: "kalman",
+}
+#: preference when several schemes have equally many POSE messages (first wins)
+_PRIMARY_PREFERENCE = ["adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
+
+#: percentiles reported, in percent
+PERCENTILES = (50, 75, 90, 95)
+
+
+class MetricsInputError(ValueError):
+    """The logs lack what scoring needs (no TRUTH, no POSE, unknown scheme); the message says what."""
+
+
+def scheme_name(code: int) -> str:
+    """Name of a pose_t.scheme code; unknown codes become ``scheme_<code>``."""
+    return SCHEME_NAMES.get(int(code), f"scheme_{int(code)}")
+
+
+def scheme_code(name: str) -> int:
+    """Inverse of :func:`scheme_name`; accepts a name (``adaptive``) or a number (``4``)."""
+    for code, known in SCHEME_NAMES.items():
+        if name.lower() == known:
+            return code
+    if name.lower().startswith("scheme_"):
+        name = name[len("scheme_"):]
+    try:
+        return int(name)
+    except ValueError:
+        raise MetricsInputError(f"unknown scheme {name!r}; known: {list(SCHEME_NAMES.values())}") \
+            from None
+
+
+# --- the causal match ----------------------------------------------------------------------------
+
+def match_causal(pose: Table, truth: Table) -> Table:
+    """Pair every truth sample with the latest pose at or before its time.
+
+    Parameters
+    ----------
+    pose : Table
+        POSE rows of one scheme, sorted by ``t_us`` [µs] (equal times: the later row wins).
+    truth : Table
+        TRUTH rows, sorted by ``t_us`` [µs].
+
+    Returns
+    -------
+    Table
+        One row per truth sample, shape (n_truth,): ``t_us``, ``truth_x_m``, ``truth_y_m``,
+        ``truth_floor``, ``scored`` (bool: a pose existed), ``pose_row`` (row in ``pose``, −1 when
+        unscored), ``pose_t_us``, ``pose_x_m``, ``pose_y_m``, ``pose_floor``, ``pose_sigma_m``
+        and ``error_m`` (horizontal distance [m], NaN when unscored).
+    """
+    t = truth["t_us"]
+    row = np.searchsorted(pose["t_us"], t, side="right") - 1
+    scored = row >= 0
+    safe = np.where(scored, row, 0)
+
+    def take(values: np.ndarray, fill):
+        if len(values) == 0:
+            return np.full(len(t), fill, dtype=np.asarray(fill).dtype)
+        return np.where(scored, values[safe], fill)
+
+    px, py = take(pose["x_m"], np.nan), take(pose["y_m"], np.nan)
+    return Table({
+        "t_us": t,
+        "truth_x_m": truth["x_m"], "truth_y_m": truth["y_m"], "truth_floor": truth["floor"],
+        "scored": scored,
+        "pose_row": np.where(scored, row, -1),
+        "pose_t_us": take(pose["t_us"], np.int64(-1)),
+        "pose_x_m": px, "pose_y_m": py,
+        "pose_floor": take(pose["floor"], np.int64(-1)),
+        "pose_sigma_m": take(pose["sigma_m"], np.nan),
+        "error_m": np.hypot(px - truth["x_m"], py - truth["y_m"]),
+    })
+
+
+# --- statistics ----------------------------------------------------------------------------------
+
+def error_stats(error_m: np.ndarray) -> dict:
+    """Summary statistics of position errors.
+
+    Parameters
+    ----------
+    error_m : ndarray, shape (n,)
+        Errors [m] of scored samples; non-finite values are left out and counted.
+
+    Returns
+    -------
+    dict
+        ``n``, ``mean``, ``median``, ``p75``, ``p90``, ``p95``, ``max``, ``rmse`` [m] (NaN when
+        n = 0; percentiles by ``np.percentile``'s linear method) and ``nonfinite`` (count).
+    """
+    error_m = np.asarray(error_m, dtype=np.float64)
+    finite = error_m[np.isfinite(error_m)]
+    stats = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
+    if finite.size == 0:
+        stats.update(dict.fromkeys(["mean", "median", "p75", "p90", "p95", "max", "rmse"],
+                                   float("nan")))
+        return stats
+    p50, p75, p90, p95 = np.percentile(finite, PERCENTILES)
+    stats.update(mean=float(finite.mean()), median=float(p50), p75=float(p75), p90=float(p90),
+                 p95=float(p95), max=float(finite.max()),
+                 rmse=float(np.sqrt(np.mean(finite ** 2))))
+    return stats
+
+
+def error_cdf(error_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Empirical CDF of the finite errors.
+
+    Returns
+    -------
+    error_sorted_m : ndarray, shape (n,)
+        Errors in ascending order [m].
+    fraction : ndarray, shape (n,)
+        Fraction of samples with error ≤ the corresponding value, (i + 1) / n.
+    """
+    e = np.sort(np.asarray(error_m, dtype=np.float64)[np.isfinite(error_m)])
+    return e, np.arange(1, e.size + 1) / max(e.size, 1)
+
+
+def distance_walked_m(truth: Table) -> float:
+    """Horizontal path length along the time-sorted truth positions [m]."""
+    if len(truth) < 2:
+        return 0.0
+    return float(np.sum(np.hypot(np.diff(truth["x_m"]), np.diff(truth["y_m"]))))
+
+
+def step_metrics(pose: Table, truth: Table, n_step_messages: int) -> dict:
+    """Detected steps against the truth's step count.
+
+    ``detected`` is the last POSE's ``step_count`` (or the number of STEP messages when there is no
+    POSE); ``truth`` is the last TRUTH ``step_count`` that is ≥ 0 (None when the truth has none).
+    ``error`` = detected − truth [steps]; ``error_pct`` = 100·error/truth [%].
+    """
+    detected = int(pose["step_count"][-1]) if len(pose) else int(n_step_messages)
+    known = truth["step_count"][truth["step_count"] >= 0] if len(truth) else np.array([])
+    out = {"detected": detected, "step_messages": int(n_step_messages),
+           "truth": None, "error": None, "error_pct": None}
+    if known.size:
+        t = int(known[-1])
+        out.update(truth=t, error=detected - t,
+                   error_pct=(100.0 * (detected - t) / t) if t > 0 else None)
+    return out
+
+
+# --- one scheme, and the whole log ---------------------------------------------------------------
+
+@dataclasses.dataclass
+class SchemeScore:
+    """Scores of one fusion scheme.
+
+    Attributes
+    ----------
+    code, name : int, str
+        pose_t.scheme code and its name.
+    summary : dict
+        JSON-ready numbers: ``n_pose``, ``position_error_m`` (see :func:`error_stats`),
+        ``unscored``, ``floor_hit_rate``, ``within_1sigma_rate``, ``steps``, ``final_error_m``,
+        ``final_error_pct_of_distance``.
+    match : Table
+        Per-truth-sample series from :func:`match_causal`, shape (n_truth,).
+    pose : Table
+        This scheme's POSE rows (for trajectory plots).
+    """
+
+    code: int
+    name: str
+    summary: dict
+    match: Table
+    pose: Table
+
+
+def score_scheme(pose: Table, truth: Table, n_step_messages: int, distance_m: float,
+                 code: int) -> SchemeScore:
+    """Score one scheme's POSE rows (sorted by time) against the TRUTH rows (sorted by time)."""
+    m = match_causal(pose, truth)
+    scored = m["scored"]
+    err = m["error_m"][scored]
+    floor_hit = (float(np.mean(m["pose_floor"][scored] == m["truth_floor"][scored]))
+                 if scored.any() else float("nan"))
+    sig = m["pose_sigma_m"][scored]
+    ok = np.isfinite(err) & np.isfinite(sig) & (sig > 0)
+    within = float(np.mean(err[ok] <= sig[ok])) if ok.any() else float("nan")
+    final = float(err[-1]) if err.size else float("nan")
+    summary = {
+        "n_pose": len(pose),
+        "position_error_m": error_stats(err),
+        "unscored": int(np.count_nonzero(~scored)),
+        "floor_hit_rate": floor_hit,
+        "within_1sigma_rate": within,
+        "steps": step_metrics(pose, truth, n_step_messages),
+        "final_error_m": final,
+        "final_error_pct_of_distance": 100.0 * final / distance_m if distance_m > 0 else None,
+    }
+    return SchemeScore(code=int(code), name=scheme_name(code), summary=summary, match=m, pose=pose)
+
+
+def choose_primary(pose: Table, requested: int | None = None) -> int:
+    """The scheme whose numbers go at the top level.
+
+    ``requested`` if given (it must occur in the log); else the scheme with most POSE messages,
+    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only.
+    """
+    codes, counts = np.unique(pose["scheme"], return_counts=True)
+    if requested is not None:
+        if requested not in codes:
+            raise MetricsInputError(
+                f"scheme {scheme_name(requested)} not in the POSE stream; present: "
+                f"{[scheme_name(c) for c in codes]}")
+        return int(requested)
+
+    def rank(i: int):
+        name = scheme_name(codes[i])
+        pref = _PRIMARY_PREFERENCE.index(name) if name in _PRIMARY_PREFERENCE else 99
+        return (-counts[i], pref, int(codes[i]))
+
+    return int(codes[min(range(len(codes)), key=rank)])
+
+
+@dataclasses.dataclass
+class Metrics:
+    """All scores of one analysis.
+
+    Attributes
+    ----------
+    primary : int
+        pose_t.scheme code of the primary scheme.
+    schemes : dict of int to SchemeScore
+        Every scheme seen in POSE, by code.
+    truth : Table
+        TRUTH rows sorted by time.
+    distance_walked_m : float
+        Horizontal path length of the truth [m].
+    """
+
+    primary: int
+    schemes: dict
+    truth: Table
+    distance_walked_m: float
+
+    def summary(self) -> dict:
+        """JSON-ready dict: the primary scheme's numbers at the top level plus ``per_scheme``."""
+        top = self.schemes[self.primary].summary
+        return {
+            "primary_scheme": scheme_name(self.primary),
+            "position_error_m": top["position_error_m"],
+            "unscored": top["unscored"],
+            "n_truth": len(self.truth),
+            "floor_hit_rate": top["floor_hit_rate"],
+            "floors_in_truth": sorted({int(f) for f in self.truth["floor"]}),
+            "within_1sigma_rate": top["within_1sigma_rate"],
+            "steps": top["steps"],
+            "distance_walked_m": self.distance_walked_m,
+            "final_error_m": top["final_error_m"],
+            "final_error_pct_of_distance": top["final_error_pct_of_distance"],
+            "per_scheme": {s.name: s.summary for s in self.schemes.values()},
+        }
+
+    def series(self) -> dict[str, np.ndarray]:
+        """Per-sample arrays for the report (saved as analysis.npz).
+
+        Keys: ``truth_t_us``, ``truth_x_m``, ``truth_y_m``, ``truth_floor`` (n_truth,);
+        the primary scheme's ``scored``, ``match_x_m``, ``match_y_m``, ``match_floor``,
+        ``error_m`` (n_truth,); ``scheme_codes`` (n_schemes,); ``primary_scheme`` (scalar); and per
+        scheme code c: ``s<c>_error_m``, ``s<c>_scored`` (n_truth,), ``s<c>_pose_t_us``,
+        ``s<c>_pose_x_m``, ``s<c>_pose_y_m``, ``s<c>_pose_floor`` (n_pose of that scheme,).
+        Unscored errors are NaN.
+        """
+        p = self.schemes[self.primary].match
+        out = {
+            "truth_t_us": self.truth["t_us"], "truth_x_m": self.truth["x_m"],
+            "truth_y_m": self.truth["y_m"], "truth_floor": self.truth["floor"],
+            "scored": p["scored"], "match_x_m": p["pose_x_m"], "match_y_m": p["pose_y_m"],
+            "match_floor": p["pose_floor"], "error_m": p["error_m"],
+            "scheme_codes": np.array(sorted(self.schemes), dtype=np.int64),
+            "primary_scheme": np.int64(self.primary),
+        }
+        for code, s in self.schemes.items():
+            out[f"s{code}_error_m"] = s.match["error_m"]
+            out[f"s{code}_scored"] = s.match["scored"]
+            for col in ("t_us", "x_m", "y_m", "floor"):
+                out[f"s{code}_pose_{col}"] = s.pose[col]
+        return out
+
+
+def run_metrics(data: LogData, scheme: int | None = None) -> Metrics:
+    """Score every POSE scheme in ``data`` against its TRUTH.
+
+    Parameters
+    ----------
+    data : LogData
+        Logs read by :func:`stridefix_analyzer.logread.read_logs`.
+    scheme : int, optional
+        pose_t.scheme code to make primary (default: see :func:`choose_primary`).
+
+    Raises
+    ------
+    MetricsInputError
+        No TRUTH or no POSE messages (both listed when both are missing), or ``scheme`` absent.
+    """
+    missing = [ch for ch in ("TRUTH", "POSE") if data.table(ch) is None or not len(data.table(ch))]
+    if missing:
+        raise MetricsInputError(f"no {' and no '.join(missing)} messages in "
+                                f"{', '.join(i['path'] for i in data.inputs) or 'the input'}")
+    truth, pose = data.table("TRUTH"), data.table("POSE")
+    steps = data.table("STEP")
+    n_steps = len(steps) if steps is not None else 0
+    distance = distance_walked_m(truth)
+    primary = choose_primary(pose, scheme)
+    schemes = {}
+    for code in np.unique(pose["scheme"]):
+        rows = pose.rows(pose["scheme"] == code)   # stays sorted by time
+        schemes[int(code)] = score_scheme(rows, truth, n_steps, distance, int(code))
+    return Metrics(primary=primary, schemes=schemes, truth=truth, distance_walked_m=distance)

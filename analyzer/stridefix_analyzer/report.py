@@ -1,0 +1,240 @@
+"""``stridefix report``: turn an ``analyze`` output directory into one self-contained HTML page.
+
+Reads ``DIR/metrics.json`` and ``DIR/analysis.npz`` (written by ``stridefix analyze``) and writes
+``report.html`` (default ``DIR/report.html``) with inline CSS and the figures of
+:mod:`stridefix_analyzer.plots` embedded as base64 PNG data URIs, so the file can be mailed or
+archived alone. Exit status: 0 written; 2 the directory or one of its two files is missing or
+unreadable.
+"""
+from __future__ import annotations
+
+import argparse
+import base64
+import html
+import json
+import os
+import sys
+
+import numpy as np
+
+from . import plots
+from .analyze import METRICS_FILE, SERIES_FILE
+
+
+class ReportInputError(Exception):
+    """An analysis directory lacks a file or holds an unreadable one; the message names it."""
+
+
+_CSS = """
+body { font-family: system-ui, -apple-system, 'Segoe UI', sans-serif; margin: 2em auto;
+       max-width: 1100px; color: #222; line-height: 1.4; padding: 0 1em; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { font-size: 1.2em; margin-top: 1.6em;
+     border-bottom: 1px solid #ddd; padding-bottom: 0.2em; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.92em; }
+th, td { border: 1px solid #ddd; padding: 0.25em 0.7em; text-align: right; }
+th { background: #f4f4f4; } td.k, th.k { text-align: left; }
+tr.primary td { font-weight: 600; background: #f3f8ff; }
+.note { color: #666; font-size: 0.9em; } .warn { color: #a40; }
+img { max-width: 100%; border: 1px solid #eee; margin: 0.4em 0; }
+.figs { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
+"""
+
+_STAT_COLS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
+
+
+def load_analysis(directory: str) -> tuple[dict, dict]:
+    """Load (metrics.json as dict, analysis.npz as dict of arrays) from ``directory``.
+
+    Raises
+    ------
+    ReportInputError
+        The directory or a file is missing, or a file cannot be parsed; names the file.
+    """
+    if not os.path.isdir(directory):
+        raise ReportInputError(f"{directory}: no such directory (run `stridefix analyze` first)")
+    json_path = os.path.join(directory, METRICS_FILE)
+    npz_path = os.path.join(directory, SERIES_FILE)
+    missing = [p for p in (json_path, npz_path) if not os.path.isfile(p)]
+    if missing:
+        raise ReportInputError(f"missing {', '.join(missing)} (run `stridefix analyze` first)")
+    try:
+        with open(json_path, encoding="utf-8") as f:
+            summary = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise ReportInputError(f"{json_path}: cannot read as JSON ({exc})") from exc
+    try:
+        with np.load(npz_path) as z:
+            series = {k: z[k] for k in z.files}
+    except (OSError, ValueError) as exc:
+        raise ReportInputError(f"{npz_path}: cannot read as .npz ({exc})") from exc
+    need = [k for k in ("truth_t_us", "truth_x_m", "truth_y_m", "scheme_codes", "primary_scheme")
+            if k not in series]
+    for key in ("per_scheme", "primary_scheme", "position_error_m"):
+        if key not in summary:
+            need.append(f"{METRICS_FILE}:{key}")
+    if need:
+        raise ReportInputError(f"{directory}: analysis files lack {', '.join(need)}")
+    return summary, series
+
+
+def _cell(value, digits: int = 2) -> str:
+    if value is None:
+        text = "–"
+    elif isinstance(value, bool):
+        text = "yes" if value else "no"
+    elif isinstance(value, float):
+        text = f"{value:.{digits}f}"
+    else:
+        text = str(value)
+    return html.escape(text)
+
+
+def _pct(rate) -> str | None:
+    return None if rate is None else f"{100 * rate:.1f} %"
+
+
+def _kv_table(rows: list[tuple[str, object]], header=("item", "value")) -> str:
+    body = "".join(f"<tr><td class='k'>{html.escape(k)}</td><td>{_cell(v)}</td></tr>"
+                   for k, v in rows)
+    return (f"<table><tr><th class='k'>{html.escape(header[0])}</th>"
+            f"<th>{html.escape(header[1])}</th></tr>{body}</table>")
+
+
+def _scheme_table(summary: dict) -> str:
+    head = ("<tr><th class='k'>scheme</th><th>POSE msgs</th>"
+            + "".join(f"<th>{c}{'' if c == 'n' else ' [m]'}</th>" for c in _STAT_COLS)
+            + "<th>unscored</th><th>floor hit</th><th>within 1σ</th><th>final [m]</th>"
+              "<th>final / distance</th></tr>")
+    rows = []
+    for name, s in summary["per_scheme"].items():
+        e = s["position_error_m"]
+        cls = " class='primary'" if name == summary["primary_scheme"] else ""
+        final_pct = s.get("final_error_pct_of_distance")
+        rows.append(
+            f"<tr{cls}><td class='k'>{html.escape(name)}</td><td>{_cell(s.get('n_pose'))}</td>"
+            + "".join(f"<td>{_cell(e.get(c))}</td>" for c in _STAT_COLS)
+            + f"<td>{_cell(s.get('unscored'))}</td><td>{_cell(_pct(s.get('floor_hit_rate')))}</td>"
+              f"<td>{_cell(_pct(s.get('within_1sigma_rate')))}</td>"
+              f"<td>{_cell(s.get('final_error_m'))}</td>"
+              f"<td>{_cell(None if final_pct is None else f'{final_pct:.2f} %')}</td></tr>")
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
+def _steps_table(summary: dict) -> str:
+    head = ("<tr><th class='k'>scheme</th><th>detected</th><th>truth</th><th>error</th>"
+            "<th>error %</th><th>STEP msgs</th></tr>")
+    rows = []
+    for name, s in summary["per_scheme"].items():
+        st = s["steps"]
+        pct = st.get("error_pct")
+        rows.append(f"<tr><td class='k'>{html.escape(name)}</td><td>{_cell(st.get('detected'))}</td>"
+                    f"<td>{_cell(st.get('truth'))}</td><td>{_cell(st.get('error'))}</td>"
+                    f"<td>{_cell(None if pct is None else f'{pct:+.2f} %')}</td>"
+                    f"<td>{_cell(st.get('step_messages'))}</td></tr>")
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
+def _img(png: bytes, alt: str) -> str:
+    data = base64.b64encode(png).decode("ascii")
+    return f"<img alt='{html.escape(alt)}' src='data:image/png;base64,{data}'>"
+
+
+def render_html(summary: dict, series: dict, title: str = "StrideFix walk report") -> str:
+    """The complete report page for one analysis, as an HTML string."""
+    figs = plots.render_all(series)
+    e = summary["position_error_m"]
+    inputs = summary.get("inputs", [])
+    input_rows = "".join(
+        f"<tr><td class='k'>{html.escape(str(i.get('path')))}</td><td>{_cell(i.get('bytes'))}</td>"
+        f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td></tr>"
+        for i in inputs)
+    overview = [
+        ("primary scheme", summary["primary_scheme"]),
+        ("truth samples scored / unscored",
+         f"{e.get('n')} / {summary.get('unscored')}"),
+        ("mean / median / p95 error [m]",
+         f"{_cell(e.get('mean'))} / {_cell(e.get('median'))} / {_cell(e.get('p95'))}"),
+        ("distance walked (truth) [m]", summary.get("distance_walked_m")),
+        ("final error [m]", summary.get("final_error_m")),
+        ("floor hit rate", _pct(summary.get("floor_hit_rate"))),
+        ("floors in truth", ", ".join(str(f) for f in summary.get("floors_in_truth", []))),
+    ]
+    health = summary.get("health") or {}
+    config = summary.get("config") or {}
+    params = config.get("params") or {}
+    version_rows = [(k, v) for k, v in config.items() if k != "params"]
+    warnings_html = "".join(f"<li class='warn'>{html.escape(w)}</li>"
+                            for w in summary.get("warnings", []))
+    messages = summary.get("messages", {})
+    extra_counts = (
+        [("unknown channel " + k, v) for k, v in summary.get("unknown_channels", {}).items()]
+        + [("decode errors on " + k, v) for k, v in summary.get("decode_errors", {}).items()])
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1>",
+        "<p class='note'>Error at each truth time = horizontal distance to the latest POSE at or "
+        "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation.</p>",
+        _kv_table(overview, ("summary", "")),
+        f"<ul>{warnings_html}</ul>" if warnings_html else "",
+        "<h2>Position error by scheme</h2>", _scheme_table(summary),
+        "<div class='figs'>", _img(figs["trajectory"], "trajectory"),
+        _img(figs["error_cdf"], "error CDF"), "</div>",
+        _img(figs["error_time"], "error over time"),
+        "<h2>Steps</h2>", _steps_table(summary),
+        "<h2>Logger health (last HEALTH report)</h2>",
+        _kv_table(list(health.items()), ("counter", "value")) if health
+        else "<p class='note'>no HEALTH message in the logs</p>",
+        "<h2>Messages per channel</h2>",
+        _kv_table(list(messages.items()) + extra_counts, ("channel", "events")),
+        "<h2>Inputs</h2>",
+        "<table><tr><th class='k'>log</th><th>bytes</th><th>events</th><th>truncated bytes</th>"
+        f"</tr>{input_rows}</table>",
+        "<h2>Configuration</h2>",
+        _kv_table(version_rows + sorted(params.items()), ("key", "value")) if (params or version_rows)
+        else "<p class='note'>no CONFIG message in the logs</p>",
+        "</body></html>",
+    ]
+    return "\n".join(parts)
+
+
+def run_report(directory: str, out_file: str | None = None) -> str:
+    """Write the report for ``directory``; return the path written.
+
+    Raises
+    ------
+    ReportInputError
+        See :func:`load_analysis`.
+    """
+    summary, series = load_analysis(directory)
+    out_file = out_file or os.path.join(directory, "report.html")
+    parent = os.path.dirname(out_file)
+    if parent:
+        os.makedirs(parent, exist_ok=True)
+    page = render_html(summary, series)
+    with open(out_file, "w", encoding="utf-8") as f:
+        f.write(page)
+    return out_file
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Declare the ``report`` sub-command and its options."""
+    p = subparsers.add_parser(
+        "report", help="render an analyze output directory as a self-contained HTML report",
+        description="Read DIR/metrics.json and DIR/analysis.npz (from `stridefix analyze`) and "
+                    "write one HTML file with inline CSS and embedded PNG figures.")
+    p.add_argument("directory", metavar="DIR", help="output directory of `stridefix analyze`")
+    p.add_argument("--out", default=None, metavar="FILE",
+                   help="HTML file to write (default: DIR/report.html)")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``stridefix report``; returns the exit status."""
+    try:
+        path = run_report(args.directory, args.out)
+    except ReportInputError as exc:
+        print(f"stridefix report: error: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}")
+    return 0

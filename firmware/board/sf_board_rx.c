@@ -1,0 +1,332 @@
+/* sf_board_rx.c — decoding, timing and reassembly of board frames (see sf_board_rx.h).
+ * The bit layouts live only in board.dbc; board.h/board.c are generated from it by cantools. */
+#include "sf_board_rx.h"
+
+#include <string.h>
+
+#include "board.h"
+#include "sf_error.h"
+
+#define DEG_TO_RAD (3.14159265358979323846 / 180.0)
+
+/* Nominal periods only seed the learnt period: the board may run mag and baro at other rates. */
+#define IMU_PERIOD_MS 10.0
+#define MAG_PERIOD_MS 20.0
+#define BARO_PERIOD_MS 50.0
+
+void sf_board_rx_init(sf_board_rx_t *const rx)
+{
+    memset(rx, 0, sizeof *rx);
+    sf_board_clock_init(&rx->clock);
+    sf_stream_time_init(&rx->imu_time, IMU_PERIOD_MS);
+    sf_stream_time_init(&rx->mag_time, MAG_PERIOD_MS);
+    sf_stream_time_init(&rx->baro_time, BARO_PERIOD_MS);
+}
+
+int32_t sf_wifi_channel_to_mhz(const unsigned channel)
+{
+    if (channel >= 1 && channel <= 13) {
+        return 2407 + 5 * (int32_t)channel;
+    }
+    if (channel == 14) {
+        return 2484;
+    }
+    if (channel >= 32 && channel <= 177) {
+        return 5000 + 5 * (int32_t)channel;
+    }
+    return 0;
+}
+
+/* Gives a sample its time; counts gaps and sync/duplicate problems. */
+static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const uint8_t seq, const uint8_t t_lo,
+                   int64_t *const t_us, int64_t *const useq)
+{
+    int64_t t_ms;
+    uint32_t lost;
+    const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, &t_ms, useq, &lost);
+    if (rc == SF_ENOTSYNC) {
+        rx->counters.unsynced++;
+        return rc;
+    }
+    if (rc == SF_EDUPLICATE) {
+        rx->counters.duplicates++;
+        return rc;
+    }
+    rx->counters.seq_gaps += lost;
+    *t_us = t_ms * 1000;
+    return SF_OK;
+}
+
+static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_imu_half_t *const half,
+                       sf_rx_event_t *const ev)
+{
+    sf_imu_half_t *const mine = is_accel ? &rx->accel : &rx->gyro;
+    sf_imu_half_t *const other = is_accel ? &rx->gyro : &rx->accel;
+    if (other->valid && other->seq == half->seq) {
+        other->valid = false;
+        if (mine->valid) { /* a stale half of ours is left over: its partner was lost */
+            mine->valid = false;
+            rx->counters.imu_unpaired++;
+        }
+        const sf_imu_half_t *const acc = is_accel ? half : other;
+        const sf_imu_half_t *const gyr = is_accel ? other : half;
+        sf_rx_imu_t *const out = &ev->u.imu;
+        const int rc = resolve(rx, &rx->imu_time, half->seq, half->t_lo_ms, &out->t_us, &out->seq);
+        if (rc != SF_OK) {
+            return rc;
+        }
+        for (int i = 0; i < 3; i++) {
+            out->accel_mps2[i] = acc->xyz[i];
+            out->gyro_radps[i] = gyr->xyz[i] * DEG_TO_RAD;
+        }
+        ev->kind = sf_rx_imu;
+        rx->counters.imu++;
+        return 1;
+    }
+    if (other->valid) { /* the other half waits for a sample we will never complete */
+        other->valid = false;
+        rx->counters.imu_unpaired++;
+    }
+    if (mine->valid) {
+        rx->counters.imu_unpaired++;
+    }
+    *mine = *half;
+    mine->valid = true;
+    return 0;
+}
+
+/* Closes the open scan into *ev. */
+static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_t *const ev)
+{
+    rx->scan_open = false;
+    if (!rx->scan_timed) {
+        return 0; /* started before the first BOARD_TIME: already counted as unsynced */
+    }
+    rx->scan.complete = complete;
+    if (!complete) {
+        rx->counters.wifi_incomplete++;
+    }
+    ev->kind = sf_rx_wifi;
+    ev->u.wifi = rx->scan;
+    rx->counters.wifi++;
+    return 1;
+}
+
+static int on_scan_begin(sf_board_rx_t *const rx, const struct board_wifi_scan_begin_t *const m,
+                         sf_rx_event_t *const ev)
+{
+    int result = 0;
+    if (rx->scan_open) {
+        result = close_scan(rx, false, ev); /* SCAN_END was lost */
+    }
+    rx->scan_open = true;
+    rx->scan_raw_id = m->scan_id;
+    int64_t t_ms;
+    rx->scan_timed = sf_board_clock_unwrap(&rx->clock, m->time_ms, &t_ms) == SF_OK;
+    if (!rx->scan_timed) {
+        rx->counters.unsynced++;
+        return result != 0 ? result : SF_ENOTSYNC;
+    }
+    rx->scan_id = rx->scan_id_started ? rx->scan_id + (uint8_t)(m->scan_id - (uint8_t)rx->scan_id) : m->scan_id;
+    rx->scan_id_started = true;
+    rx->scan.t_us = t_ms * 1000;
+    rx->scan.scan_id = rx->scan_id;
+    rx->scan.n_ap = 0;
+    return result;
+}
+
+static int on_scan_ap(sf_board_rx_t *const rx, const struct board_wifi_ap_t *const m)
+{
+    const int32_t mhz = sf_wifi_channel_to_mhz(m->channel);
+    if (!rx->scan_open || mhz == 0 || m->rssi >= 0 || rx->scan.n_ap >= SF_WIFI_MAX_AP) {
+        rx->counters.decode_errors++;
+        return SF_ERANGE;
+    }
+    if (!rx->scan_timed) {
+        return 0;
+    }
+    const int32_t i = rx->scan.n_ap++;
+    rx->scan.bssid[i] = (int64_t)m->bssid;
+    rx->scan.rssi_dbm[i] = (float)m->rssi;
+    rx->scan.freq_mhz[i] = mhz;
+    return 0;
+}
+
+static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end_t *const m,
+                       sf_rx_event_t *const ev)
+{
+    if (!rx->scan_open || m->scan_id != rx->scan_raw_id) {
+        const bool was_open = rx->scan_open;
+        rx->counters.decode_errors++;
+        if (was_open) {
+            (void)close_scan(rx, false, ev);
+            return 1;
+        }
+        return SF_ERANGE;
+    }
+    return close_scan(rx, rx->scan.n_ap == (int32_t)m->n_ap, ev);
+}
+
+static int decode(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    switch (f->id) {
+    case BOARD_BOARD_TIME_FRAME_ID: {
+        struct board_board_time_t m;
+        (void)board_board_time_unpack(&m, f->data, f->dlc);
+        const uint32_t restarts = rx->clock.restarts;
+        sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id);
+        if (rx->clock.restarts != restarts) {
+            rx->counters.board_restarts++;
+            rx->accel.valid = rx->gyro.valid = false;
+        }
+        return 0;
+    }
+    case BOARD_IMU_ACCEL_FRAME_ID: {
+        struct board_imu_accel_t m;
+        (void)board_imu_accel_unpack(&m, f->data, f->dlc);
+        const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
+                                 {board_imu_accel_accel_x_decode(m.accel_x), board_imu_accel_accel_y_decode(m.accel_y),
+                                  board_imu_accel_accel_z_decode(m.accel_z)}};
+        return on_imu_half(rx, true, &h, ev);
+    }
+    case BOARD_IMU_GYRO_FRAME_ID: {
+        struct board_imu_gyro_t m;
+        (void)board_imu_gyro_unpack(&m, f->data, f->dlc);
+        const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
+                                 {board_imu_gyro_gyro_x_decode(m.gyro_x), board_imu_gyro_gyro_y_decode(m.gyro_y),
+                                  board_imu_gyro_gyro_z_decode(m.gyro_z)}};
+        return on_imu_half(rx, false, &h, ev);
+    }
+    case BOARD_MAG_FRAME_ID: {
+        struct board_mag_t m;
+        (void)board_mag_unpack(&m, f->data, f->dlc);
+        sf_rx_mag_t *const out = &ev->u.mag;
+        const int rc = resolve(rx, &rx->mag_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
+        if (rc != SF_OK) {
+            return rc;
+        }
+        out->field_ut[0] = board_mag_mag_x_decode(m.mag_x);
+        out->field_ut[1] = board_mag_mag_y_decode(m.mag_y);
+        out->field_ut[2] = board_mag_mag_z_decode(m.mag_z);
+        ev->kind = sf_rx_mag;
+        rx->counters.mag++;
+        return 1;
+    }
+    case BOARD_BARO_FRAME_ID: {
+        struct board_baro_t m;
+        (void)board_baro_unpack(&m, f->data, f->dlc);
+        if (!board_baro_pressure_is_in_range(m.pressure)) {
+            rx->counters.decode_errors++;
+            return SF_ERANGE;
+        }
+        sf_rx_baro_t *const out = &ev->u.baro;
+        const int rc = resolve(rx, &rx->baro_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
+        if (rc != SF_OK) {
+            return rc;
+        }
+        out->pressure_pa = board_baro_pressure_decode(m.pressure);
+        out->temperature_degc = board_baro_temperature_decode(m.temperature);
+        ev->kind = sf_rx_baro;
+        rx->counters.baro++;
+        return 1;
+    }
+    case BOARD_WIFI_SCAN_BEGIN_FRAME_ID: {
+        struct board_wifi_scan_begin_t m;
+        (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
+        return on_scan_begin(rx, &m, ev);
+    }
+    case BOARD_WIFI_AP_FRAME_ID: {
+        struct board_wifi_ap_t m;
+        (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
+        return on_scan_ap(rx, &m);
+    }
+    case BOARD_WIFI_SCAN_END_FRAME_ID: {
+        struct board_wifi_scan_end_t m;
+        (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
+        return on_scan_end(rx, &m, ev);
+    }
+    case BOARD_GNSS_INFO_FRAME_ID: {
+        struct board_gnss_info_t m;
+        (void)board_gnss_info_unpack(&m, f->data, f->dlc);
+        int64_t t_ms;
+        if (sf_board_clock_unwrap(&rx->clock, m.time_ms, &t_ms) != SF_OK) {
+            rx->counters.unsynced++;
+            return SF_ENOTSYNC;
+        }
+        rx->gnss_info_valid = true;
+        rx->gnss_t_ms = t_ms;
+        rx->gnss_alt_m = board_gnss_info_altitude_decode(m.altitude);
+        rx->gnss_accuracy_m = (float)board_gnss_info_accuracy_decode(m.accuracy);
+        return 0;
+    }
+    case BOARD_GNSS_POSITION_FRAME_ID: {
+        struct board_gnss_position_t m;
+        (void)board_gnss_position_unpack(&m, f->data, f->dlc);
+        if (!rx->gnss_info_valid || !board_gnss_position_latitude_is_in_range(m.latitude) ||
+            !board_gnss_position_longitude_is_in_range(m.longitude)) {
+            rx->gnss_info_valid = false;
+            rx->counters.decode_errors++;
+            return SF_ERANGE;
+        }
+        rx->gnss_info_valid = false;
+        sf_rx_gnss_t *const out = &ev->u.gnss;
+        out->t_us = rx->gnss_t_ms * 1000;
+        out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
+        out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
+        out->alt_m = rx->gnss_alt_m;
+        out->accuracy_m = rx->gnss_accuracy_m;
+        ev->kind = sf_rx_gnss;
+        rx->counters.gnss++;
+        return 1;
+    }
+    case BOARD_BOARD_STATUS_FRAME_ID: {
+        struct board_board_status_t m;
+        (void)board_board_status_unpack(&m, f->data, f->dlc);
+        rx->counters.board_status++;
+        rx->counters.board_tx_overflows = m.tx_overflows;
+        return 0;
+    }
+    default:
+        rx->counters.unknown_id++;
+        return SF_EUNKNOWN_ID;
+    }
+}
+
+/* The DBC length of a known id, or 0 for an unknown one. */
+static unsigned dbc_length(const uint32_t id)
+{
+    switch (id) {
+    case BOARD_BOARD_TIME_FRAME_ID: return BOARD_BOARD_TIME_LENGTH;
+    case BOARD_IMU_ACCEL_FRAME_ID: return BOARD_IMU_ACCEL_LENGTH;
+    case BOARD_IMU_GYRO_FRAME_ID: return BOARD_IMU_GYRO_LENGTH;
+    case BOARD_MAG_FRAME_ID: return BOARD_MAG_LENGTH;
+    case BOARD_BARO_FRAME_ID: return BOARD_BARO_LENGTH;
+    case BOARD_WIFI_SCAN_BEGIN_FRAME_ID: return BOARD_WIFI_SCAN_BEGIN_LENGTH;
+    case BOARD_WIFI_AP_FRAME_ID: return BOARD_WIFI_AP_LENGTH;
+    case BOARD_WIFI_SCAN_END_FRAME_ID: return BOARD_WIFI_SCAN_END_LENGTH;
+    case BOARD_GNSS_POSITION_FRAME_ID: return BOARD_GNSS_POSITION_LENGTH;
+    case BOARD_GNSS_INFO_FRAME_ID: return BOARD_GNSS_INFO_LENGTH;
+    case BOARD_BOARD_STATUS_FRAME_ID: return BOARD_BOARD_STATUS_LENGTH;
+    default: return 0;
+    }
+}
+
+int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    rx->counters.frames++;
+    ev->kind = sf_rx_none;
+    const unsigned len = f->extended || f->remote ? 0u : dbc_length(f->id);
+    if (len == 0) {
+        rx->counters.unknown_id++;
+        return SF_EUNKNOWN_ID;
+    }
+    if (f->dlc < len) {
+        rx->counters.bad_length++;
+        return SF_ELENGTH;
+    }
+    const int rc = decode(rx, f, ev);
+    if (rc >= 0) {
+        rx->counters.frames_ok++;
+    }
+    return rc;
+}

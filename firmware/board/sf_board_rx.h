@@ -1,0 +1,132 @@
+/* sf_board_rx.h — board frames in, timed sensor samples out.
+ *
+ * Decodes each frame with the pack/unpack code that cantools generates from firmware/board.dbc,
+ * gives every sample its board time (sf_board_time.h), pairs IMU_ACCEL with IMU_GYRO by seq,
+ * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END, and pairs GNSS_INFO with GNSS_POSITION.
+ * One frame yields at most one event. Bad frames are counted in sf_rx_counters_t and skipped: the
+ * return code says which counter moved, so the caller can print a message naming the line.
+ *
+ * Memory: sizeof(sf_board_rx_t) ≈ 5 KiB (one scan in progress); no heap. */
+#ifndef SF_BOARD_RX_H
+#define SF_BOARD_RX_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_board_time.h"
+#include "sf_can_frame.h"
+
+#define SF_WIFI_MAX_AP 255 /* WIFI_SCAN_END.n_ap is 8 bits */
+
+typedef enum { sf_rx_none = 0, sf_rx_imu, sf_rx_mag, sf_rx_baro, sf_rx_wifi, sf_rx_gnss } sf_rx_kind_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double accel_mps2[3];
+    double gyro_radps[3];
+} sf_rx_imu_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double field_ut[3];
+} sf_rx_mag_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double pressure_pa;
+    double temperature_degc;
+} sf_rx_baro_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t scan_id;
+    bool complete;
+    int32_t n_ap;
+    int64_t bssid[SF_WIFI_MAX_AP];
+    float rssi_dbm[SF_WIFI_MAX_AP];
+    int32_t freq_mhz[SF_WIFI_MAX_AP];
+} sf_rx_wifi_t;
+
+typedef struct {
+    int64_t t_us;
+    double lat_deg;
+    double lon_deg;
+    double alt_m;
+    float accuracy_m;
+} sf_rx_gnss_t;
+
+typedef struct {
+    sf_rx_kind_t kind;
+    union {
+        sf_rx_imu_t imu;
+        sf_rx_mag_t mag;
+        sf_rx_baro_t baro;
+        sf_rx_wifi_t wifi;
+        sf_rx_gnss_t gnss;
+    } u;
+} sf_rx_event_t;
+
+/* Counters never decrease. */
+typedef struct {
+    uint64_t frames;          /* frames offered */
+    uint64_t frames_ok;       /* decoded and used */
+    uint64_t unknown_id;      /* id not in the DBC, extended or remote frames */
+    uint64_t bad_length;      /* shorter than the DBC length */
+    uint64_t decode_errors;   /* out-of-range signal, orphan AP or GNSS half, bad channel */
+    uint64_t seq_gaps;        /* samples missing by sequence, all streams */
+    uint64_t unsynced;        /* samples before the first BOARD_TIME */
+    uint64_t duplicates;      /* repeated seq */
+    uint64_t imu_unpaired;    /* IMU halves whose other half never came */
+    uint64_t wifi_incomplete; /* scans with lost AP frames or without SCAN_END */
+    uint64_t imu;
+    uint64_t mag;
+    uint64_t baro;
+    uint64_t wifi;
+    uint64_t gnss;
+    uint64_t board_status;
+    uint64_t board_restarts;
+    uint64_t board_tx_overflows; /* last value the board reported */
+} sf_rx_counters_t;
+
+typedef struct {
+    bool valid;
+    uint8_t seq;
+    uint8_t t_lo_ms;
+    double xyz[3];
+} sf_imu_half_t;
+
+typedef struct {
+    sf_board_clock_t clock;
+    sf_stream_time_t imu_time;
+    sf_stream_time_t mag_time;
+    sf_stream_time_t baro_time;
+    sf_imu_half_t accel;
+    sf_imu_half_t gyro;
+    bool scan_open;       /* between SCAN_BEGIN and SCAN_END */
+    bool scan_timed;      /* the open scan has a board time */
+    uint8_t scan_raw_id;
+    bool scan_id_started;
+    int64_t scan_id;      /* unwrapped id of the open scan */
+    sf_rx_wifi_t scan;
+    bool gnss_info_valid;
+    int64_t gnss_t_ms;
+    double gnss_alt_m;
+    float gnss_accuracy_m;
+    sf_rx_counters_t counters;
+} sf_board_rx_t;
+
+void sf_board_rx_init(sf_board_rx_t *rx);
+
+/* Consumes one frame. Returns 1 when *event was filled (a SCAN_BEGIN that finds a scan still open
+ * returns that scan, marked incomplete), 0 when the frame was used without an event, or a negative
+ * code when the frame was skipped and counted: SF_EUNKNOWN_ID, SF_ELENGTH, SF_ERANGE (decode error),
+ * SF_ENOTSYNC (no board time yet), SF_EDUPLICATE. */
+int sf_board_rx_frame(sf_board_rx_t *rx, const sf_can_frame_t *frame, sf_rx_event_t *event);
+
+/* Wi-Fi channel → centre frequency [MHz]; 0 when the channel is not a 2.4 or 5 GHz channel. */
+int32_t sf_wifi_channel_to_mhz(unsigned channel);
+
+#endif

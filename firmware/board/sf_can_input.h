@@ -1,0 +1,36 @@
+/* sf_can_input.h — where frames come from: a candump -L file, standard input ("-"), or a
+ * SocketCAN interface ("socketcan:IFACE").
+ *
+ * SocketCAN is compiled on every Linux build; where the kernel lacks AF_CAN, opening it fails with
+ * SF_EUNSUPPORTED and a message, nothing else changes. File and stdin inputs report the line number
+ * of each bad line so that messages can name it. */
+#ifndef SF_CAN_INPUT_H
+#define SF_CAN_INPUT_H
+
+#include <stdio.h>
+
+#include "sf_can_frame.h"
+
+typedef enum { sf_can_input_file, sf_can_input_socketcan } sf_can_input_kind_t;
+
+typedef struct {
+    sf_can_input_kind_t kind;
+    char name[256]; /* the spec as given, for messages */
+    FILE *file;     /* file kind */
+    int fd;         /* socketcan kind */
+    long line_no;   /* file kind: number of the line last read (1-based) */
+    char line[512]; /* file kind: the line last read, newline stripped, for messages */
+} sf_can_input_t;
+
+/* Opens a spec: "-" (stdin), "socketcan:IFACE", or a file path. SF_OK, SF_ENOENT (no such file or
+ * interface), SF_EIO (unreadable), SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL. *err_text (may be
+ * NULL) receives a one-line explanation on failure. */
+int sf_can_input_open(sf_can_input_t *in, const char *spec, char *err_text, size_t err_size);
+
+/* Reads the next frame: 1 a frame, 0 end of input, SF_ESYNTAX a line that is not candump -L (the
+ * line is skipped; in->line_no and in->line name it), SF_EIO a read error. */
+int sf_can_input_next(sf_can_input_t *in, sf_can_frame_t *frame);
+
+void sf_can_input_close(sf_can_input_t *in);
+
+#endif

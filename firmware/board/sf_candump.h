@@ -1,0 +1,23 @@
+/* sf_candump.h — the can-utils `candump -L` text format, one frame per line:
+ *
+ *     (1700000000.123456) can0 100#0011223344556677
+ *     (1700000000.123456) can0 12345678#00         (extended id: 8 hex digits)
+ *     (1700000000.123456) can0 100#R                (remote frame)
+ *
+ * Parsing is strict: anything else (CAN FD `##`, odd hex digits, more than 8 bytes, junk after the
+ * data) is SF_ESYNTAX so the caller can count and skip the line. */
+#ifndef SF_CANDUMP_H
+#define SF_CANDUMP_H
+
+#include <stddef.h>
+
+#include "sf_can_frame.h"
+
+/* Parses one line (a trailing newline is allowed). SF_OK or SF_ESYNTAX. */
+int sf_candump_parse(const char *line, sf_can_frame_t *frame);
+
+/* Formats one frame as a candump -L line with a newline; returns the length, or SF_EINVAL when
+ * the buffer is too small (80 bytes always suffice). */
+int sf_candump_format(const sf_can_frame_t *frame, const char *iface, char *buf, size_t size);
+
+#endif

@@ -1,0 +1,21 @@
+/* sf_error.c — text for the closed error list of sf_error.h. */
+#include "sf_error.h"
+
+const char *sf_strerror(const int code)
+{
+    switch (code) {
+    case SF_OK: return "ok";
+    case SF_EINVAL: return "invalid argument";
+    case SF_ESYNTAX: return "bad syntax";
+    case SF_EUNKNOWN_ID: return "unknown CAN id";
+    case SF_ELENGTH: return "frame truncated (shorter than its DBC length)";
+    case SF_ERANGE: return "value out of range";
+    case SF_ENOTSYNC: return "no board time yet";
+    case SF_EDUPLICATE: return "duplicate sequence number";
+    case SF_EIO: return "I/O error";
+    case SF_ENOENT: return "no such file or interface";
+    case SF_EUNSUPPORTED: return "not supported here";
+    case SF_EFULL: return "queue full";
+    default: return "unknown error";
+    }
+}

@@ -1,0 +1,53 @@
+/* sf_types.h — the plain data that flows into and out of the estimator core.
+ *
+ * Frames and units: sensor axes are the board's; the map frame is x, y in metres with headings
+ * counter-clockwise from +x. Times are board time in int64 microseconds, carried by every input: the
+ * core never reads a clock. */
+#ifndef SF_TYPES_H
+#define SF_TYPES_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* One accelerometer + gyroscope sample. */
+typedef struct {
+    int64_t t_us;
+    double accel_mps2[3]; /* specific force, sensor axes */
+    double gyro_radps[3]; /* angular rate, sensor axes */
+} sf_imu_sample_t;
+
+/* Activity codes, identical to step_t.ACTIVITY_* in lcmtypes/stridefix/step_t.lcm. */
+enum {
+    sf_activity_unknown = 0,
+    sf_activity_still = 1,
+    sf_activity_walking = 2,
+    sf_activity_stairs_up = 3,
+    sf_activity_stairs_down = 4,
+    sf_activity_elevator = 5
+};
+
+/* Pose schemes, identical to pose_t.SCHEME_* in lcmtypes/stridefix/pose_t.lcm. */
+enum { sf_scheme_pdr_only = 0 };
+
+/* One detected step. */
+typedef struct {
+    int64_t t_us;
+    int32_t index; /* first step is 1 */
+    double length_m;
+    double heading_rad; /* map frame */
+    int8_t activity;
+} sf_step_t;
+
+/* The estimator's position output. */
+typedef struct {
+    int64_t t_us;
+    double x_m;
+    double y_m;
+    int16_t floor;
+    double heading_rad;
+    double sigma_m;
+    int32_t step_count;
+    int8_t scheme;
+} sf_pose_t;
+
+#endif

@@ -1,0 +1,87 @@
+"""Wi-Fi scan model: log-distance path loss with per-wall attenuation (multi-wall model, cf. COST-231
+Motley-Keenan; Seidel & Rappaport 1992).
+
+    RSSI = P0 − 10 · n · log10(d / 1 m) − W · (walls crossed) + X,   X ~ N(0, σ²) (seeded)
+    P0   = tx_power_dbm − FSPL(1 m, f),   FSPL(1 m, f) = 20 · log10(f / MHz) − 27.55 dB
+
+d is the 3-D distance from the board (sensor height) to the access point (ceiling, 2.8 m); walls are the
+world's segments crossed by the straight line between them. The result is rounded to whole dBm as a
+receiver reports it; access points below the detection floor (−95 dBm) are not reported. Scans start
+every U(min, max) seconds (2–4 s); each returns every AP above the floor, in channel order, measured at
+the position where the scan started.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .walker import Walk
+from .world import World
+
+AP_HEIGHT_M = 2.8
+
+
+@dataclass
+class Scan:
+    t_ms: int                                   # scan start, ms since the simulation start
+    aps: list[tuple[int, int, int]]             # (bssid, rssi_dbm, channel)
+
+
+def walls_crossed(px: np.ndarray, py: np.ndarray, ax: np.ndarray, ay: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """Count of walls properly crossed by segments (px,py)→(ax,ay); inputs broadcast to shape S, walls (W,4)."""
+    px, py, ax, ay = (np.asarray(v, float)[..., None] for v in (px, py, ax, ay))
+    x0, y0, x1, y1 = walls[:, 0], walls[:, 1], walls[:, 2], walls[:, 3]
+
+    def orient(ox, oy, bx, by, cx, cy):
+        return (bx - ox) * (cy - oy) - (by - oy) * (cx - ox)
+
+    d1 = orient(x0, y0, x1, y1, px, py)
+    d2 = orient(x0, y0, x1, y1, ax, ay)
+    d3 = orient(px, py, ax, ay, x0, y0)
+    d4 = orient(px, py, ax, ay, x1, y1)
+    hit = (d1 * d2 < 0) & (d3 * d4 < 0)
+    return hit.sum(axis=-1)
+
+
+def scan_times_ms(duration_ms: int, rng: np.random.Generator, r: dict) -> np.ndarray:
+    times = []
+    t = rng.uniform(0.5, 2.0)
+    lo, hi = r["scan_interval_min_s"], r["scan_interval_max_s"]
+    while True:
+        t_ms = int(round(t * 1000.0))
+        if t_ms + r["scan_duration_ms"] > duration_ms:
+            break
+        times.append(t_ms)
+        t += rng.uniform(lo, hi)
+    return np.asarray(times, dtype=np.int64)
+
+
+def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator) -> list[Scan]:
+    r = sc["radio"]
+    duration_ms = int(round(walk.t_s[-1] * 1000.0))
+    t_ms = scan_times_ms(duration_ms, rng, r)
+    if len(t_ms) == 0:
+        return []
+    dt_ms = int(round((walk.t_s[1] - walk.t_s[0]) * 1000.0)) if len(walk.t_s) > 1 else 10
+    idx = np.minimum(np.round(t_ms / dt_ms).astype(int), len(walk.t_s) - 1)
+    px, py = walk.x_m[idx][:, None], walk.y_m[idx][:, None]
+    aps = world.aps
+    ax = np.array([a.x_m for a in aps])[None, :]
+    ay = np.array([a.y_m for a in aps])[None, :]
+    tx = np.array([a.tx_power_dbm for a in aps])
+    f_mhz = np.array([a.freq_mhz for a in aps], dtype=float)
+    p0 = tx - (20.0 * np.log10(f_mhz) - 27.55)
+    dz = AP_HEIGHT_M - sc["baro"]["sensor_height_m"]
+    d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + dz * dz)
+    n_walls = walls_crossed(np.broadcast_to(px, d.shape), np.broadcast_to(py, d.shape),
+                            np.broadcast_to(ax, d.shape), np.broadcast_to(ay, d.shape), world.walls_m)
+    rssi = (p0[None, :] - 10.0 * r["path_loss_exponent"] * np.log10(np.maximum(d, 1.0))
+            - r["wall_loss_db"] * n_walls + r["shadowing_db"] * rng.standard_normal(d.shape))
+    rssi = np.clip(np.round(rssi), -128, 127).astype(int)
+    order = sorted(range(len(aps)), key=lambda j: (aps[j].channel, aps[j].bssid))
+    scans = []
+    for i, t in enumerate(t_ms):
+        heard = [(aps[j].bssid, int(rssi[i, j]), aps[j].channel) for j in order if rssi[i, j] >= r["floor_dbm"]]
+        scans.append(Scan(t_ms=int(t), aps=heard))
+    return scans

@@ -1,0 +1,146 @@
+"""The built-in default world: one office floor, its walls, the walking loop and the Wi-Fi access points.
+
+Model: a 60 m x 30 m single floor (floor 0). A rectangular corridor loop, 2 m wide, runs around a block
+of inner rooms; outer rooms sit between the corridor and the exterior wall. Walls are line segments
+(used by the radio model to count crossed walls); door gaps are left where rooms open onto the
+corridor. The walking route is the corridor centre line, a rectangle with rounded corners.
+
+Map frame: x east-ish, y north-ish, metres; heading counter-clockwise from +x [rad]. The map is rotated
+from magnetic axes by ``map_rotation_deg``: the map frame is the magnetic east-north frame turned
+counter-clockwise by that angle, so magnetic north lies along map heading ``90 deg - map_rotation_deg``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+FLOOR_W_M = 60.0
+FLOOR_H_M = 30.0
+# corridor centre line: rectangle corners (x_m, y_m), counter-clockwise, starting bottom-left
+LOOP_X0_M, LOOP_X1_M = 8.0, 52.0
+LOOP_Y0_M, LOOP_Y1_M = 5.0, 25.0
+CORRIDOR_HALF_W_M = 1.0
+
+
+@dataclass(frozen=True)
+class AccessPoint:
+    bssid: int            # 48-bit MAC as an integer (aa:bb:cc:dd:ee:ff = 0xaabbccddeeff)
+    channel: int          # 1..14 (2.4 GHz) or 36..165 (5 GHz)
+    x_m: float
+    y_m: float
+    tx_power_dbm: float   # EIRP
+
+    @property
+    def freq_mhz(self) -> int:
+        if self.channel <= 14:
+            return 2407 + 5 * self.channel if self.channel < 14 else 2484
+        return 5000 + 5 * self.channel
+
+
+@dataclass(frozen=True)
+class World:
+    name: str
+    floor_w_m: float
+    floor_h_m: float
+    walls_m: np.ndarray          # (n_wall, 4): x0, y0, x1, y1
+    aps: tuple[AccessPoint, ...]
+    loop_corners_m: np.ndarray   # (4, 2) corridor centre-line rectangle, counter-clockwise
+    start_xy_m: tuple[float, float]
+    map_rotation_deg: float = 20.0
+    floor_height_m: float = 0.0  # height of floor 0 above the pressure reference [m]
+    extra: dict = field(default_factory=dict)
+
+
+def _rect(x0: float, y0: float, x1: float, y1: float, doors=()) -> list:
+    """Walls of an axis-aligned rectangle; ``doors`` = [(side, centre_m, width_m)], side in bottom/top/left/right."""
+    sides = {
+        "bottom": ((x0, y0), (x1, y0)),
+        "top": ((x0, y1), (x1, y1)),
+        "left": ((x0, y0), (x0, y1)),
+        "right": ((x1, y0), (x1, y1)),
+    }
+    walls = []
+    for name, (a, b) in sides.items():
+        horiz = a[1] == b[1]
+        lo, hi = (a[0], b[0]) if horiz else (a[1], b[1])
+        cur = lo
+        pieces = []
+        for g0, g1 in sorted((c - w / 2, c + w / 2) for s, c, w in doors if s == name):
+            if g0 > cur:
+                pieces.append((cur, g0))
+            cur = max(cur, g1)
+        if cur < hi:
+            pieces.append((cur, hi))
+        for u0, u1 in pieces:
+            walls.append((u0, a[1], u1, a[1]) if horiz else (a[0], u0, a[0], u1))
+    return walls
+
+
+def _default_walls() -> np.ndarray:
+    w = []
+    # exterior wall
+    w += list(_rect(0.0, 0.0, FLOOR_W_M, FLOOR_H_M))
+    # corridor walls (outer and inner edge of the loop), with doors to the rooms
+    ox0, oy0 = LOOP_X0_M - CORRIDOR_HALF_W_M, LOOP_Y0_M - CORRIDOR_HALF_W_M
+    ox1, oy1 = LOOP_X1_M + CORRIDOR_HALF_W_M, LOOP_Y1_M + CORRIDOR_HALF_W_M
+    ix0, iy0 = LOOP_X0_M + CORRIDOR_HALF_W_M, LOOP_Y0_M + CORRIDOR_HALF_W_M
+    ix1, iy1 = LOOP_X1_M - CORRIDOR_HALF_W_M, LOOP_Y1_M - CORRIDOR_HALF_W_M
+    outer_doors = [("bottom", x, 1.0) for x in (14.0, 26.0, 38.0, 48.0)] + \
+                  [("top", x, 1.0) for x in (12.0, 24.0, 36.0, 46.0)] + \
+                  [("left", 15.0, 1.0), ("right", 15.0, 1.0)]
+    inner_doors = [("bottom", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)] + \
+                  [("top", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)]
+    w += list(_rect(ox0, oy0, ox1, oy1, outer_doors))
+    w += list(_rect(ix0, iy0, ix1, iy1, inner_doors))
+    # inner rooms: a spine wall and partitions every 8 m
+    w.append((ix0, 15.0, ix1, 15.0))
+    for x in np.arange(ix0 + 8.0, ix1 - 1.0, 8.0):
+        w.append((float(x), iy0, float(x), iy1))
+    # outer rooms: partitions from the corridor to the exterior wall
+    for x in (10.0, 20.0, 32.0, 44.0):
+        w.append((x, 0.0, x, oy0))
+        w.append((x, oy1, x, FLOOR_H_M))
+    for y in (10.0, 20.0):
+        w.append((0.0, y, ox0, y))
+        w.append((ox1, y, FLOOR_W_M, y))
+    return np.asarray(w, dtype=float)
+
+
+def _default_aps() -> tuple[AccessPoint, ...]:
+    # (x_m, y_m, channel, tx_power_dbm); BSSIDs share a vendor OUI, last octets differ
+    spec = [
+        (5.0, 3.0, 1, 18.0), (16.0, 2.0, 6, 17.0), (27.0, 2.5, 11, 18.0), (40.0, 2.0, 36, 20.0),
+        (55.0, 3.0, 6, 17.0), (57.0, 15.0, 44, 20.0), (55.0, 27.0, 1, 18.0), (40.0, 28.0, 149, 20.0),
+        (26.0, 27.5, 6, 17.0), (14.0, 28.0, 11, 18.0), (3.0, 26.0, 40, 20.0), (3.0, 14.0, 6, 16.0),
+        (17.0, 11.0, 1, 15.0), (33.0, 19.0, 11, 15.0), (45.0, 10.0, 48, 18.0), (30.0, 5.0, 157, 20.0),
+    ]
+    aps = []
+    for i, (x, y, ch, p) in enumerate(spec):
+        bssid = 0x3C_84_6A_00_10_00 + (i << 4) + (1 if ch > 14 else 0)
+        aps.append(AccessPoint(bssid=bssid, channel=ch, x_m=x, y_m=y, tx_power_dbm=p))
+    return tuple(aps)
+
+
+def default_world(map_rotation_deg: float = 20.0) -> World:
+    corners = np.array([[LOOP_X0_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y0_M],
+                        [LOOP_X1_M, LOOP_Y1_M], [LOOP_X0_M, LOOP_Y1_M]])
+    return World(
+        name="default",
+        floor_w_m=FLOOR_W_M,
+        floor_h_m=FLOOR_H_M,
+        walls_m=_default_walls(),
+        aps=_default_aps(),
+        loop_corners_m=corners,
+        start_xy_m=(12.0, LOOP_Y0_M),
+        map_rotation_deg=map_rotation_deg,
+    )
+
+
+WORLDS = {"default": default_world}
+
+
+def load_world(name: str, map_rotation_deg: float) -> World:
+    if name not in WORLDS:
+        raise KeyError(f"unknown world {name!r} (known: {', '.join(sorted(WORLDS))})")
+    return WORLDS[name](map_rotation_deg=map_rotation_deg)

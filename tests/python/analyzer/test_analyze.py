@@ -1,0 +1,66 @@
+"""analyze sub-command: outputs, exit statuses."""
+import json
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+
+def test_analyze_writes_metrics_and_series(walk_logs, tmp_path, cli_main, capsys):
+    fw, sim = walk_logs
+    out = tmp_path / "an"
+    assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    for key in ("inputs", "position_error_m", "unscored", "floor_hit_rate", "steps",
+                "distance_walked_m", "final_error_m", "final_error_pct_of_distance", "per_scheme",
+                "messages", "health", "config"):
+        assert key in m, key
+    # poses come 20 ms after their truth sample: the first truth sample is unscored, and each later
+    # one is scored against the pose of the previous sample (0.1 m behind along x)
+    assert m["unscored"] == 1 and m["position_error_m"]["n"] == 99
+    assert_allclose(m["position_error_m"]["median"], np.hypot(0.1, 1.0), rtol=1e-9)
+    assert_allclose(m["per_scheme"]["pdr_only"]["position_error_m"]["max"], 1.9, rtol=1e-9)
+    assert m["steps"] == {"detected": 99, "step_messages": 0, "truth": 99, "error": 0,
+                          "error_pct": 0.0}
+    assert m["messages"] == {"CONFIG": 1, "HEALTH": 1, "POSE": 200, "TRUTH": 100}
+    assert m["health"]["frames_total"] == 99
+    assert m["config"]["params"] == {"fusion.mode": "adaptive"}
+    assert [i["events"] for i in m["inputs"]] == [202, 100]
+    z = np.load(out / "analysis.npz")
+    assert z["truth_x_m"].shape == z["error_m"].shape == (100,)
+    assert np.isnan(z["error_m"][0]) and not z["scored"][0]
+    assert_allclose(z["match_y_m"][1:], 1.0)
+    assert_allclose(z["match_x_m"][1:], z["truth_x_m"][:-1])
+    assert "adaptive" in capsys.readouterr().out
+
+
+def test_analyze_scheme_option(walk_logs, tmp_path, cli_main):
+    fw, sim = walk_logs
+    out = tmp_path / "pdr"
+    assert cli_main(["analyze", str(fw), str(sim), "--out", str(out), "--scheme", "pdr_only"]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    assert m["primary_scheme"] == "pdr_only"
+    assert cli_main(["analyze", str(fw), str(sim), "--out", str(out), "--scheme", "kalman"]) == 2
+
+
+def test_missing_log_exits_2(tmp_path, cli_main, capsys):
+    assert cli_main(["analyze", str(tmp_path / "gone.lcmlog"), "--out", str(tmp_path / "o")]) == 2
+    assert "gone.lcmlog" in capsys.readouterr().err
+
+
+def test_no_truth_exits_2(msg, write_log, tmp_path, cli_main, capsys):
+    path = write_log("p.lcmlog", [("POSE", msg.pose(0, 0, 0))])
+    assert cli_main(["analyze", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "no TRUTH" in capsys.readouterr().err
+
+
+def test_no_pose_exits_2(msg, write_log, tmp_path, cli_main, capsys):
+    path = write_log("t.lcmlog", [("TRUTH", msg.truth(0, 0, 0))])
+    assert cli_main(["analyze", str(path), "--out", str(tmp_path / "o")]) == 2
+    assert "no POSE" in capsys.readouterr().err
+
+
+def test_nothing_scored_exits_1(msg, write_log, tmp_path, cli_main):
+    path = write_log("late.lcmlog", [("TRUTH", msg.truth(0, 0, 0)), ("POSE", msg.pose(5, 0, 0))])
+    assert cli_main(["analyze", str(path), "--out", str(tmp_path / "o")]) == 1
+    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert m["position_error_m"]["n"] == 0 and m["position_error_m"]["mean"] is None

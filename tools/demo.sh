@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# The default SIL walk, end to end, timing each step:
+#   simulator -> candump log -> stridefixd -> LCM log -> analyzer -> metrics.json + report.html
+set -euo pipefail
+out=${1:-out/demo}; stridefixd=${2:-build/firmware/stridefixd}; venv=${3:-.venv}
+mkdir -p "$out"
+step() { local name=$1; shift; local t0 t1; t0=$(date +%s%N); "$@"; t1=$(date +%s%N);
+         local ms=$(( (t1 - t0) / 1000000 ))
+         printf 'demo: %-10s %4d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000)) | tee -a "$out/timings.txt"; }
+: > "$out/timings.txt"
+step sim       "$venv/bin/stridefix" sim --out "$out"
+step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --config "$out/init_truth.ini"
+step analyze   "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out"
+step report    "$venv/bin/stridefix" report "$out"
+echo "demo: wrote $out/report.html and $out/metrics.json"
