@@ -1,0 +1,113 @@
+/* sf_test_frames.h — board frames for the tests, packed by the C that cantools generates from
+ * firmware/board.dbc (never by hand, so the tests follow the DBC). Header-only; values are physical
+ * (m/s², deg/s, ...) and go through the generated *_encode functions. */
+#ifndef SF_TEST_FRAMES_H
+#define SF_TEST_FRAMES_H
+
+#include <stdint.h>
+#include <string.h>
+
+#include "board.h"
+#include "sf_can_frame.h"
+
+/* A classic 8-byte frame with id; data filled by the caller. */
+static inline sf_can_frame_t tf_frame(const uint32_t id)
+{
+    sf_can_frame_t f;
+    memset(&f, 0, sizeof f);
+    f.id = id;
+    f.dlc = 8;
+    return f;
+}
+
+static inline sf_can_frame_t tf_board_time(const uint32_t time_ms, const uint8_t boot_id)
+{
+    sf_can_frame_t f = tf_frame(BOARD_BOARD_TIME_FRAME_ID);
+    const struct board_board_time_t m = {.time_ms = time_ms, .boot_id = boot_id};
+    (void)board_board_time_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_accel(const uint8_t seq, const uint8_t t_lo_ms, const double x, const double y,
+                                      const double z)
+{
+    sf_can_frame_t f = tf_frame(BOARD_IMU_ACCEL_FRAME_ID);
+    const struct board_imu_accel_t m = {.accel_x = board_imu_accel_accel_x_encode(x),
+                                        .accel_y = board_imu_accel_accel_y_encode(y),
+                                        .accel_z = board_imu_accel_accel_z_encode(z),
+                                        .seq = seq,
+                                        .t_lo_ms = t_lo_ms};
+    (void)board_imu_accel_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_gyro(const uint8_t seq, const uint8_t t_lo_ms, const double x_dps,
+                                     const double y_dps, const double z_dps)
+{
+    sf_can_frame_t f = tf_frame(BOARD_IMU_GYRO_FRAME_ID);
+    const struct board_imu_gyro_t m = {.gyro_x = board_imu_gyro_gyro_x_encode(x_dps),
+                                       .gyro_y = board_imu_gyro_gyro_y_encode(y_dps),
+                                       .gyro_z = board_imu_gyro_gyro_z_encode(z_dps),
+                                       .seq = seq,
+                                       .t_lo_ms = t_lo_ms};
+    (void)board_imu_gyro_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_mag(const uint8_t seq, const uint8_t t_lo_ms, const double x, const double y,
+                                    const double z)
+{
+    sf_can_frame_t f = tf_frame(BOARD_MAG_FRAME_ID);
+    const struct board_mag_t m = {.mag_x = board_mag_mag_x_encode(x),
+                                  .mag_y = board_mag_mag_y_encode(y),
+                                  .mag_z = board_mag_mag_z_encode(z),
+                                  .seq = seq,
+                                  .t_lo_ms = t_lo_ms};
+    (void)board_mag_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_scan_begin(const uint8_t scan_id, const uint32_t time_ms)
+{
+    sf_can_frame_t f = tf_frame(BOARD_WIFI_SCAN_BEGIN_FRAME_ID);
+    const struct board_wifi_scan_begin_t m = {.scan_id = scan_id, .time_ms = time_ms};
+    (void)board_wifi_scan_begin_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_scan_ap(const uint64_t bssid, const int8_t rssi, const uint8_t channel)
+{
+    sf_can_frame_t f = tf_frame(BOARD_WIFI_AP_FRAME_ID);
+    const struct board_wifi_ap_t m = {.bssid = bssid, .rssi = rssi, .channel = channel};
+    (void)board_wifi_ap_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_scan_end(const uint8_t scan_id, const uint8_t n_ap)
+{
+    sf_can_frame_t f = tf_frame(BOARD_WIFI_SCAN_END_FRAME_ID);
+    const struct board_wifi_scan_end_t m = {.scan_id = scan_id, .n_ap = n_ap};
+    (void)board_wifi_scan_end_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_gnss_info(const uint32_t time_ms, const double alt_m, const double accuracy_m)
+{
+    sf_can_frame_t f = tf_frame(BOARD_GNSS_INFO_FRAME_ID);
+    const struct board_gnss_info_t m = {.time_ms = time_ms,
+                                        .altitude = board_gnss_info_altitude_encode(alt_m),
+                                        .accuracy = board_gnss_info_accuracy_encode(accuracy_m)};
+    (void)board_gnss_info_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_gnss_position(const double lat_deg, const double lon_deg)
+{
+    sf_can_frame_t f = tf_frame(BOARD_GNSS_POSITION_FRAME_ID);
+    const struct board_gnss_position_t m = {.latitude = board_gnss_position_latitude_encode(lat_deg),
+                                            .longitude = board_gnss_position_longitude_encode(lon_deg)};
+    (void)board_gnss_position_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+#endif
