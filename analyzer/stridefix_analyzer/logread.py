@@ -288,10 +288,55 @@ class _Collector:
 
 _SYNC_WORD = bytes.fromhex("EDA1DA01")   # first 4 bytes of every LCM log record (big-endian)
 _RECORD_OVERHEAD = 4 + 8 + 8 + 4 + 4   # sync word, event number, timestamp, channel and data lengths
+_MAX_CHANNEL_BYTES = 255               # sanity bound when salvaging (LCM itself allows 63)
+_CHUNK = 1 << 20
+
+
+def _find_sync(f, offset: int) -> int | None:
+    """Byte offset of the first LCM sync word at or after ``offset``, or None."""
+    f.seek(offset)
+    carry = b""
+    base = offset
+    while True:
+        chunk = f.read(_CHUNK)
+        if not chunk:
+            return None
+        buf = carry + chunk
+        hit = buf.find(_SYNC_WORD)
+        if hit >= 0:
+            return base + hit
+        carry = buf[-3:]
+        base += len(buf) - len(carry)
+
+
+def _parse_record(f, offset: int, size: int) -> tuple[str, bytes, int] | None:
+    """The whole record starting at ``offset`` as (channel, payload, end offset), or None."""
+    f.seek(offset)
+    head = f.read(_RECORD_OVERHEAD)
+    if len(head) < _RECORD_OVERHEAD or head[:4] != _SYNC_WORD:
+        return None
+    channel_len = int.from_bytes(head[20:24], "big", signed=True)
+    data_len = int.from_bytes(head[24:28], "big", signed=True)
+    end = offset + _RECORD_OVERHEAD + channel_len + data_len
+    if not 0 < channel_len <= _MAX_CHANNEL_BYTES or data_len < 0 or end > size:
+        return None
+    try:
+        channel = f.read(channel_len).decode("utf-8")
+    except UnicodeDecodeError:
+        return None
+    if not channel.isprintable():
+        return None
+    return channel, f.read(data_len), end
 
 
 def _read_file(path: str, collector: _Collector) -> None:
-    """Read every whole record of one log into ``collector``; note truncation and resyncs."""
+    """Read every whole record of one log into ``collector``; note truncation and skipped bytes.
+
+    ``lcm.EventLog`` does the reading. Its reader (LCM 1.5) stops for good at the first bytes that
+    are not a record, and also drops the whole record just before them (it checks the header that
+    follows each record). So when it stops before the end of the file, the records from there on
+    are salvaged by hand (sync word search + header check) and ``lcm.EventLog`` resumes after them.
+    """
     if not os.path.exists(path):
         raise LogReadError(path, "no such file")
     if not os.path.isfile(path):
@@ -300,30 +345,51 @@ def _read_file(path: str, collector: _Collector) -> None:
         raise LogReadError(path, "permission denied")
     try:
         log = lcm.EventLog(path, "r")
-    except (OSError, IOError, ValueError) as exc:
+        raw = open(path, "rb")
+    except (OSError, ValueError) as exc:
         raise LogReadError(path, f"cannot open as an LCM event log ({exc})") from exc
     size = os.path.getsize(path)
-    events = skipped = 0
-    end_of_last = 0
+    events = skipped = salvaged = 0
+    end_of_last = 0   # byte offset just past the last whole record read
     try:
         while True:
-            start = end_of_last
             event = log.read_next_event()
-            if event is None:
+            if event is not None:
+                channel = event.channel
+                if isinstance(channel, bytes):
+                    channel = channel.decode("utf-8", "replace")
+                end = log.tell()
+                expected = _RECORD_OVERHEAD + len(channel.encode()) + len(event.data)
+                skipped += max(0, end - end_of_last - expected)
+                end_of_last = end
+                events += 1
+                collector.add_event(channel, event.data, path)
+                continue
+            if end_of_last >= size:
                 break
-            channel = event.channel
-            if isinstance(channel, bytes):
-                channel = channel.decode("utf-8", "replace")
-            end_of_last = log.tell()
-            expected = _RECORD_OVERHEAD + len(channel.encode()) + len(event.data)
-            skipped += max(0, end_of_last - start - expected)
+            # the reader stopped early: find the next whole record by hand
+            scan, record = end_of_last, None
+            while record is None:
+                at = _find_sync(raw, scan)
+                if at is None:
+                    break
+                record = _parse_record(raw, at, size)
+                scan = at + 1
+            if record is None:
+                break           # only a partial record or junk up to the end: truncated
+            channel, payload, end = record
+            skipped += at - end_of_last
+            end_of_last = end
             events += 1
-            collector.add_event(channel, event.data, path)
+            salvaged += 1
+            collector.add_event(channel, payload, path)
+            log.seek(end_of_last)
     finally:
         log.close()
+        raw.close()
     trailing = size - end_of_last
     info = {"path": path, "bytes": size, "events": events, "truncated_bytes": trailing,
-            "skipped_bytes": skipped}
+            "skipped_bytes": skipped, "salvaged_events": salvaged}
     collector.data.inputs.append(info)
     if events == 0 and size > 0:
         with open(path, "rb") as f:

@@ -146,7 +146,8 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
     inputs = summary.get("inputs", [])
     input_rows = "".join(
         f"<tr><td class='k'>{html.escape(str(i.get('path')))}</td><td>{_cell(i.get('bytes'))}</td>"
-        f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td></tr>"
+        f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td>"
+        f"<td>{_cell(i.get('skipped_bytes'))}</td></tr>"
         for i in inputs)
     overview = [
         ("primary scheme", summary["primary_scheme"]),
@@ -189,7 +190,7 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         _kv_table(list(messages.items()) + extra_counts, ("channel", "events")),
         "<h2>Inputs</h2>",
         "<table><tr><th class='k'>log</th><th>bytes</th><th>events</th><th>truncated bytes</th>"
-        f"</tr>{input_rows}</table>",
+        f"<th>skipped bytes</th></tr>{input_rows}</table>",
         "<h2>Configuration</h2>",
         _kv_table(version_rows + sorted(params.items()), ("key", "value")) if (params or version_rows)
         else "<p class='note'>no CONFIG message in the logs</p>",

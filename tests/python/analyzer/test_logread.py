@@ -132,3 +132,30 @@ def test_garbage_between_records_is_skipped_and_reported(write_log, tmp_path, ms
         d = read_logs([spliced])
     assert_array_equal(d.table("POSE")["t_us"], [1, 2])
     assert d.inputs[0]["skipped_bytes"] == 13 and d.inputs[0]["truncated_bytes"] == 0
+
+
+@pytest.mark.parametrize("junk", [b"\x00" * 5, b"\x00" * 4096, b"\xed\xa1"])
+def test_junk_after_last_record_keeps_it(write_log, tmp_path, msg, junk):
+    # LCM 1.5's reader drops the last whole record when non-record bytes follow it (e.g. the
+    # zero-filled tail a power cut can leave); the analyzer must still return all three records.
+    path = write_log("z.lcmlog", [("POSE", msg.pose(i, i, 0)) for i in range(3)])
+    tail = tmp_path / "tail.lcmlog"
+    tail.write_bytes(path.read_bytes() + junk)
+    with pytest.warns(LogTruncatedWarning):
+        d = read_logs([tail])
+    assert_array_equal(d.table("POSE")["t_us"], [0, 1, 2])
+    info = d.inputs[0]
+    assert info["truncated_bytes"] + info["skipped_bytes"] == len(junk)
+
+
+def test_several_corrupt_regions_lose_no_whole_record(write_log, tmp_path, msg):
+    records = [write_log(f"r{i}.lcmlog", [("POSE", msg.pose(i, i, 0))]).read_bytes()
+               for i in range(8)]
+    junk = [b"", b"\x00" * 3, b"\xed\xa1\xda\x01garbage", b"", b"\xff" * 100, b"", b"\x01", b""]
+    path = tmp_path / "patchy.lcmlog"
+    path.write_bytes(b"".join(r + j for r, j in zip(records, junk)) + records[0][:20])
+    with pytest.warns(LogTruncatedWarning):
+        d = read_logs([path])
+    assert_array_equal(d.table("POSE")["t_us"], np.arange(8))
+    info = d.inputs[0]
+    assert info["skipped_bytes"] == sum(map(len, junk[:-1])) and info["truncated_bytes"] == 20
