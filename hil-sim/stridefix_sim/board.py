@@ -29,7 +29,7 @@ import cantools
 import numpy as np
 
 from .radio import Scan
-from .sensors import BARO_DECIMATION, MAG_DECIMATION, SensorData
+from .sensors import SensorData
 
 EPOCH_US = 1_700_000_000 * 1_000_000
 DBC_PATH = Path(__file__).resolve().parents[2] / "firmware" / "board.dbc"

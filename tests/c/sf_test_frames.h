@@ -1,6 +1,7 @@
 /* sf_test_frames.h — board frames for the tests, packed by the C that cantools generates from
  * firmware/board.dbc (never by hand, so the tests follow the DBC). Header-only; values are physical
- * (m/s², deg/s, ...) and go through the generated *_encode functions. */
+ * (m/s², deg/s, ...) and are rounded to the nearest raw value with the generated *_decode scale.
+ * (The generated *_encode functions truncate toward zero: 10 deg/s would become 9.95 deg/s.) */
 #ifndef SF_TEST_FRAMES_H
 #define SF_TEST_FRAMES_H
 
@@ -9,6 +10,13 @@
 
 #include "board.h"
 #include "sf_can_frame.h"
+
+#include <math.h>
+
+/* The raw value of signal sig of message msg nearest to the physical value v. */
+#define TF_RAW(msg, sig, v)                                                                                 \
+    llround(((v) - board_##msg##_##sig##_decode(0)) /                                                      \
+            (board_##msg##_##sig##_decode(1) - board_##msg##_##sig##_decode(0)))
 
 /* A classic 8-byte frame with id; data filled by the caller. */
 static inline sf_can_frame_t tf_frame(const uint32_t id)
@@ -32,9 +40,9 @@ static inline sf_can_frame_t tf_accel(const uint8_t seq, const uint8_t t_lo_ms, 
                                       const double z)
 {
     sf_can_frame_t f = tf_frame(BOARD_IMU_ACCEL_FRAME_ID);
-    const struct board_imu_accel_t m = {.accel_x = board_imu_accel_accel_x_encode(x),
-                                        .accel_y = board_imu_accel_accel_y_encode(y),
-                                        .accel_z = board_imu_accel_accel_z_encode(z),
+    const struct board_imu_accel_t m = {.accel_x = TF_RAW(imu_accel, accel_x, x),
+                                        .accel_y = TF_RAW(imu_accel, accel_y, y),
+                                        .accel_z = TF_RAW(imu_accel, accel_z, z),
                                         .seq = seq,
                                         .t_lo_ms = t_lo_ms};
     (void)board_imu_accel_pack(f.data, &m, sizeof f.data);
@@ -45,9 +53,9 @@ static inline sf_can_frame_t tf_gyro(const uint8_t seq, const uint8_t t_lo_ms, c
                                      const double y_dps, const double z_dps)
 {
     sf_can_frame_t f = tf_frame(BOARD_IMU_GYRO_FRAME_ID);
-    const struct board_imu_gyro_t m = {.gyro_x = board_imu_gyro_gyro_x_encode(x_dps),
-                                       .gyro_y = board_imu_gyro_gyro_y_encode(y_dps),
-                                       .gyro_z = board_imu_gyro_gyro_z_encode(z_dps),
+    const struct board_imu_gyro_t m = {.gyro_x = TF_RAW(imu_gyro, gyro_x, x_dps),
+                                       .gyro_y = TF_RAW(imu_gyro, gyro_y, y_dps),
+                                       .gyro_z = TF_RAW(imu_gyro, gyro_z, z_dps),
                                        .seq = seq,
                                        .t_lo_ms = t_lo_ms};
     (void)board_imu_gyro_pack(f.data, &m, sizeof f.data);
@@ -58,9 +66,9 @@ static inline sf_can_frame_t tf_mag(const uint8_t seq, const uint8_t t_lo_ms, co
                                     const double z)
 {
     sf_can_frame_t f = tf_frame(BOARD_MAG_FRAME_ID);
-    const struct board_mag_t m = {.mag_x = board_mag_mag_x_encode(x),
-                                  .mag_y = board_mag_mag_y_encode(y),
-                                  .mag_z = board_mag_mag_z_encode(z),
+    const struct board_mag_t m = {.mag_x = TF_RAW(mag, mag_x, x),
+                                  .mag_y = TF_RAW(mag, mag_y, y),
+                                  .mag_z = TF_RAW(mag, mag_z, z),
                                   .seq = seq,
                                   .t_lo_ms = t_lo_ms};
     (void)board_mag_pack(f.data, &m, sizeof f.data);
@@ -95,8 +103,8 @@ static inline sf_can_frame_t tf_gnss_info(const uint32_t time_ms, const double a
 {
     sf_can_frame_t f = tf_frame(BOARD_GNSS_INFO_FRAME_ID);
     const struct board_gnss_info_t m = {.time_ms = time_ms,
-                                        .altitude = board_gnss_info_altitude_encode(alt_m),
-                                        .accuracy = board_gnss_info_accuracy_encode(accuracy_m)};
+                                        .altitude = TF_RAW(gnss_info, altitude, alt_m),
+                                        .accuracy = TF_RAW(gnss_info, accuracy, accuracy_m)};
     (void)board_gnss_info_pack(f.data, &m, sizeof f.data);
     return f;
 }
@@ -104,8 +112,8 @@ static inline sf_can_frame_t tf_gnss_info(const uint32_t time_ms, const double a
 static inline sf_can_frame_t tf_gnss_position(const double lat_deg, const double lon_deg)
 {
     sf_can_frame_t f = tf_frame(BOARD_GNSS_POSITION_FRAME_ID);
-    const struct board_gnss_position_t m = {.latitude = board_gnss_position_latitude_encode(lat_deg),
-                                            .longitude = board_gnss_position_longitude_encode(lon_deg)};
+    const struct board_gnss_position_t m = {.latitude = TF_RAW(gnss_position, latitude, lat_deg),
+                                            .longitude = TF_RAW(gnss_position, longitude, lon_deg)};
     (void)board_gnss_position_pack(f.data, &m, sizeof f.data);
     return f;
 }

@@ -8,6 +8,7 @@
  * values in the documented units (gyro in rad/s).
  *
  * Usage: test_can_vectors VECTORS_TXT */
+#define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>

@@ -1,1 +1,331 @@
-int main(void){return 0;}
+/* test_candump.c — the candump -L parser and formatter (sf_candump.h) and the frame inputs
+ * (sf_can_input.h): files, bad lines with their line numbers, missing files, SocketCAN where the
+ * kernel has no AF_CAN. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sf_can_input.h"
+#include "sf_candump.h"
+#include "sf_error.h"
+
+static void test_parse_standard_id_8_bytes(void **state)
+{
+    (void)state;
+    sf_can_frame_t f;
+    assert_int_equal(sf_candump_parse("(1700000000.123456) can0 100#0011223344556677", &f), SF_OK);
+    assert_int_equal(f.host_t_us, 1700000000123456LL);
+    assert_int_equal(f.id, 0x100);
+    assert_false(f.extended);
+    assert_false(f.remote);
+    assert_int_equal(f.dlc, 8);
+    const uint8_t want[8] = {0x00, 0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77};
+    assert_memory_equal(f.data, want, 8);
+}
+
+static void test_parse_extended_id(void **state)
+{
+    (void)state;
+    sf_can_frame_t f;
+    assert_int_equal(sf_candump_parse("(1700000000.000001) vcan0 12345678#00\n", &f), SF_OK);
+    assert_int_equal(f.host_t_us, 1700000000000001LL);
+    assert_int_equal(f.id, 0x12345678);
+    assert_true(f.extended);
+    assert_int_equal(f.dlc, 1);
+    assert_int_equal(f.data[0], 0x00);
+    /* the largest 29-bit id */
+    assert_int_equal(sf_candump_parse("(1.000000) can0 1FFFFFFF#", &f), SF_OK);
+    assert_int_equal(f.id, 0x1FFFFFFF);
+    assert_true(f.extended);
+}
+
+static void test_parse_remote(void **state)
+{
+    (void)state;
+    sf_can_frame_t f;
+    assert_int_equal(sf_candump_parse("(1700000000.123456) can0 100#R", &f), SF_OK);
+    assert_true(f.remote);
+    assert_int_equal(f.id, 0x100);
+    assert_int_equal(f.dlc, 0);
+}
+
+static void test_parse_every_length(void **state)
+{
+    (void)state;
+    char line[80];
+    for (int n = 0; n <= 8; n++) {
+        int k = snprintf(line, sizeof line, "(12.500000) can0 7F0#");
+        for (int i = 0; i < n; i++) {
+            k += snprintf(line + k, sizeof line - (size_t)k, "%02x", 0xA0 + i); /* lower-case hex too */
+        }
+        sf_can_frame_t f;
+        assert_int_equal(sf_candump_parse(line, &f), SF_OK);
+        assert_int_equal(f.dlc, n);
+        assert_int_equal(f.id, 0x7F0);
+        assert_int_equal(f.host_t_us, 12500000);
+        for (int i = 0; i < n; i++) {
+            assert_int_equal(f.data[i], 0xA0 + i);
+        }
+    }
+}
+
+static void test_parse_line_endings(void **state)
+{
+    (void)state;
+    const char *const lines[] = {
+        "(1.000000) can0 080#0102\n",
+        "(1.000000) can0 080#0102\r\n",
+        "(1.000000) can0 080#0102\r",
+        "(1.000000)\tcan0\t080#0102",
+    };
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+        sf_can_frame_t f;
+        assert_int_equal(sf_candump_parse(lines[i], &f), SF_OK);
+        assert_int_equal(f.dlc, 2);
+        assert_int_equal(f.data[1], 0x02);
+    }
+}
+
+static void test_parse_garbage_is_syntax_error(void **state)
+{
+    (void)state;
+    const char *const bad[] = {
+        "",
+        "\n",
+        "1700000000.123456) can0 100#00",                  /* missing ( */
+        "(1700000000.123456 can0 100#00",                  /* missing ) */
+        "(1700000000.12345) can0 100#00",                  /* 5 fraction digits */
+        "(1700000000.1234567) can0 100#00",                /* 7 fraction digits */
+        "(.123456) can0 100#00",                           /* no seconds */
+        "(1700000000.123456)can0 100#00",                  /* no space after ) */
+        "(1700000000.123456) can0",                        /* no frame */
+        "(1700000000.123456) 100#00",                      /* no interface */
+        "(1700000000.123456) can0 100#001",                /* odd hex digits */
+        "(1700000000.123456) can0 100#0g",                 /* not hex */
+        "(1700000000.123456) can0 100#001122334455667788", /* 9 bytes */
+        "(1700000000.123456) can0 100##0011",              /* CAN FD */
+        "(1700000000.123456) can0 100##10011",             /* CAN FD with flags */
+        "(1700000000.123456) can0 100#00 junk",            /* junk after the data */
+        "(1700000000.123456) can0 100#R00",                /* data after R */
+        "(1700000000.123456) can0 100",                    /* no # */
+        "(1700000000.123456) can0 10#00",                  /* 2-digit id */
+        "(1700000000.123456) can0 1000#00",                /* 4-digit id */
+        "(1700000000.123456) can0 800#00",                 /* > 0x7FF in 3 digits */
+        "(1700000000.123456) can0 FFF#00",                 /* > 0x7FF in 3 digits */
+        "(1700000000.123456) can0 20000000#00",            /* > 29 bits */
+        "(1700000000.123456) can0 123456789#00",           /* 9-digit id */
+        "(1700000000.123456) can0 #00",                    /* no id */
+        "(1700000000.123456) can0 100#00\n\nx",            /* junk after the newline */
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        sf_can_frame_t f;
+        memset(&f, 0x5A, sizeof f);
+        const int rc = sf_candump_parse(bad[i], &f);
+        if (rc != SF_ESYNTAX) {
+            fail_msg("bad[%zu] \"%s\": got %d, want SF_ESYNTAX (%d)", i, bad[i], rc, SF_ESYNTAX);
+        }
+        assert_int_equal(f.id, 0x5A5A5A5A); /* *frame untouched on error */
+    }
+}
+
+static void test_parse_null_is_einval(void **state)
+{
+    (void)state;
+    sf_can_frame_t f;
+    assert_int_equal(sf_candump_parse(NULL, &f), SF_EINVAL);
+    assert_int_equal(sf_candump_parse("(1.000000) can0 100#00", NULL), SF_EINVAL);
+}
+
+static void test_format_parse_round_trip(void **state)
+{
+    (void)state;
+    srand(12345);
+    for (int i = 0; i < 2000; i++) {
+        sf_can_frame_t f;
+        memset(&f, 0, sizeof f);
+        f.extended = (i % 3) == 0;
+        f.remote = (i % 7) == 0;
+        f.id = f.extended ? (uint32_t)rand() & 0x1FFFFFFFu : (uint32_t)rand() & 0x7FFu;
+        f.host_t_us = (int64_t)rand() * 1000 + i;
+        f.dlc = f.remote ? 0 : (uint8_t)(i % 9);
+        for (int k = 0; k < f.dlc; k++) {
+            f.data[k] = (uint8_t)rand();
+        }
+        char buf[80];
+        const int n = sf_candump_format(&f, "can0", buf, sizeof buf);
+        assert_true(n > 0);
+        assert_int_equal((size_t)n, strlen(buf));
+        assert_int_equal(buf[n - 1], '\n');
+        sf_can_frame_t g;
+        assert_int_equal(sf_candump_parse(buf, &g), SF_OK);
+        assert_int_equal(g.host_t_us, f.host_t_us);
+        assert_int_equal(g.id, f.id);
+        assert_int_equal(g.extended, f.extended);
+        assert_int_equal(g.remote, f.remote);
+        assert_int_equal(g.dlc, f.dlc);
+        assert_memory_equal(g.data, f.data, f.dlc);
+    }
+}
+
+static void test_format_exact_text_and_small_buffer(void **state)
+{
+    (void)state;
+    sf_can_frame_t f = {.host_t_us = 1700000000123456LL, .id = 0x100, .dlc = 2, .data = {0xAB, 0x01}};
+    char buf[80];
+    assert_int_equal(sf_candump_format(&f, "can0", buf, sizeof buf), 34);
+    assert_string_equal(buf, "(1700000000.123456) can0 100#AB01\n");
+    f.extended = true;
+    f.id = 0x1ABCDEF;
+    assert_int_equal(sf_candump_format(&f, "can0", buf, sizeof buf), 39);
+    assert_string_equal(buf, "(1700000000.123456) can0 01ABCDEF#AB01\n");
+    char small[10];
+    assert_int_equal(sf_candump_format(&f, "can0", small, sizeof small), SF_EINVAL);
+}
+
+/* ---- sf_can_input on files ---- */
+
+static void write_temp(char *const path, const char *const text)
+{
+    strcpy(path, "/tmp/sf_test_candump_XXXXXX");
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    const size_t len = strlen(text);
+    assert_int_equal(write(fd, text, len), (ssize_t)len);
+    close(fd);
+}
+
+static void test_input_file_good_blank_and_garbage(void **state)
+{
+    (void)state;
+    char path[64];
+    write_temp(path,
+               "(1.000000) can0 080#0102030405060708\n" /* 1 */
+               "\n"                                      /* 2 blank */
+               "garbage\n"                               /* 3 */
+               "(2.000000) can0 100#00\r\n"              /* 4 */
+               "   \n"                                   /* 5 spaces: not blank, bad */
+               "(3.000000) can0 100##00\n"               /* 6 CAN FD */
+               "\r\n"                                    /* 7 blank */
+               "(4.000000) can0 12345678#R");            /* 8, no final newline */
+    sf_can_input_t in;
+    char err[256] = "";
+    assert_int_equal(sf_can_input_open(&in, path, err, sizeof err), SF_OK);
+    sf_can_frame_t f;
+
+    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(in.line_no, 1);
+    assert_int_equal(f.host_t_us, 1000000);
+    assert_int_equal(f.dlc, 8);
+
+    assert_int_equal(sf_can_input_next(&in, &f), SF_ESYNTAX);
+    assert_int_equal(in.line_no, 3);
+    assert_string_equal(in.line, "garbage");
+
+    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(in.line_no, 4);
+    assert_int_equal(f.host_t_us, 2000000);
+    assert_int_equal(f.id, 0x100);
+
+    assert_int_equal(sf_can_input_next(&in, &f), SF_ESYNTAX);
+    assert_int_equal(in.line_no, 5);
+
+    assert_int_equal(sf_can_input_next(&in, &f), SF_ESYNTAX);
+    assert_int_equal(in.line_no, 6);
+    assert_string_equal(in.line, "(3.000000) can0 100##00");
+
+    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(in.line_no, 8);
+    assert_true(f.extended);
+    assert_true(f.remote);
+
+    assert_int_equal(sf_can_input_next(&in, &f), 0);
+    assert_int_equal(sf_can_input_next(&in, &f), 0); /* EOF stays EOF */
+    sf_can_input_close(&in);
+    unlink(path);
+}
+
+static void test_input_overlong_line_is_skipped(void **state)
+{
+    (void)state;
+    char text[2048];
+    memset(text, 'x', 1500);
+    strcpy(text + 1500, "\n(5.000000) can0 100#01\n");
+    char path[64];
+    write_temp(path, text);
+    sf_can_input_t in;
+    assert_int_equal(sf_can_input_open(&in, path, NULL, 0), SF_OK);
+    sf_can_frame_t f;
+    assert_int_equal(sf_can_input_next(&in, &f), SF_ESYNTAX);
+    assert_int_equal(in.line_no, 1);
+    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(in.line_no, 2);
+    assert_int_equal(f.host_t_us, 5000000);
+    assert_int_equal(sf_can_input_next(&in, &f), 0);
+    sf_can_input_close(&in);
+    unlink(path);
+}
+
+static void test_input_missing_file(void **state)
+{
+    (void)state;
+    sf_can_input_t in;
+    char err[256] = "";
+    assert_int_equal(sf_can_input_open(&in, "/nonexistent/dir/log.candump", err, sizeof err), SF_ENOENT);
+    assert_non_null(strstr(err, "/nonexistent/dir/log.candump"));
+}
+
+static void test_input_empty_spec(void **state)
+{
+    (void)state;
+    sf_can_input_t in;
+    char err[256] = "";
+    assert_int_equal(sf_can_input_open(&in, "", err, sizeof err), SF_EINVAL);
+    assert_true(strlen(err) > 0);
+}
+
+static void test_input_socketcan_nonexistent(void **state)
+{
+    (void)state;
+    sf_can_input_t in;
+    char err[256] = "";
+    const int rc = sf_can_input_open(&in, "socketcan:sfnonexist0", err, sizeof err);
+    if (rc == SF_OK) {
+        sf_can_input_close(&in);
+        fail_msg("opened a CAN interface that does not exist");
+    }
+    /* no AF_CAN in this kernel → SF_EUNSUPPORTED; AF_CAN but no such interface → SF_ENOENT */
+    if (rc != SF_EUNSUPPORTED && rc != SF_ENOENT) {
+        fail_msg("got %d (%s), want SF_EUNSUPPORTED or SF_ENOENT", rc, sf_strerror(rc));
+    }
+    assert_true(strlen(err) > 0);
+    assert_non_null(strstr(err, "socketcan:sfnonexist0"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_parse_standard_id_8_bytes),
+        cmocka_unit_test(test_parse_extended_id),
+        cmocka_unit_test(test_parse_remote),
+        cmocka_unit_test(test_parse_every_length),
+        cmocka_unit_test(test_parse_line_endings),
+        cmocka_unit_test(test_parse_garbage_is_syntax_error),
+        cmocka_unit_test(test_parse_null_is_einval),
+        cmocka_unit_test(test_format_parse_round_trip),
+        cmocka_unit_test(test_format_exact_text_and_small_buffer),
+        cmocka_unit_test(test_input_file_good_blank_and_garbage),
+        cmocka_unit_test(test_input_overlong_line_is_skipped),
+        cmocka_unit_test(test_input_missing_file),
+        cmocka_unit_test(test_input_empty_spec),
+        cmocka_unit_test(test_input_socketcan_nonexistent),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -8,7 +8,7 @@ from pathlib import Path
 import cantools
 import pytest
 
-from stridefix_sim import cli as sim_cli
+from stridefix_sim import cli as sim_cli_module
 from stridefix_sim.board import DBC_PATH
 
 SHORT_S = 25.0
@@ -20,8 +20,8 @@ def run_cli(argv: list[str]) -> int:
     """Run ``stridefix sim ARGV`` through the sub-command's own parser; returns the exit status."""
     parser = argparse.ArgumentParser(prog="stridefix")
     sub = parser.add_subparsers(dest="command", required=True)
-    sim_cli.add_parser(sub)
-    return sim_cli.run(parser.parse_args(["sim", *argv]))
+    sim_cli_module.add_parser(sub)
+    return sim_cli_module.run(parser.parse_args(["sim", *argv]))
 
 
 def parse_candump(path: Path) -> list[tuple[int, int, bytes]]:
@@ -67,3 +67,27 @@ def lossy_run(sim_run) -> Path:
 @pytest.fixture(scope="session")
 def wrap_run(sim_run) -> Path:
     return sim_run("--duration-s", str(SHORT_S), "--seed", "11", "--board-time-start-ms", str(WRAP_START_MS))
+
+
+@pytest.fixture(scope="session")
+def short_s() -> float:
+    """Simulated duration of the short runs [s]."""
+    return SHORT_S
+
+
+@pytest.fixture(scope="session")
+def wrap_start_ms() -> int:
+    """Board time start of the wrap run: 5 s before the uint32 millisecond counter wraps."""
+    return WRAP_START_MS
+
+
+@pytest.fixture(scope="session")
+def candump():
+    """The candump -L parser: path -> [(host time µs, CAN id, data)]."""
+    return parse_candump
+
+
+@pytest.fixture(scope="session")
+def sim_cli():
+    """``stridefix sim`` entry: argv list -> exit status."""
+    return run_cli

@@ -5,11 +5,13 @@ import json
 
 import numpy as np
 import pytest
-from conftest import SHORT_S, WRAP_START_MS, parse_candump, run_cli
 
 from stridefix_sim.board import EPOCH_US, emulate_board
 from stridefix_sim.scenario import default_scenario
 from stridefix_sim.sensors import SensorData
+
+SHORT_S = 25.0  # must match conftest.SHORT_S (checked by test_constants)
+WRAP_START_MS = 2**32 - 5_000
 
 ID_TIME, ID_ACCEL, ID_GYRO, ID_MAG, ID_BARO = 0x080, 0x100, 0x101, 0x110, 0x120
 ID_BEGIN, ID_AP, ID_END, ID_STATUS = 0x200, 0x201, 0x202, 0x7F0
@@ -19,8 +21,8 @@ def summary(out):
     return json.loads((out / "sim_summary.json").read_text())
 
 
-def decoded(out, dbc):
-    return [(t, fid, dbc.decode_message(fid, data)) for t, fid, data in parse_candump(out / "board.candump")]
+def decoded(out, dbc, candump):
+    return [(t, fid, dbc.decode_message(fid, data)) for t, fid, data in candump(out / "board.candump")]
 
 
 def count_imu_pairs(frames) -> int:
@@ -37,9 +39,9 @@ def count_imu_pairs(frames) -> int:
 
 
 @pytest.mark.parametrize("run", ["short_run", "lossy_run", "wrap_run"])
-def test_every_line_is_candump_and_decodes(run, request, dbc):
+def test_every_line_is_candump_and_decodes(run, request, dbc, candump):
     out = request.getfixturevalue(run)
-    frames = parse_candump(out / "board.candump")
+    frames = candump(out / "board.candump")
     assert len(frames) == summary(out)["frames_total"]
     for _, fid, data in frames:
         msg = dbc.get_message_by_frame_id(fid)
@@ -49,8 +51,8 @@ def test_every_line_is_candump_and_decodes(run, request, dbc):
     assert all(b >= a for a, b in zip(times, times[1:])), "host timestamps must not decrease"
 
 
-def test_board_time_first_then_every_second(short_run, dbc):
-    frames = decoded(short_run, dbc)
+def test_board_time_first_then_every_second(short_run, dbc, candump):
+    frames = decoded(short_run, dbc, candump)
     t0, fid0, sig0 = frames[0]
     assert fid0 == ID_TIME
     assert sig0["time_ms"] == 1_000_000
@@ -60,8 +62,8 @@ def test_board_time_first_then_every_second(short_run, dbc):
     assert len(times) == int(SHORT_S) + 1
 
 
-def test_imu_seq_and_t_lo_follow_board_time(short_run, dbc):
-    frames = decoded(short_run, dbc)
+def test_imu_seq_and_t_lo_follow_board_time(short_run, dbc, candump):
+    frames = decoded(short_run, dbc, candump)
     start = frames[0][2]["time_ms"]
     accel = [s for _, f, s in frames if f == ID_ACCEL]
     gyro = [s for _, f, s in frames if f == ID_GYRO]
@@ -80,20 +82,20 @@ def test_imu_seq_and_t_lo_follow_board_time(short_run, dbc):
             assert ids[k + 1] == ID_GYRO
 
 
-def test_imu_pairs_match_summary(short_run, lossy_run, dbc):
+def test_imu_pairs_match_summary(short_run, lossy_run, dbc, candump):
     for out in (short_run, lossy_run):
-        assert count_imu_pairs(decoded(out, dbc)) == summary(out)["imu_samples"]
+        assert count_imu_pairs(decoded(out, dbc, candump)) == summary(out)["imu_samples"]
     assert summary(short_run)["imu_samples"] == int(SHORT_S * 100) + 1
 
 
-def test_loss_rate_drops_frames_and_counts_match(short_run, lossy_run, dbc):
+def test_loss_rate_drops_frames_and_counts_match(short_run, lossy_run, dbc, candump):
     clean, lossy = summary(short_run), summary(lossy_run)
     assert clean["frames_dropped"] == 0
     assert lossy["frames_dropped"] > 0
     # same seed: the board sends the same frames; loss only removes some of them
     assert lossy["frames_total"] + lossy["frames_dropped"] == clean["frames_total"]
     assert lossy["frames_dropped"] / clean["frames_total"] == pytest.approx(0.1, abs=0.02)
-    frames = decoded(lossy_run, dbc)
+    frames = decoded(lossy_run, dbc, candump)
     assert len(frames) == lossy["frames_total"]
     by_id = {}
     for _, f, _ in frames:
@@ -106,8 +108,8 @@ def test_loss_rate_drops_frames_and_counts_match(short_run, lossy_run, dbc):
     assert frames[0][1] == ID_TIME
 
 
-def test_wifi_scans_are_framed(short_run, dbc):
-    frames = decoded(short_run, dbc)
+def test_wifi_scans_are_framed(short_run, dbc, candump):
+    frames = decoded(short_run, dbc, candump)
     s = summary(short_run)
     assert s["wifi_scans"] >= int(SHORT_S / 4) - 1
     open_scan, n_ap, scans = None, 0, 0
@@ -128,8 +130,8 @@ def test_wifi_scans_are_framed(short_run, dbc):
     assert scans == s["wifi_scans"]
 
 
-def test_board_time_wraps_at_2_pow_32(wrap_run, dbc):
-    frames = decoded(wrap_run, dbc)
+def test_board_time_wraps_at_2_pow_32(wrap_run, dbc, candump):
+    frames = decoded(wrap_run, dbc, candump)
     bt = [s["time_ms"] for _, f, s in frames if f == ID_TIME]
     assert bt[0] == WRAP_START_MS
     steps = [(b - a) % 2**32 for a, b in zip(bt, bt[1:])]
@@ -160,10 +162,14 @@ def test_values_are_clamped_into_dbc_range(dbc):
     assert baro["temperature"] == pytest.approx(327.67)
 
 
-def test_stdout_streams_the_same_candump(short_run, tmp_path, capsys):
-    assert run_cli(["--duration-s", str(SHORT_S), "--seed", "11", "--stdout", "--out", str(tmp_path)]) == 0
+def test_stdout_streams_the_same_candump(short_run, tmp_path, capsys, sim_cli):
+    assert sim_cli(["--duration-s", str(SHORT_S), "--seed", "11", "--stdout", "--out", str(tmp_path)]) == 0
     captured = capsys.readouterr()
     assert captured.out == (short_run / "board.candump").read_text()
     assert not (tmp_path / "board.candump").exists()
     assert (tmp_path / "truth.lcmlog").exists() and (tmp_path / "sim_summary.json").exists()
     assert "steps" in captured.err
+
+
+def test_constants(short_s, wrap_start_ms):
+    assert (SHORT_S, WRAP_START_MS) == (short_s, wrap_start_ms)

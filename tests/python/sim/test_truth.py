@@ -8,11 +8,13 @@ import time
 import lcm
 import numpy as np
 import pytest
-from conftest import SHORT_S, WRAP_START_MS
 from stridefix import truth_t
 
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.scenario import default_scenario
+
+SHORT_S = 25.0  # conftest.SHORT_S
+WRAP_START_MS = 2**32 - 5_000  # conftest.WRAP_START_MS
 
 
 def truth(out):
