@@ -10,6 +10,7 @@ step() { local name=$1; shift; local t0 t1; t0=$(date +%s%N); "$@"; t1=$(date +%
 : > "$out/timings.txt"
 step sim       "$venv/bin/stridefix" sim --out "$out"
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --config "$out/init_truth.ini"
-step analyze   "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out"
+step analyze   "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" \
+               --label "default SIL walk, PDR only, truth-initialised start (init_truth.ini)"
 step report    "$venv/bin/stridefix" report "$out"
 echo "demo: wrote $out/report.html and $out/metrics.json"

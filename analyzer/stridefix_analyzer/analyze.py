@@ -49,6 +49,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="pose scheme reported at the top level when POSE holds several "
                         "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
                         "default: the one with most POSE messages)")
+    p.add_argument("--label", default=None, metavar="TEXT",
+                   help="what this run is (e.g. 'PDR only, truth-initialised start'); kept in "
+                        "metrics.json and shown as the report's title")
     p.add_argument("--all-channels", action="store_true",
                    help=f"decode every known channel ({', '.join(KNOWN_CHANNELS)}) to check their "
                         "payloads, not only those the analysis needs (slower on long logs)")
@@ -70,9 +73,9 @@ def _json_ready(value):
     return value
 
 
-def build_summary(data: LogData, metrics: Metrics) -> dict:
+def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> dict:
     """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
-    doc = {"inputs": data.inputs}
+    doc = {"label": label, "inputs": data.inputs}
     doc.update(metrics.summary())
     doc.update(messages=dict(sorted(data.messages.items())),
                unknown_channels=data.unknown_channels,
@@ -124,7 +127,7 @@ def format_summary(summary: dict) -> str:
 
 
 def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None = None,
-                all_channels: bool = False) -> tuple[dict, Metrics]:
+                all_channels: bool = False, label: str | None = None) -> tuple[dict, Metrics]:
     """Read ``logs``, score them and write the outputs; return (summary, metrics).
 
     Raises
@@ -139,7 +142,7 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
     metrics = run_metrics(data, scheme=code)
-    summary = build_summary(data, metrics)
+    summary = build_summary(data, metrics, label)
     write_outputs(out_dir, summary, metrics)
     return summary, metrics
 
@@ -147,7 +150,7 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
-        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels)
+        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels, args.label)
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return 2

@@ -212,7 +212,8 @@ def run_report(directory: str, out_file: str | None = None) -> str:
     parent = os.path.dirname(out_file)
     if parent:
         os.makedirs(parent, exist_ok=True)
-    page = render_html(summary, series)
+    label = summary.get("label")
+    page = render_html(summary, series, f"StrideFix walk report: {label}" if label else "StrideFix walk report")
     with open(out_file, "w", encoding="utf-8") as f:
         f.write(page)
     return out_file

@@ -173,12 +173,16 @@ static void test_300_lost_without_board_time(void **state)
     free(s);
 }
 
+/* Regression test for "stale BOARD_TIME anchor after a loss" (open). 50 samples are lost around a
+ * second boundary whose BOARD_TIME arrives. sf_stream_time_resolve then predicts the next sample's
+ * time as that BOARD_TIME (new clock generation) although the sample comes 200 ms later; 200 > 128,
+ * so the t_lo snap lands 256 ms early, and every sample up to the next BOARD_TIME is 256 ms off.
+ * Δseq = 51 < 256 made the time recoverable (the header promises exactness for gaps up to 255
+ * samples). Any outage that takes the sample right after a BOARD_TIME and the next 12+ samples
+ * triggers it. */
 static void test_50_lost_across_a_received_board_time(void **state)
 {
     (void)state;
-    /* 50 samples lost around a second boundary whose BOARD_TIME arrives: the first sample after the
-     * outage is 190 ms after that BOARD_TIME. Δseq = 50 < 256, so the time is recoverable (the header
-     * promises exactness for gaps up to 255 samples). */
     scenario_t *const s = new_scenario(50000, 400);
     lose(s, 170, 50, false); /* 170..219; BOARD_TIME before 200 arrives; next sample 220 */
     const totals_t tot = run_direct(s);
