@@ -63,10 +63,16 @@ int sf_stream_time_resolve(sf_stream_time_t *const s, const sf_board_clock_t *co
     if (s->started && dseq == 0) {
         return SF_EDUPLICATE;
     }
-    const bool new_anchor = !s->started || s->generation != clock->generation;
-    const int64_t predicted = new_anchor ? clock->board_ms
-                                         : s->last_t_ms + (int64_t)llround((double)dseq * s->period_ms);
-    const int64_t t = snap(predicted, t_lo_ms, 8);
+    int64_t t = snap(clock->board_ms, t_lo_ms, 8);
+    if (s->started) {
+        const int64_t by_seq = snap(s->last_t_ms + (int64_t)llround((double)dseq * s->period_ms), t_lo_ms, 8);
+        /* Trust the sequence unless a newer BOARD_TIME proves it wrapped: a sample is never sent
+         * long before the BOARD_TIME that precedes it on the bus. */
+        const bool new_anchor = s->generation != clock->generation;
+        if (!new_anchor || by_seq >= clock->board_ms - 128) {
+            t = by_seq;
+        }
+    }
 
     uint32_t missing = 0;
     int64_t useq = seq;

@@ -6,11 +6,12 @@
  *
  * Reconstruction, per stream: predict the sample's time, then take the one time that has the
  * received low 8 bits and lies within ±128 ms of the prediction. The prediction is
- *   - the latest BOARD_TIME, when one arrived since this stream's previous sample (frames are sent
- *     as they are sampled, so a sample follows its BOARD_TIME within milliseconds: this recovers
- *     from any outage, however long);
- *   - otherwise previous time + Δseq · period, with Δseq = (seq − previous seq) mod 256 and the
- *     period learnt from consecutive samples (exact for gaps up to 255 samples).
+ *   - previous time + Δseq · period, with Δseq = (seq − previous seq) mod 256 and the period
+ *     learnt from consecutive samples (exact for gaps up to 255 samples);
+ *   - the latest BOARD_TIME for a stream's first sample, and whenever the sequence prediction
+ *     falls more than 128 ms before a BOARD_TIME that arrived since the previous sample: frames
+ *     are sent as they are sampled, so that only happens when the sequence wrapped during a long
+ *     outage; the BOARD_TIME then recovers the time, however long the outage.
  * The 32-bit board time itself is unwrapped into int64, so 49.7-day wrap is invisible downstream.
  * Lost samples are counted from the time step (round(Δt/period) − 1), which stays right past a
  * seq wrap. A board restart (new boot_id) resets every stream.

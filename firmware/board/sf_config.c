@@ -43,6 +43,9 @@ static int apply(sf_params_t *const params, const char *const section, const cha
 static int on_entry(void *const user, const char *const section, const char *const name, const char *const value)
 {
     ctx_t *const ctx = user;
+    if (ctx->rc != SF_OK) {
+        return 0; /* inih goes on after an error: keep the first one, apply nothing after it */
+    }
     ctx->rc = apply(ctx->params, section, name, value, ctx->what, sizeof ctx->what);
     return ctx->rc == SF_OK;
 }

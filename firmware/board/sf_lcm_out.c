@@ -80,7 +80,7 @@ static void *writer_main(void *arg)
         pthread_mutex_lock(&out->lock);
         if (rc == 0) {
             out->counters.events++;
-            out->counters.bytes += 20u + (uint64_t)ev.channellen + (uint64_t)it.size;
+            out->counters.bytes += 28u + (uint64_t)ev.channellen + (uint64_t)it.size;
         } else {
             out->counters.drops++;
             out->write_failed = true;

@@ -18,7 +18,7 @@ typedef struct sf_lcm_out sf_lcm_out_t;
 
 typedef struct {
     uint64_t events;  /* written to the log */
-    uint64_t bytes;   /* log bytes written (payload + channel + 20-byte event header) */
+    uint64_t bytes;   /* log bytes written (payload + channel + 28-byte event header) */
     uint64_t drops;   /* dropped: queue full, or a write failed */
     uint64_t publish_errors;
 } sf_lcm_out_counters_t;
