@@ -18,6 +18,7 @@
 #include "sf_can_input.h"
 #include "sf_config.h"
 #include "sf_error.h"
+#include "sf_lcm_input.h"
 #include "sf_lcm_out.h"
 #include "sf_params.h"
 #include "sf_pdr.h"
@@ -41,6 +42,7 @@
 #define EXIT_USAGE 2
 #define LOG_QUEUE_MESSAGES 8192
 #define MAX_SETS 64
+#define LCMLOG_PREFIX "lcmlog:"
 
 typedef struct {
     const char *input;
@@ -59,6 +61,7 @@ typedef struct {
     options_t opt;
     sf_params_t params;
     sf_can_input_t in;
+    sf_lcm_input_t *lcm_in; /* set when replaying a raw-sensor LCM log instead of CAN frames */
     sf_lcm_out_t *out;
     sf_board_rx_t rx;
     sf_pdr_t pdr;
@@ -83,7 +86,8 @@ static void usage(FILE *const f)
             "\n"
             "Inputs\n"
             "  -i, --input SPEC       board frames: a candump -L file, '-' for stdin, or socketcan:IFACE\n"
-            "                         (SocketCAN needs a kernel with AF_CAN)\n"
+            "                         (SocketCAN needs a kernel with AF_CAN), or lcmlog:FILE, a raw-sensor\n"
+            "                         LCM log (IMU MAG BARO WIFI GNSS channels) as `stridefix import` writes\n"
             "Outputs\n"
             "  -l, --log FILE         LCM event log to write (default: DIR/stridefixd-YYYYmmdd-HHMMSS.lcmlog)\n"
             "  -d, --log-dir DIR      directory for the default log name (default: .)\n"
@@ -290,8 +294,11 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
         stridefix_step_t sm = {.t_us = step.t_us,
                                .index = step.index,
                                .length_m = (float)step.length_m,
+                               .accel_range_mps2 = (float)step.accel_range_mps2,
+                               .period_s = (float)step.period_s,
                                .heading_rad = (float)step.heading_rad,
-                               .activity = step.activity};
+                               .activity = step.activity,
+                               .floor = step.floor};
         SF_LCM_WRITE(d->out, "STEP", d->host_t_us, stridefix_step_t, &sm);
         write_pose(d);
     } else if (s->t_us - d->last_pose_t_us >= (int64_t)d->params.output_pose_period_ms * 1000) {
@@ -372,18 +379,36 @@ static double monotonic_us(void)
     return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
 }
 
-static int run(daemon_t *const d)
+/* Bookkeeping shared by both input paths, around the handling of one input item. */
+static double begin_item(daemon_t *const d, const int64_t host_t_us)
+{
+    d->host_t_us = host_t_us;
+    if (!d->config_written) {
+        write_config(d);
+    }
+    return monotonic_us();
+}
+
+static void end_item(daemon_t *const d, const double t0)
+{
+    if (d->board_t_us - d->last_health_t_us >= (int64_t)d->params.output_health_period_ms * 1000) {
+        write_health(d);
+    }
+    const double dt = monotonic_us() - t0;
+    d->loop_sum_us += dt;
+    d->loop_n++;
+    if (dt > d->loop_max_us) {
+        d->loop_max_us = dt;
+    }
+}
+
+static int run_can(daemon_t *const d, sf_rx_event_t *const ev)
 {
     sf_can_frame_t frame;
-    sf_rx_event_t *const ev = malloc(sizeof *ev);
-    if (ev == NULL) {
-        return 1;
-    }
-    int status = 0;
     for (;;) {
         const int rc = sf_can_input_next(&d->in, &frame);
         if (rc == 0) {
-            break;
+            return 0;
         }
         if (rc == SF_ESYNTAX) {
             d->bad_syntax++;
@@ -392,30 +417,54 @@ static int run(daemon_t *const d)
         }
         if (rc < 0) {
             fprintf(stderr, "stridefixd: %s: read failed: %s\n", d->in.name, strerror(errno));
-            status = 1;
-            break;
+            return 1;
         }
-        const double t0 = monotonic_us();
-        d->host_t_us = frame.host_t_us;
-        if (!d->config_written) {
-            write_config(d);
-        }
+        const double t0 = begin_item(d, frame.host_t_us);
         const int r = sf_board_rx_frame(&d->rx, &frame, ev);
         if (r < 0) {
             on_bad_frame(d, r, &frame);
         } else if (r == 1) {
             on_event(d, ev);
         }
-        if (d->board_t_us - d->last_health_t_us >= (int64_t)d->params.output_health_period_ms * 1000) {
-            write_health(d);
-        }
-        const double dt = monotonic_us() - t0;
-        d->loop_sum_us += dt;
-        d->loop_n++;
-        if (dt > d->loop_max_us) {
-            d->loop_max_us = dt;
-        }
+        end_item(d, t0);
     }
+}
+
+/* Replay of a raw-sensor LCM log: events are already decoded and timed; the counters the CAN path
+ * keeps in sf_board_rx are kept here so HEALTH reads the same. */
+static int run_lcm(daemon_t *const d, sf_rx_event_t *const ev)
+{
+    sf_rx_counters_t *const c = &d->rx.counters;
+    for (;;) {
+        int64_t log_t_us = 0;
+        const int rc = sf_lcm_input_next(d->lcm_in, ev, &log_t_us);
+        if (rc == 0) {
+            return 0;
+        }
+        c->frames++;
+        if (rc < 0) {
+            c->decode_errors++;
+            continue;
+        }
+        c->frames_ok++;
+        c->imu += ev->kind == sf_rx_imu;
+        c->mag += ev->kind == sf_rx_mag;
+        c->baro += ev->kind == sf_rx_baro;
+        c->wifi += ev->kind == sf_rx_wifi;
+        c->gnss += ev->kind == sf_rx_gnss;
+        const double t0 = begin_item(d, log_t_us);
+        on_event(d, ev);
+        end_item(d, t0);
+    }
+}
+
+static int run(daemon_t *const d)
+{
+    sf_rx_event_t *const ev = malloc(sizeof *ev);
+    if (ev == NULL) {
+        return 1;
+    }
+    const int status = d->lcm_in != NULL ? run_lcm(d, ev) : run_can(d, ev);
     free(ev);
     if (!d->config_written) {
         write_config(d);
@@ -455,6 +504,16 @@ static void default_log_path(daemon_t *const d)
     snprintf(d->log_path, sizeof d->log_path, "%s/%s", d->opt.log_dir, name);
 }
 
+static void close_input(daemon_t *const d)
+{
+    if (d->lcm_in != NULL) {
+        sf_lcm_input_close(d->lcm_in);
+        d->lcm_in = NULL;
+    } else {
+        sf_can_input_close(&d->in);
+    }
+}
+
 int main(int argc, char **argv)
 {
     static daemon_t d; /* large (scan buffers): static, not on the stack */
@@ -463,18 +522,20 @@ int main(int argc, char **argv)
         return prc;
     }
     char err[512];
-    const int irc = sf_can_input_open(&d.in, d.opt.input, err, sizeof err);
+    const bool lcm_input = strncmp(d.opt.input, LCMLOG_PREFIX, strlen(LCMLOG_PREFIX)) == 0;
+    const int irc = lcm_input ? sf_lcm_input_open(&d.lcm_in, d.opt.input + strlen(LCMLOG_PREFIX), err, sizeof err)
+                              : sf_can_input_open(&d.in, d.opt.input, err, sizeof err);
     if (irc != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return EXIT_USAGE;
     }
     default_log_path(&d);
     /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
-    const bool block = d.in.kind == sf_can_input_file;
+    const bool block = lcm_input || d.in.kind == sf_can_input_file;
     if (sf_lcm_out_open(&d.out, d.opt.no_log ? NULL : d.log_path, d.opt.lcm_url, LOG_QUEUE_MESSAGES, block, err,
                         sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
-        sf_can_input_close(&d.in);
+        close_input(&d);
         return 1;
     }
     sf_board_rx_init(&d.rx);

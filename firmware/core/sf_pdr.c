@@ -73,6 +73,8 @@ bool sf_pdr_update(sf_pdr_t *const pdr, const sf_params_t *const params, const s
     const double a_v = dot3(s->accel_mps2, up) - g_norm;
     pdr->accel_v_mps2 += lowpass_gain(dt_s, tau_v) * (a_v - pdr->accel_v_mps2);
 
+    pdr->step_max_mps2 = fmax(pdr->step_max_mps2, pdr->accel_v_mps2);
+    pdr->step_min_mps2 = fmin(pdr->step_min_mps2, pdr->accel_v_mps2);
     const double thr = params->pdr_step_threshold_mps2;
     if (pdr->accel_v_mps2 > thr) {
         if (!pdr->above || pdr->accel_v_mps2 > pdr->peak_mps2) {
@@ -90,6 +92,7 @@ bool sf_pdr_update(sf_pdr_t *const pdr, const sf_params_t *const params, const s
     if (pdr->peak_t_us - pdr->last_step_t_us < (int64_t)params->pdr_step_min_interval_ms * 1000) {
         return false;
     }
+    const double period_s = (double)(pdr->peak_t_us - pdr->last_step_t_us) * 1e-6;
     pdr->last_step_t_us = pdr->peak_t_us;
     pdr->step_count++;
     pdr->x_m += params->pdr_stride_m * cos(pdr->heading_rad);
@@ -97,8 +100,12 @@ bool sf_pdr_update(sf_pdr_t *const pdr, const sf_params_t *const params, const s
     step->t_us = s->t_us; /* published when known: causal, not back-dated to the peak */
     step->index = pdr->step_count;
     step->length_m = params->pdr_stride_m;
+    step->accel_range_mps2 = pdr->step_max_mps2 - pdr->step_min_mps2;
+    step->period_s = pdr->step_count > 1 ? period_s : 0.0;
     step->heading_rad = pdr->heading_rad;
     step->activity = sf_activity_walking;
+    step->floor = (int16_t)params->init_floor;
+    pdr->step_max_mps2 = pdr->step_min_mps2 = pdr->accel_v_mps2;
     return true;
 }
 

@@ -29,6 +29,8 @@ typedef struct {
     double peak_mps2;
     int64_t peak_t_us;
     int64_t last_step_t_us;
+    double step_max_mps2; /* extremes of a_v since the previous step */
+    double step_min_mps2;
     double heading_rad;
     double x_m;
     double y_m;

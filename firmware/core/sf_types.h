@@ -34,8 +34,11 @@ typedef struct {
     int64_t t_us;
     int32_t index; /* first step is 1 */
     double length_m;
-    double heading_rad; /* map frame */
+    double accel_range_mps2; /* vertical acceleration amax − amin over the step (Weinberg's input) */
+    double period_s;         /* time since the previous step */
+    double heading_rad;      /* map frame */
     int8_t activity;
+    int16_t floor;
 } sf_step_t;
 
 /* The estimator's position output. */
