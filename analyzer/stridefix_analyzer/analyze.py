@@ -110,16 +110,20 @@ def format_summary(summary: dict) -> str:
     """A compact plain-text table of the per-scheme scores, for the terminal."""
     cols = ["n", "mean", "median", "p75", "p90", "p95", "max", "rmse"]
     lines = [f"{'scheme':<11}" + "".join(f"{c:>8}" for c in cols)
-             + f"{'floor%':>8}{'final':>8}{'steps':>8}"]
+             + f"{'floor%':>8}{'final':>8}{'final%':>8}{'hdgRMS':>8}{'steps':>8}"]
     for name, s in summary["per_scheme"].items():
         e = s["position_error_m"]
         mark = "*" if name == summary["primary_scheme"] else " "
         floor = s["floor_hit_rate"]
         lines.append(f"{mark}{name:<10}" + "".join(f"{_fmt(e[c]):>8}" for c in cols)
                      + f"{_fmt(None if floor is None else 100 * floor, 1):>8}"
-                     + f"{_fmt(s['final_error_m']):>8}" + f"{_fmt(s['steps']['error']):>8}")
+                     + f"{_fmt(s['final_error_m']):>8}"
+                     + f"{_fmt(s['final_error_pct_of_distance']):>8}"
+                     + f"{_fmt(s['heading_error']['rms_deg'], 1):>8}"
+                     + f"{_fmt(s['steps']['error']):>8}")
     st = summary["steps"]
-    lines.append(f"(errors in m; * primary scheme; steps = detected - truth)  "
+    lines.append(f"(errors in m; final% of distance walked; hdgRMS in deg; * primary scheme; "
+                 f"steps = detected - truth)  "
                  f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
                  f"walked {summary['distance_walked_m']:.1f} m, "
                  f"steps detected {st['detected']} / truth {_fmt(st['truth'])}")

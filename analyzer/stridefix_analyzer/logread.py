@@ -15,7 +15,7 @@ BARO      t_us, seq, pressure_pa, temperature_degc
 WIFI      t_us, scan_id, complete, n_ap   (per scan; the APs are in the WIFI_AP table)
 WIFI_AP   scan_row (row in WIFI), bssid, rssi_dbm, freq_mhz
 GNSS      t_us, lat_deg, lon_deg, alt_m, accuracy_m
-STEP      t_us, index, length_m, heading_rad, activity
+STEP      t_us, index, length_m, accel_range_mps2, period_s, heading_rad, activity, floor
 FIX       t_us, method, x_m, y_m, floor, accuracy_m, n_ap_used, innovation_{x,y}_m,
           innovation_var_m2, test_ratio, alpha, accepted, reason, reason_text
 POSE      t_us, x_m, y_m, floor, heading_rad, sigma_m, step_count, scheme
@@ -168,8 +168,10 @@ _CHANNELS: dict[str, tuple[type, list[str], Callable]] = {
              lambda m: (m.t_us, m.scan_id, bool(m.complete), m.n_ap)),
     "GNSS": (stridefix.gnss_t, ["t_us", "lat_deg", "lon_deg", "alt_m", "accuracy_m"],
              lambda m: (m.t_us, m.lat_deg, m.lon_deg, m.alt_m, m.accuracy_m)),
-    "STEP": (stridefix.step_t, ["t_us", "index", "length_m", "heading_rad", "activity"],
-             lambda m: (m.t_us, m.index, m.length_m, m.heading_rad, m.activity)),
+    "STEP": (stridefix.step_t, ["t_us", "index", "length_m", "accel_range_mps2", "period_s",
+                                "heading_rad", "activity", "floor"],
+             lambda m: (m.t_us, m.index, m.length_m, m.accel_range_mps2, m.period_s,
+                        m.heading_rad, m.activity, m.floor)),
     "FIX": (stridefix.fix_t,
             ["t_us", "method", "x_m", "y_m", "floor", "accuracy_m", "n_ap_used", "innovation_x_m",
              "innovation_y_m", "innovation_var_m2", "test_ratio", "alpha", "accepted", "reason",

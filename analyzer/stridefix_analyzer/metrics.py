@@ -102,7 +102,24 @@ def match_causal(pose: Table, truth: Table) -> Table:
         "pose_floor": take(pose["floor"], np.int64(-1)),
         "pose_sigma_m": take(pose["sigma_m"], np.nan),
         "error_m": np.hypot(px - truth["x_m"], py - truth["y_m"]),
+        "heading_error_rad": wrap_pi(take(pose["heading_rad"], np.nan) - truth["heading_rad"]),
     })
+
+
+def wrap_pi(angle_rad: np.ndarray) -> np.ndarray:
+    """Angles wrapped to (−π, π] [rad]; NaN stays NaN."""
+    a = np.asarray(angle_rad, dtype=np.float64)
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+def heading_stats(heading_error_rad: np.ndarray) -> dict:
+    """RMS and mean absolute heading error [deg] over the finite samples, and their count."""
+    e = np.degrees(np.asarray(heading_error_rad, dtype=np.float64))
+    e = e[np.isfinite(e)]
+    if e.size == 0:
+        return {"n": 0, "rms_deg": float("nan"), "mean_abs_deg": float("nan")}
+    return {"n": int(e.size), "rms_deg": float(np.sqrt(np.mean(e ** 2))),
+            "mean_abs_deg": float(np.mean(np.abs(e)))}
 
 
 # --- statistics ----------------------------------------------------------------------------------
@@ -219,6 +236,7 @@ def score_scheme(pose: Table, truth: Table, n_step_messages: int, distance_m: fl
         "unscored": int(np.count_nonzero(~scored)),
         "floor_hit_rate": floor_hit,
         "within_1sigma_rate": within,
+        "heading_error": heading_stats(m["heading_error_rad"][scored]),
         "steps": step_metrics(pose, truth, n_step_messages),
         "final_error_m": final,
         "final_error_pct_of_distance": 100.0 * final / distance_m if distance_m > 0 else None,
@@ -280,6 +298,7 @@ class Metrics:
             "floor_hit_rate": top["floor_hit_rate"],
             "floors_in_truth": sorted({int(f) for f in self.truth["floor"]}),
             "within_1sigma_rate": top["within_1sigma_rate"],
+            "heading_error": top["heading_error"],
             "steps": top["steps"],
             "distance_walked_m": self.distance_walked_m,
             "final_error_m": top["final_error_m"],

@@ -158,3 +158,20 @@ def test_scheme_code_accepts_names_and_numbers():
     assert scheme_code("5") == pose_t.SCHEME_KALMAN
     with pytest.raises(MetricsInputError, match="bogus"):
         scheme_code("bogus")
+
+
+def test_heading_rms_error_wraps_at_pi(msg, write_log, straight_walk):
+    """Pose heading 179° against truth −171° is a 10° error, not 350°; truth without heading
+    (NaN) is left out of the heading statistics but still scored for position."""
+    t, x, y = straight_walk
+    events = []
+    for k, (ti, xi, yi) in enumerate(zip(t, x, y)):
+        pose = msg.pose(ti, xi, yi)
+        pose.heading_rad = float(np.radians(179.0))
+        truth_heading = float(np.radians(-171.0)) if k % 2 == 0 else float("nan")
+        events += [("POSE", pose), ("TRUTH", msg.truth(ti, xi, yi, heading_rad=truth_heading))]
+    m = run_metrics(read_logs([write_log("h.lcmlog", events)])).summary()
+    assert m["heading_error"]["n"] == 50
+    assert_allclose(m["heading_error"]["rms_deg"], 10.0, rtol=1e-4)
+    assert_allclose(m["heading_error"]["mean_abs_deg"], 10.0, rtol=1e-4)
+    assert m["position_error_m"]["n"] == 100
