@@ -16,6 +16,7 @@ all: build
 help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end)"
+	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
 	@echo "make clean  - remove $(BUILD)/ and out/"
@@ -39,6 +40,9 @@ test-python:
 
 demo: build
 	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
+
+bench: build
+	$(PY) -m stridefix_analyzer.cli bench sil-pdr --stridefixd $(STRIDEFIXD) --out out/bench
 
 clean:
 	rm -rf $(BUILD) $(BUILD).cmake.log out

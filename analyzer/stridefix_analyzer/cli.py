@@ -15,6 +15,7 @@ SUBCOMMANDS = {
     "sim": "stridefix_sim.cli",
     "analyze": "stridefix_analyzer.analyze",
     "report": "stridefix_analyzer.report",
+    "bench": "stridefix_analyzer.bench",
 }
 
 

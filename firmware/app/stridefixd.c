@@ -50,7 +50,8 @@ typedef struct {
     const char *log_dir;
     bool no_log;
     const char *lcm_url;
-    const char *config_path;
+    const char *config_paths[MAX_SETS];
+    int n_configs;
     const char *sets[MAX_SETS];
     int n_sets;
     bool quiet;
@@ -94,7 +95,8 @@ static void usage(FILE *const f)
             "      --no-log           write no log (live publishing only)\n"
             "  -u, --lcm-url URL      also publish live to this LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0\n"
             "Configuration\n"
-            "  -c, --config FILE      INI file of [section] key = value (every key: --print-config)\n"
+            "  -c, --config FILE      INI file of [section] key = value (every key: --print-config);\n"
+            "                         repeatable, later files override earlier ones\n"
             "  -s, --set KEY=VALUE    override one key, e.g. --set pdr.stride_m=0.72 (repeatable)\n"
             "      --print-config     print every key with its default, range, unit and meaning; exit\n"
             "Messages\n"
@@ -145,7 +147,13 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
         case 'd': o->log_dir = optarg; break;
         case opt_no_log: o->no_log = true; break;
         case 'u': o->lcm_url = optarg; break;
-        case 'c': o->config_path = optarg; break;
+        case 'c':
+            if (o->n_configs == MAX_SETS) {
+                fprintf(stderr, "stridefixd: at most %d --config options\n", MAX_SETS);
+                return EXIT_USAGE;
+            }
+            o->config_paths[o->n_configs++] = optarg;
+            break;
         case 's':
             if (o->n_sets == MAX_SETS) {
                 fprintf(stderr, "stridefixd: at most %d --set options\n", MAX_SETS);
@@ -167,9 +175,11 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
     }
     sf_params_default(params);
     char err[512];
-    if (o->config_path != NULL && sf_config_load(o->config_path, params, err, sizeof err) != SF_OK) {
-        fprintf(stderr, "stridefixd: %s\n", err);
-        return EXIT_USAGE;
+    for (int i = 0; i < o->n_configs; i++) {
+        if (sf_config_load(o->config_paths[i], params, err, sizeof err) != SF_OK) {
+            fprintf(stderr, "stridefixd: %s\n", err);
+            return EXIT_USAGE;
+        }
     }
     for (int i = 0; i < o->n_sets; i++) {
         if (sf_config_set(o->sets[i], params, err, sizeof err) != SF_OK) {

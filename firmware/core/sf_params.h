@@ -28,13 +28,69 @@
     X(pdr,    max_gap_ms,          int32_t, 500,     20,      10000,   "ms",    "IMU gap beyond which integration restarts")
 
 /* sf_attitude.h, sf_heading.h */
-#define SF_PARAMS_ATTITUDE(X)
+#define SF_PARAMS_ATTITUDE(X)                                                                          \
+    X(attitude, mode,                int32_t, 0,       0,       1,       "",      "0 = complementary (Ramadhan 2016), 1 = Mahony") \
+    X(attitude, tau_s,               double,  0.75,    0.02,    30.0,    "s",     "complementary time constant: alpha = tau/(tau+dt)") \
+    X(attitude, mahony_kp,           double,  1.0,     0.0,     20.0,    "1/s",   "Mahony proportional gain on the gravity error") \
+    X(attitude, mahony_ki,           double,  0.1,     0.0,     5.0,     "1/s2",  "Mahony integral gain (gyro bias) on gravity and yaw errors") \
+    X(attitude, mahony_kp_mag,       double,  1.0,     0.0,     20.0,    "1/s",   "Mahony proportional gain on the magnetometer yaw error") \
+    X(attitude, accel_gate_mps2,     double,  2.0,     0.05,    50.0,    "m/s2",  "| |a| - g | above which the accelerometer does not correct tilt") \
+    X(attitude, rest_gyro_radps,     double,  0.05,    0.001,   1.0,     "rad/s", "rest: bias-corrected gyro norm below this") \
+    X(attitude, rest_accel_mps2,     double,  0.3,     0.01,    5.0,     "m/s2",  "rest: | |a| - g | below this") \
+    X(attitude, rest_time_s,         double,  1.0,     0.05,    60.0,    "s",     "rest: both conditions held this long") \
+    X(attitude, rest_bias_tau_s,     double,  2.0,     0.05,    100.0,   "s",     "Mahony: gyro-bias low-pass time constant while at rest") \
+    X(attitude, gyro_bias_max_radps, double,  0.1,     0.0,     1.0,     "rad/s", "bound on each estimated gyro-bias component") \
+    X(attitude, max_gap_ms,          int32_t, 500,     20,      10000,   "ms",    "IMU gap beyond which the gyro is not integrated") \
+    X(attitude, mag_field_ut,        double,  48.0,    1.0,     200.0,   "uT",    "expected undisturbed field strength") \
+    X(attitude, mag_dip_deg,         double,  60.0,    -90.0,   90.0,    "deg",   "expected dip (inclination), positive downwards") \
+    X(attitude, mag_field_tol_ut,    double,  8.0,     0.1,     1e6,     "uT",    "accepted | |m| - field | (huge = rejection off)") \
+    X(attitude, mag_dip_tol_deg,     double,  8.0,     0.1,     360.0,   "deg",   "accepted | dip - expected dip | (>= 180 = off)") \
+    X(attitude, mag_settle_s,        double,  1.0,     0.0,     60.0,    "s",     "field consistent this long before use after a rejection") \
+    X(attitude, mag_learn_tau_s,     double,  60.0,    0.0,     3600.0,  "s",     "learn field/dip from accepted samples (0 = off); bounded to +-tol") \
+    X(heading,  map_rotation_deg,    double,  0.0,     -360.0,  360.0,   "deg",   "map heading = ENU heading - rotation (set by the site file)") \
+    X(heading,  mount_offset_deg,    double,  0.0,     -180.0,  180.0,   "deg",   "walking direction minus device yaw, until estimated") \
+    X(heading,  window_steps,        double,  4.0,     1.0,     50.0,    "steps", "memory of the acceleration covariance (PCA window)") \
+    X(heading,  smooth_steps,        double,  6.0,     1.0,     200.0,   "steps", "memory of the circular mean of the offset") \
+    X(heading,  min_steps,           int32_t, 10,      1,       1000,    "steps", "good steps before the estimated offset is used") \
+    X(heading,  pca_min_ratio,       double,  2.0,     1.0,     1000.0,  "",      "major/minor eigenvalue ratio for a good step") \
+    X(heading,  min_corr,            double,  0.2,     0.0,     1.0,     "",      "|corr(a_forward, v_up)| for a good step") \
+    X(heading,  vz_tau_s,            double,  1.0,     0.1,     20.0,    "s",     "leak of the vertical-velocity integrator")
 
 /* sf_steps.h, sf_stride.h */
-#define SF_PARAMS_STEPS(X)
+#define SF_PARAMS_STEPS(X)                                                                             \
+    X(steps,  detector,            int32_t, 0,       0,       1,       "",      "0 = Pan-Tompkins (Jaeger et al.), 1 = trough-then-peak (SmartLocator)") \
+    X(steps,  refractory_ms,       int32_t, 300,     100,     2000,    "ms",    "minimum time between two steps (both detectors)") \
+    X(steps,  max_gap_ms,          int32_t, 500,     20,      10000,   "ms",    "a_v gap beyond which the filters and the detector restart") \
+    X(steps,  max_period_ms,       int32_t, 2000,    500,     2500,    "ms",    "a step later than this after the previous one starts a walk (period 0)") \
+    X(steps,  pt_lowpass_hz,       double,  5.0,     1.0,     20.0,    "Hz",    "Pan-Tompkins: low-pass of a_v before the derivative") \
+    X(steps,  pt_threshold,        double,  0.5,     0.01,    100.0,   "",      "Pan-Tompkins: peak of (1+y)^2-1 needed, y = 50 Hz derivative in m/s2") \
+    X(steps,  tp_lowpass_hz,       double,  3.0,     0.5,     10.0,    "Hz",    "trough-peak: low-pass of a_v (also the amax/amin signal)") \
+    X(steps,  tp_max_interval_ms,  int32_t, 800,     100,     3000,    "ms",    "trough-peak: longest trough-to-peak time") \
+    X(steps,  tp_min_rise_mps2,    double,  1.0,     0.05,    20.0,    "m/s2",  "trough-peak: smallest peak minus trough") \
+    X(stride, weinberg_k,          double,  0.47,    0.05,    2.0,     "m/(m/s2)^0.25", "Weinberg K: length = K (amax-amin)^(1/4), start value") \
+    X(stride, k_min,               double,  0.25,    0.05,    2.0,     "m/(m/s2)^0.25", "lowest K that calibration may reach") \
+    X(stride, k_max,               double,  0.80,    0.05,    2.0,     "m/(m/s2)^0.25", "highest K that calibration may reach") \
+    X(stride, k_gain,              double,  0.3,     0.0,     1.0,     "",      "fraction of the way K moves toward distance/sum per calibration") \
+    X(stride, k_max_change,        double,  0.10,    0.0,     1.0,     "",      "bound on |K_new/K - 1| per calibration") \
+    X(stride, min_calib_distance_m, double, 10.0,    1.0,     10000.0, "m",     "shortest fix-to-fix distance used for calibration")
 
 /* sf_activity.h, sf_floor.h */
-#define SF_PARAMS_ACTIVITY(X)
+#define SF_PARAMS_ACTIVITY(X)                                                                          \
+    X(activity, var_tau_s,         double,  1.0,     0.1,     20.0,    "s",     "time constant of the a_v mean/variance") \
+    X(activity, still_var_m2ps4,   double,  0.05,    0.0,     100.0,   "m2/s4", "a_v variance below which the body is quiet (steps rejected)") \
+    X(activity, still_time_ms,     int32_t, 2000,    100,     60000,   "ms",    "no step for this long (and quiet) is still") \
+    X(activity, step_window_ms,    int32_t, 2500,    500,     10000,   "ms",    "steps counted over this window for the step rate") \
+    X(activity, min_steps,         int32_t, 2,       1,       8,       "steps", "steps in the window needed to be walking") \
+    X(activity, stairs_vspeed_mps, double,  0.15,    0.01,    5.0,     "m/s",   "|baro vertical speed| beyond this while stepping is stairs") \
+    X(activity, elevator_vspeed_mps, double, 0.30,   0.01,    10.0,    "m/s",   "|baro vertical speed| beyond this without steps is an elevator") \
+    X(floor,  height_m,            double,  3.5,     1.0,     20.0,    "m",     "uniform floor-to-floor height (until a site file gives a table)") \
+    X(floor,  height_tau_s,        double,  1.0,     0.05,    30.0,    "s",     "low-pass time constant of the baro height") \
+    X(floor,  vspeed_tau_s,        double,  1.0,     0.05,    30.0,    "s",     "low-pass time constant of the vertical speed") \
+    X(floor,  hysteresis_m,        double,  0.25,    0.0,     5.0,     "m",     "height beyond the mid-floor boundary before a floor change counts") \
+    X(floor,  confirm_ms,          int32_t, 2000,    0,       60000,   "ms",    "the new floor must hold this long") \
+    X(floor,  settle_vspeed_mps,   double,  0.10,    0.01,    5.0,     "m/s",   "|vertical speed| below which the altimeter may be re-referenced") \
+    X(floor,  drift_tau_s,         double,  120.0,   1.0,     1e6,     "s",     "while settled, height relaxes to the floor's height (drift removal)") \
+    X(floor,  max_gap_ms,          int32_t, 5000,    100,     600000,  "ms",    "baro gap beyond which the filters restart")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, pose_period_ms,      int32_t, 1000,    10,      60000,   "ms",    "POSE publish period between steps") \
