@@ -16,6 +16,8 @@ SUBCOMMANDS = {
     "analyze": "stridefix_analyzer.analyze",
     "report": "stridefix_analyzer.report",
     "bench": "stridefix_analyzer.bench",
+    "import": "stridefix_sim.importers.cli",
+    "realbench": "stridefix_analyzer.realbench",
 }
 
 

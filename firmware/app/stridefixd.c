@@ -21,7 +21,7 @@
 #include "sf_lcm_input.h"
 #include "sf_lcm_out.h"
 #include "sf_params.h"
-#include "sf_pdr.h"
+#include "sf_estimator.h"
 #include "stridefix_baro_t.h"
 #include "stridefix_config_t.h"
 #include "stridefix_gnss_t.h"
@@ -65,7 +65,7 @@ typedef struct {
     sf_lcm_input_t *lcm_in; /* set when replaying a raw-sensor LCM log instead of CAN frames */
     sf_lcm_out_t *out;
     sf_board_rx_t rx;
-    sf_pdr_t pdr;
+    sf_estimator_t est;
     char log_path[4096];
     uint64_t bad_syntax;
     long messages_printed;
@@ -97,7 +97,7 @@ static void usage(FILE *const f)
             "Configuration\n"
             "  -c, --config FILE      INI file of [section] key = value (every key: --print-config);\n"
             "                         repeatable, later files override earlier ones\n"
-            "  -s, --set KEY=VALUE    override one key, e.g. --set pdr.stride_m=0.72 (repeatable)\n"
+            "  -s, --set KEY=VALUE    override one key, e.g. --set stride.weinberg_k=0.5 (repeatable)\n"
             "      --print-config     print every key with its default, range, unit and meaning; exit\n"
             "Messages\n"
             "  -q, --quiet            no per-line bad-input messages (counts still in HEALTH and the summary)\n"
@@ -262,7 +262,8 @@ static void write_health(daemon_t *const d)
         .baro_samples = (int64_t)c->baro,
         .wifi_scans = (int64_t)c->wifi,
         .gnss_fixes = (int64_t)c->gnss,
-        .steps = d->pdr.step_count,
+        .steps = d->est.step_count,
+        .mag_rejected = (int64_t)d->est.attitude.mag_rejected,
         .log_events = (int64_t)oc.events,
         .log_bytes = (int64_t)oc.bytes,
         .log_drops = (int64_t)oc.drops,
@@ -276,7 +277,7 @@ static void write_health(daemon_t *const d)
 static void write_pose(daemon_t *const d)
 {
     sf_pose_t p;
-    sf_pdr_pose(&d->pdr, &d->params, &p);
+    sf_estimator_pose(&d->est, &p);
     stridefix_pose_t msg = {.t_us = p.t_us,
                             .x_m = p.x_m,
                             .y_m = p.y_m,
@@ -300,7 +301,7 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     memcpy(in.accel_mps2, s->accel_mps2, sizeof in.accel_mps2);
     memcpy(in.gyro_radps, s->gyro_radps, sizeof in.gyro_radps);
     sf_step_t step;
-    if (sf_pdr_update(&d->pdr, &d->params, &in, &step)) {
+    if (sf_estimator_imu(&d->est, &d->params, &in, &step)) {
         stridefix_step_t sm = {.t_us = step.t_us,
                                .index = step.index,
                                .length_m = (float)step.length_m,
@@ -328,6 +329,7 @@ static void on_event(daemon_t *const d, const sf_rx_event_t *const ev)
         stridefix_mag_t msg = {.t_us = s->t_us, .seq = s->seq};
         memcpy(msg.field_ut, s->field_ut, sizeof msg.field_ut);
         SF_LCM_WRITE(d->out, "MAG", d->host_t_us, stridefix_mag_t, &msg);
+        sf_estimator_mag(&d->est, &d->params, s->t_us, s->field_ut);
         d->board_t_us = s->t_us;
         break;
     }
@@ -336,6 +338,7 @@ static void on_event(daemon_t *const d, const sf_rx_event_t *const ev)
         stridefix_baro_t msg = {.t_us = s->t_us, .seq = s->seq, .pressure_pa = s->pressure_pa,
                                 .temperature_degc = s->temperature_degc};
         SF_LCM_WRITE(d->out, "BARO", d->host_t_us, stridefix_baro_t, &msg);
+        sf_estimator_baro(&d->est, &d->params, s->t_us, s->pressure_pa);
         d->board_t_us = s->t_us;
         break;
     }
@@ -496,7 +499,7 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
     fprintf(stderr,
             "stridefixd: %" PRIu64 " IMU, %" PRIu64 " MAG, %" PRIu64 " BARO, %" PRIu64 " WIFI, %" PRIu64
             " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
-            c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)d->pdr.step_count,
+            c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)d->est.step_count,
             d->opt.no_log ? "(none)" : d->log_path, oc.events, (double)oc.bytes / 1e6, oc.drops, wall_s);
 }
 
@@ -549,7 +552,7 @@ int main(int argc, char **argv)
         return 1;
     }
     sf_board_rx_init(&d.rx);
-    sf_pdr_init(&d.pdr, &d.params);
+    sf_estimator_init(&d.est, &d.params);
     d.last_pose_t_us = INT64_MIN / 2;
     const double t0 = monotonic_us();
     int status = run(&d);

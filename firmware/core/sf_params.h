@@ -19,13 +19,10 @@
     X(init,   heading_rad,         double,  0.0,     -7.0,    7.0,     "rad",   "start walking direction, CCW from +x") \
     X(init,   floor,               int32_t, 0,       -20,     200,     "",      "start floor index")
 
-#define SF_PARAMS_PDR(X)                                                                               \
-    X(pdr,    stride_m,            double,  0.70,    0.2,     1.5,     "m",     "fixed step length")            \
-    X(pdr,    step_threshold_mps2, double,  1.0,     0.1,     10.0,    "m/s2",  "vertical acceleration peak needed for a step") \
-    X(pdr,    step_min_interval_ms, int32_t, 300,    100,     2000,    "ms",    "refractory time between steps") \
-    X(pdr,    gravity_tau_s,       double,  1.0,     0.05,    20.0,    "s",     "time constant of the gravity low-pass") \
-    X(pdr,    accel_cutoff_hz,     double,  4.0,     0.5,     20.0,    "Hz",    "low-pass cut-off on vertical acceleration") \
-    X(pdr,    max_gap_ms,          int32_t, 500,     20,      10000,   "ms",    "IMU gap beyond which integration restarts")
+/* sf_estimator.h */
+#define SF_PARAMS_ESTIMATOR(X)                                                                         \
+    X(estimator, gravity_tau_s,    double,  2.0,     0.1,     60.0,    "s",     "time constant of the gravity magnitude low-pass (a_v = f_up - g)") \
+    X(estimator, sigma_per_m,      double,  0.03,    0.0,     1.0,     "m/m",   "position sigma growth per metre walked (PDR drift)")
 
 /* sf_attitude.h, sf_heading.h */
 #define SF_PARAMS_ATTITUDE(X)                                                                          \
@@ -97,7 +94,7 @@
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 
 #define SF_PARAM_LIST(X) \
-    SF_PARAMS_INIT(X) SF_PARAMS_PDR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_STEPS(X) SF_PARAMS_ACTIVITY(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_STEPS(X) SF_PARAMS_ACTIVITY(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

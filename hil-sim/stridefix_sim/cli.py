@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from .pipeline import simulate, write_outputs
-from .scenario import ScenarioError, default_scenario, load_scenario
+from .scenario import BUILTIN, ScenarioError, resolve_scenario
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -21,7 +21,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Simulate a walk with the wearable board and write board.candump (candump -L), "
                     "truth.lcmlog (TRUTH, 10 Hz), sim_summary.json and init_truth.ini into --out.",
     )
-    p.add_argument("--scenario", metavar="FILE", help="scenario TOML file (default: the built-in scenario)")
+    p.add_argument("--scenario", metavar="NAME|FILE",
+                   help=f"a built-in scenario ({', '.join(BUILTIN)}) or a scenario TOML file (default: default)")
     p.add_argument("--seed", type=int, help="random seed (overrides the scenario)")
     p.add_argument("--out", metavar="DIR", default="out/sim", help="output directory (default: out/sim)")
     p.add_argument("--stdout", action="store_true", help="stream the candump lines to stdout instead of DIR/board.candump")
@@ -34,7 +35,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     t_start = time.perf_counter()
     try:
-        scenario = load_scenario(args.scenario) if args.scenario else default_scenario()
+        scenario = resolve_scenario(args.scenario)
         scenario = scenario.with_overrides(**{
             "seed": args.seed,
             "duration_s": None if args.duration_s is None else float(args.duration_s),
@@ -54,7 +55,7 @@ def run(args) -> int:
     elapsed = time.perf_counter() - t_start
     where = "stdout" if args.stdout else str(out_dir / "board.candump")
     print(f"stridefix sim: seed {summary['seed']}, {summary['duration_s']:.1f} s simulated, "
-          f"{summary['steps']} steps, {summary['distance_m']:.1f} m, "
+          f"{summary['steps']} steps, {summary['distance_m']:.1f} m, floors {summary['floors_visited']}, "
           f"{summary['frames_total']} frames written to {where} ({summary['frames_dropped']} dropped), "
           f"{summary['imu_samples']} IMU samples, {summary['wifi_scans']} Wi-Fi scans; "
           f"outputs in {out_dir}; {elapsed:.2f} s", file=sys.stderr)

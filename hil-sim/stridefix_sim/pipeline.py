@@ -1,11 +1,13 @@
 """One simulated run: scenario → world → walker → sensors + radio → board emulator → output files.
 
 Seeding: one ``numpy.random.SeedSequence(seed)`` spawns independent streams for the walker, the sensors,
-the radio and the CAN link, so e.g. changing the loss rate does not change the sensor noise. The same
-scenario and seed give byte-identical outputs.
+the radio, the CAN link and the person (body: stride and cadence scales, Weinberg K), so e.g. changing
+the loss rate does not change the sensor noise, and changing the pace does not change the person. The
+same scenario and seed give byte-identical outputs.
 
 Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
-10 Hz, t_us = unwrapped board time in µs, also the event timestamp), ``sim_summary.json`` and
+10 Hz, t_us = unwrapped board time in µs, also the event timestamp; x, y, the true floor, the true
+heading = walking direction in the map frame, steps so far), ``sim_summary.json`` and
 ``init_truth.ini`` (the true start pose for the firmware).
 """
 from __future__ import annotations
@@ -22,7 +24,7 @@ from .board import IMU_PERIOD_MS, BoardOutput, emulate_board
 from .radio import Scan, simulate_scans
 from .scenario import Scenario
 from .sensors import IMU_RATE_HZ, SensorData, simulate_sensors
-from .walker import Walk, simulate_walk
+from .walker import ACTIVITIES, Walk, make_person, simulate_walk
 from .world import World, load_world
 
 TRUTH_DECIMATION = 10  # 10 Hz truth from 100 Hz walker samples
@@ -56,7 +58,12 @@ class SimResult:
     def init_pose(self) -> dict:
         w = self.walk
         return {"x_m": round(float(w.x_m[0]), 6), "y_m": round(float(w.y_m[0]), 6),
-                "heading_rad": round(_wrap(float(w.heading_rad[0])), 9), "floor": 0}
+                "heading_rad": round(_wrap(float(w.heading_rad[0])), 9), "floor": int(w.floor[0])}
+
+    def activity_s(self) -> dict:
+        """Seconds spent in each activity (IMU samples x period, up to the end of the run)."""
+        counts = np.bincount(self.walk.activity[:-1], minlength=len(ACTIVITIES))
+        return {name: round(float(c) * IMU_PERIOD_MS / 1000.0, 2) for name, c in zip(ACTIVITIES, counts)}
 
     def summary(self) -> dict:
         c = self.board.counts
@@ -78,7 +85,16 @@ class SimResult:
             "truth_messages": len(self.truth_indices()),
             "board_time_start_ms": self.board_time_start_ms,
             "board_time_end_ms": (self.board_time_start_ms + (len(self.walk.t_s) - 1) * IMU_PERIOD_MS) % 2**32,
-            "turn_radius_m": self.walk.route.radius_m,
+            "turn_radius_m": round(self.walk.route.radius_m, 6),
+            "route": self.walk.route.name,
+            "pace": self.walk.person.pace,
+            "weinberg_k": round(self.walk.person.weinberg_k, 6),
+            "person": self.walk.person.as_dict(),
+            "map_rotation_deg": self.world.map_rotation_deg,
+            "floors_visited": sorted({int(f) for f in np.unique(self.walk.floor)}),
+            "floor_height_m": self.world.storey_m,
+            "activity_s": self.activity_s(),
+            "elevator_rides": len([r for r in self.walk.rides if r[0] <= self.duration_s]),
             "init": self.init_pose(),
             "scenario": self.scenario.data,
         }
@@ -92,10 +108,11 @@ def simulate(scenario: Scenario) -> SimResult:
     sc = scenario.data
     world = load_world(sc["world"]["name"], sc["world"]["map_rotation_deg"])
     ss = np.random.SeedSequence(scenario.seed)
-    r_walk, r_sens, r_radio, r_can = (np.random.default_rng(s) for s in ss.spawn(4))
+    r_walk, r_sens, r_radio, r_can, r_person = (np.random.default_rng(s) for s in ss.spawn(5))
     duration = float(sc["duration_s"])
     duration = math.ceil(duration * 10 - 1e-9) / 10 if duration > 0 else None  # whole truth periods
-    walk = simulate_walk(sc, world, r_walk, rate_hz=IMU_RATE_HZ, duration_s=duration)
+    person = make_person(sc, r_person)
+    walk = simulate_walk(sc, world, r_walk, rate_hz=IMU_RATE_HZ, duration_s=duration, person=person)
     duration_s = float(walk.t_s[-1])
     sensors = simulate_sensors(sc, world, walk, r_sens)
     scans = simulate_scans(sc, world, walk, r_radio)
@@ -119,7 +136,7 @@ def write_truth_log(result: SimResult, path: Path) -> int:
             msg.t_us = start_us + i * IMU_PERIOD_MS * 1000
             msg.x_m = float(w.x_m[i])
             msg.y_m = float(w.y_m[i])
-            msg.floor = 0
+            msg.floor = int(w.floor[i])
             msg.heading_rad = _wrap(float(w.heading_rad[i]))
             msg.step_count = int(n_steps)
             msg.source = truth_t.SOURCE_SIMULATION

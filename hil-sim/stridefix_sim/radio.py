@@ -1,14 +1,16 @@
 """Wi-Fi scan model: log-distance path loss with per-wall attenuation (multi-wall model, cf. COST-231
 Motley-Keenan; Seidel & Rappaport 1992).
 
-    RSSI = P0 − 10 · n · log10(d / 1 m) − W · (walls crossed) + X,   X ~ N(0, σ²) (seeded)
+    RSSI = P0 − 10 · n · log10(d / 1 m) − W · (walls crossed) − FL · (floors crossed) + X,   X ~ N(0, σ²)
     P0   = tx_power_dbm − FSPL(1 m, f),   FSPL(1 m, f) = 20 · log10(f / MHz) − 27.55 dB
 
-d is the 3-D distance from the board (sensor height) to the access point (ceiling, 2.8 m); walls are the
-world's segments crossed by the straight line between them. The result is rounded to whole dBm as a
-receiver reports it; access points below the detection floor (−95 dBm) are not reported. Scans start
-every U(min, max) seconds (2–4 s); each returns every AP above the floor, in channel order, measured at
-the position where the scan started.
+d is the 3-D distance from the board (walking-surface level + sensor height) to the access point
+(ceiling of its floor, 2.8 m above it); walls are the floor plan's segments crossed by the plan-view line
+between them (every floor has the same plan); floors crossed = |AP floor − the person's floor|, FL =
+``radio.floor_loss_db`` (15 dB, cf. the ITU-R P.1238 floor penetration factor). The result is
+rounded to whole dBm as a receiver reports it; access points below the detection floor (−95 dBm) are
+not reported. Scans start every U(min, max) seconds (2–4 s); each returns every AP above the floor, in
+channel order, measured at the position where the scan started.
 """
 from __future__ import annotations
 
@@ -66,18 +68,22 @@ def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator)
     dt_ms = int(round((walk.t_s[1] - walk.t_s[0]) * 1000.0)) if len(walk.t_s) > 1 else 10
     idx = np.minimum(np.round(t_ms / dt_ms).astype(int), len(walk.t_s) - 1)
     px, py = walk.x_m[idx][:, None], walk.y_m[idx][:, None]
+    pz = (walk.level_m[idx] + sc["baro"]["sensor_height_m"])[:, None]
+    pf = walk.floor[idx][:, None]
     aps = world.aps
     ax = np.array([a.x_m for a in aps])[None, :]
     ay = np.array([a.y_m for a in aps])[None, :]
+    af = np.array([a.floor for a in aps])[None, :]
+    az = af * world.storey_m + AP_HEIGHT_M
     tx = np.array([a.tx_power_dbm for a in aps])
     f_mhz = np.array([a.freq_mhz for a in aps], dtype=float)
     p0 = tx - (20.0 * np.log10(f_mhz) - 27.55)
-    dz = AP_HEIGHT_M - sc["baro"]["sensor_height_m"]
-    d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + dz * dz)
+    d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + (pz - az) ** 2)
     n_walls = walls_crossed(np.broadcast_to(px, d.shape), np.broadcast_to(py, d.shape),
                             np.broadcast_to(ax, d.shape), np.broadcast_to(ay, d.shape), world.walls_m)
     rssi = (p0[None, :] - 10.0 * r["path_loss_exponent"] * np.log10(np.maximum(d, 1.0))
-            - r["wall_loss_db"] * n_walls + r["shadowing_db"] * rng.standard_normal(d.shape))
+            - r["wall_loss_db"] * n_walls - r["floor_loss_db"] * np.abs(af - pf)
+            + r["shadowing_db"] * rng.standard_normal(d.shape))
     rssi = np.clip(np.round(rssi), -128, 127).astype(int)
     order = sorted(range(len(aps)), key=lambda j: (aps[j].channel, aps[j].bssid))
     scans = []

@@ -1,10 +1,15 @@
 """Scenario: everything that defines one simulated run, read from a TOML file (tomllib) or built in.
 
-A scenario names the world, the walk (laps, pauses, cadence, stride), the sensor imperfections (noise,
-biases, board mounting rotation), the radio model, the CAN link (frame loss, board time start), the seed
-and the duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: 2 laps of the
-default office loop with 3 pauses, about 3.5 minutes). A file only needs the keys it changes. An unknown
-key, a wrong type or an out-of-range value raises :class:`ScenarioError` naming the file and the key.
+A scenario names the world, the walk (route, pace, pauses), the person, stairs and elevator, the sensor
+imperfections (noise, biases and their drift, scale errors, board mounting rotation, magnetic
+disturbances, weather), the radio model, the CAN link (frame loss, board time start), the seed and the
+duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: the two-floor tour —
+a lap of floor 0, the stairs up, a lap of floor 1, the elevator down, a partial lap — at normal pace
+with 3 pauses, about 5 minutes). A file only needs the keys it changes. An unknown key, a wrong type or
+an out-of-range value raises :class:`ScenarioError` naming the file and the key.
+
+Built-in named scenarios (``BUILTIN``, ``stridefix sim --scenario NAME``): ``default`` and
+``pace_slow`` / ``pace_normal`` / ``pace_fast``: two laps of the floor-0 loop at one pace, two pauses.
 """
 from __future__ import annotations
 
@@ -23,25 +28,41 @@ DEFAULTS: dict[str, Any] = {
         "map_rotation_deg": 20.0,    # map frame = magnetic east-north frame turned CCW by this angle
     },
     "walk": {
-        "laps": 2.0,                 # laps of the corridor loop (fractions allowed)
+        "route": "tour",             # "tour": two floors, stairs up, elevator down; "loop": laps of floor 0
+        "laps": 2.0,                 # route "loop" only: laps of the corridor loop (fractions allowed)
+        "pace": "normal",            # "slow" 1.5 Hz / 0.55 m, "normal" 1.8 Hz / 0.70 m, "fast" 2.1 Hz / 0.85 m
         "start_still_s": 3.0,        # standing still before the first step
         "trailing_still_s": 3.0,     # standing still after the last step (when duration_s = 0)
-        "cadence_hz": 1.8,           # mean step rate, 1.6..2.0 for normal walking
+        "cadence_hz": 0.0,           # > 0: mean step rate instead of pace x person
         "cadence_jitter": 0.03,      # step-to-step relative std of the step period
-        "stride_m": 0.72,            # mean step length
+        "stride_m": 0.0,             # > 0: mean step length instead of pace x person
         "stride_jitter": 0.04,       # step-to-step relative std of the step length
-        "speed_mps": 0.0,            # > 0: overrides stride_m = speed_mps / cadence_hz
-        "turn_radius_m": 0.8,        # corner radius of the route (centre line)
-        "max_yaw_rate_dps": 120.0,   # corners are widened so that speed/radius stays below this
-        "bounce_peak_mps2": 3.0,     # vertical acceleration peak per step (gravity removed)
-        "bounce_jitter": 0.1,        # step-to-step relative std of that peak
-        "surge": 0.12,               # forward speed oscillation within a step, fraction of the mean
-        "sway_mps2": 0.4,            # lateral acceleration amplitude (half the step rate)
+        "speed_mps": 0.0,            # > 0: stride = speed_mps / cadence
+        "turn_radius_m": 0.8,        # corner radius of the route in the corridor (centre line)
+        "max_yaw_rate_dps": 120.0,   # corridor corners are widened so that speed/radius stays below this
+        "bounce_jitter": 0.08,       # step-to-step log-normal std of the vertical amplitude (Weinberg)
+        "pendulum_recovery": 0.65,   # inverted pendulum: fraction of potential energy returned as kinetic
+        "sway_mps2": 0.6,            # lateral acceleration amplitude (half the step rate)
         "pause": [                   # [[walk.pause]] at_m (distance walked), duration_s
             {"at_m": 40.0, "duration_s": 5.0},
-            {"at_m": 120.0, "duration_s": 4.0},
-            {"at_m": 200.0, "duration_s": 6.0},
+            {"at_m": 200.0, "duration_s": 4.0},
+            {"at_m": 320.0, "duration_s": 6.0},
         ],
+    },
+    "person": {                      # 0 = drawn from the seed (own random stream)
+        "weinberg_k": 0.0,           # step length = K (amax - amin)^(1/4); drawn U(0.45, 0.55)
+        "stride_scale": 0.0,         # x the pace's stride; drawn N(1, 0.06) within 0.88..1.12
+        "cadence_scale": 0.0,        # x the pace's (and the stairs') cadence; drawn N(1, 0.04) within 0.92..1.08
+    },
+    "stairs": {
+        "cadence_hz": 1.5,           # steps per second on a flight (x the person's cadence scale)
+        "bounce_p2p_mps2": 3.5,      # vertical acceleration peak-to-peak per stair step
+    },
+    "elevator": {
+        "speed_mps": 1.0,            # cruise speed
+        "accel_mps2": 0.8,           # peak acceleration (sin² ramps, jerk-limited)
+        "door_s": 4.0,               # standing in the cab before it moves (the turn happens here)
+        "exit_s": 2.0,               # standing in the cab after it stops
     },
     "mounting": {                    # board axes relative to the body (x forward, y left, z up), ZYX
         "roll_deg": 0.0,
@@ -52,24 +73,29 @@ DEFAULTS: dict[str, Any] = {
         "accel_noise_mps2": 0.02,    # white noise std per sample
         "accel_bias_mps2": [0.03, -0.02, 0.05],
         "gyro_noise_dps": 0.05,
-        "gyro_bias_dps": [0.10, -0.08, 0.05],
+        "gyro_bias_dps": [0.10, -0.08, 0.05],        # initial bias
+        "gyro_bias_rw_dps_per_sqrt_s": 0.002,        # bias random walk: std after t seconds = this x sqrt(t)
+        "gyro_scale_error": [0.008, -0.006, 0.010],  # per board axis, fraction
     },
     "mag": {
-        "field_ut": 48.0,            # total intensity of the earth field
+        "field_ut": 48.0,            # total intensity of the (undisturbed) earth field
         "dip_deg": 60.0,             # inclination, positive = pointing down
         "noise_ut": 0.3,
-        "hard_iron_ut": [0.0, 0.0, 0.0],
+        "hard_iron_ut": [0.8, -0.6, 0.5],
+        "disturbance_scale": 1.0,    # x the world's magnetic disturbance zones (0 = none)
     },
     "baro": {
         "sea_level_pa": 101325.0,
         "sensor_height_m": 1.1,      # board height above the floor
         "noise_pa": 1.5,
+        "drift_pa_per_sqrt_h": 20.0, # weather: random walk, std after one hour [Pa]
         "temperature_degc": 22.5,    # board temperature at start; warms by 2 degC with 2 min time constant
         "temperature_noise_degc": 0.05,
     },
     "radio": {
         "path_loss_exponent": 2.5,
         "wall_loss_db": 5.0,         # per crossed wall
+        "floor_loss_db": 15.0,       # per floor between the AP and the receiver
         "shadowing_db": 2.5,         # gaussian noise std per reading
         "floor_dbm": -95.0,          # detection floor: weaker APs are not reported
         "scan_interval_min_s": 2.0,
@@ -154,7 +180,7 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
                     or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
                 raise ScenarioError(source, f"key '{name}' must be a list of {len(dflt)} numbers")
             out[key] = [float(v) for v in value]
-        elif isinstance(dflt, str):
+        elif isinstance(dflt, str):  # (strings are checked against their choices in _validate_values)
             if not isinstance(value, str):
                 raise ScenarioError(source, f"key '{name}' must be a string")
             out[key] = value
@@ -174,19 +200,36 @@ def _validate_values(d: dict, source: str) -> None:
         if not ok:
             raise ScenarioError(source, f"key '{key}' {what}")
 
-    w, c, r = d["walk"], d["can"], d["radio"]
+    w, c, r, p, st, el = d["walk"], d["can"], d["radio"], d["person"], d["stairs"], d["elevator"]
     check(d["world"]["name"] == "default", "world.name", "must be 'default' (the only built-in world)")
     check(d["duration_s"] >= 0, "duration_s", "must be >= 0")
+    check(w["route"] in ("tour", "loop"), "walk.route", "must be 'tour' or 'loop'")
+    check(w["pace"] in ("slow", "normal", "fast"), "walk.pace", "must be 'slow', 'normal' or 'fast'")
     check(w["laps"] > 0, "walk.laps", "must be > 0")
-    check(0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be in 0.5..3.0")
-    check(0.2 <= w["stride_m"] <= 1.5, "walk.stride_m", "must be in 0.2..1.5")
+    check(w["cadence_hz"] == 0 or 0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be 0 or in 0.5..3.0")
+    check(w["stride_m"] == 0 or 0.2 <= w["stride_m"] <= 1.5, "walk.stride_m", "must be 0 or in 0.2..1.5")
     check(w["speed_mps"] == 0 or 0.2 <= w["speed_mps"] <= 3.0, "walk.speed_mps", "must be 0 or in 0.2..3.0")
     check(0 <= w["cadence_jitter"] <= 0.2, "walk.cadence_jitter", "must be in 0..0.2")
     check(0 <= w["stride_jitter"] <= 0.2, "walk.stride_jitter", "must be in 0..0.2")
     check(0.1 <= w["turn_radius_m"] <= 1.0, "walk.turn_radius_m", "must be in 0.1..1.0 (corridor half width)")
     check(w["max_yaw_rate_dps"] > 10, "walk.max_yaw_rate_dps", "must be > 10")
-    check(0 <= w["surge"] < 0.5, "walk.surge", "must be in 0..0.5")
+    check(0 <= w["pendulum_recovery"] <= 1.0, "walk.pendulum_recovery", "must be in 0..1")
     check(0 <= w["bounce_jitter"] < 0.5, "walk.bounce_jitter", "must be in 0..0.5")
+    check(0 <= w["sway_mps2"] <= 3.0, "walk.sway_mps2", "must be in 0..3")
+    check(p["weinberg_k"] == 0 or 0.2 <= p["weinberg_k"] <= 1.0, "person.weinberg_k", "must be 0 or in 0.2..1.0")
+    check(p["stride_scale"] == 0 or 0.5 <= p["stride_scale"] <= 1.5, "person.stride_scale", "must be 0 or in 0.5..1.5")
+    check(p["cadence_scale"] == 0 or 0.5 <= p["cadence_scale"] <= 1.5, "person.cadence_scale",
+          "must be 0 or in 0.5..1.5")
+    check(0.5 <= st["cadence_hz"] <= 3.0, "stairs.cadence_hz", "must be in 0.5..3.0")
+    check(0 <= st["bounce_p2p_mps2"] <= 20.0, "stairs.bounce_p2p_mps2", "must be in 0..20")
+    check(0.2 <= el["speed_mps"] <= 5.0, "elevator.speed_mps", "must be in 0.2..5")
+    check(0.1 <= el["accel_mps2"] <= 3.0, "elevator.accel_mps2", "must be in 0.1..3")
+    check(el["door_s"] >= 0 and el["exit_s"] >= 0, "elevator.door_s", "must be >= 0 (and exit_s too)")
+    check(d["imu"]["gyro_bias_rw_dps_per_sqrt_s"] >= 0, "imu.gyro_bias_rw_dps_per_sqrt_s", "must be >= 0")
+    check(all(abs(v) < 0.2 for v in d["imu"]["gyro_scale_error"]), "imu.gyro_scale_error", "must be within ±0.2")
+    check(d["mag"]["disturbance_scale"] >= 0, "mag.disturbance_scale", "must be >= 0")
+    check(d["baro"]["drift_pa_per_sqrt_h"] >= 0, "baro.drift_pa_per_sqrt_h", "must be >= 0")
+    check(r["floor_loss_db"] >= 0, "radio.floor_loss_db", "must be >= 0")
     check(w["start_still_s"] >= 0 and w["trailing_still_s"] >= 0, "walk.start_still_s", "must be >= 0")
     for i, p in enumerate(w["pause"]):
         check(p["at_m"] > 0 and p["duration_s"] >= 0, f"walk.pause[{i}]", "needs at_m > 0 and duration_s >= 0")
@@ -199,8 +242,41 @@ def _validate_values(d: dict, source: str) -> None:
           "must be >= 0 and shorter than the scan interval")
 
 
+def _pace_scenario(pace: str) -> dict:
+    return {"walk": {"route": "loop", "laps": 2.0, "pace": pace,
+                     "pause": [{"at_m": 60.0, "duration_s": 4.0}, {"at_m": 170.0, "duration_s": 5.0}]}}
+
+
+# name -> TOML-like overrides of DEFAULTS
+BUILTIN: dict[str, dict] = {
+    "default": {},
+    "pace_slow": _pace_scenario("slow"),
+    "pace_normal": _pace_scenario("normal"),
+    "pace_fast": _pace_scenario("fast"),
+}
+
+
 def default_scenario() -> Scenario:
     return Scenario(data=copy.deepcopy(DEFAULTS))
+
+
+def builtin_scenario(name: str) -> Scenario:
+    """A built-in named scenario (``BUILTIN``)."""
+    if name not in BUILTIN:
+        raise ScenarioError(name, f"unknown built-in scenario (known: {', '.join(BUILTIN)})")
+    source = "<built-in default>" if name == "default" else f"<built-in {name}>"
+    data = _merge(DEFAULTS, BUILTIN[name], source)
+    _validate_values(data, source)
+    return Scenario(data=data, source=source)
+
+
+def resolve_scenario(name_or_path: str | None) -> Scenario:
+    """``None`` → the default; a built-in name → that scenario; anything else → a TOML file path."""
+    if name_or_path is None:
+        return default_scenario()
+    if name_or_path in BUILTIN:
+        return builtin_scenario(name_or_path)
+    return load_scenario(name_or_path)
 
 
 def parse_scenario(text: str, source: str = "<string>") -> Scenario:

@@ -1,13 +1,31 @@
-"""The built-in default world: one office floor, its walls, the walking loop and the Wi-Fi access points.
+"""The built-in default world: a two-floor office, its walls, stairs, elevator, access points and
+magnetic disturbances.
 
-Model: a 60 m x 30 m single floor (floor 0). A rectangular corridor loop, 2 m wide, runs around a block
-of inner rooms; outer rooms sit between the corridor and the exterior wall. Walls are line segments
-(used by the radio model to count crossed walls); door gaps are left where rooms open onto the
-corridor. The walking route is the corridor centre line, a rectangle with rounded corners.
+Model: a 60 m x 30 m floor plan, used for both floors (floor 0 and floor 1, ``STOREY_M`` = 3.5 m apart).
+A rectangular corridor loop, 2 m wide, runs around a block of inner rooms; outer rooms sit between the
+corridor and the exterior wall. Walls are line segments (used by the radio model to count crossed
+walls), the same on every floor; door gaps are left where rooms open onto the corridor. The route
+follows the corridor centre line (see ``route.py``).
+
+Vertical links: the west outer room (x 0-7 m, y 10-20 m) is the stairwell, door at (7, 15): a dog-leg
+staircase, flight 1 heading south along x = 4.8 m (10 risers of 0.175 m, 0.28 m treads), a landing at
+y = 10.6 m, flight 2 heading north along x = 2.2 m (10 risers) up to floor 1. The elevator cab
+(2.5 m x 2.5 m, centre (4.25, 22.5), door to the east) sits in the shaft of the north-west outer room,
+door at (7, 22.5).
+
+Access points: 16 per floor at the same plan positions (ceiling, 2.8 m above their floor), floor-1
+BSSIDs differ from floor-0 ones in the 4th-from-last hex digit (…1x0 → …2x0).
+
+Magnetic disturbances (``MagZone``): regions where steel perturbs the earth field — the elevator shaft
+(both floors) and steel columns beside the corridor. Inside a zone of radius R at distance d from its
+centre the local field is the earth field with its intensity multiplied by 1 + w·(gain − 1), its
+azimuth turned by w·azimuth_deg and its inclination changed by w·dip_deg, with the weight
+w = (1 − (d/R)²)² (1 at the centre, 0 from R on: outside every zone the field is undisturbed).
 
 Map frame: x east-ish, y north-ish, metres; heading counter-clockwise from +x [rad]. The map is rotated
 from magnetic axes by ``map_rotation_deg``: the map frame is the magnetic east-north frame turned
 counter-clockwise by that angle, so magnetic north lies along map heading ``90 deg - map_rotation_deg``.
+Heights: metres above the floor-0 walking surface; floor f's surface is at f · STOREY_M.
 """
 from __future__ import annotations
 
@@ -21,6 +39,8 @@ FLOOR_H_M = 30.0
 LOOP_X0_M, LOOP_X1_M = 8.0, 52.0
 LOOP_Y0_M, LOOP_Y1_M = 5.0, 25.0
 CORRIDOR_HALF_W_M = 1.0
+STOREY_M = 3.5           # floor-to-floor height
+N_FLOORS = 2
 
 
 @dataclass(frozen=True)
@@ -30,6 +50,7 @@ class AccessPoint:
     x_m: float
     y_m: float
     tx_power_dbm: float   # EIRP
+    floor: int = 0
 
     @property
     def freq_mhz(self) -> int:
@@ -39,16 +60,68 @@ class AccessPoint:
 
 
 @dataclass(frozen=True)
+class Stairs:
+    """A dog-leg staircase between floor 0 and floor 1 (plan coordinates, metres)."""
+
+    door_y_m: float                        # the stairwell door on the corridor's west wall
+    flight1_start: tuple[float, float]
+    flight1_end: tuple[float, float]
+    landing_y_m: float                     # centre line of the landing between the flights
+    flight2_start: tuple[float, float]
+    flight2_end: tuple[float, float]
+    risers_per_flight: int = 10
+    riser_m: float = 0.175
+    tread_m: float = 0.28
+
+    @property
+    def flight_rise_m(self) -> float:
+        return self.risers_per_flight * self.riser_m
+
+
+@dataclass(frozen=True)
+class Elevator:
+    x_m: float          # cab centre
+    door_y_m: float     # cab centre y = door y (the cab door faces east, onto the corridor)
+    half_m: float = 1.25
+
+
+@dataclass(frozen=True)
+class MagZone:
+    """A magnetic disturbance (see the module docstring)."""
+
+    name: str
+    x_m: float
+    y_m: float
+    radius_m: float
+    floors: tuple[int, ...]
+    gain: float           # field intensity factor at the centre
+    azimuth_deg: float    # horizontal direction change at the centre (CCW)
+    dip_deg: float        # inclination change at the centre (+ = steeper)
+
+    def weight(self, x_m: np.ndarray, y_m: np.ndarray, floor: np.ndarray) -> np.ndarray:
+        q = ((np.asarray(x_m) - self.x_m) ** 2 + (np.asarray(y_m) - self.y_m) ** 2) / self.radius_m ** 2
+        w = np.where(q < 1.0, (1.0 - np.minimum(q, 1.0)) ** 2, 0.0)
+        return np.where(np.isin(floor, self.floors), w, 0.0)
+
+
+@dataclass(frozen=True)
 class World:
     name: str
     floor_w_m: float
     floor_h_m: float
-    walls_m: np.ndarray          # (n_wall, 4): x0, y0, x1, y1
+    walls_m: np.ndarray          # (n_wall, 4): x0, y0, x1, y1 — the plan of every floor
     aps: tuple[AccessPoint, ...]
     loop_corners_m: np.ndarray   # (4, 2) corridor centre-line rectangle, counter-clockwise
-    start_xy_m: tuple[float, float]
+    start_xy_m: tuple[float, float]   # start of the ``loop`` route (bottom straight)
     map_rotation_deg: float = 20.0
-    floor_height_m: float = 0.0  # height of floor 0 above the pressure reference [m]
+    ground_z_m: float = 0.0      # height of floor 0 above the pressure reference [m]
+    n_floors: int = N_FLOORS
+    storey_m: float = STOREY_M
+    stairs: Stairs | None = None
+    elevator: Elevator | None = None
+    mag_zones: tuple[MagZone, ...] = ()
+    tour_start_y_m: float = 13.0      # the ``tour`` route starts at (loop x0, this), heading south
+    tour_end_y_m: float = 15.0        # and ends at (loop x1, this)
     extra: dict = field(default_factory=dict)
 
 
@@ -88,7 +161,7 @@ def _default_walls() -> np.ndarray:
     ix1, iy1 = LOOP_X1_M - CORRIDOR_HALF_W_M, LOOP_Y1_M - CORRIDOR_HALF_W_M
     outer_doors = [("bottom", x, 1.0) for x in (14.0, 26.0, 38.0, 48.0)] + \
                   [("top", x, 1.0) for x in (12.0, 24.0, 36.0, 46.0)] + \
-                  [("left", 15.0, 1.0), ("right", 15.0, 1.0)]
+                  [("left", 15.0, 1.2), ("left", 22.5, 1.2), ("right", 15.0, 1.0)]
     inner_doors = [("bottom", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)] + \
                   [("top", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)]
     w += list(_rect(ox0, oy0, ox1, oy1, outer_doors))
@@ -104,6 +177,10 @@ def _default_walls() -> np.ndarray:
     for y in (10.0, 20.0):
         w.append((0.0, y, ox0, y))
         w.append((ox1, y, FLOOR_W_M, y))
+    # stairwell: the wall between the two flights
+    w.append((3.5, 11.2, 3.5, 14.5))
+    # elevator shaft around the cab, door east
+    w += list(_rect(3.0, 21.25, 5.5, 23.75, [("right", 22.5, 1.0)]))
     return np.asarray(w, dtype=float)
 
 
@@ -116,15 +193,27 @@ def _default_aps() -> tuple[AccessPoint, ...]:
         (17.0, 11.0, 1, 15.0), (33.0, 19.0, 11, 15.0), (45.0, 10.0, 48, 18.0), (30.0, 5.0, 157, 20.0),
     ]
     aps = []
-    for i, (x, y, ch, p) in enumerate(spec):
-        bssid = 0x3C_84_6A_00_10_00 + (i << 4) + (1 if ch > 14 else 0)
-        aps.append(AccessPoint(bssid=bssid, channel=ch, x_m=x, y_m=y, tx_power_dbm=p))
+    for floor in range(N_FLOORS):
+        for i, (x, y, ch, p) in enumerate(spec):
+            bssid = 0x3C_84_6A_00_10_00 + (floor << 12) + (i << 4) + (1 if ch > 14 else 0)
+            aps.append(AccessPoint(bssid=bssid, channel=ch, x_m=x, y_m=y, tx_power_dbm=p, floor=floor))
     return tuple(aps)
+
+
+def _default_mag_zones() -> tuple[MagZone, ...]:
+    return (
+        MagZone("elevator shaft", 4.25, 22.5, 3.0, (0, 1), gain=1.45, azimuth_deg=40.0, dip_deg=-15.0),
+        MagZone("steel column south", 30.0, 6.0, 2.0, (0,), gain=0.6, azimuth_deg=-35.0, dip_deg=10.0),
+        MagZone("steel column west", 7.0, 9.0, 2.0, (0,), gain=1.3, azimuth_deg=-25.0, dip_deg=8.0),
+        MagZone("steel column east", 53.0, 12.0, 2.0, (1,), gain=1.35, azimuth_deg=30.0, dip_deg=-10.0),
+    )
 
 
 def default_world(map_rotation_deg: float = 20.0) -> World:
     corners = np.array([[LOOP_X0_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y0_M],
                         [LOOP_X1_M, LOOP_Y1_M], [LOOP_X0_M, LOOP_Y1_M]])
+    stairs = Stairs(door_y_m=15.0, flight1_start=(4.8, 14.0), flight1_end=(4.8, 11.2), landing_y_m=10.6,
+                    flight2_start=(2.2, 11.2), flight2_end=(2.2, 14.0))
     return World(
         name="default",
         floor_w_m=FLOOR_W_M,
@@ -134,6 +223,9 @@ def default_world(map_rotation_deg: float = 20.0) -> World:
         loop_corners_m=corners,
         start_xy_m=(12.0, LOOP_Y0_M),
         map_rotation_deg=map_rotation_deg,
+        stairs=stairs,
+        elevator=Elevator(x_m=4.25, door_y_m=22.5),
+        mag_zones=_default_mag_zones(),
     )
 
 

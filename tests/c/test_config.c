@@ -74,9 +74,10 @@ static void test_good_file_sets_values(void **state)
                                "x_m = 12.5\n"
                                "floor = 3\n"
                                "\n"
-                               "[pdr]\n"
-                               "stride_m = 0.72   ; a comment\n"
-                               "step_min_interval_ms = 250\n"
+                               "[stride]\n"
+                               "weinberg_k = 0.72   ; a comment\n"
+                               "[steps]\n"
+                               "refractory_ms = 250\n"
                                "max_gap_ms=1000\n"
                                "[output]\n"
                                "pose_period_ms = 200\n",
@@ -85,13 +86,13 @@ static void test_good_file_sets_values(void **state)
     sf_params_default(&d);
     assert_true(p.init_x_m == 12.5);
     assert_int_equal(p.init_floor, 3);
-    assert_true(p.pdr_stride_m == 0.72);
-    assert_int_equal(p.pdr_step_min_interval_ms, 250);
-    assert_int_equal(p.pdr_max_gap_ms, 1000);
+    assert_true(p.stride_weinberg_k == 0.72);
+    assert_int_equal(p.steps_refractory_ms, 250);
+    assert_int_equal(p.steps_max_gap_ms, 1000);
     assert_int_equal(p.output_pose_period_ms, 200);
     /* the rest keep their defaults */
     assert_true(p.init_y_m == d.init_y_m);
-    assert_true(p.pdr_step_threshold_mps2 == d.pdr_step_threshold_mps2);
+    assert_true(p.steps_pt_threshold == d.steps_pt_threshold);
     assert_int_equal(p.output_health_period_ms, d.output_health_period_ms);
 }
 
@@ -104,57 +105,57 @@ static void test_empty_file_keeps_defaults(void **state)
     for (size_t i = 0; i < sf_param_count; i++) {
         assert_true(sf_param_get(&p, &sf_param_table[i]) == sf_param_get(&d, &sf_param_table[i]));
     }
-    assert_true(d.pdr_stride_m == 0.70);
-    assert_int_equal(d.pdr_max_gap_ms, 500);
+    assert_true(d.stride_weinberg_k == 0.47);
+    assert_int_equal(d.steps_max_gap_ms, 500);
 }
 
 static void test_unknown_key(void **state)
 {
     (void)state;
-    load("[pdr]\nstride_m = 0.8\n\nstrid_m = 0.9\n", SF_ESYNTAX, 4, "strid_m");
+    load("[stride]\nweinberg_k = 0.8\n\nweinberg = 0.9\n", SF_ESYNTAX, 4, "weinberg");
 }
 
 static void test_unknown_section(void **state)
 {
     (void)state;
-    load("[pdr]\nstride_m = 0.8\n[gnss]\nweight = 2\n", SF_ESYNTAX, 4, "gnss");
+    load("[stride]\nweinberg_k = 0.8\n[gnss]\nweight = 2\n", SF_ESYNTAX, 4, "gnss");
 }
 
 static void test_key_outside_section(void **state)
 {
     (void)state;
-    load("stride_m = 0.8\n", SF_ESYNTAX, 1, "stride_m");
+    load("weinberg_k = 0.8\n", SF_ESYNTAX, 1, "weinberg_k");
 }
 
 static void test_out_of_range(void **state)
 {
     (void)state;
-    load("[pdr]\nstride_m = 1.6\n", SF_ERANGE, 2, "stride_m");
-    load("[pdr]\nstride_m = 0.1\n", SF_ERANGE, 2, "stride_m");
+    load("[stride]\nweinberg_k = 2.1\n", SF_ERANGE, 2, "weinberg_k");
+    load("[stride]\nweinberg_k = 0.04\n", SF_ERANGE, 2, "weinberg_k");
     load("[init]\nfloor = -21\n", SF_ERANGE, 2, "floor");
-    load("[pdr]\n\n\nmax_gap_ms = 10001\n", SF_ERANGE, 4, "max_gap_ms");
+    load("[steps]\n\n\nmax_gap_ms = 10001\n", SF_ERANGE, 4, "max_gap_ms");
     /* an int32 key with a fraction */
-    load("[pdr]\nmax_gap_ms = 500.5\n", SF_ERANGE, 2, "max_gap_ms");
+    load("[steps]\nmax_gap_ms = 500.5\n", SF_ERANGE, 2, "max_gap_ms");
     /* the bounds themselves are allowed */
-    const sf_params_t p = load("[pdr]\nstride_m = 1.5\nmax_gap_ms = 20\n", SF_OK, 0, NULL);
-    assert_true(p.pdr_stride_m == 1.5);
-    assert_int_equal(p.pdr_max_gap_ms, 20);
+    const sf_params_t p = load("[stride]\nweinberg_k = 2.0\n[steps]\nmax_gap_ms = 20\n", SF_OK, 0, NULL);
+    assert_true(p.stride_weinberg_k == 2.0);
+    assert_int_equal(p.steps_max_gap_ms, 20);
 }
 
 static void test_not_a_number(void **state)
 {
     (void)state;
-    load("[pdr]\nstride_m = long\n", SF_ESYNTAX, 2, "long");
-    load("[pdr]\nstride_m = 0.8m\n", SF_ESYNTAX, 2, "0.8m");
-    load("[pdr]\nstride_m =\n", SF_ESYNTAX, 2, "stride_m");
-    load("[pdr]\nstride_m = nan\n", SF_ERANGE, 2, "stride_m"); /* a number, but not in range */
+    load("[stride]\nweinberg_k = long\n", SF_ESYNTAX, 2, "long");
+    load("[stride]\nweinberg_k = 0.8m\n", SF_ESYNTAX, 2, "0.8m");
+    load("[stride]\nweinberg_k =\n", SF_ESYNTAX, 2, "weinberg_k");
+    load("[stride]\nweinberg_k = nan\n", SF_ERANGE, 2, "weinberg_k"); /* a number, but not in range */
 }
 
 static void test_bad_line(void **state)
 {
     (void)state;
-    load("[pdr]\nstride_m = 0.8\nthis is not ini\n", SF_ESYNTAX, 3, NULL);
-    load("[pdr\nstride_m = 0.8\n", SF_ESYNTAX, 1, NULL);
+    load("[stride]\nweinberg_k = 0.8\nthis is not ini\n", SF_ESYNTAX, 3, NULL);
+    load("[stride\nweinberg_k = 0.8\n", SF_ESYNTAX, 1, NULL);
 }
 
 /* Regression test for "config error forgotten after a later good line" (open). inih (Debian's
@@ -166,10 +167,10 @@ static void test_bad_line(void **state)
 static void test_error_is_kept_when_good_lines_follow(void **state)
 {
     (void)state;
-    const sf_params_t p = load("[pdr]\nstride_m = 0.8\nbogus = 1\nmax_gap_ms = 900\n", SF_ESYNTAX, 3, "bogus");
-    assert_int_equal(p.pdr_max_gap_ms, 500); /* the line after the error was not applied */
-    load("[pdr]\nstride_m = 9\nmax_gap_ms = 900\n", SF_ERANGE, 2, "stride_m");
-    load("[pdr]\nstride_m = abc\n[init]\nfloor = 1\n", SF_ESYNTAX, 2, "abc");
+    const sf_params_t p = load("[steps]\nrefractory_ms = 250\nbogus = 1\nmax_gap_ms = 900\n", SF_ESYNTAX, 3, "bogus");
+    assert_int_equal(p.steps_max_gap_ms, 500); /* the line after the error was not applied */
+    load("[stride]\nweinberg_k = 9\nmax_gap_ms = 900\n", SF_ERANGE, 2, "weinberg_k");
+    load("[stride]\nweinberg_k = abc\n[init]\nfloor = 1\n", SF_ESYNTAX, 2, "abc");
 }
 
 static void test_missing_file(void **state)
@@ -188,19 +189,19 @@ static void test_set(void **state)
     sf_params_t p;
     sf_params_default(&p);
     char err[256] = "";
-    assert_int_equal(sf_config_set("pdr.stride_m=0.8", &p, err, sizeof err), SF_OK);
-    assert_true(p.pdr_stride_m == 0.8);
+    assert_int_equal(sf_config_set("stride.weinberg_k=0.8", &p, err, sizeof err), SF_OK);
+    assert_true(p.stride_weinberg_k == 0.8);
     assert_int_equal(sf_config_set("init.floor=-2", &p, err, sizeof err), SF_OK);
     assert_int_equal(p.init_floor, -2);
 
-    assert_int_equal(sf_config_set("pdr.stride_m=9", &p, err, sizeof err), SF_ERANGE);
-    assert_true(p.pdr_stride_m == 0.8); /* unchanged */
-    assert_non_null(strstr(err, "stride_m"));
-    assert_int_equal(sf_config_set("pdr.stride=0.8", &p, err, sizeof err), SF_ESYNTAX);
-    assert_non_null(strstr(err, "stride"));
-    assert_int_equal(sf_config_set("pdr.stride_m=x", &p, err, sizeof err), SF_ESYNTAX);
-    assert_int_equal(sf_config_set("stride_m=0.8", &p, err, sizeof err), SF_ESYNTAX);
-    assert_int_equal(sf_config_set("pdr.stride_m", &p, err, sizeof err), SF_ESYNTAX);
+    assert_int_equal(sf_config_set("stride.weinberg_k=9", &p, err, sizeof err), SF_ERANGE);
+    assert_true(p.stride_weinberg_k == 0.8); /* unchanged */
+    assert_non_null(strstr(err, "weinberg_k"));
+    assert_int_equal(sf_config_set("stride.weinberg=0.8", &p, err, sizeof err), SF_ESYNTAX);
+    assert_non_null(strstr(err, "weinberg"));
+    assert_int_equal(sf_config_set("stride.weinberg_k=x", &p, err, sizeof err), SF_ESYNTAX);
+    assert_int_equal(sf_config_set("weinberg_k=0.8", &p, err, sizeof err), SF_ESYNTAX);
+    assert_int_equal(sf_config_set("stride.weinberg_k", &p, err, sizeof err), SF_ESYNTAX);
     assert_true(strlen(err) > 0);
 }
 

@@ -1,0 +1,131 @@
+/* sf_activity.c — see sf_activity.h for the rules. */
+#include "sf_activity.h"
+
+#include <math.h>
+
+void sf_activity_init(sf_activity_t *const a, const sf_params_t *const p)
+{
+    (void)p;
+    *a = (sf_activity_t){0};
+    a->activity = sf_activity_unknown;
+}
+
+double sf_activity_variance_m2ps4(const sf_activity_t *const a)
+{
+    const double v = a->meansq_m2ps4 - a->mean_mps2 * a->mean_mps2;
+    return v > 0.0 ? v : 0.0;
+}
+
+/* Accepted steps within the window ending at t_us, and the newest step time. */
+static int32_t steps_in_window(const sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us)
+{
+    const int64_t from_us = t_us - (int64_t)p->activity_step_window_ms * 1000;
+    int32_t n = 0;
+    for (int32_t k = 0; k < a->step_count; k++) {
+        const int32_t i = (a->step_head + SF_ACTIVITY_STEPS - k) % SF_ACTIVITY_STEPS;
+        if (a->step_t_us[i] > from_us) {
+            n++;
+        }
+    }
+    return n;
+}
+
+double sf_activity_step_rate_hz(const sf_activity_t *const a, const sf_params_t *const p)
+{
+    return (double)steps_in_window(a, p, a->last_t_us) / ((double)p->activity_step_window_ms * 1e-3);
+}
+
+static void classify(sf_activity_t *const a, const sf_params_t *const p)
+{
+    if (!a->started) {
+        a->activity = sf_activity_unknown;
+        return;
+    }
+    const int64_t t_us = a->last_t_us;
+    const bool stepping = steps_in_window(a, p, t_us) >= p->activity_min_steps;
+    const bool recent_step =
+        a->step_count > 0 && t_us - a->step_t_us[a->step_head] <= (int64_t)p->activity_still_time_ms * 1000;
+    const double v = a->vspeed_mps;
+    if (stepping && v > p->activity_stairs_vspeed_mps) {
+        a->activity = sf_activity_stairs_up;
+    } else if (stepping && v < -p->activity_stairs_vspeed_mps) {
+        a->activity = sf_activity_stairs_down;
+    } else if (stepping) {
+        a->activity = sf_activity_walking;
+    } else if (fabs(v) > p->activity_elevator_vspeed_mps) {
+        a->activity = sf_activity_elevator;
+    } else if (!recent_step && sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4) {
+        a->activity = sf_activity_still;
+    } else if (recent_step) {
+        a->activity = sf_activity_walking;
+    } else {
+        a->activity = sf_activity_unknown;
+    }
+}
+
+static void advance_time(sf_activity_t *const a, const int64_t t_us)
+{
+    if (t_us > a->last_t_us) {
+        a->last_t_us = t_us;
+    }
+}
+
+void sf_activity_accel(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,
+                       const double accel_v_mps2)
+{
+    if (!isfinite(accel_v_mps2)) {
+        return;
+    }
+    if (!a->started) {
+        a->started = true;
+        a->accel_t_us = t_us;
+        a->last_t_us = t_us;
+        a->mean_mps2 = accel_v_mps2;
+        a->meansq_m2ps4 = accel_v_mps2 * accel_v_mps2;
+        classify(a, p);
+        return;
+    }
+    if (t_us <= a->accel_t_us) {
+        return;
+    }
+    const double dt_s = (double)(t_us - a->accel_t_us) * 1e-6;
+    const double k = -expm1(-dt_s / p->activity_var_tau_s);
+    a->mean_mps2 += k * (accel_v_mps2 - a->mean_mps2);
+    a->meansq_m2ps4 += k * (accel_v_mps2 * accel_v_mps2 - a->meansq_m2ps4);
+    a->accel_t_us = t_us;
+    advance_time(a, t_us);
+    classify(a, p);
+}
+
+bool sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
+{
+    if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4) {
+        a->rejected_steps++;
+        return false;
+    }
+    a->step_head = (a->step_head + 1) % SF_ACTIVITY_STEPS;
+    a->step_t_us[a->step_head] = ev->t_us;
+    if (a->step_count < SF_ACTIVITY_STEPS) {
+        a->step_count++;
+    }
+    a->accepted_steps++;
+    advance_time(a, ev->t_us);
+    classify(a, p);
+    return true;
+}
+
+void sf_activity_vspeed(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,
+                        const double vspeed_mps)
+{
+    if (!isfinite(vspeed_mps)) {
+        return;
+    }
+    a->vspeed_mps = vspeed_mps;
+    advance_time(a, t_us);
+    classify(a, p);
+}
+
+int8_t sf_activity_current(const sf_activity_t *const a)
+{
+    return a->activity;
+}

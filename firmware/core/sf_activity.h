@@ -1,0 +1,82 @@
+/* sf_activity.h — still, walking, stairs up/down, elevator, from steps, a_v variance and the
+ * barometric vertical speed.
+ *
+ * Inputs (each at its own rate, each with its time): a_v [m/s²] (the same signal sf_steps sees) through
+ * sf_activity_accel; the step events of sf_steps through sf_activity_step; the vertical speed v [m/s] of
+ * sf_floor through sf_activity_vspeed. The class is recomputed at every input and read with
+ * sf_activity_current (codes sf_activity_* of sf_types.h, identical to step_t.ACTIVITY_*).
+ *
+ * Features.
+ *   - variance σ² of a_v: exponentially weighted mean and mean square, time constant
+ *     activity_var_tau_s, exact for any dt (k = 1 − exp(−dt/τ)); rate-independent.
+ *   - stepping: at least activity_min_steps accepted steps in the last activity_step_window_ms
+ *     (times kept in a ring of SF_ACTIVITY_STEPS); step rate = steps in the window / window, which
+ *     saturates at SF_ACTIVITY_STEPS / window (3.2 steps/s with the default 2.5 s).
+ * Rules, in this order (t = the newest input time):
+ *   1. stepping and v >  activity_stairs_vspeed_mps (0.15 m/s)  → stairs_up
+ *   2. stepping and v < −activity_stairs_vspeed_mps              → stairs_down
+ *   3. stepping                                                  → walking
+ *   4. |v| > activity_elevator_vspeed_mps (0.30 m/s)             → elevator (no steps; the variance
+ *      is not required to be low: an elevator's start and stop and a fidgeting rider raise it, and the
+ *      barometer is the telling cue)
+ *   5. no accepted step for activity_still_time_ms and σ² < activity_still_var_m2ps4 → still
+ *   6. otherwise: walking while the last step is less than activity_still_time_ms old (a pause in the
+ *      gait), else unknown (handling the device without steps).
+ * Before any a_v sample the class is unknown.
+ *
+ * False steps while still. sf_activity_step refuses (returns false, counts in `rejected_steps`) a
+ * step that comes while σ² < activity_still_var_m2ps4: a body that quiet is not walking, whatever the
+ * detector saw. A refused step does not count for the rules above; the estimator must not move the
+ * position for it. While the class is still, the estimator also holds the position (zero-velocity).
+ *
+ * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v sample. Memory: sizeof(sf_activity_t) ≈ 140 B.
+ * No heap, no I/O, no clock. Cannot fail. */
+#ifndef SF_ACTIVITY_H
+#define SF_ACTIVITY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_params.h"
+#include "sf_steps.h"
+#include "sf_types.h"
+
+/* Step times kept: the window (max 10 s) at the fastest gait (≈ 3.3 steps/s at 300 ms) would need 34;
+ * the rules only need activity_min_steps (≤ 8) of them, so 8 suffice. */
+#define SF_ACTIVITY_STEPS 8
+_Static_assert(SF_ACTIVITY_STEPS >= 8, "activity_min_steps may be 8");
+
+typedef struct {
+    bool started;
+    int64_t last_t_us;   /* newest input time */
+    int64_t accel_t_us;  /* newest a_v time */
+    double mean_mps2;    /* EW mean of a_v */
+    double meansq_m2ps4; /* EW mean of a_v² */
+    double vspeed_mps;   /* latest baro vertical speed */
+    int64_t step_t_us[SF_ACTIVITY_STEPS]; /* ring of accepted step times */
+    int32_t step_head, step_count;
+    int8_t activity;
+    uint32_t accepted_steps, rejected_steps; /* counters, never decrease */
+} sf_activity_t;
+
+void sf_activity_init(sf_activity_t *a, const sf_params_t *p);
+
+/* One a_v sample [m/s²]. Non-finite values and samples at or before the previous a_v time are ignored. */
+void sf_activity_accel(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double accel_v_mps2);
+
+/* One step event. Returns true when the step is accepted (the estimator moves), false when refused. */
+bool sf_activity_step(sf_activity_t *a, const sf_params_t *p, const sf_step_event_t *ev);
+
+/* One vertical-speed estimate [m/s] (sf_floor_vertical_speed_mps after a baro sample). */
+void sf_activity_vspeed(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double vspeed_mps);
+
+/* The current class (sf_activity_*). */
+int8_t sf_activity_current(const sf_activity_t *a);
+
+/* a_v variance [m²/s⁴]. */
+double sf_activity_variance_m2ps4(const sf_activity_t *a);
+
+/* Accepted steps per second over the window ending at the newest input. */
+double sf_activity_step_rate_hz(const sf_activity_t *a, const sf_params_t *p);
+
+#endif

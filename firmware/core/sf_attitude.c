@@ -1,0 +1,417 @@
+/* sf_attitude.c — see sf_attitude.h for the model. */
+#include "sf_attitude.h"
+
+#include <math.h>
+
+#define PI 3.14159265358979323846
+#define G_MPS2 9.80665
+#define MAG_DT_MAX_S 0.2     /* clamp of the mag blend interval (header: "clamped to [0, 0.2] s") */
+#define MIN_ACCEL_MPS2 1.0   /* below this the accelerometer carries no usable "up" */
+#define MIN_HORIZONTAL 0.01  /* horizontal field / |m| below this: no yaw information */
+#define FUSE_DT_MAX_S 0.1    /* clamp of the interval used by the accelerometer corrections */
+#define INTEGRAL_MAX_ERR_RAD (10.0 * PI / 180.0) /* anti-windup: larger errors do not feed the bias */
+
+/* ---- small vector and quaternion helpers (q = w, x, y, z) ---- */
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double norm3(const double a[3])
+{
+    return sqrt(dot3(a, a));
+}
+
+static bool finite3(const double a[3])
+{
+    return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
+}
+
+static double wrap_pi(const double a)
+{
+    return atan2(sin(a), cos(a));
+}
+
+static double clamp(const double v, const double lo, const double hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+static void qmul(const double a[4], const double b[4], double out[4])
+{
+    const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+    const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+    const double y = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+    const double z = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+    out[0] = w;
+    out[1] = x;
+    out[2] = y;
+    out[3] = z;
+}
+
+static void qnormalise(double q[4])
+{
+    const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int i = 0; i < 4; i++) {
+        q[i] /= n;
+    }
+    if (q[0] < 0.0) { /* one of the two signs, so outputs are unique */
+        for (int i = 0; i < 4; i++) {
+            q[i] = -q[i];
+        }
+    }
+}
+
+/* exp of a rotation vector r (axis × angle, rad): the quaternion of that rotation. */
+static void qexp(const double r[3], double q[4])
+{
+    const double angle = norm3(r);
+    if (angle < 1e-12) {
+        q[0] = 1.0;
+        q[1] = 0.5 * r[0];
+        q[2] = 0.5 * r[1];
+        q[3] = 0.5 * r[2];
+        return;
+    }
+    const double s = sin(0.5 * angle) / angle;
+    q[0] = cos(0.5 * angle);
+    q[1] = s * r[0];
+    q[2] = s * r[1];
+    q[3] = s * r[2];
+}
+
+static void rotate(const double q[4], const bool transpose, const double v[3], double out[3])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    const double r[3][3] = {
+        {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
+        {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
+        {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
+    };
+    double o[3];
+    for (int i = 0; i < 3; i++) {
+        o[i] = transpose ? r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2]
+                         : r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2];
+    }
+    out[0] = o[0];
+    out[1] = o[1];
+    out[2] = o[2];
+}
+
+/* q ← exp(r_nav) ⊗ q: rotate the body by r_nav expressed in the nav frame. */
+static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
+{
+    double dq[4];
+    qexp(r_nav, dq);
+    double out[4];
+    qmul(dq, att->q, out);
+    qnormalise(out);
+    for (int i = 0; i < 4; i++) {
+        att->q[i] = out[i];
+    }
+}
+
+/* The rotation (nav frame, axis × angle) that takes the measured up direction onto nav z.
+ * Horizontal axis, so it never changes yaw about the vertical. */
+static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mps2[3], double r_nav[3])
+{
+    double u[3];
+    rotate(att->q, false, accel_mps2, u);
+    const double n = norm3(u);
+    const double c[3] = {u[1] / n, -u[0] / n, 0.0}; /* (u/|u|) × ẑ */
+    const double s = sqrt(c[0] * c[0] + c[1] * c[1]);
+    const double angle = atan2(s, u[2] / n);
+    if (s < 1e-15) {
+        r_nav[0] = r_nav[1] = r_nav[2] = 0.0; /* aligned (or exactly upside down: no axis; next sample) */
+        return;
+    }
+    r_nav[0] = c[0] / s * angle;
+    r_nav[1] = c[1] / s * angle;
+    r_nav[2] = 0.0;
+}
+
+/* Roll/pitch from one accelerometer sample, yaw 0 (body x towards east, or as close as tilt allows). */
+static void init_tilt(sf_attitude_t *const att, const double accel_mps2[3])
+{
+    att->q[0] = 1.0;
+    att->q[1] = att->q[2] = att->q[3] = 0.0;
+    double r[3];
+    tilt_error_nav(att, accel_mps2, r);
+    if (r[0] == 0.0 && r[1] == 0.0 && accel_mps2[2] < 0.0) {
+        r[0] = PI; /* upside down: half turn about east */
+    }
+    rotate_in_nav(att, r);
+    const double yaw_r[3] = {0.0, 0.0, -sf_attitude_yaw_rad(att)};
+    rotate_in_nav(att, yaw_r);
+    att->tilt_initialised = true;
+}
+
+static void clamp_bias(sf_attitude_t *const att, const sf_params_t *const p)
+{
+    const double m = p->attitude_gyro_bias_max_radps;
+    for (int i = 0; i < 3; i++) {
+        att->gyro_bias_radps[i] = clamp(att->gyro_bias_radps[i], -m, m);
+    }
+}
+
+static void judge_mag(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double field_ut[3]);
+
+void sf_attitude_init(sf_attitude_t *const att)
+{
+    *att = (sf_attitude_t){0};
+    att->q[0] = 1.0;
+    att->last_mag.dip_rad = (double)NAN;
+}
+
+void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
+                            const double accel_mps2[3], const double gyro_radps[3])
+{
+    if (!finite3(accel_mps2) || !finite3(gyro_radps)) {
+        att->imu_invalid++;
+        return;
+    }
+    const double a_norm = norm3(accel_mps2);
+    const bool accel_usable = a_norm > MIN_ACCEL_MPS2;
+
+    if (!att->imu_started) {
+        att->imu_started = true;
+        att->last_imu_t_us = t_us;
+        for (int i = 0; i < 3; i++) {
+            att->last_gyro_radps[i] = gyro_radps[i];
+        }
+        if (accel_usable) {
+            init_tilt(att, accel_mps2);
+        }
+    } else {
+        const int64_t dt_us = t_us - att->last_imu_t_us;
+        if (dt_us <= 0) {
+            att->imu_time_errors++;
+            return; /* nothing to integrate; a repeated or backwards time is not a new sample */
+        }
+        const double dt_s = (double)dt_us * 1e-6;
+        const bool gap = dt_us > (int64_t)p->attitude_max_gap_ms * 1000;
+        if (gap) {
+            att->imu_gaps++;
+        }
+        att->last_imu_t_us = t_us;
+
+        /* rest detector (control): both conditions held for rest_time_s */
+        const double w_c[3] = {gyro_radps[0] - att->gyro_bias_radps[0], gyro_radps[1] - att->gyro_bias_radps[1],
+                               gyro_radps[2] - att->gyro_bias_radps[2]};
+        const bool still = !gap && norm3(w_c) < p->attitude_rest_gyro_radps &&
+                           fabs(a_norm - G_MPS2) < p->attitude_rest_accel_mps2;
+        if (!still) {
+            att->rest_candidate = false;
+        } else if (!att->rest_candidate) {
+            att->rest_candidate = true;
+            att->rest_since_t_us = t_us;
+        }
+        att->at_rest = att->rest_candidate &&
+                       (double)(t_us - att->rest_since_t_us) * 1e-6 >= p->attitude_rest_time_s;
+
+        if (!att->tilt_initialised) {
+            if (accel_usable) {
+                init_tilt(att, accel_mps2);
+            }
+        } else {
+            const bool mahony = p->attitude_mode == sf_attitude_mahony;
+            /* fusion: gyro propagation (trapezoid over the interval) */
+            if (!gap) {
+                double r_body[3];
+                for (int i = 0; i < 3; i++) {
+                    r_body[i] = (0.5 * (att->last_gyro_radps[i] + gyro_radps[i]) - att->gyro_bias_radps[i]) * dt_s;
+                }
+                double dq[4];
+                qexp(r_body, dq);
+                double out[4];
+                qmul(att->q, dq, out);
+                qnormalise(out);
+                for (int i = 0; i < 4; i++) {
+                    att->q[i] = out[i];
+                }
+            }
+            /* fusion: gravity */
+            const bool gated = !accel_usable || fabs(a_norm - G_MPS2) > p->attitude_accel_gate_mps2;
+            if (gated) {
+                att->accel_gated++;
+            } else {
+                /* after a gap the interval says nothing about the gyro: clamp it, no integral */
+                const double dt_f = fmin(dt_s, FUSE_DT_MAX_S);
+                double r_nav[3];
+                tilt_error_nav(att, accel_mps2, r_nav);
+                double k;
+                if (mahony) {
+                    k = fmin(p->attitude_mahony_kp * dt_f, 1.0);
+                    if (!gap && norm3(r_nav) < INTEGRAL_MAX_ERR_RAD) {
+                        double e_body[3];
+                        rotate(att->q, true, r_nav, e_body);
+                        for (int i = 0; i < 3; i++) {
+                            att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_f;
+                        }
+                    }
+                } else {
+                    k = 1.0 - p->attitude_tau_s / (p->attitude_tau_s + dt_f); /* 1 − α */
+                }
+                const double r_k[3] = {k * r_nav[0], k * r_nav[1], 0.0};
+                rotate_in_nav(att, r_k);
+            }
+            /* fusion: fast bias at rest (Mahony only; the thesis filter has no bias state) */
+            if (mahony && att->at_rest) {
+                const double kb = dt_s / (p->attitude_rest_bias_tau_s + dt_s);
+                for (int i = 0; i < 3; i++) {
+                    att->gyro_bias_radps[i] += kb * (gyro_radps[i] - att->gyro_bias_radps[i]);
+                }
+            }
+            if (mahony) {
+                clamp_bias(att, p);
+            }
+        }
+        for (int i = 0; i < 3; i++) {
+            att->last_gyro_radps[i] = gyro_radps[i];
+        }
+    }
+
+    if (att->tilt_initialised && att->mag_pending) {
+        att->mag_pending = false;
+        judge_mag(att, p, att->mag_pending_t_us, att->mag_pending_ut);
+    }
+}
+
+static void reject(sf_attitude_t *const att, const sf_mag_verdict_t v)
+{
+    att->mag_rejected++;
+    att->mag_by_verdict[v]++;
+    att->last_mag.verdict = v;
+}
+
+void sf_attitude_update_mag(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
+                            const double field_ut[3])
+{
+    if (!att->tilt_initialised && finite3(field_ut)) {
+        if (att->mag_pending) {
+            reject(att, sf_mag_no_tilt); /* the held sample is replaced by a newer one */
+        }
+        att->mag_pending = true;
+        att->mag_pending_t_us = t_us;
+        for (int i = 0; i < 3; i++) {
+            att->mag_pending_ut[i] = field_ut[i];
+        }
+        att->last_mag = (sf_attitude_mag_audit_t){.t_us = t_us, .field_ut = norm3(field_ut), .dip_rad = (double)NAN,
+                                                  .verdict = sf_mag_no_tilt};
+        return;
+    }
+    judge_mag(att, p, t_us, field_ut);
+}
+
+/* Control (verdict) then fusion for one magnetometer sample; the tilt is known. */
+static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
+                      const double field_ut[3])
+{
+    const double deg = PI / 180.0;
+    if (!att->mag_ref_set) {
+        att->mag_ref_set = true;
+        att->mag_ref_field_ut = p->attitude_mag_field_ut;
+        att->mag_ref_dip_rad = p->attitude_mag_dip_deg * deg;
+    }
+    const double dt_s = att->mag_seen ? clamp((double)(t_us - att->last_mag_t_us) * 1e-6, 0.0, MAG_DT_MAX_S) : 0.0;
+    att->mag_seen = true;
+    att->last_mag_t_us = t_us;
+
+    sf_attitude_mag_audit_t *const audit = &att->last_mag;
+    *audit = (sf_attitude_mag_audit_t){.t_us = t_us, .dip_rad = (double)NAN, .ref_field_ut = att->mag_ref_field_ut,
+                                       .ref_dip_rad = att->mag_ref_dip_rad};
+    const double f = finite3(field_ut) ? norm3(field_ut) : (double)NAN;
+    audit->field_ut = f;
+    double m_nav[3] = {0.0, 0.0, 0.0};
+    if (isfinite(f) && f > 0.0) {
+        rotate(att->q, false, field_ut, m_nav);
+    }
+    const double h = sqrt(m_nav[0] * m_nav[0] + m_nav[1] * m_nav[1]);
+    if (!isfinite(f) || f <= 0.0 || h < MIN_HORIZONTAL * f) {
+        reject(att, sf_mag_degenerate);
+        return;
+    }
+    const double dip = asin(clamp(-m_nav[2] / f, -1.0, 1.0));
+    audit->dip_rad = dip;
+    audit->yaw_innov_rad = wrap_pi(0.5 * PI - atan2(m_nav[1], m_nav[0]));
+
+    /* control: disturbance tests, then the settle hysteresis */
+    const bool field_ok = fabs(f - att->mag_ref_field_ut) <= p->attitude_mag_field_tol_ut;
+    const bool dip_ok = fabs(dip - att->mag_ref_dip_rad) <= p->attitude_mag_dip_tol_deg * deg;
+    if (!field_ok || !dip_ok) {
+        att->mag_disturbed = true;
+        att->mag_consistent = false;
+        reject(att, field_ok ? sf_mag_dip : sf_mag_field);
+        return;
+    }
+    if (att->mag_disturbed) {
+        if (!att->mag_consistent) {
+            att->mag_consistent = true;
+            att->mag_consistent_t_us = t_us;
+        }
+        if ((double)(t_us - att->mag_consistent_t_us) * 1e-6 < p->attitude_mag_settle_s) {
+            reject(att, sf_mag_settling);
+            return;
+        }
+        att->mag_disturbed = false;
+        att->mag_consistent = false;
+    }
+
+    /* fusion: yaw about nav z only */
+    double gain;
+    if (!att->yaw_absolute) {
+        gain = 1.0;
+        att->yaw_absolute = true;
+    } else if (p->attitude_mode == sf_attitude_mahony) {
+        gain = fmin(p->attitude_mahony_kp_mag * dt_s, 1.0);
+        if (fabs(audit->yaw_innov_rad) < INTEGRAL_MAX_ERR_RAD) {
+            const double e_nav[3] = {0.0, 0.0, audit->yaw_innov_rad};
+            double e_body[3];
+            rotate(att->q, true, e_nav, e_body);
+            for (int i = 0; i < 3; i++) {
+                att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_s;
+            }
+            clamp_bias(att, p);
+        }
+    } else {
+        gain = 1.0 - p->attitude_tau_s / (p->attitude_tau_s + dt_s); /* 1 − α */
+    }
+    const double r_nav[3] = {0.0, 0.0, gain * audit->yaw_innov_rad};
+    rotate_in_nav(att, r_nav);
+    audit->gain = gain;
+    audit->verdict = sf_mag_accepted;
+    att->mag_accepted++;
+    att->mag_by_verdict[sf_mag_accepted]++;
+
+    /* control: learn the undisturbed references, bounded to configured ± tolerance */
+    if (p->attitude_mag_learn_tau_s > 0.0) {
+        const double k = dt_s / (p->attitude_mag_learn_tau_s + dt_s);
+        const double f0 = p->attitude_mag_field_ut, ft = p->attitude_mag_field_tol_ut;
+        const double d0 = p->attitude_mag_dip_deg * deg, dtol = p->attitude_mag_dip_tol_deg * deg;
+        att->mag_ref_field_ut = clamp(att->mag_ref_field_ut + k * (f - att->mag_ref_field_ut), f0 - ft, f0 + ft);
+        att->mag_ref_dip_rad = clamp(att->mag_ref_dip_rad + k * (dip - att->mag_ref_dip_rad), d0 - dtol, d0 + dtol);
+    }
+}
+
+void sf_attitude_body_to_nav(const sf_attitude_t *const att, const double v_body[3], double v_nav[3])
+{
+    rotate(att->q, false, v_body, v_nav);
+}
+
+void sf_attitude_nav_to_body(const sf_attitude_t *const att, const double v_nav[3], double v_body[3])
+{
+    rotate(att->q, true, v_nav, v_body);
+}
+
+double sf_attitude_yaw_rad(const sf_attitude_t *const att)
+{
+    const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
+    return atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
+}
+
+double sf_attitude_tilt_rad(const sf_attitude_t *const att)
+{
+    const double x = att->q[1], y = att->q[2];
+    return acos(clamp(1 - 2 * (x * x + y * y), -1.0, 1.0));
+}

@@ -1,0 +1,158 @@
+/* sf_attitude.h — device attitude from gyroscope, accelerometer and magnetometer, two filters
+ * selectable by attitude_mode, with magnetic-disturbance rejection.
+ *
+ * Frames. Navigation frame n: x = magnetic east, y = magnetic north, z = up (ENU on magnetic north).
+ * Body frame b: the sensor axes. The attitude is the unit quaternion q = (w, x, y, z) that rotates body
+ * vectors into nav: v_n = q ⊗ v_b ⊗ q*. At rest the accelerometer measures the specific force, which
+ * points up (+g along nav z); the undisturbed field is m_n = F·(0, cos δ, −sin δ), F = field strength,
+ * δ = dip (positive downwards, 60° in central Europe). Yaw (sf_attitude_yaw_rad) is the heading of the
+ * body x axis projected on the horizontal plane, counter-clockwise from nav +x (east), in (−π, π]; it
+ * is ill-conditioned when body x is within a few degrees of vertical.
+ *
+ * Propagation (both modes). The gyro rate, minus the bias estimate, is averaged over the interval
+ * (trapezoid of the previous and the current sample) and integrated exactly as a rotation over δt from
+ * the sample times: q ← q ⊗ exp(½ ω̄ δt). Any rate 20–200 Hz with jitter works; an interval ≤ 0 or
+ * longer than attitude_max_gap_ms is not integrated (counted in imu_time_errors / imu_gaps), the
+ * accelerometer still corrects tilt. The accelerometer corrections below use δt clamped to 0.1 s, and
+ * the Mahony integral skips the sample after a gap, so a gap never turns into one large step.
+ *
+ * Complementary (attitude_mode 0; Ramadhan 2016 Eq. 2.15–2.16, τ = attitude_tau_s = 0.75 s). The
+ * absolute references are the accelerometer (roll/pitch) and the tilt-compensated magnetometer (yaw),
+ * each blended with the gyro-integrated attitude as θ̂ = α(θ̂ + ω δt) + (1−α) θ_ref, α = τ/(τ+δt).
+ * Written as θ̂_gyro + (1−α)(θ_ref − θ̂_gyro), it is applied geometrically instead of on Euler angles:
+ * the tilt error is the rotation that takes the measured up direction (accelerometer, rotated into nav)
+ * onto nav z, about a horizontal axis; the yaw error is the angle about nav z between the measured
+ * horizontal field and magnetic north. Each is corrected by the fraction (1−α) of its angle, δt being
+ * the interval of its own sensor. This removes the thesis' two flaws (body rates added to Euler angles,
+ * no ±180° wrap; notes §2 [FLAG]) and has no gimbal lock: any fixed device orientation works. The
+ * complementary filter has no bias state (as in the thesis): a gyro bias b leaves an error ≈ b·τ.
+ *
+ * Mahony (attitude_mode 1; Mahony, Hamel, Pflimlin 2008, explicit complementary filter). Body-frame
+ * errors e (axis × angle) feed the gyro: ω = ω_gyro − b̂ + Kp·e, and b̂ ← b̂ − Ki·e·δt (the integral
+ * term). The gravity error uses attitude_mahony_kp on each IMU sample; the magnetometer error is the
+ * yaw angle of the horizontal field only (rotation about nav z, mapped into body), so a magnetometer
+ * error never tilts the attitude; it uses attitude_mahony_kp_mag at each accepted mag sample. Rest:
+ * when |ω − b̂| < attitude_rest_gyro_radps and | |a| − g | < attitude_rest_accel_mps2 have both held
+ * for attitude_rest_time_s, b̂ also low-passes the raw gyro (time constant attitude_rest_bias_tau_s),
+ * much faster than the integral term. Each bias component is bounded by attitude_gyro_bias_max_radps,
+ * and an error above 10° (a wrong start, a fast manoeuvre) does not feed the integral (anti-windup).
+ *
+ * Accelerometer gating (both modes): a sample with | |a| − g | > attitude_accel_gate_mps2 does not
+ * correct tilt (counted in accel_gated); g = 9.80665 m/s².
+ *
+ * Magnetometer control (both modes), separate from the fusion above. For each sample, field strength
+ * |m| and dip δ = asin(−m·û/|m|) (û = up in body, from the current attitude) are compared with the
+ * references. Verdicts (sf_mag_verdict_t, one audit record per sample in last_mag):
+ *   - no_tilt: the sample came before any accelerometer sample; it is held (one slot, the newest) and
+ *     judged when the first IMU sample has set roll/pitch (so mag and IMU may come in either order);
+ *   - degenerate: zero or non-finite vector, or horizontal component < 1 % of |m|;
+ *   - field / dip: outside attitude_mag_field_tol_ut / attitude_mag_dip_tol_deg: disturbed;
+ *   - settling: within tolerance, but not yet for attitude_mag_settle_s since the last disturbed
+ *     sample (hysteresis: accept again only after the field has been consistent for a while);
+ *   - accepted: fused. The first accepted sample sets yaw outright and sets yaw_absolute; until then
+ *     yaw starts at 0 (body x towards east) and yaw_absolute is false.
+ * References start at attitude_mag_field_ut / attitude_mag_dip_deg and, when attitude_mag_learn_tau_s
+ * > 0, follow the accepted samples with that time constant, bounded to configured ± tolerance, so a
+ * slow local difference is learned but a disturbance can never walk the reference away.
+ * Time for the mag blend is the interval since the previous mag sample, clamped to [0, 0.2] s.
+ *
+ * Counters never decrease. Cost: O(1) per call, a few hundred flops and a handful of sqrt/trig;
+ * memory sizeof(sf_attitude_t) (< 400 bytes). No heap, no I/O, no clock, no hidden state: the same
+ * inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are a contract
+ * violation. */
+#ifndef SF_ATTITUDE_H
+#define SF_ATTITUDE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_params.h"
+
+enum { sf_attitude_complementary = 0, sf_attitude_mahony = 1 };
+
+/* Verdict on one magnetometer sample, see the header comment. */
+typedef enum {
+    sf_mag_accepted = 0,
+    sf_mag_no_tilt = 1,
+    sf_mag_degenerate = 2,
+    sf_mag_field = 3,
+    sf_mag_dip = 4,
+    sf_mag_settling = 5,
+    sf_mag_verdict_count = 6
+} sf_mag_verdict_t;
+
+/* Audit record of the last magnetometer sample (the FIX habit: innovation, gain, verdict). */
+typedef struct {
+    int64_t t_us;
+    double field_ut;       /* measured |m| */
+    double dip_rad;        /* measured dip, NaN when not computed */
+    double ref_field_ut;   /* reference used for the test */
+    double ref_dip_rad;
+    double yaw_innov_rad;  /* magnetic yaw minus predicted yaw, wrapped; 0 when not computed */
+    double gain;           /* fraction of the innovation applied this sample (1 = yaw set outright) */
+    sf_mag_verdict_t verdict;
+} sf_attitude_mag_audit_t;
+
+typedef struct {
+    double q[4]; /* body → nav, (w, x, y, z), unit */
+    bool tilt_initialised; /* an accelerometer sample set roll/pitch */
+    bool yaw_absolute;     /* a magnetometer sample set yaw */
+    bool at_rest;
+    double gyro_bias_radps[3];
+
+    /* IMU propagation */
+    bool imu_started;
+    int64_t last_imu_t_us;
+    double last_gyro_radps[3]; /* previous raw sample, for the trapezoid */
+    int64_t rest_since_t_us;   /* start of the current rest candidate; valid when rest_candidate */
+    bool rest_candidate;
+
+    /* magnetometer control */
+    bool mag_pending; /* held sample from before the first IMU sample */
+    int64_t mag_pending_t_us;
+    double mag_pending_ut[3];
+    bool mag_seen;
+    int64_t last_mag_t_us;
+    bool mag_disturbed;          /* since the last out-of-tolerance sample, not yet settled */
+    bool mag_consistent;         /* mag_consistent_t_us is valid */
+    int64_t mag_consistent_t_us; /* first in-tolerance sample after the last disturbed one */
+    bool mag_ref_set;
+    double mag_ref_field_ut;
+    double mag_ref_dip_rad;
+
+    /* health: counters never decrease */
+    uint32_t mag_accepted;
+    uint32_t mag_rejected; /* all verdicts but accepted; no_tilt counted only when a held sample is replaced */
+    uint32_t mag_by_verdict[sf_mag_verdict_count];
+    uint32_t imu_gaps;
+    uint32_t imu_time_errors; /* interval ≤ 0 */
+    uint32_t imu_invalid;     /* non-finite accel or gyro: sample skipped */
+    uint32_t accel_gated;
+    sf_attitude_mag_audit_t last_mag;
+} sf_attitude_t;
+
+/* Identity attitude, nothing initialised, bias 0, counters 0. */
+void sf_attitude_init(sf_attitude_t *att);
+
+/* One accelerometer + gyroscope sample (sensor axes). The first sample sets roll/pitch (yaw 0). */
+void sf_attitude_update_imu(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double accel_mps2[3],
+                            const double gyro_radps[3]);
+
+/* One magnetometer sample (sensor axes, calibrated: hard/soft iron removed). Sets the counters and
+ * last_mag; see the header comment for the verdicts. */
+void sf_attitude_update_mag(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double field_ut[3]);
+
+/* v_nav = R(q) v_body. v_body and v_nav may alias. */
+void sf_attitude_body_to_nav(const sf_attitude_t *att, const double v_body[3], double v_nav[3]);
+
+/* v_body = R(q)ᵀ v_nav. May alias. */
+void sf_attitude_nav_to_body(const sf_attitude_t *att, const double v_nav[3], double v_body[3]);
+
+/* Heading of body x projected on the horizontal plane, CCW from nav +x (magnetic east), (−π, π]. */
+double sf_attitude_yaw_rad(const sf_attitude_t *att);
+
+/* Angle between body "up" as estimated and the nav z axis image: the tilt of the body z axis from
+ * vertical, [0, π]. Handy for tests and health. */
+double sf_attitude_tilt_rad(const sf_attitude_t *att);
+
+#endif

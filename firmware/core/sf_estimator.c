@@ -1,0 +1,107 @@
+/* sf_estimator.c — composition of the PDR modules (see sf_estimator.h). */
+#include "sf_estimator.h"
+
+#include <math.h>
+
+static double wrap_pi(const double a)
+{
+    return atan2(sin(a), cos(a));
+}
+
+void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
+{
+    *e = (sf_estimator_t){0};
+    sf_attitude_init(&e->attitude);
+    sf_heading_init(&e->heading, p);
+    sf_steps_init(&e->steps, p);
+    sf_stride_init(&e->stride, p);
+    sf_activity_init(&e->activity, p);
+    sf_floor_init(&e->floor, p);
+    e->x_m = p->init_x_m;
+    e->y_m = p->init_y_m;
+    e->heading_rad = p->init_heading_rad;
+}
+
+/* Walking direction in the map frame for the current device yaw. */
+static double walk_heading(const sf_estimator_t *const e, const sf_params_t *const p)
+{
+    const double yaw = sf_attitude_yaw_rad(&e->attitude);
+    if (e->attitude.yaw_absolute) {
+        return sf_heading_walk_rad(&e->heading, p, yaw);
+    }
+    return wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
+}
+
+bool sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
+                      sf_step_t *const step)
+{
+    sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
+    double f_nav[3];
+    sf_attitude_body_to_nav(&e->attitude, s->accel_mps2, f_nav);
+    if (!e->started) {
+        e->gravity_mps2 = f_nav[2];
+        e->started = true;
+    } else if (s->t_us > e->t_us) {
+        const double dt_s = (double)(s->t_us - e->t_us) * 1e-6;
+        e->gravity_mps2 += (1.0 - exp(-dt_s / p->estimator_gravity_tau_s)) * (f_nav[2] - e->gravity_mps2);
+    }
+    e->t_us = s->t_us;
+    const double a_v = f_nav[2] - e->gravity_mps2;
+    e->accel_v_mps2 = a_v;
+
+    sf_heading_update(&e->heading, p, s->t_us, f_nav, sf_attitude_yaw_rad(&e->attitude));
+    sf_activity_accel(&e->activity, p, s->t_us, a_v);
+    e->heading_rad = walk_heading(e, p);
+
+    sf_step_event_t ev;
+    if (!sf_steps_update(&e->steps, p, s->t_us, a_v, &ev)) {
+        return false;
+    }
+    sf_heading_on_step(&e->heading, p, s->t_us);
+    if (!sf_activity_step(&e->activity, p, &ev)) {
+        e->steps_refused++;
+        return false;
+    }
+    const double length_m = sf_stride_length_m(&e->stride, &ev);
+    e->step_count++;
+    e->x_m += length_m * cos(e->heading_rad);
+    e->y_m += length_m * sin(e->heading_rad);
+    e->distance_m += length_m;
+    e->sigma_m += p->estimator_sigma_per_m * length_m;
+    e->weinberg_sum += sf_stride_weinberg_term(&ev);
+
+    step->t_us = s->t_us; /* published when known (causal); ev.t_us is the extremum, slightly earlier */
+    step->index = e->step_count;
+    step->length_m = length_m;
+    step->accel_range_mps2 = sf_stride_range_mps2(&ev);
+    step->period_s = ev.period_s;
+    step->heading_rad = e->heading_rad;
+    step->activity = sf_activity_current(&e->activity);
+    step->floor = sf_floor_current(&e->floor);
+    return true;
+}
+
+void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
+                      const double field_ut[3])
+{
+    sf_attitude_update_mag(&e->attitude, p, t_us, field_ut);
+}
+
+void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
+                       const double pressure_pa)
+{
+    sf_floor_update(&e->floor, p, t_us, pressure_pa);
+    sf_activity_vspeed(&e->activity, p, t_us, sf_floor_vertical_speed_mps(&e->floor));
+}
+
+void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
+{
+    pose->t_us = e->t_us;
+    pose->x_m = e->x_m;
+    pose->y_m = e->y_m;
+    pose->floor = sf_floor_current(&e->floor);
+    pose->heading_rad = e->heading_rad;
+    pose->sigma_m = e->sigma_m;
+    pose->step_count = e->step_count;
+    pose->scheme = sf_scheme_pdr_only;
+}

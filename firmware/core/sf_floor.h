@@ -1,0 +1,98 @@
+/* sf_floor.h — floor and vertical speed from the barometer.
+ *
+ * Height. Pressure p [Pa] → height by the hypsometric formula of the ICAO standard atmosphere,
+ *     h_baro = 44330.77 m · (1 − (p / 101325 Pa)^0.190263),
+ * whose slope is −0.0832 m/Pa (≈ −1/12 m/Pa, i.e. −dp/(ρg) with ρ = 1.225 kg/m³) at sea level and
+ * steeper higher up (≈ −0.1 m/Pa at 2000 m), so one metre means one metre at any site altitude. Only
+ * differences matter: height = h_baro + offset, where the offset is chosen at the first sample so that
+ * the height equals the start floor's height (init_floor), and is re-chosen at each re-reference.
+ *
+ * Filters (continuous time, exact for any dt): h_f = first-order low-pass of height with
+ * floor_height_tau_s; vertical speed v = first-order low-pass (floor_vspeed_tau_s) of Δh_f/Δt. Delay
+ * ≈ the sum of the two time constants (2 s by default); noise of 2 Pa rms at 25 Hz gives |v| ≈ 0.02 m/s.
+ *
+ * Floors. A table of floor heights H[i] [m] for floors lowest_floor + i (strictly increasing, at most
+ * SF_FLOOR_CAPACITY). Default (from params): uniform, H = floor_height_m · floor, for floors
+ * init_floor − SF_FLOOR_DEFAULT_BELOW … up to the capacity. A site file replaces it with
+ * sf_floor_set_heights.
+ * Control (current floor f; candidate g = the floor whose height is nearest to h_f):
+ *   - start a change: g ≠ f and |h_f − H(f)| − |h_f − H(g)| ≥ 2 · floor_hysteresis_m, i.e. h_f lies
+ *     floor_hysteresis_m beyond the mid-height between the two floors;
+ *   - continue: the same g holds; any other candidate restarts the clock, f itself cancels it;
+ *   - commit: after floor_confirm_ms, f ← g, and a re-reference is due;
+ *   - re-reference: once |v| < floor_settle_vspeed_mps (standing or walking on the landing, not still
+ *     climbing through an intermediate floor), the offset is moved so h_f = H(f) exactly. So baro drift
+ *     does not accumulate across floors;
+ *   - drift: while no change is pending and |v| < floor_settle_vspeed_mps, h_f relaxes toward H(f)
+ *     with floor_drift_tau_s (120 s), which absorbs weather drift on one floor (≈ 0.01 Pa/s) without
+ *     touching a climb (stairs ≥ 0.2 m/s, elevators more).
+ *
+ * Bad data: a non-finite pressure or one outside [SF_FLOOR_MIN_PA, SF_FLOOR_MAX_PA] is counted in `bad`
+ * and skipped; a sample at or before the previous time in `backwards`; a gap longer than
+ * floor_max_gap_ms restarts the filters at the new height (offset and floor kept) and counts in `gaps`.
+ *
+ * Errors: sf_floor_set_heights returns SF_OK or SF_EINVAL (NULL, n_floors outside
+ * [1, SF_FLOOR_CAPACITY], a height not finite or not strictly above the one below, or a table that
+ * would leave int16 floor numbers). Everything else cannot fail.
+ * Cost: one pow() and two exp() per sample, O(n_floors) for the nearest floor. Memory:
+ * sizeof(sf_floor_t) ≈ 0.6 kB. No heap, no I/O, no clock. */
+#ifndef SF_FLOOR_H
+#define SF_FLOOR_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_params.h"
+
+#define SF_FLOOR_CAPACITY 64
+#define SF_FLOOR_DEFAULT_BELOW 16 /* default table: this many floors below init_floor */
+#define SF_FLOOR_MIN_PA 30000.0   /* ≈ 9 km altitude */
+#define SF_FLOOR_MAX_PA 120000.0  /* deep mine; beyond is a broken sensor */
+_Static_assert(SF_FLOOR_CAPACITY > SF_FLOOR_DEFAULT_BELOW, "default table needs floors above the start");
+_Static_assert(SF_FLOOR_CAPACITY <= 1000, "floor numbers are int16");
+
+typedef struct {
+    /* table */
+    double height_m[SF_FLOOR_CAPACITY];
+    int32_t n_floors;
+    int16_t lowest_floor;
+    /* altimeter */
+    bool started;
+    int64_t last_t_us;
+    double offset_m;   /* height = h_baro + offset */
+    double height_m_f; /* low-passed height h_f [m] */
+    double vspeed_mps; /* low-passed vertical speed v [m/s] */
+    /* control */
+    int16_t floor;          /* current floor f */
+    int16_t candidate;      /* candidate g while a change is pending */
+    bool change_pending;
+    int64_t candidate_since_us;
+    bool reref_due;
+    /* counters, never decrease */
+    uint32_t changes, rereferences, gaps, backwards, bad;
+} sf_floor_t;
+
+/* Default uniform table from floor_height_m around init_floor; current floor = init_floor. */
+void sf_floor_init(sf_floor_t *f, const sf_params_t *p);
+
+/* Replaces the table: floor_height_m[i] is the height of floor lowest_floor + i. The current floor is
+ * kept (moved to the nearest floor of the table if outside it) and, once started, the altimeter is
+ * re-referenced at once: the user is taken to be on that floor now. */
+int sf_floor_set_heights(sf_floor_t *f, const double *floor_height_m, int n_floors, int16_t lowest_floor);
+
+/* Consumes one barometer sample. */
+void sf_floor_update(sf_floor_t *f, const sf_params_t *p, int64_t t_us, double pressure_pa);
+
+/* The current floor. */
+int16_t sf_floor_current(const sf_floor_t *f);
+
+/* The low-passed vertical speed [m/s], up positive; 0 before two samples. */
+double sf_floor_vertical_speed_mps(const sf_floor_t *f);
+
+/* The low-passed height [m] in the floor table's datum. */
+double sf_floor_height_m(const sf_floor_t *f);
+
+/* ICAO standard-atmosphere height for a pressure [Pa → m]. */
+double sf_floor_pressure_to_height_m(double pressure_pa);
+
+#endif

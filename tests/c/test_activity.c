@@ -1,0 +1,298 @@
+/* test_activity.c — sf_activity fed by sf_steps and sf_floor, as the estimator will wire them, on
+ * synthetic IMU (sf_test_gait.h) and barometer signals: still, walking, stairs up and down, an
+ * elevator ride, refused steps while still, determinism. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "sf_activity.h"
+#include "sf_floor.h"
+#include "sf_params.h"
+#include "sf_steps.h"
+#include "sf_test_gait.h"
+
+#define T0_US 3000000LL
+#define IMU_NOISE_MPS2 0.10
+#define BARO_NOISE_PA 1.5
+#define BARO_DRIFT_PA_PER_S 0.02
+#define P0_PA 101000.0
+#define PA_PER_M 12.0
+#define MAX_SAMPLES 20000
+
+/* A scenario: a gait (possibly no steps), a true height ramp [t_up0, t_up1] from 0 to dh_m, and an
+ * elevator's vertical acceleration (see elevator_accel) when elevator is set. */
+typedef struct {
+    const pace_t *pace;
+    int n_steps;
+    double walk_start_s;
+    double t_up0_s, t_up1_s, dh_m;
+    int elevator;
+    double duration_s;
+    int16_t init_floor;
+} scenario_t;
+
+typedef struct {
+    int n;                          /* IMU samples */
+    double t_s[MAX_SAMPLES];
+    int8_t activity[MAX_SAMPLES];   /* after each IMU sample */
+    int detected, accepted;
+    int16_t floor_at_end;
+    gait_t gait;
+    sf_activity_t act;
+} trace_t;
+
+static trace_t g_tr, g_tr2;
+
+static double true_height(const scenario_t *const sc, const double t)
+{
+    if (t <= sc->t_up0_s) {
+        return 0.0;
+    }
+    if (t >= sc->t_up1_s) {
+        return sc->dh_m;
+    }
+    return sc->dh_m * (t - sc->t_up0_s) / (sc->t_up1_s - sc->t_up0_s);
+}
+
+/* Elevator vertical acceleration: a jerk-limited start and stop, each a raised-cosine pulse of 2 s
+ * centred on the ends of the height ramp, peak = speed / 1 s (1.5 m/s² at 1.5 m/s), jerk ≤ 2.4 m/s³. */
+static double elevator_accel(const scenario_t *const sc, const double t)
+{
+    if (!sc->elevator) {
+        return 0.0;
+    }
+    const double v = sc->dh_m / (sc->t_up1_s - sc->t_up0_s);
+    const double u0 = t - (sc->t_up0_s - 1.0), u1 = t - (sc->t_up1_s - 1.0);
+    if (u0 >= 0.0 && u0 < 2.0) {
+        return v * pow(sin(GAIT_PI * u0 / 2.0), 2);
+    }
+    if (u1 >= 0.0 && u1 < 2.0) {
+        return -v * pow(sin(GAIT_PI * u1 / 2.0), 2);
+    }
+    return 0.0;
+}
+
+static void run(trace_t *const tr, const scenario_t *const sc, const clock_t_ *const imu_clk, const uint64_t seed)
+{
+    sf_params_t p;
+    sf_params_default(&p);
+    p.init_floor = sc->init_floor;
+    memset(tr, 0, sizeof *tr);
+    rng_t rng = {seed};
+    gait_make(&tr->gait, sc->pace, sc->n_steps, sc->walk_start_s, &rng);
+    sf_steps_t steps;
+    sf_floor_t floor;
+    sf_steps_init(&steps, &p);
+    sf_floor_init(&floor, &p);
+    sf_activity_init(&tr->act, &p);
+    double t_imu = 0.0, t_baro = 0.0;
+    while (t_imu < sc->duration_s || t_baro < sc->duration_s) {
+        if (t_baro <= t_imu) { /* barometer at 25 Hz ±20 % */
+            const double pa = P0_PA - PA_PER_M * true_height(sc, t_baro) + BARO_DRIFT_PA_PER_S * t_baro +
+                              BARO_NOISE_PA * rng_gauss(&rng);
+            const int64_t t_us = T0_US + (int64_t)llround(t_baro * 1e6);
+            sf_floor_update(&floor, &p, t_us, pa);
+            sf_activity_vspeed(&tr->act, &p, t_us, sf_floor_vertical_speed_mps(&floor));
+            t_baro += 0.04 * (1.0 + 0.2 * rng_pm1(&rng));
+            continue;
+        }
+        const double a = gait_accel(&tr->gait, t_imu) + elevator_accel(sc, t_imu) + IMU_NOISE_MPS2 * rng_gauss(&rng);
+        const int64_t t_us = T0_US + (int64_t)llround(t_imu * 1e6);
+        sf_activity_accel(&tr->act, &p, t_us, a);
+        sf_step_event_t ev;
+        if (sf_steps_update(&steps, &p, t_us, a, &ev)) {
+            tr->detected++;
+            tr->accepted += sf_activity_step(&tr->act, &p, &ev);
+        }
+        assert_true(tr->n < MAX_SAMPLES);
+        tr->t_s[tr->n] = t_imu;
+        tr->activity[tr->n++] = sf_activity_current(&tr->act);
+        t_imu += clock_next_dt(imu_clk, &rng);
+    }
+    tr->floor_at_end = sf_floor_current(&floor);
+}
+
+/* Fraction of IMU samples in [t0, t1) classified as `want`. */
+static double fraction(const trace_t *const tr, const double t0, const double t1, const int8_t want)
+{
+    int n = 0, hit = 0;
+    for (int i = 0; i < tr->n; i++) {
+        if (tr->t_s[i] >= t0 && tr->t_s[i] < t1) {
+            n++;
+            hit += tr->activity[i] == want;
+        }
+    }
+    assert_true(n > 0);
+    return (double)hit / n;
+}
+
+static int count(const trace_t *const tr, const double t0, const double t1, const int8_t what)
+{
+    int hit = 0;
+    for (int i = 0; i < tr->n; i++) {
+        hit += tr->t_s[i] >= t0 && tr->t_s[i] < t1 && tr->activity[i] == what;
+    }
+    return hit;
+}
+
+static const clock_t_ k_100hz = {100.0, 0.0};
+static const clock_t_ k_50hz_jitter = {50.0, 0.3};
+
+static void test_still(void **state)
+{
+    (void)state;
+    const scenario_t sc = {&k_normal, 0, 1.0, 1e9, 2e9, 0.0, 0, 30.0, 0};
+    run(&g_tr, &sc, &k_50hz_jitter, 1);
+    assert_int_equal(g_tr.detected, 0);
+    assert_int_equal(g_tr.accepted, 0);
+    assert_true(g_tr.activity[0] == sf_activity_unknown || g_tr.activity[0] == sf_activity_still);
+    /* still from the start: no step ever, and the noise variance (0.01 m²/s⁴) is below 0.05 */
+    assert_true(fraction(&g_tr, 3.0, 30.0, sf_activity_still) == 1.0);
+    assert_true(sf_activity_variance_m2ps4(&g_tr.act) < 0.02);
+}
+
+/* GIVEN a walker standing 5 s, WHEN she walks 60 steps on one floor and stops, THEN walking from the
+ * second step to the last, still again 5 s after the last step (the walking variance, ≈ 2 m²/s⁴,
+ * takes ≈ 3.7 τ to fall below 0.05), never stairs or elevator. */
+static void check_walk(const pace_t *const pace, const clock_t_ *const clk)
+{
+    const scenario_t sc = {pace, 60, 5.0, 1e9, 2e9, 0.0, 0, 60.0, 0};
+    run(&g_tr, &sc, clk, 2);
+    const gait_t *const g = &g_tr.gait;
+    assert_true(fraction(&g_tr, 1.0, 4.0, sf_activity_still) == 1.0);
+    assert_true(fraction(&g_tr, g->t_s[1] + 0.2, g->t_s[60], sf_activity_walking) == 1.0);
+    const double stop_s = g->t_s[60];
+    assert_true(fraction(&g_tr, stop_s + 5.0, 60.0, sf_activity_still) == 1.0);
+    assert_int_equal(count(&g_tr, 0, 60, sf_activity_stairs_up) + count(&g_tr, 0, 60, sf_activity_stairs_down) +
+                         count(&g_tr, 0, 60, sf_activity_elevator),
+                     0);
+    /* every detected step of the walk is accepted (the variance is far above the still level) */
+    assert_true(g_tr.detected >= 60 && g_tr.detected <= 61);
+    assert_int_equal(g_tr.accepted, g_tr.detected);
+    assert_int_equal(g_tr.floor_at_end, 0);
+}
+
+static void test_walking(void **state)
+{
+    (void)state;
+    check_walk(&k_slow, &k_100hz);
+    check_walk(&k_normal, &k_50hz_jitter);
+    check_walk(&k_fast, &k_50hz_jitter);
+}
+
+/* Stairs: 20 steps up 3.5 m (≈ 0.32 m/s) between flat walking; stairs_up while climbing (after the
+ * vertical-speed filter's ≈ 2 s delay), walking before and after, floor 0 → 1. Then the way down. */
+static void check_stairs(const double dh_m, const int16_t init_floor, const int8_t want, const int8_t never,
+                         const int16_t floor_after)
+{
+    scenario_t sc = {&k_normal, 80, 5.0, 0, 0, dh_m, 0, 60.0, init_floor};
+    run(&g_tr, &sc, &k_50hz_jitter, 3); /* first pass: the gait's step times */
+    sc.t_up0_s = g_tr.gait.t_s[20];
+    sc.t_up1_s = g_tr.gait.t_s[40];
+    run(&g_tr, &sc, &k_50hz_jitter, 3); /* same seed: the same gait */
+    const double up0 = sc.t_up0_s, up1 = sc.t_up1_s;
+    assert_true(fraction(&g_tr, up0 + 3.0, up1, want) > 0.95);
+    assert_int_equal(count(&g_tr, 0, 60, never), 0);
+    assert_int_equal(count(&g_tr, 0, 60, sf_activity_elevator), 0);
+    assert_true(fraction(&g_tr, g_tr.gait.t_s[2], up0, sf_activity_walking) == 1.0);
+    assert_true(fraction(&g_tr, up1 + 4.0, g_tr.gait.t_s[80], sf_activity_walking) == 1.0);
+    assert_int_equal(g_tr.floor_at_end, floor_after);
+}
+
+static void test_stairs_up(void **state)
+{
+    (void)state;
+    check_stairs(3.5, 0, sf_activity_stairs_up, sf_activity_stairs_down, 1);
+}
+
+static void test_stairs_down(void **state)
+{
+    (void)state;
+    check_stairs(-3.5, 2, sf_activity_stairs_down, sf_activity_stairs_up, 1);
+}
+
+/* GIVEN a rider standing in an elevator, WHEN it rises 10.5 m in 7 s (1.5 m/s, up to 1.5 m/s² at
+ * both ends), THEN elevator during the ride, no steps, floor 3, still again afterwards. */
+static void test_elevator(void **state)
+{
+    (void)state;
+    const scenario_t sc = {&k_normal, 0, 1.0, 10.0, 17.0, 10.5, 1, 40.0, 0};
+    run(&g_tr, &sc, &k_100hz, 4);
+    assert_int_equal(g_tr.detected, 0);
+    assert_int_equal(g_tr.accepted, 0);
+    assert_true(fraction(&g_tr, 12.0, 17.0, sf_activity_elevator) == 1.0);
+    assert_true(fraction(&g_tr, 3.0, 9.0, sf_activity_still) == 1.0); /* the lift starts at 9 s */
+    assert_true(fraction(&g_tr, 25.0, 40.0, sf_activity_still) == 1.0);
+    assert_int_equal(count(&g_tr, 0, 40, sf_activity_stairs_up) + count(&g_tr, 0, 40, sf_activity_walking), 0);
+    assert_int_equal(g_tr.floor_at_end, 3);
+    /* the same ride down */
+    const scenario_t down = {&k_normal, 0, 1.0, 10.0, 17.0, -10.5, 1, 40.0, 3};
+    run(&g_tr, &down, &k_50hz_jitter, 5);
+    assert_true(fraction(&g_tr, 12.0, 17.0, sf_activity_elevator) == 1.0);
+    assert_int_equal(g_tr.floor_at_end, 0);
+}
+
+/* A step reported while the body is quiet is refused and does not make the walker walk. */
+static void test_step_refused_while_still(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_activity_t a;
+    sf_activity_init(&a, &p);
+    const sf_step_event_t ev0 = {.t_us = 500000, .amax_mps2 = 1, .amin_mps2 = -1, .period_s = 0};
+    assert_false(sf_activity_step(&a, &p, &ev0)); /* before any a_v: refused */
+    rng_t rng = {8};
+    int64_t t_us = 1000000;
+    for (; t_us < 6000000; t_us += 10000) {
+        sf_activity_accel(&a, &p, t_us, 0.05 * rng_gauss(&rng));
+    }
+    assert_int_equal(sf_activity_current(&a), sf_activity_still);
+    for (int i = 0; i < 3; i++) {
+        const sf_step_event_t ev = {.t_us = t_us - 300000 * (3 - i), .amax_mps2 = 1, .amin_mps2 = -1, .period_s = 0.3};
+        assert_false(sf_activity_step(&a, &p, &ev));
+    }
+    assert_int_equal(a.rejected_steps, 4);
+    assert_int_equal(a.accepted_steps, 0);
+    assert_int_equal(sf_activity_current(&a), sf_activity_still);
+    assert_true(sf_activity_step_rate_hz(&a, &p) == 0.0);
+    /* the same steps with a moving body are accepted and make it walk */
+    for (int i = 0; i < 100; i++, t_us += 10000) {
+        sf_activity_accel(&a, &p, t_us, 2.0 * sin(i * 0.35));
+    }
+    for (int i = 0; i < 3; i++) {
+        const sf_step_event_t ev = {.t_us = t_us - 500000 * (3 - i), .amax_mps2 = 1, .amin_mps2 = -1, .period_s = 0.5};
+        assert_true(sf_activity_step(&a, &p, &ev));
+    }
+    assert_int_equal(sf_activity_current(&a), sf_activity_walking);
+    assert_true(fabs(sf_activity_step_rate_hz(&a, &p) - 3 / 2.5) < 1e-12);
+}
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    const scenario_t sc = {&k_fast, 40, 3.0, 8.0, 16.0, 3.5, 0, 30.0, 0};
+    run(&g_tr, &sc, &k_50hz_jitter, 6);
+    run(&g_tr2, &sc, &k_50hz_jitter, 6);
+    assert_memory_equal(&g_tr, &g_tr2, sizeof g_tr);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_still),
+        cmocka_unit_test(test_walking),
+        cmocka_unit_test(test_stairs_up),
+        cmocka_unit_test(test_stairs_down),
+        cmocka_unit_test(test_elevator),
+        cmocka_unit_test(test_step_refused_while_still),
+        cmocka_unit_test(test_deterministic),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,179 @@
+/* test_estimator.c — the whole PDR chain (sf_estimator) on a synthetic walk with known answers.
+ *
+ * GIVEN a walker standing 5 s, walking N steps straight along a known direction, then standing
+ * 10 s, with the device level and yawed by a fixed mounting offset, WHEN every IMU and magnetometer
+ * sample goes through sf_estimator, THEN the step count is N, the displacement points along the
+ * walking direction, the position does not move while standing, and the same input gives
+ * bit-identical output. The gait follows the inverted pendulum: forward acceleration is in antiphase
+ * with vertical velocity. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "sf_estimator.h"
+
+#define PI 3.14159265358979323846
+#define G 9.80665
+
+typedef struct {
+    int steps;              /* accepted steps */
+    double x_m, y_m;        /* final position */
+    double walk_end_x_m, walk_end_y_m; /* position when the walk stopped */
+    double mid_x_m, mid_y_m; /* position half-way through the walk */
+    sf_step_t last_step;
+    uint64_t digest;        /* FNV-1a over every output, for determinism */
+} run_result_t;
+
+static uint64_t fnv(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h = (h ^ p[i]) * 1099511628211ull;
+    }
+    return h;
+}
+
+/* Rotates a nav vector into a level body frame whose x axis points at yaw (CCW from east). */
+static void nav_to_body(const double v[3], double yaw, double out[3])
+{
+    out[0] = cos(yaw) * v[0] + sin(yaw) * v[1];
+    out[1] = -sin(yaw) * v[0] + cos(yaw) * v[1];
+    out[2] = v[2];
+}
+
+static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offset_rad, double step_hz)
+{
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_estimator_t est;
+    sf_estimator_init(&est, &p);
+    run_result_t r = {0};
+    r.digest = 1469598103934665603ull;
+
+    const double rate_hz = 100.0, still0_s = 5.0, still1_s = 10.0;
+    /* n heel strikes (peaks of a_z at phase ¼), ending at phase ½ of the last cycle: the walker
+     * stops in stance, not mid-rise (a cut-off rise would read as one more step) */
+    const double walk_s = (n_steps - 0.5) / step_hz;
+    const double total_s = still0_s + walk_s + still1_s;
+    const double device_yaw = walk_dir_rad - mount_offset_rad; /* offset = walk − device yaw */
+    const double dip = 60.0 * PI / 180.0, field = 48.0;
+    const double m_nav[3] = {0.0, field * cos(dip), -field * sin(dip)};
+    const double a_v = 2.5, w = 2.0 * PI * step_hz;
+    unsigned rng = 12345u;
+    for (int k = 0; k < (int)(total_s * rate_hz); k++) {
+        const double t = k / rate_hz;
+        const double tw = t - still0_s;
+        const bool walking = tw >= 0.0 && tw < walk_s;
+        /* vertical: a_z = A sin(ωt); v_z = −A/ω cos(ωt); forward a_f = −c·v_z (inverted pendulum) */
+        const double az = walking ? a_v * sin(w * tw) : 0.0;
+        const double af = walking ? 1.2 * cos(w * tw) : 0.0;
+        const double al = walking ? 0.3 * sin(0.5 * w * tw) : 0.0;
+        rng = rng * 1103515245u + 12345u;
+        const double noise = ((double)(rng >> 8) / 16777216.0 - 0.5) * 0.1;
+        const double f_nav[3] = {af * cos(walk_dir_rad) - al * sin(walk_dir_rad),
+                                 af * sin(walk_dir_rad) + al * cos(walk_dir_rad), G + az + noise};
+        sf_imu_sample_t s = {.t_us = (int64_t)llround(t * 1e6)};
+        nav_to_body(f_nav, device_yaw, s.accel_mps2);
+        if (k % 2 == 0) {
+            double m_body[3];
+            nav_to_body(m_nav, device_yaw, m_body);
+            sf_estimator_mag(&est, &p, s.t_us, m_body);
+        }
+        sf_step_t step;
+        memset(&step, 0, sizeof step); /* padding too: the digest hashes raw bytes */
+        if (sf_estimator_imu(&est, &p, &s, &step)) {
+            r.steps++;
+            r.last_step = step;
+            r.digest = fnv(r.digest, &step, sizeof step);
+            if (r.steps == n_steps / 2) {
+                r.mid_x_m = est.x_m;
+                r.mid_y_m = est.y_m;
+            }
+        }
+        if (walking || tw < walk_s + 1.0) {
+            r.walk_end_x_m = est.x_m;
+            r.walk_end_y_m = est.y_m;
+        }
+        sf_pose_t pose;
+        memset(&pose, 0, sizeof pose);
+        sf_estimator_pose(&est, &pose);
+        r.digest = fnv(r.digest, &pose, sizeof pose);
+    }
+    r.x_m = est.x_m;
+    r.y_m = est.y_m;
+    return r;
+}
+
+static double angle_deg(double a)
+{
+    return fabs(atan2(sin(a), cos(a))) * 180.0 / PI;
+}
+
+static void test_counts_steps_and_walks_straight(void **state)
+{
+    (void)state;
+    const double dir = 30.0 * PI / 180.0;
+    const run_result_t r = run_walk(100, dir, 0.0, 1.8);
+    assert_int_equal(r.steps, 100);
+    const double dist = hypot(r.x_m, r.y_m);
+    assert_true(dist > 30.0 && dist < 120.0); /* Weinberg with the default K, 0.3–1.2 m per step */
+    assert_true(angle_deg(atan2(r.y_m, r.x_m) - dir) < 3.0);
+    assert_true(angle_deg(r.last_step.heading_rad - dir) < 3.0);
+    assert_true(r.last_step.accel_range_mps2 > 3.0 && r.last_step.accel_range_mps2 < 6.0);
+}
+
+static void test_still_does_not_drift(void **state)
+{
+    (void)state;
+    const run_result_t r = run_walk(60, 0.0, 0.0, 1.8);
+    /* 9 s of standing after the walk: not a millimetre */
+    assert_true(r.x_m == r.walk_end_x_m && r.y_m == r.walk_end_y_m);
+}
+
+static void test_mounting_offset_is_learnt(void **state)
+{
+    (void)state;
+    const double dir = -60.0 * PI / 180.0;
+    const run_result_t r = run_walk(120, dir, 90.0 * PI / 180.0, 1.8);
+    /* the second half of the walk, after the offset is learnt, goes the right way */
+    const double dx = r.x_m - r.mid_x_m, dy = r.y_m - r.mid_y_m;
+    assert_true(angle_deg(atan2(dy, dx) - dir) < 5.0);
+    assert_true(angle_deg(r.last_step.heading_rad - dir) < 5.0);
+}
+
+static void test_paces(void **state)
+{
+    (void)state;
+    const double hz[] = {1.4, 1.8, 2.2};
+    for (int i = 0; i < 3; i++) {
+        const run_result_t r = run_walk(150, 1.0, 0.0, hz[i]);
+        assert_int_equal(r.steps, 150);
+    }
+}
+
+static void test_same_input_gives_identical_output(void **state)
+{
+    (void)state;
+    const run_result_t a = run_walk(80, 2.0, 0.5, 1.9);
+    const run_result_t b = run_walk(80, 2.0, 0.5, 1.9);
+    assert_true(a.digest == b.digest);
+    assert_true(a.x_m == b.x_m && a.y_m == b.y_m && a.steps == b.steps);
+    assert_true(a.last_step.length_m == b.last_step.length_m && a.last_step.t_us == b.last_step.t_us);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_counts_steps_and_walks_straight),
+        cmocka_unit_test(test_still_does_not_drift),
+        cmocka_unit_test(test_mounting_offset_is_learnt),
+        cmocka_unit_test(test_paces),
+        cmocka_unit_test(test_same_input_gives_identical_output),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
