@@ -130,18 +130,19 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
     const double root = sqrt(half_diff * half_diff + cxy * cxy);
     const double l1 = 0.5 * (cxx + cyy) + root;
     const double l2 = 0.5 * (cxx + cyy) - root;
-    double axis = 0.5 * atan2(2.0 * cxy, cxx - cyy);
-    /* sign: forward acceleration anti-correlated with vertical velocity */
-    double cov_fz = cos(axis) * cxz + sin(axis) * cyz;
-    if (cov_fz > 0.0) {
-        axis += PI;
-        cov_fz = -cov_fz;
-    }
-    const double denom = sqrt(fmax(l1, 0.0) * fmax(czz, 0.0));
+    /* The forward axis is the direction of −cov(a_h, v_up): forward acceleration is anti-correlated
+     * with vertical velocity (inverted pendulum), while the lateral sway (half the step rate, its sign
+     * alternating step by step) and turns (centripetal) are not correlated with v_up at all. The
+     * principal axis of a_h alone is not used for the direction: with a sway as strong as the
+     * fore-aft oscillation (common at the waist) it can point anywhere between the two. */
+    const double axis = atan2(-cyz, -cxz);
+    const double var_f = cos(axis) * cos(axis) * cxx + 2.0 * cos(axis) * sin(axis) * cxy + sin(axis) * sin(axis) * cyy;
+    const double cov_fz = -hypot(cxz, cyz);
+    const double denom = sqrt(fmax(var_f, 0.0) * fmax(czz, 0.0));
     a->ratio = l1 / fmax(l2, 1e-12 * fmax(l1, 1e-300));
     a->corr = denom > 0.0 ? cov_fz / denom : 0.0;
     a->offset_rad = wrap_pi(axis);
-    a->good = l1 > 0.0 && a->ratio >= p->heading_pca_min_ratio && a->corr <= -p->heading_min_corr;
+    a->good = l1 > 0.0 && a->corr <= -p->heading_min_corr;
     if (!a->good) {
         return;
     }

@@ -19,13 +19,15 @@
  * dt-weighted first and second moments of the yaw-relative horizontal acceleration a_h (2-D) and of
  * the vertical velocity v_up (a leaky integral, time constant heading_vz_tau_s, of the de-meaned
  * vertical acceleration). Closed windows are summed with a forgetting factor 1 − 1/heading_window_steps.
- * From the sum: the 2×2 covariance C of a_h, its principal axis e (PCA: the walking axis, since the
- * fore-aft acceleration of gait is larger than the lateral sway) and eigenvalue ratio λ1/λ2, and the
- * cross-covariance c = cov(a_h, v_up). The sign of the axis follows the inverted pendulum: the body
- * is highest at mid-stance, where forward speed is lowest, so forward acceleration a_f = e·a_h is
- * negatively correlated with v_up; e is flipped when cov(a_f, v_up) > 0. The step is "good" when
- * λ1/λ2 ≥ heading_pca_min_ratio and corr(a_f, v_up) ≤ −heading_min_corr; the angle of e is then one
- * offset sample. Offset samples are smoothed by a circular mean (exponential, memory
+ * From the sum: the cross-covariance c = cov(a_h, v_up) and the 2×2 covariance C of a_h. The walking
+ * axis follows the inverted pendulum: the body is highest at mid-stance, where forward speed is
+ * lowest, so forward acceleration is negatively correlated with v_up and e = −c/|c| points forward.
+ * The lateral sway (half the step rate, alternating sign from step to step) and centripetal
+ * acceleration in turns are uncorrelated with v_up, so they do not bend e — unlike the principal axis
+ * of C, which a sway as strong as the fore-aft oscillation (common at the waist) turns by tens of
+ * degrees (the first version used PCA + sign and was 74° off on the simulator's gait). The step is
+ * "good" when corr(e·a_h, v_up) ≤ −heading_min_corr; the angle of e is then one
+ *  * offset sample. Offset samples are smoothed by a circular mean (exponential, memory
  * heading_smooth_steps). The estimate is used ("confident") after heading_min_steps good steps with
  * a mean resultant length ≥ 0.5; before that the offset is heading_mount_offset_deg. Once
  * confident it stays so; while the resultant is below 0.5 the last estimate is held.

@@ -50,7 +50,7 @@ DEFAULTS: dict[str, Any] = {
         ],
     },
     "person": {                      # 0 = drawn from the seed (own random stream)
-        "weinberg_k": 0.0,           # step length = K (amax - amin)^(1/4); drawn U(0.45, 0.55)
+        "weinberg_k": 0.0,           # step length = K (amax - amin)^(1/4); drawn 0.5 x stride_scale, 0.45..0.55
         "stride_scale": 0.0,         # x the pace's stride; drawn N(1, 0.06) within 0.88..1.12
         "cadence_scale": 0.0,        # x the pace's (and the stairs') cadence; drawn N(1, 0.04) within 0.92..1.08
     },

@@ -2,7 +2,8 @@
 
 Person (seeded by its own random stream, so the same seed is the same person whatever the pace):
 stride scale ~ N(1, 0.06) and cadence scale ~ N(1, 0.04) (clipped to ±12 % / ±8 %), Weinberg constant
-K ~ U(0.45, 0.55). Pace (``walk.pace``): slow 1.5 Hz / 0.55 m, normal 1.8 Hz / 0.70 m, fast 2.1 Hz /
+K = 0.5 × stride scale × (1 ± 3 %) within 0.45..0.55 (K, like the stride, grows with leg length, so
+people of one pace bounce alike). Pace (``walk.pace``): slow 1.5 Hz / 0.55 m, normal 1.8 Hz / 0.70 m, fast 2.1 Hz /
 0.85 m, times the person's scales. Around a staircase the person slows down (0.9 × cadence, 0.85 ×
 stride); on a flight each step climbs one stair: stride = the tread (0.28 m), cadence
 ``stairs.cadence_hz`` × the person's scale (1.5 Hz: 0.26 m/s vertical).
@@ -111,12 +112,11 @@ class Person:
 def make_person(sc: dict, rng: np.random.Generator) -> Person:
     """The walker's body: drawn from ``rng`` (always the same three draws), scenario values override."""
     p, w = sc["person"], sc["walk"]
-    stride_scale = float(np.clip(1.0 + 0.06 * rng.standard_normal(), 0.88, 1.12))
-    cadence_scale = float(np.clip(1.0 + 0.04 * rng.standard_normal(), 0.92, 1.08))
-    k = float(rng.uniform(0.45, 0.55))
-    stride_scale = p["stride_scale"] or stride_scale
-    cadence_scale = p["cadence_scale"] or cadence_scale
-    k = p["weinberg_k"] or k
+    n_stride, n_cadence, n_k = rng.standard_normal(3)   # always three draws: same seed, same person
+    stride_scale = p["stride_scale"] or float(np.clip(1.0 + 0.06 * n_stride, 0.88, 1.12))
+    cadence_scale = p["cadence_scale"] or float(np.clip(1.0 + 0.04 * n_cadence, 0.92, 1.08))
+    # Weinberg's K grows with leg length, as the stride does: 0.5 x stride scale, ±3 %, within 0.45..0.55
+    k = p["weinberg_k"] or float(np.clip(0.5 * stride_scale * math.exp(0.03 * n_k), 0.45, 0.55))
     c0, l0 = PACES[w["pace"]]
     cadence = w["cadence_hz"] or c0 * cadence_scale
     stride = w["speed_mps"] / cadence if w["speed_mps"] > 0 else (w["stride_m"] or l0 * stride_scale)

@@ -1,15 +1,21 @@
-"""Fixtures for the simulator tests: short simulated runs (via the CLI) and a candump parser."""
+"""Fixtures for the simulator tests: short simulated runs (via the CLI), the default walk simulated
+once in-process, a reference step detector and a candump parser."""
 from __future__ import annotations
 
 import argparse
 import re
+import time
 from pathlib import Path
+
+import numpy as np
 
 import cantools
 import pytest
 
 from stridefix_sim import cli as sim_cli_module
 from stridefix_sim.board import DBC_PATH
+from stridefix_sim.pipeline import simulate
+from stridefix_sim.scenario import default_scenario
 
 SHORT_S = 25.0
 WRAP_START_MS = 2**32 - 5_000
@@ -91,3 +97,33 @@ def candump():
 def sim_cli():
     """``stridefix sim`` entry: argv list -> exit status."""
     return run_cli
+
+
+@pytest.fixture(scope="session")
+def default_result():
+    """GIVEN the built-in default scenario (two-floor tour) simulated once: (SimResult, seconds taken)."""
+    t0 = time.perf_counter()
+    result = simulate(default_scenario())
+    return result, time.perf_counter() - t0
+
+
+def detect_steps(accel_mps2: np.ndarray, rate_hz: float = 100.0, threshold_mps2: float = 0.3,
+                 min_gap_s: float = 0.3) -> np.ndarray:
+    """Reference step detector (not the firmware's): project on the mean gravity direction (fixed
+    mounting), remove the mean, keep samples above ``threshold_mps2`` that are the maximum within
+    ±``min_gap_s``. Returns sample indices."""
+    g = accel_mps2.mean(axis=0)
+    vert = accel_mps2 @ (g / np.linalg.norm(g))
+    vert = vert - np.median(vert)
+    half = int(round(min_gap_s * rate_hz))
+    padded = np.pad(vert, half, constant_values=-np.inf)
+    win_max = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1).max(axis=1)
+    peaks = np.flatnonzero((vert >= win_max) & (vert > threshold_mps2))
+    peaks = peaks[peaks < len(vert) - half]  # a peak is confirmed only by a full window after it
+    # plateaus (equal neighbours) would count twice: keep the first of a run
+    return peaks[np.concatenate([[True], np.diff(peaks) > half])] if len(peaks) else peaks
+
+
+@pytest.fixture(scope="session")
+def step_detector():
+    return detect_steps

@@ -3,15 +3,11 @@ from __future__ import annotations
 
 import configparser
 import json
-import time
-
 import lcm
 import numpy as np
 import pytest
 from stridefix import truth_t
 
-from stridefix_sim.pipeline import simulate
-from stridefix_sim.scenario import default_scenario
 
 SHORT_S = 25.0  # conftest.SHORT_S
 WRAP_START_MS = 2**32 - 5_000  # conftest.WRAP_START_MS
@@ -71,7 +67,8 @@ def test_summary_steps_equal_truth_log_last_step_count(short_run):
     assert s["distance_m"] == pytest.approx(
         sum(np.hypot(b.x_m - a.x_m, b.y_m - a.y_m) for a, b in zip(msgs, msgs[1:])), rel=0.02)
     for key in ("seed", "duration_s", "distance_m", "steps", "imu_samples", "mag_samples", "baro_samples",
-                "wifi_scans", "wifi_ap_frames", "frames_total", "frames_dropped", "board_time_start_ms", "init"):
+                "wifi_scans", "wifi_ap_frames", "frames_total", "frames_dropped", "board_time_start_ms", "init",
+                "floors_visited", "activity_s", "pace", "weinberg_k", "map_rotation_deg"):
         assert key in s
 
 
@@ -97,17 +94,21 @@ def test_init_truth_ini_is_the_first_truth_pose(short_run):
                                           "heading_rad": pytest.approx(first.heading_rad, abs=1e-6), "floor": 0}
 
 
-def test_default_scenario_is_a_2_lap_demo_and_fast():
-    t0 = time.perf_counter()
-    r = simulate(default_scenario())
-    elapsed = time.perf_counter() - t0
+def test_default_scenario_is_the_two_floor_tour_and_fast(default_result):
+    r, elapsed = default_result
     s = r.summary()
     assert elapsed < 15.0
-    assert 180 <= s["duration_s"] <= 240
-    assert s["distance_m"] == pytest.approx(2 * r.walk.route.perimeter_m, rel=1e-3)
-    # back at the start after two laps
-    assert np.hypot(r.walk.x_m[-1] - r.walk.x_m[0], r.walk.y_m[-1] - r.walk.y_m[0]) < 0.05
-    # standing still during the three pauses: no steps, no motion for several seconds
+    assert 240 <= s["duration_s"] <= 360  # 4-6 minutes
+    assert s["route"] == "tour" and s["pace"] == "normal"
+    assert s["floors_visited"] == [0, 1]
+    assert s["map_rotation_deg"] == 20.0
+    assert 0.45 <= s["weinberg_k"] <= 0.55
+    act = s["activity_s"]
+    assert set(act) == {"walking", "still", "stairs", "elevator"}
+    assert sum(act.values()) == pytest.approx(s["duration_s"], abs=0.02)
+    assert act["stairs"] > 8 and 4 < act["elevator"] < 10 and act["still"] > 20 and act["walking"] > 200
+    assert s["distance_m"] == pytest.approx(r.walk.route.length_m, rel=1e-3)
+    # standing still at the start, at the three pauses, in the elevator and at the end
     still = r.walk.speed_mps == 0
     runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], still.astype(int), [0]]))))[::2]
-    assert sum(n >= 300 for n in runs) >= 5  # start, 3 pauses, end
+    assert sum(n >= 300 for n in runs) >= 6
