@@ -73,6 +73,7 @@ typedef struct {
     int64_t board_t_us;   /* latest board time seen */
     int64_t last_health_t_us;
     int64_t last_pose_t_us;
+    int16_t last_pose_floor;
     bool config_written;
     double loop_sum_us;
     double loop_max_us;
@@ -288,6 +289,7 @@ static void write_pose(daemon_t *const d)
                             .scheme = p.scheme};
     SF_LCM_WRITE(d->out, "POSE", d->host_t_us, stridefix_pose_t, &msg);
     d->last_pose_t_us = p.t_us;
+    d->last_pose_floor = p.floor;
 }
 
 static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
@@ -312,7 +314,8 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
                                .floor = step.floor};
         SF_LCM_WRITE(d->out, "STEP", d->host_t_us, stridefix_step_t, &sm);
         write_pose(d);
-    } else if (s->t_us - d->last_pose_t_us >= (int64_t)d->params.output_pose_period_ms * 1000) {
+    } else if (s->t_us - d->last_pose_t_us >= (int64_t)d->params.output_pose_period_ms * 1000 ||
+               sf_floor_current(&d->est.floor) != d->last_pose_floor) {
         write_pose(d);
     }
 }

@@ -83,14 +83,14 @@
     X(floor,  height_m,            double,  3.5,     1.0,     20.0,    "m",     "uniform floor-to-floor height (until a site file gives a table)") \
     X(floor,  height_tau_s,        double,  1.0,     0.05,    30.0,    "s",     "low-pass time constant of the baro height") \
     X(floor,  vspeed_tau_s,        double,  1.0,     0.05,    30.0,    "s",     "low-pass time constant of the vertical speed") \
-    X(floor,  hysteresis_m,        double,  0.25,    0.0,     5.0,     "m",     "height beyond the mid-floor boundary before a floor change counts") \
-    X(floor,  confirm_ms,          int32_t, 2000,    0,       60000,   "ms",    "the new floor must hold this long") \
+    X(floor,  hysteresis_m,        double,  0.15,    0.0,     5.0,     "m",     "height beyond the mid-floor boundary before a floor change counts (> 3 sigma of the filtered height)") \
+    X(floor,  confirm_ms,          int32_t, 500,     0,       60000,   "ms",    "the new floor must hold this long") \
     X(floor,  settle_vspeed_mps,   double,  0.10,    0.01,    5.0,     "m/s",   "|vertical speed| below which the altimeter may be re-referenced") \
     X(floor,  drift_tau_s,         double,  120.0,   1.0,     1e6,     "s",     "while settled, height relaxes to the floor's height (drift removal)") \
     X(floor,  max_gap_ms,          int32_t, 5000,    100,     600000,  "ms",    "baro gap beyond which the filters restart")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
-    X(output, pose_period_ms,      int32_t, 1000,    10,      60000,   "ms",    "POSE publish period between steps") \
+    X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 
 #define SF_PARAM_LIST(X) \

@@ -276,7 +276,10 @@ def resolve_scenario(name_or_path: str | None) -> Scenario:
         return default_scenario()
     if name_or_path in BUILTIN:
         return builtin_scenario(name_or_path)
-    return load_scenario(name_or_path)
+    path = Path(name_or_path)
+    if not path.exists() and path.suffix == "" and len(path.parts) == 1:
+        raise ScenarioError(name_or_path, f"neither a built-in scenario ({', '.join(BUILTIN)}) nor a file")
+    return load_scenario(path)
 
 
 def parse_scenario(text: str, source: str = "<string>") -> Scenario:

@@ -1,9 +1,12 @@
 """Scenario files: defaults, overrides, and clear errors (file and key named, exit status 2)."""
 from __future__ import annotations
 
+import json
+
 import pytest
 
-from stridefix_sim.scenario import DEFAULTS, ScenarioError, load_scenario, parse_scenario
+from stridefix_sim.scenario import (BUILTIN, DEFAULTS, ScenarioError, builtin_scenario, load_scenario,
+                                    parse_scenario, resolve_scenario)
 
 
 def test_file_overrides_only_its_keys(tmp_path):
@@ -36,6 +39,10 @@ def test_unknown_key_is_an_error_naming_file_and_key(tmp_path, text, key):
     ("[can]\nboard_time_start_ms = 4294967296\n", "can.board_time_start_ms"),
     ("[imu]\ngyro_bias_dps = [1, 2]\n", "imu.gyro_bias_dps"),
     ("[world]\nname = 'mars'\n", "world.name"),
+    ("[walk]\npace = 'jog'\n", "walk.pace"),
+    ("[walk]\nroute = 'roof'\n", "walk.route"),
+    ("[walk]\nsurge = 0.1\n", "walk.surge"),
+    ("[person]\nweinberg_k = 2.0\n", "person.weinberg_k"),
 ])
 def test_bad_values_are_errors_naming_the_key(text, key):
     with pytest.raises(ScenarioError, match=f"x.toml: .*'{key}'"):
@@ -65,3 +72,22 @@ def test_cli_missing_file_and_bad_toml_exit_2(tmp_path, sim_cli, capsys):
 def test_cli_bad_override_exits_2(tmp_path, sim_cli, capsys):
     assert sim_cli(["--loss-rate", "2", "--out", str(tmp_path / "o")]) == 2
     assert "can.loss_rate" in capsys.readouterr().err
+
+
+def test_builtin_named_scenarios():
+    assert set(BUILTIN) == {"default", "pace_slow", "pace_normal", "pace_fast"}
+    assert resolve_scenario(None).data == resolve_scenario("default").data == DEFAULTS
+    assert DEFAULTS["walk"]["route"] == "tour" and DEFAULTS["walk"]["pace"] == "normal"
+    for pace in ("slow", "normal", "fast"):
+        sc = builtin_scenario(f"pace_{pace}")
+        assert sc["walk"]["pace"] == pace and sc["walk"]["route"] == "loop" and sc["walk"]["laps"] == 2.0
+        assert sc.source == f"<built-in pace_{pace}>"
+
+
+def test_cli_named_scenario_and_unknown_name(tmp_path, sim_cli, capsys):
+    assert sim_cli(["--scenario", "pace_fast", "--duration-s", "5", "--out", str(tmp_path / "o")]) == 0
+    summary = json.loads((tmp_path / "o" / "sim_summary.json").read_text())
+    assert summary["pace"] == "fast" and summary["scenario_source"] == "<built-in pace_fast>"
+    assert sim_cli(["--scenario", "pace_jog", "--out", str(tmp_path / "p")]) == 2
+    err = capsys.readouterr().err
+    assert "pace_jog" in err and "pace_slow" in err
