@@ -41,8 +41,15 @@ test-python:
 demo: build
 	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
 
+MSINDOOR ?= ../shared/data/msindoor
 bench: build
 	$(PY) -m stridefix_analyzer.cli bench sil-pdr --stridefixd $(STRIDEFIXD) --out out/bench
+	@for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
+		if [ -d "$$floor" ]; then \
+			$(PY) -m stridefix_analyzer.cli realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
+				--out out/bench/realbench/$$(basename $$(dirname $$floor))-$$(basename $$floor) || exit 1; \
+		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
+	done
 
 clean:
 	rm -rf $(BUILD) $(BUILD).cmake.log out
