@@ -302,17 +302,21 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     sf_imu_sample_t in = {.t_us = s->t_us};
     memcpy(in.accel_mps2, s->accel_mps2, sizeof in.accel_mps2);
     memcpy(in.gyro_radps, s->gyro_radps, sizeof in.gyro_radps);
-    sf_step_t step;
-    if (sf_estimator_imu(&d->est, &d->params, &in, &step)) {
-        stridefix_step_t sm = {.t_us = step.t_us,
-                               .index = step.index,
-                               .length_m = (float)step.length_m,
-                               .accel_range_mps2 = (float)step.accel_range_mps2,
-                               .period_s = (float)step.period_s,
-                               .heading_rad = (float)step.heading_rad,
-                               .activity = step.activity,
-                               .floor = step.floor};
+    sf_step_t steps[SF_ESTIMATOR_MAX_STEPS];
+    const int n_steps = sf_estimator_imu(&d->est, &d->params, &in, steps);
+    for (int i = 0; i < n_steps; i++) {
+        const sf_step_t *const st = &steps[i];
+        stridefix_step_t sm = {.t_us = st->t_us,
+                               .index = st->index,
+                               .length_m = (float)st->length_m,
+                               .accel_range_mps2 = (float)st->accel_range_mps2,
+                               .period_s = (float)st->period_s,
+                               .heading_rad = (float)st->heading_rad,
+                               .activity = st->activity,
+                               .floor = st->floor};
         SF_LCM_WRITE(d->out, "STEP", d->host_t_us, stridefix_step_t, &sm);
+    }
+    if (n_steps > 0) {
         write_pose(d);
     } else if (s->t_us - d->last_pose_t_us >= (int64_t)d->params.output_pose_period_ms * 1000 ||
                sf_floor_current(&d->est.floor) != d->last_pose_floor) {

@@ -8,6 +8,7 @@ void sf_activity_init(sf_activity_t *const a, const sf_params_t *const p)
     (void)p;
     *a = (sf_activity_t){0};
     a->activity = sf_activity_unknown;
+    a->last_detection_t_us = INT64_MIN / 2; /* no detection yet: the first one starts a bout */
 }
 
 double sf_activity_variance_m2ps4(const sf_activity_t *const a)
@@ -97,21 +98,48 @@ void sf_activity_accel(sf_activity_t *const a, const sf_params_t *const p, const
     classify(a, p);
 }
 
-bool sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
+/* Records one credited step at t_us. */
+static void credit(sf_activity_t *const a, const int64_t t_us)
 {
-    if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4) {
-        a->rejected_steps++;
-        return false;
-    }
     a->step_head = (a->step_head + 1) % SF_ACTIVITY_STEPS;
-    a->step_t_us[a->step_head] = ev->t_us;
+    a->step_t_us[a->step_head] = t_us;
     if (a->step_count < SF_ACTIVITY_STEPS) {
         a->step_count++;
     }
     a->accepted_steps++;
+}
+
+int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
+{
+    if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4) {
+        a->rejected_steps++;
+        return 0;
+    }
+    const int64_t since_us = ev->t_us - a->last_detection_t_us;
+    /* a second step of the same walk comes one gait period later: not sooner than a fast walker's
+     * step (activity_min_step_period_ms), not later than steps_max_period_ms */
+    const bool in_bout = since_us <= (int64_t)p->steps_max_period_ms * 1000 &&
+                         (!a->held || since_us >= (int64_t)p->activity_min_step_period_ms * 1000);
+    a->last_detection_t_us = ev->t_us;
+    int credited = 0;
+    if (!in_bout) {
+        if (a->held) {
+            a->lone_steps++; /* the previous held detection never got its second step */
+        }
+        a->held = true;
+        a->held_t_us = ev->t_us;
+    } else {
+        if (a->held) {
+            credit(a, a->held_t_us);
+            a->held = false;
+            credited++;
+        }
+        credit(a, ev->t_us);
+        credited++;
+    }
     advance_time(a, ev->t_us);
     classify(a, p);
-    return true;
+    return credited;
 }
 
 void sf_activity_vspeed(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,

@@ -24,6 +24,13 @@
  *      gait), else unknown (handling the device without steps).
  * Before any a_v sample the class is unknown.
  *
+ * A walk has at least two steps. The first detection after steps_max_period_ms without one is held,
+ * not credited: it is credited together with the next detection if that comes between
+ * activity_min_step_period_ms (0.4 s, a fast walker's step) and steps_max_period_ms after it, and
+ * dropped (counted in lone_steps) otherwise. A lone jolt — a lift starting
+ * or stopping, a door slammed, the device knocked — therefore never moves the position, and a real
+ * walk loses nothing; its first step is credited one step late.
+ *
  * False steps while still. sf_activity_step refuses (returns false, counts in `rejected_steps`) a
  * step that comes while σ² < activity_still_var_m2ps4: a body that quiet is not walking, whatever the
  * detector saw. A refused step does not count for the rules above; the estimator must not move the
@@ -57,6 +64,10 @@ typedef struct {
     int32_t step_head, step_count;
     int8_t activity;
     uint32_t accepted_steps, rejected_steps; /* counters, never decrease */
+    uint32_t lone_steps;       /* held first detections that no second one confirmed */
+    bool held;                 /* a first detection waits for its confirmation */
+    int64_t held_t_us;
+    int64_t last_detection_t_us; /* newest detection that was not refused */
 } sf_activity_t;
 
 void sf_activity_init(sf_activity_t *a, const sf_params_t *p);
@@ -64,8 +75,10 @@ void sf_activity_init(sf_activity_t *a, const sf_params_t *p);
 /* One a_v sample [m/s²]. Non-finite values and samples at or before the previous a_v time are ignored. */
 void sf_activity_accel(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double accel_v_mps2);
 
-/* One step event. Returns true when the step is accepted (the estimator moves), false when refused. */
-bool sf_activity_step(sf_activity_t *a, const sf_params_t *p, const sf_step_event_t *ev);
+/* One step event. Returns how many steps the estimator should move now: 0 (refused: the body is
+ * quiet; or held: the first detection of a bout), 1 (this step), or 2 (the held first step of the
+ * bout, confirmed by this one, and this step). */
+int sf_activity_step(sf_activity_t *a, const sf_params_t *p, const sf_step_event_t *ev);
 
 /* One vertical-speed estimate [m/s] (sf_floor_vertical_speed_mps after a baro sample). */
 void sf_activity_vspeed(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double vspeed_mps);

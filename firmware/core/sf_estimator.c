@@ -12,6 +12,7 @@ void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
 {
     *e = (sf_estimator_t){0};
     sf_attitude_init(&e->attitude);
+    sf_magcal_init(&e->magcal, p);
     sf_heading_init(&e->heading, p);
     sf_steps_init(&e->steps, p);
     sf_stride_init(&e->stride, p);
@@ -32,8 +33,30 @@ static double walk_heading(const sf_estimator_t *const e, const sf_params_t *con
     return wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
 }
 
-bool sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
-                      sf_step_t *const step)
+/* Moves the position by one credited step and fills its STEP record. */
+static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_step_event_t *const ev,
+                 const int64_t now_us, sf_step_t *const step)
+{
+    const double length_m = sf_stride_length_m(&e->stride, ev);
+    e->step_count++;
+    e->x_m += length_m * cos(e->heading_rad);
+    e->y_m += length_m * sin(e->heading_rad);
+    e->distance_m += length_m;
+    e->sigma_m += p->estimator_sigma_per_m * length_m;
+    e->weinberg_sum += sf_stride_weinberg_term(ev);
+
+    step->t_us = now_us; /* published when known (causal); ev->t_us is the extremum, earlier */
+    step->index = e->step_count;
+    step->length_m = length_m;
+    step->accel_range_mps2 = sf_stride_range_mps2(ev);
+    step->period_s = ev->period_s;
+    step->heading_rad = e->heading_rad;
+    step->activity = sf_activity_current(&e->activity);
+    step->floor = sf_floor_current(&e->floor);
+}
+
+int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
+                     sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
     sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
     double f_nav[3];
@@ -55,36 +78,33 @@ bool sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const
 
     sf_step_event_t ev;
     if (!sf_steps_update(&e->steps, p, s->t_us, a_v, &ev)) {
-        return false;
+        return 0;
     }
     sf_heading_on_step(&e->heading, p, s->t_us);
-    if (!sf_activity_step(&e->activity, p, &ev)) {
-        e->steps_refused++;
-        return false;
+    const int credited = sf_activity_step(&e->activity, p, &ev);
+    if (credited == 0) {
+        if (e->activity.held && e->activity.held_t_us == ev.t_us) {
+            e->held_event = ev; /* the first step of a bout waits for its second */
+        } else {
+            e->steps_refused++;
+        }
+        return 0;
     }
-    const double length_m = sf_stride_length_m(&e->stride, &ev);
-    e->step_count++;
-    e->x_m += length_m * cos(e->heading_rad);
-    e->y_m += length_m * sin(e->heading_rad);
-    e->distance_m += length_m;
-    e->sigma_m += p->estimator_sigma_per_m * length_m;
-    e->weinberg_sum += sf_stride_weinberg_term(&ev);
-
-    step->t_us = s->t_us; /* published when known (causal); ev.t_us is the extremum, slightly earlier */
-    step->index = e->step_count;
-    step->length_m = length_m;
-    step->accel_range_mps2 = sf_stride_range_mps2(&ev);
-    step->period_s = ev.period_s;
-    step->heading_rad = e->heading_rad;
-    step->activity = sf_activity_current(&e->activity);
-    step->floor = sf_floor_current(&e->floor);
-    return true;
+    int n = 0;
+    if (credited == 2) {
+        move(e, p, &e->held_event, s->t_us, &steps[n++]);
+    }
+    move(e, p, &ev, s->t_us, &steps[n++]);
+    return n;
 }
 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
-    sf_attitude_update_mag(&e->attitude, p, t_us, field_ut);
+    sf_magcal_update(&e->magcal, p, t_us, field_ut);
+    double corrected_ut[3];
+    sf_magcal_apply(&e->magcal, field_ut, corrected_ut);
+    sf_attitude_update_mag(&e->attitude, p, t_us, corrected_ut);
 }
 
 void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,

@@ -53,6 +53,16 @@
     X(heading,  min_corr,            double,  0.2,     0.0,     1.0,     "",      "|corr(a_forward, v_up)| for a good step") \
     X(heading,  vz_tau_s,            double,  1.0,     0.1,     20.0,    "s",     "leak of the vertical-velocity integrator")
 
+/* sf_magcal.h */
+#define SF_PARAMS_MAGCAL(X)                                                                            \
+    X(magcal, enable,              int32_t, 1,       0,       1,       "",      "online hard-iron calibration: 1 = on, 0 = off (field used as measured)") \
+    X(magcal, tau_s,               double,  600.0,   10.0,    1e5,     "s",     "memory of the sphere fit (exponential forgetting time constant)") \
+    X(magcal, ridge_ut,            double,  0.5,     0.0,     100.0,   "uT",    "ridge prior toward b = 0 on observed directions: weight 4 W ridge^2, shrink ridge^2/(spread^2+ridge^2)") \
+    X(magcal, min_spread_ut,       double,  6.0,     0.1,     200.0,   "uT",    "RMS spread of the samples along a direction for it to be observed (180 deg turn: 0.31 H)") \
+    X(magcal, max_offset_ut,       double,  30.0,    0.0,     500.0,   "uT",    "bound on |b|: a larger solution is not taken") \
+    X(magcal, gate_ut,             double,  5.0,     0.1,     1e6,     "uT",    "use a sample when | |m - b| - R | <= gate (before the first fit: gate + max_offset around attitude.mag_field_ut)") \
+    X(magcal, max_rms_ut,          double,  2.0,     0.05,    1e6,     "uT",    "take a fit only when the RMS of |m - b| - R over the memory is below this (before the first fit: restart the memory)")
+
 /* sf_steps.h, sf_stride.h */
 #define SF_PARAMS_STEPS(X)                                                                             \
     X(steps,  detector,            int32_t, 0,       0,       1,       "",      "0 = Pan-Tompkins (Jaeger et al.), 1 = trough-then-peak (SmartLocator)") \
@@ -60,7 +70,10 @@
     X(steps,  max_gap_ms,          int32_t, 500,     20,      10000,   "ms",    "a_v gap beyond which the filters and the detector restart") \
     X(steps,  max_period_ms,       int32_t, 2000,    500,     2500,    "ms",    "a step later than this after the previous one starts a walk (period 0)") \
     X(steps,  pt_lowpass_hz,       double,  5.0,     1.0,     20.0,    "Hz",    "Pan-Tompkins: low-pass of a_v before the derivative") \
-    X(steps,  pt_threshold,        double,  0.5,     0.01,    100.0,   "",      "Pan-Tompkins: peak of (1+y)^2-1 needed, y = 50 Hz derivative in m/s2") \
+    X(steps,  pt_threshold,        double,  0.15,     0.01,    100.0,   "",      "Pan-Tompkins: lowest threshold on the peak of (1+y)^2-1, y = 50 Hz derivative in m/s2") \
+    X(steps,  pt_adaptive,         double,  0.25,    0.0,     1.0,     "",      "Pan-Tompkins: threshold = NPK + this x (SPK - NPK), as in the QRS detector; 0 = fixed") \
+    X(steps,  pt_noise_factor,     double,  4,     0.0,     20.0,    "",      "Pan-Tompkins: threshold at least this x NPK (the level of non-step peaks: sensor noise when still)") \
+    X(steps,  min_range_mps2,      double,  0.5,     0.0,     20.0,    "m/s2",  "both detectors: smallest a_v range (amax - amin, 3 Hz) over a step") \
     X(steps,  tp_lowpass_hz,       double,  3.0,     0.5,     10.0,    "Hz",    "trough-peak: low-pass of a_v (also the amax/amin signal)") \
     X(steps,  tp_max_interval_ms,  int32_t, 800,     100,     3000,    "ms",    "trough-peak: longest trough-to-peak time") \
     X(steps,  tp_min_rise_mps2,    double,  1.0,     0.05,    20.0,    "m/s2",  "trough-peak: smallest peak minus trough") \
@@ -75,6 +88,7 @@
 #define SF_PARAMS_ACTIVITY(X)                                                                          \
     X(activity, var_tau_s,         double,  1.0,     0.1,     20.0,    "s",     "time constant of the a_v mean/variance") \
     X(activity, still_var_m2ps4,   double,  0.05,    0.0,     100.0,   "m2/s4", "a_v variance below which the body is quiet (steps rejected)") \
+    X(activity, min_step_period_ms, int32_t, 400,    200,     2000,    "ms",    "a detection this soon after a bout's held first one does not confirm it") \
     X(activity, still_time_ms,     int32_t, 2000,    100,     60000,   "ms",    "no step for this long (and quiet) is still") \
     X(activity, step_window_ms,    int32_t, 2500,    500,     10000,   "ms",    "steps counted over this window for the step rate") \
     X(activity, min_steps,         int32_t, 2,       1,       8,       "steps", "steps in the window needed to be walking") \
@@ -94,7 +108,7 @@
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 
 #define SF_PARAM_LIST(X) \
-    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_STEPS(X) SF_PARAMS_ACTIVITY(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) SF_PARAMS_ACTIVITY(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

@@ -13,9 +13,11 @@ static double lp_gain(const double dt_s, const double cutoff_hz)
 
 void sf_steps_init(sf_steps_t *const s, const sf_params_t *const p)
 {
-    (void)p;
     *s = (sf_steps_t){0};
     s->last_step_t_us = INT64_MIN / 2;
+    /* Start cautious: the noise level is unknown, so assume non-step peaks twice the lowest threshold;
+     * NPK learns the real level within a few seconds of peaks. */
+    s->npk = 2.0 * p->steps_pt_threshold;
 }
 
 /* Restart filters, grid and detector at sample (t, a); the previous step time survives. */
@@ -45,10 +47,10 @@ static void push_event(sf_steps_t *const s, const sf_step_event_t *const ev)
 }
 
 /* Builds the event for a step at step_t_us found at grid point now_us (the ring's newest). */
-static void emit(sf_steps_t *const s, const sf_params_t *const p, const int64_t step_t_us)
+static bool emit(sf_steps_t *const s, const sf_params_t *const p, const int64_t step_t_us)
 {
     if (step_t_us - s->last_step_t_us < (int64_t)p->steps_refractory_ms * 1000) {
-        return;
+        return false;
     }
     sf_step_event_t ev = {.t_us = step_t_us, .amax_mps2 = -INFINITY, .amin_mps2 = INFINITY, .period_s = 0.0};
     int32_t i = s->ring_head;
@@ -63,6 +65,10 @@ static void emit(sf_steps_t *const s, const sf_params_t *const p, const int64_t 
     if (s->ring_count == 0) { /* cannot happen: a detection needs grid points; keep the event sane */
         ev.amax_mps2 = ev.amin_mps2 = 0.0;
     }
+    if (ev.amax_mps2 - ev.amin_mps2 < p->steps_min_range_mps2) {
+        s->too_small++; /* the body barely moved: sensor noise or a fidget, not a step */
+        return false;
+    }
     const int64_t since_us = step_t_us - s->last_step_t_us;
     if (since_us <= (int64_t)p->steps_max_period_ms * 1000) {
         ev.period_s = (double)since_us * 1e-6;
@@ -70,6 +76,7 @@ static void emit(sf_steps_t *const s, const sf_params_t *const p, const int64_t 
     s->last_step_t_us = step_t_us;
     s->steps++;
     push_event(s, &ev);
+    return true;
 }
 
 static void pan_tompkins(sf_steps_t *const s, const sf_params_t *const p, const int64_t t_us, const double x)
@@ -86,16 +93,29 @@ static void pan_tompkins(sf_steps_t *const s, const sf_params_t *const p, const 
     const double y = d > 0.0 ? d : 0.0;
     const double z = (1.0 + y) * (1.0 + y) - 1.0;
     const int64_t peak_t_us = t_us - SF_STEPS_GRID_US;
-    if (s->n_grid >= 7 && s->z1 > s->z2 && s->z1 >= z && s->z1 > p->steps_pt_threshold &&
-        peak_t_us - s->last_step_t_us >= (int64_t)p->steps_refractory_ms * 1000 &&
-        (!s->cand_valid || s->z1 > s->cand_z)) {
-        s->cand_valid = true; /* a first peak, or a higher one within the search time */
-        s->cand_z = s->z1;
-        s->cand_t_us = peak_t_us;
+    if (peak_t_us - s->last_step_t_us > (int64_t)p->steps_max_period_ms * 1000) {
+        /* no step for a while: let the step level fall back so a softer gait is found again */
+        s->spk += (1.0 - exp(-(double)SF_STEPS_GRID_US * 1e-6 / 1.0)) * (s->npk - s->spk);
+    }
+    const double theta = fmax(fmax(p->steps_pt_threshold, p->steps_pt_noise_factor * s->npk),
+                              s->npk + p->steps_pt_adaptive * (s->spk - s->npk));
+    if (s->n_grid >= 7 && s->z1 > s->z2 && s->z1 >= z) {
+        if (s->z1 > theta && peak_t_us - s->last_step_t_us >= (int64_t)p->steps_refractory_ms * 1000 &&
+            (!s->cand_valid || s->z1 > s->cand_z)) {
+            s->cand_valid = true; /* a first peak, or a higher one within the search time */
+            s->cand_z = s->z1;
+            s->cand_t_us = peak_t_us;
+        } else if (s->z1 <= theta) {
+            s->npk += 0.125 * (s->z1 - s->npk);
+        }
     }
     if (s->cand_valid && t_us - s->cand_t_us >= (int64_t)SF_STEPS_PT_SEARCH_MS * 1000) {
         s->cand_valid = false;
-        emit(s, p, s->cand_t_us);
+        if (emit(s, p, s->cand_t_us)) {
+            s->spk += 0.125 * (s->cand_z - s->spk);
+        } else {
+            s->npk += 0.125 * (s->cand_z - s->npk);
+        }
     }
     s->z2 = s->z1;
     s->z1 = z;
@@ -116,7 +136,7 @@ static void trough_peak(sf_steps_t *const s, const sf_params_t *const p, const i
         } else if (mid > s->tp_prev2 && mid >= x && s->trough_valid) { /* local maximum */
             if (mid_t_us - s->trough_t_us <= max_us && mid - s->trough_mps2 >= p->steps_tp_min_rise_mps2 &&
                 mid_t_us - s->last_step_t_us >= (int64_t)p->steps_refractory_ms * 1000) {
-                emit(s, p, mid_t_us);
+                (void)emit(s, p, mid_t_us);
                 s->trough_valid = false;
             }
         }

@@ -14,8 +14,21 @@
  *      a 200 Hz input downsampled (after the low-pass).
  *   3a. steps_detector = 0, Pan–Tompkins variant (Jäger, Süß, Becker, Eq. 6–7) on x_pt:
  *      d(n) = ¼[2x(n) + x(n−1) − x(n−3) − 2x(n−4)], y(n) = max(d(n), 0), z(n) = (1 + y(n))² − 1.
- *      A step is z(n−1) > z(n−2), z(n−1) ≥ z(n), z(n−1) > steps_pt_threshold (the peak over the last
- *      three values), at least steps_refractory_ms after the previous step. Because n counts 20 ms
+ *      A step is z(n−1) > z(n−2), z(n−1) ≥ z(n), z(n−1) > θ (the peak over the last three values),
+ *      at least steps_refractory_ms after the previous step. The paper leaves the threshold open; θ
+ *      adapts as in Pan and Tompkins' QRS detector: SPK and NPK are running levels (gain ⅛) of the
+ *      peaks taken as steps and of the other local maxima of z, and
+ *          θ = max(steps_pt_threshold, steps_pt_noise_factor · NPK, NPK + steps_pt_adaptive · (SPK − NPK)),
+ *      so a slow, soft gait (z peaks ≈ 0.3) and a fast one (≈ 3) are both counted without counting
+ *      the fast gait's secondary bumps, nor the sensor noise of a still body (the NPK term). After steps_max_period_ms without a step SPK decays toward
+ *      NPK (time constant 1 s), so a slow walk after a fast one is found again; steps_pt_adaptive = 0
+ *      gives the fixed threshold steps_pt_threshold. NPK starts at 2 · steps_pt_threshold (the noise
+ *      level is not known yet) and learns the real one from the peaks that follow.
+ *   4. Both detectors: a detection is a step only if the 3 Hz a_v moved by at least
+ *      steps_min_range_mps2 (amax − amin) since the previous step. By Weinberg's law a step of length
+ *      L needs a range (L/K)⁴: 0.5 m/s² is a 0.4 m step at K = 0.47, shorter than any walking step,
+ *      while a still body's noise and a lift's smooth start move it far less. A refused detection
+ *      counts in too_small (and as a noise peak for the adaptive threshold). Because n counts 20 ms
  *      grid points, d is ≈ 40 ms × da_v/dt at every input rate; on a raw 100 Hz stream the same
  *      formula would give half the value and the threshold would mean something else.
  *      DEVIATION: the paper takes the first such peak. Noise makes local maxima of z on the steep swing
@@ -96,6 +109,7 @@ typedef struct {
     bool cand_valid; /* a peak waiting out SF_STEPS_PT_SEARCH_MS */
     double cand_z;
     int64_t cand_t_us;
+    double spk, npk; /* adaptive threshold: levels of step peaks and of other peaks of z */
     /* trough-peak history: x_tp(n−1), x_tp(n−2), trough */
     double tp_prev1, tp_prev2;
     bool trough_valid;
@@ -112,6 +126,7 @@ typedef struct {
     int32_t queue_head, queue_count;
     /* counters, never decrease */
     uint32_t steps;     /* events produced */
+    uint32_t too_small; /* detections refused: a_v range over the step below steps_min_range_mps2 */
     uint32_t gaps;      /* restarts after a gap */
     uint32_t backwards; /* samples at or before the previous time, ignored */
     uint32_t dropped;   /* events lost because the queue was full (should stay 0) */

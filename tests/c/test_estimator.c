@@ -84,12 +84,13 @@ static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offs
             nav_to_body(m_nav, device_yaw, m_body);
             sf_estimator_mag(&est, &p, s.t_us, m_body);
         }
-        sf_step_t step;
-        memset(&step, 0, sizeof step); /* padding too: the digest hashes raw bytes */
-        if (sf_estimator_imu(&est, &p, &s, &step)) {
+        sf_step_t steps[SF_ESTIMATOR_MAX_STEPS];
+        memset(steps, 0, sizeof steps); /* padding too: the digest hashes raw bytes */
+        const int n = sf_estimator_imu(&est, &p, &s, steps);
+        for (int i = 0; i < n; i++) {
             r.steps++;
-            r.last_step = step;
-            r.digest = fnv(r.digest, &step, sizeof step);
+            r.last_step = steps[i];
+            r.digest = fnv(r.digest, &steps[i], sizeof steps[i]);
             if (r.steps == n_steps / 2) {
                 r.mid_x_m = est.x_m;
                 r.mid_y_m = est.y_m;
