@@ -8,6 +8,11 @@ and the floor hit rate, next to the targets, and writes ``OUT/sil_pdr.json``.
 The start position is truth-initialised (the simulator's ``init_truth.ini``): PDR alone has no
 absolute position. Site facts the firmware will later read from the site file (map rotation) are
 passed from the simulator's summary with ``--set``.
+
+Stride calibration, as a user would do it: before the scored walks, the same person (same seed)
+walks one lap of the floor-0 loop at normal pace; stridefixd runs on it and K = lap distance /
+Σ (amax − amin)^¼ over its STEP messages. The scored walk then runs with that K. Nothing of the
+scored walk's truth enters the estimator; the person's true K is reported beside the learnt one.
 """
 from __future__ import annotations
 
@@ -22,6 +27,15 @@ from pathlib import Path
 import numpy as np
 
 from stridefix_analyzer.analyze import run_analyze
+from stridefix_analyzer.logread import read_logs
+
+CALIBRATION_SCENARIO = """# one lap of the floor-0 loop at normal pace, no pauses: the stride calibration walk
+[walk]
+route = "loop"
+laps = 1
+pace = "normal"
+pause = []
+"""
 
 DEFAULT_OUT = "out/bench"
 DEFAULT_SCENARIOS = ["default", "pace_slow", "pace_normal", "pace_fast"]
@@ -43,10 +57,34 @@ def _run(cmd: list[str], what: str) -> subprocess.CompletedProcess:
     return proc
 
 
-def run_one(scenario: str, seed: int, stridefixd: Path, out_dir: Path) -> dict:
+def _stridefix() -> str:
+    return str(Path(sys.executable).with_name("stridefix"))
+
+
+def calibrate_k(seed: int, stridefixd: Path, out_dir: Path, sets: list[str] = ()) -> float:
+    """Weinberg K of the person of ``seed`` from a calibration lap of known length (see module doc)."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    scenario = out_dir / "calibration.toml"
+    scenario.write_text(CALIBRATION_SCENARIO)
+    _run([_stridefix(), "sim", "--out", str(out_dir), "--seed", str(seed), "--scenario", str(scenario)],
+         f"calibration sim seed {seed}")
+    summary = json.loads((out_dir / "sim_summary.json").read_text())
+    log = out_dir / "stridefixd.lcmlog"
+    _run([str(stridefixd), "--input", str(out_dir / "board.candump"), "--log", str(log), "-q",
+          "--config", str(out_dir / "init_truth.ini"), *[a for kv in sets for a in ("--set", kv)]],
+         f"calibration stridefixd seed {seed}")
+    steps = read_logs([str(log)]).tables["STEP"]
+    weinberg_sum = float(np.sum(np.asarray(steps["accel_range_mps2"], float) ** 0.25))
+    if weinberg_sum <= 0:
+        raise BenchError(f"calibration walk seed {seed}: no steps detected in {log}")
+    return summary["distance_m"] / weinberg_sum
+
+
+def run_one(scenario: str, seed: int, stridefixd: Path, out_dir: Path, weinberg_k: float | None,
+            sets: list[str] = ()) -> dict:
     """Simulate one walk, replay it through stridefixd, score it; return the row of numbers."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    stridefix = str(Path(sys.executable).with_name("stridefix"))
+    stridefix = _stridefix()
     t0 = time.perf_counter()
     sim = [stridefix, "sim", "--out", str(out_dir), "--seed", str(seed)]
     if scenario != "default":
@@ -58,12 +96,17 @@ def run_one(scenario: str, seed: int, stridefixd: Path, out_dir: Path) -> dict:
           "--config", str(out_dir / "init_truth.ini")]
     if "map_rotation_deg" in summary:
         fw += ["--set", f"heading.map_rotation_deg={summary['map_rotation_deg']}"]
+    if weinberg_k is not None:
+        fw += ["--set", f"stride.weinberg_k={weinberg_k:.6f}"]
+    for kv in sets:
+        fw += ["--set", kv]
     _run(fw, f"stridefixd {scenario} seed {seed}")
     metrics, _ = run_analyze([str(log), str(out_dir / "truth.lcmlog")], str(out_dir),
                              label=f"{scenario} seed {seed}, PDR only, truth-initialised start")
     steps = metrics["steps"]
     return {
         "scenario": scenario, "seed": seed,
+        "weinberg_k_used": weinberg_k, "weinberg_k_true": summary.get("weinberg_k"),
         "duration_s": summary.get("duration_s"), "distance_m": metrics["distance_walked_m"],
         "steps_truth": steps["truth"], "steps_detected": steps["detected"],
         "step_error_pct": steps["error_pct"],
@@ -89,14 +132,17 @@ def meets_targets(row: dict) -> dict:
 
 
 def format_table(rows: list[dict]) -> str:
-    head = (f"{'scenario':<12}{'seed':>5}{'dist m':>8}{'steps':>7}{'err %':>7}{'hdg°':>6}"
+    head = (f"{'scenario':<12}{'seed':>5}{'K used':>7}{'K true':>7}{'dist m':>8}{'steps':>7}{'err %':>7}{'hdg°':>6}"
             f"{'mean m':>8}{'final m':>8}{'final %':>8}{'floor':>7}  targets (steps/floor/final)")
     lines = [head]
     for r in rows:
         t = r["targets"]
         mark = " ".join({True: "ok", False: "MISS", None: "-"}[t[k]] for k in ("steps", "floor", "final"))
         fh = r["floor_hit_rate"]
-        lines.append(f"{r['scenario']:<12}{r['seed']:>5}{r['distance_m']:>8.1f}{r['steps_truth']:>7}"
+        ku = r["weinberg_k_used"]
+        kt = r["weinberg_k_true"]
+        lines.append(f"{r['scenario']:<12}{r['seed']:>5}{(ku if ku else float('nan')):>7.3f}"
+                     f"{(kt if kt else float('nan')):>7.3f}{r['distance_m']:>8.1f}{r['steps_truth']:>7}"
                      f"{r['step_error_pct']:>+7.2f}{r['heading_rms_deg']:>6.1f}{r['mean_error_m']:>8.2f}"
                      f"{r['final_error_m']:>8.2f}{r['final_error_pct']:>8.2f}"
                      f"{(100 * fh if fh is not None else float('nan')):>6.1f}%  {mark}")
@@ -106,15 +152,23 @@ def format_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def run_sil_pdr(scenarios: list[str], seeds: list[int], stridefixd: Path, out: Path) -> dict:
+def run_sil_pdr(scenarios: list[str], seeds: list[int], stridefixd: Path, out: Path,
+                calibrate: bool = True, sets: list[str] = ()) -> dict:
     rows = []
+    k_by_seed = {}
+    if calibrate:
+        for seed in seeds:
+            print(f"bench sil-pdr: calibration walk, seed {seed}", file=sys.stderr, flush=True)
+            k_by_seed[seed] = calibrate_k(seed, stridefixd, out / "sil_pdr" / f"calibration-s{seed}", sets)
     n = len(scenarios) * len(seeds)
     for i, (scenario, seed) in enumerate((s, k) for s in scenarios for k in seeds):
         print(f"bench sil-pdr: [{i + 1}/{n}] {scenario} seed {seed}", file=sys.stderr, flush=True)
-        row = run_one(scenario, seed, stridefixd, out / "sil_pdr" / f"{scenario}-s{seed}")
+        row = run_one(scenario, seed, stridefixd, out / "sil_pdr" / f"{scenario}-s{seed}", k_by_seed.get(seed),
+                      sets)
         row["targets"] = meets_targets(row)
         rows.append(row)
-    doc = {"bench": "sil_pdr", "targets": TARGETS, "runs": rows,
+    doc = {"bench": "sil_pdr", "targets": TARGETS, "stride_calibration": calibrate, "sets": list(sets),
+           "runs": rows,
            "all_targets_met": all(v is not False for r in rows for v in r["targets"].values())}
     out.mkdir(parents=True, exist_ok=True)
     (out / "sil_pdr.json").write_text(json.dumps(doc, indent=2, default=float) + "\n")
@@ -132,6 +186,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--stridefixd", default=str(DEFAULT_STRIDEFIXD), metavar="PATH",
                    help=f"the firmware binary (default: {DEFAULT_STRIDEFIXD})")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default: {DEFAULT_OUT})")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
+                   help="passed to stridefixd (e.g. attitude.mode=1), to compare variants; repeatable")
+    p.add_argument("--no-calibration", action="store_true",
+                   help="skip the per-person stride calibration walk (use the configured default K)")
     return p
 
 
@@ -147,7 +205,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     scenarios = [s for s in args.scenarios.split(",") if s]
     try:
-        doc = run_sil_pdr(scenarios, seeds, stridefixd, Path(args.out))
+        doc = run_sil_pdr(scenarios, seeds, stridefixd, Path(args.out), calibrate=not args.no_calibration,
+                          sets=args.sets)
     except BenchError as exc:
         print(f"stridefix bench: error: {exc}", file=sys.stderr)
         return 1

@@ -47,7 +47,9 @@ static void classify(sf_activity_t *const a, const sf_params_t *const p)
     const bool recent_step =
         a->step_count > 0 && t_us - a->step_t_us[a->step_head] <= (int64_t)p->activity_still_time_ms * 1000;
     const double v = a->vspeed_mps;
-    if (stepping && v > p->activity_stairs_vspeed_mps) {
+    if (fabs(v) > 2.0 * p->activity_elevator_vspeed_mps) {
+        a->activity = sf_activity_elevator; /* faster than anyone climbs stairs: whatever the steps say */
+    } else if (stepping && v > p->activity_stairs_vspeed_mps) {
         a->activity = sf_activity_stairs_up;
     } else if (stepping && v < -p->activity_stairs_vspeed_mps) {
         a->activity = sf_activity_stairs_down;
@@ -111,8 +113,9 @@ static void credit(sf_activity_t *const a, const int64_t t_us)
 
 int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
 {
-    if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4) {
-        a->rejected_steps++;
+    if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4 ||
+        fabs(a->vspeed_mps) > 2.0 * p->activity_elevator_vspeed_mps) {
+        a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */
         return 0;
     }
     const int64_t since_us = ev->t_us - a->last_detection_t_us;

@@ -13,6 +13,8 @@
  *     (times kept in a ring of SF_ACTIVITY_STEPS); step rate = steps in the window / window, which
  *     saturates at SF_ACTIVITY_STEPS / window (3.2 steps/s with the default 2.5 s).
  * Rules, in this order (t = the newest input time):
+ *   0. |v| > 2 · activity_elevator_vspeed_mps (0.6 m/s: faster than stairs are climbed) → elevator,
+ *      and step detections are refused meanwhile (a lift's jerks are not steps)
  *   1. stepping and v >  activity_stairs_vspeed_mps (0.15 m/s)  → stairs_up
  *   2. stepping and v < −activity_stairs_vspeed_mps              → stairs_down
  *   3. stepping                                                  → walking

@@ -26,7 +26,7 @@
 
 /* sf_attitude.h, sf_heading.h */
 #define SF_PARAMS_ATTITUDE(X)                                                                          \
-    X(attitude, mode,                int32_t, 0,       0,       1,       "",      "0 = complementary (Ramadhan 2016), 1 = Mahony") \
+    X(attitude, mode,                int32_t, 1,       0,       1,       "",      "0 = complementary (Ramadhan 2016), 1 = Mahony (with gyro bias; the default: better heading in SIL)") \
     X(attitude, tau_s,               double,  0.75,    0.02,    30.0,    "s",     "complementary time constant: alpha = tau/(tau+dt)") \
     X(attitude, mahony_kp,           double,  1.0,     0.0,     20.0,    "1/s",   "Mahony proportional gain on the gravity error") \
     X(attitude, mahony_ki,           double,  0.1,     0.0,     5.0,     "1/s2",  "Mahony integral gain (gyro bias) on gravity and yaw errors") \
@@ -71,8 +71,8 @@
     X(steps,  max_period_ms,       int32_t, 2000,    500,     2500,    "ms",    "a step later than this after the previous one starts a walk (period 0)") \
     X(steps,  pt_lowpass_hz,       double,  5.0,     1.0,     20.0,    "Hz",    "Pan-Tompkins: low-pass of a_v before the derivative") \
     X(steps,  pt_threshold,        double,  0.15,     0.01,    100.0,   "",      "Pan-Tompkins: lowest threshold on the peak of (1+y)^2-1, y = 50 Hz derivative in m/s2") \
-    X(steps,  pt_adaptive,         double,  0.25,    0.0,     1.0,     "",      "Pan-Tompkins: threshold = NPK + this x (SPK - NPK), as in the QRS detector; 0 = fixed") \
-    X(steps,  pt_noise_factor,     double,  4,     0.0,     20.0,    "",      "Pan-Tompkins: threshold at least this x NPK (the level of non-step peaks: sensor noise when still)") \
+    X(steps,  pt_adaptive,         double,  0.1,    0.0,     1.0,     "",      "Pan-Tompkins: threshold = NPK + this x (SPK - NPK), as in the QRS detector; 0 = fixed") \
+    X(steps,  pt_noise_factor,     double,  2,     0.0,     20.0,    "",      "Pan-Tompkins: threshold at least this x NPK (the level of non-step peaks: sensor noise when still)") \
     X(steps,  min_range_mps2,      double,  0.5,     0.0,     20.0,    "m/s2",  "both detectors: smallest a_v range (amax - amin, 3 Hz) over a step") \
     X(steps,  tp_lowpass_hz,       double,  3.0,     0.5,     10.0,    "Hz",    "trough-peak: low-pass of a_v (also the amax/amin signal)") \
     X(steps,  tp_max_interval_ms,  int32_t, 800,     100,     3000,    "ms",    "trough-peak: longest trough-to-peak time") \

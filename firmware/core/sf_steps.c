@@ -109,7 +109,7 @@ static void pan_tompkins(sf_steps_t *const s, const sf_params_t *const p, const 
             s->npk += 0.125 * (s->z1 - s->npk);
         }
     }
-    if (s->cand_valid && t_us - s->cand_t_us >= (int64_t)SF_STEPS_PT_SEARCH_MS * 1000) {
+    if (s->cand_valid && t_us - s->cand_t_us >= (int64_t)p->steps_refractory_ms * 1000) {
         s->cand_valid = false;
         if (emit(s, p, s->cand_t_us)) {
             s->spk += 0.125 * (s->cand_z - s->spk);

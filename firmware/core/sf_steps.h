@@ -34,9 +34,10 @@
  *      DEVIATION: the paper takes the first such peak. Noise makes local maxima of z on the steep swing
  *      rise into a heel strike, and the refractory time then hides the heel strike itself, so the step
  *      time wanders by up to 0.25 s (worst at 20 Hz, where interpolation makes z piecewise). As in the
- *      original Pan–Tompkins QRS detector, a peak is held for SF_STEPS_PT_SEARCH_MS (200 ms) and a
- *      higher peak within that time replaces it; the step is reported when the time is up. Latency:
- *      ≈ 0.2 s; the count is unchanged.
+ *      original Pan–Tompkins QRS detector, a peak is held for the refractory time (steps_refractory_ms,
+ *      300 ms) and a higher peak within that time replaces it; the step is reported when the time is
+ *      up, so a swing bump just before a heel strike cannot take the heel strike's place. Latency:
+ *      ≈ 0.3 s; the count is unchanged.
  *   3b. steps_detector = 1, trough-then-peak (SmartLocator, Couceiro 2017, Eq. 3.4) on x_tp: local
  *      minima are troughs (the lowest one is kept; one older than steps_tp_max_interval_ms is
  *      replaced by any newer one); a local maximum is a step when it comes at most
@@ -82,7 +83,6 @@
 /* Events found within one call beyond the first wait here (a call can span a gap of many grid points). */
 #define SF_STEPS_QUEUE 4
 /* Pan–Tompkins search time: a higher z peak this soon after a candidate replaces it (see the model). */
-#define SF_STEPS_PT_SEARCH_MS 200
 _Static_assert(SF_STEPS_WINDOW * SF_STEPS_GRID_US >= 2500 * 1000, "window must cover steps_max_period_ms");
 _Static_assert(1000000 % SF_STEPS_RATE_HZ == 0, "grid interval must be a whole number of µs");
 
@@ -106,7 +106,7 @@ typedef struct {
     /* Pan–Tompkins history: x(n−1..n−4) and z(n−1), z(n−2). */
     double x_hist[4];
     double z1, z2;
-    bool cand_valid; /* a peak waiting out SF_STEPS_PT_SEARCH_MS */
+    bool cand_valid; /* a peak waiting out the refractory time */
     double cand_z;
     int64_t cand_t_us;
     double spk, npk; /* adaptive threshold: levels of step peaks and of other peaks of z */

@@ -167,9 +167,9 @@ static void check_walk(const pace_t *const pace, const clock_t_ *const clk)
     run(&g_tr, &sc, clk, 2);
     const gait_t *const g = &g_tr.gait;
     assert_true(fraction(&g_tr, 1.0, 4.0, sf_activity_still) == 1.0);
-    /* the second heel strike is detected ≈ 0.2 s late (Pan–Tompkins search time) and only then
-     * credits the bout's held first step: walking from 0.3 s after it */
-    assert_true(fraction(&g_tr, g->t_s[1] + 0.3, g->t_s[60], sf_activity_walking) == 1.0);
+    /* the second heel strike is detected ≈ 0.3 s late (Pan–Tompkins holds a peak for the refractory
+     * time) and only then credits the bout's held first step: walking from 0.4 s after it */
+    assert_true(fraction(&g_tr, g->t_s[1] + 0.4, g->t_s[60], sf_activity_walking) == 1.0);
     const double stop_s = g->t_s[60];
     assert_true(fraction(&g_tr, stop_s + 5.0, 60.0, sf_activity_still) == 1.0);
     assert_int_equal(count(&g_tr, 0, 60, sf_activity_stairs_up) + count(&g_tr, 0, 60, sf_activity_stairs_down) +
@@ -223,17 +223,18 @@ static void test_stairs_down(void **state)
 /* GIVEN a rider standing in an elevator, WHEN it rises 10.5 m in 7 s (1.5 m/s, up to 1.5 m/s² at
  * both ends), THEN elevator during the ride, floor 3, still again afterwards.
  * Steps: with the fixed Pan–Tompkins threshold this ride gave none; since the threshold adapts (so
- * that a slow, soft gait is counted: the simulator's slow pace went from 45 % to 99.4 % of its steps),
- * the lift's two jerks — its start and its stop, 1.5 m/s² within a fraction of a second, at the high
+ * that a slow, soft gait is counted: the simulator's slow pace went from 45 % to 99.2 % of its steps,
+ * and the real phone walks of msindoor lost whole segments of steps with a high threshold),
+ * the lift's jerks — its start and its stop, 1.5 m/s² within a fraction of a second, at the high
  * end of real lifts — can each pass for one soft step. That trade is deliberate: the bound below
- * keeps it to those two jerks (measured: two detections 0.36 s apart at the start of the ride), and
- * the bout rule of sf_activity.h credits neither: too close together for a walker's steps. */
+ * keeps it to the jerks (measured: 3 detections, at the ride's start and stop), and the bout rule of
+ * sf_activity.h credits none of them: a walk's steps come a gait period apart, these do not. */
 static void test_elevator(void **state)
 {
     (void)state;
     const scenario_t sc = {&k_normal, 0, 1.0, 10.0, 17.0, 10.5, 1, 40.0, 0};
     run(&g_tr, &sc, &k_100hz, 4);
-    assert_in_range(g_tr.detected, 0, 2);
+    assert_in_range(g_tr.detected, 0, 3);
     assert_int_equal(g_tr.accepted, 0);
     assert_true(fraction(&g_tr, 12.0, 17.0, sf_activity_elevator) == 1.0);
     assert_true(fraction(&g_tr, 3.0, 9.0, sf_activity_still) == 1.0); /* the lift starts at 9 s */

@@ -104,7 +104,10 @@ static void check_events_match_gait(const run_t *const r, const int detector, co
         assert_true(r->ev[k].t_us <= r->reported_at_us[k]);
         /* reported at most two grid points plus one (jittered) input interval after the extremum, plus
          * the Pan–Tompkins search time */
-        const int64_t search_us = detector == sf_steps_pan_tompkins ? SF_STEPS_PT_SEARCH_MS * 1000 : 0;
+        sf_params_t dp;
+        sf_params_default(&dp);
+        /* Pan–Tompkins holds a peak for the refractory time (the highest peak within it is the step) */
+        const int64_t search_us = detector == sf_steps_pan_tompkins ? (int64_t)dp.steps_refractory_ms * 1000 : 0;
         assert_true(r->reported_at_us[k] - r->ev[k].t_us <=
                     search_us + 2 * SF_STEPS_GRID_US + (int64_t)(1.3e6 / clk->rate_hz));
     }
