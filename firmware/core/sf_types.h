@@ -27,7 +27,37 @@ enum {
 };
 
 /* Pose schemes, identical to pose_t.SCHEME_* in lcmtypes/stridefix/pose_t.lcm. */
-enum { sf_scheme_pdr_only = 0 };
+enum {
+    sf_scheme_pdr_only = 0,
+    sf_scheme_wifi_only = 1,
+    sf_scheme_overwrite = 2,
+    sf_scheme_static = 3,
+    sf_scheme_adaptive = 4,
+    sf_scheme_kalman = 5,
+    sf_scheme_count = 6
+};
+
+/* One Wi-Fi scan as the core sees it (views into the caller's arrays). */
+typedef struct {
+    int64_t t_us;
+    int32_t n_ap;
+    const int64_t *bssid;   /* [n_ap] */
+    const float *rssi_dbm;  /* [n_ap] */
+} sf_wifi_scan_t;
+
+/* Fix methods, identical to fix_t.METHOD_*. */
+enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3 };
+
+/* An absolute position fix offered to the fusion. */
+typedef struct {
+    int64_t t_us;
+    int8_t method;
+    double x_m;
+    double y_m;
+    int16_t floor;
+    double accuracy_m; /* 1σ, horizontal */
+    int16_t n_ap_used; /* Wi-Fi: APs of the scan found in the map */
+} sf_fix_t;
 
 /* One detected step. */
 typedef struct {
