@@ -107,8 +107,15 @@
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 
+/* sf_fingerprint.h */
+#define SF_PARAMS_FINGERPRINT(X)
+
+/* sf_fusion.h */
+#define SF_PARAMS_FUSION(X)
+
 #define SF_PARAM_LIST(X) \
-    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) SF_PARAMS_ACTIVITY(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;
