@@ -49,6 +49,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="pose scheme reported at the top level when POSE holds several "
                         "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
                         "default: the one with most POSE messages)")
+    p.add_argument("--truth-source", default=None, choices=["simulation", "waypoint"],
+                   help="score only TRUTH of this source, e.g. waypoint = the reference points of a "
+                        "walk (default: all TRUTH)")
     p.add_argument("--label", default=None, metavar="TEXT",
                    help="what this run is (e.g. 'PDR only, truth-initialised start'); kept in "
                         "metrics.json and shown as the report's title")
@@ -131,7 +134,8 @@ def format_summary(summary: dict) -> str:
 
 
 def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None = None,
-                all_channels: bool = False, label: str | None = None) -> tuple[dict, Metrics]:
+                all_channels: bool = False, label: str | None = None,
+                truth_source: str | None = None) -> tuple[dict, Metrics]:
     """Read ``logs``, score them and write the outputs; return (summary, metrics).
 
     Raises
@@ -145,7 +149,7 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
         warnings.simplefilter("ignore", LogTruncatedWarning)   # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
-    metrics = run_metrics(data, scheme=code)
+    metrics = run_metrics(data, scheme=code, truth_source=truth_source)
     summary = build_summary(data, metrics, label)
     write_outputs(out_dir, summary, metrics)
     return summary, metrics
@@ -154,7 +158,8 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
-        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels, args.label)
+        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels, args.label,
+                                 args.truth_source)
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return 2

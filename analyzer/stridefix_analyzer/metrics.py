@@ -333,7 +333,10 @@ class Metrics:
         return out
 
 
-def run_metrics(data: LogData, scheme: int | None = None) -> Metrics:
+TRUTH_SOURCES = {"simulation": 1, "waypoint": 2}
+
+
+def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | None = None) -> Metrics:
     """Score every POSE scheme in ``data`` against its TRUTH.
 
     Parameters
@@ -342,6 +345,9 @@ def run_metrics(data: LogData, scheme: int | None = None) -> Metrics:
         Logs read by :func:`stridefix_analyzer.logread.read_logs`.
     scheme : int, optional
         pose_t.scheme code to make primary (default: see :func:`choose_primary`).
+    truth_source : {"simulation", "waypoint"}, optional
+        Score only TRUTH rows of this source (truth_t.SOURCE_*): e.g. the reference points of a
+        walk ("waypoint") instead of the simulator's 10 Hz truth. Default: every TRUTH row.
 
     Raises
     ------
@@ -353,6 +359,12 @@ def run_metrics(data: LogData, scheme: int | None = None) -> Metrics:
         raise MetricsInputError(f"no {' and no '.join(missing)} messages in "
                                 f"{', '.join(i['path'] for i in data.inputs) or 'the input'}")
     truth, pose = data.table("TRUTH"), data.table("POSE")
+    if truth_source is not None:
+        if truth_source not in TRUTH_SOURCES:
+            raise MetricsInputError(f"unknown truth source {truth_source!r}; known: {list(TRUTH_SOURCES)}")
+        truth = truth.rows(truth["source"] == TRUTH_SOURCES[truth_source])
+        if not len(truth):
+            raise MetricsInputError(f"no TRUTH messages of source {truth_source!r}")
     steps = data.table("STEP")
     n_steps = len(steps) if steps is not None else 0
     distance = distance_walked_m(truth)

@@ -175,3 +175,24 @@ def test_heading_rms_error_wraps_at_pi(msg, write_log, straight_walk):
     assert_allclose(m["heading_error"]["rms_deg"], 10.0, rtol=1e-4)
     assert_allclose(m["heading_error"]["mean_abs_deg"], 10.0, rtol=1e-4)
     assert m["position_error_m"]["n"] == 100
+
+
+def test_truth_source_waypoint_scores_only_reference_points(msg, write_log, straight_walk):
+    """10 Hz simulation truth plus a few WAYPOINT truths (the reference points of a walk): with
+    truth_source='waypoint' only the reference points are scored."""
+    from stridefix import truth_t
+    t, x, y = straight_walk
+    events = [("POSE", msg.pose(ti, xi, yi + 1.0)) for ti, xi, yi in zip(t, x, y)]
+    events += [("TRUTH", msg.truth(ti, xi, yi)) for ti, xi, yi in zip(t, x, y)]
+    for k in (10, 50, 90):
+        wp = msg.truth(t[k], x[k], y[k] + 3.0)   # the reference points sit 3 m off: error 2 m
+        wp.source = truth_t.SOURCE_WAYPOINT
+        events.append(("TRUTH", wp))
+    data = read_logs([write_log("wp.lcmlog", events)])
+    all_truth = run_metrics(data).summary()
+    assert all_truth["position_error_m"]["n"] == 103
+    wp_only = run_metrics(data, truth_source="waypoint").summary()
+    assert wp_only["position_error_m"]["n"] == 3
+    assert_allclose(wp_only["position_error_m"]["mean"], 2.0, rtol=1e-12)
+    with pytest.raises(MetricsInputError):
+        run_metrics(data, truth_source="nonsense")
