@@ -18,6 +18,7 @@ SUBCOMMANDS = {
     "bench": "stridefix_analyzer.bench",
     "import": "stridefix_sim.importers.cli",
     "realbench": "stridefix_analyzer.realbench",
+    "radiomap": "stridefix_analyzer.radiomap",
 }
 
 

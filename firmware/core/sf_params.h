@@ -108,10 +108,48 @@
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 
 /* sf_fingerprint.h */
-#define SF_PARAMS_FINGERPRINT(X)
+#define SF_PARAMS_FINGERPRINT(X)                                                                       \
+    X(fingerprint, method,         int32_t, 0,       0,       1,       "",      "0 = WkNN (Ramadhan 2016, SmartLocator), 1 = Gaussian naive Bayes (Jaeger et al.)") \
+    X(fingerprint, k,              int32_t, 3,       1,       16,      "RPs",   "neighbours averaged: WkNN the k nearest (1/d weights), naive Bayes the k most probable (posterior weights)") \
+    X(fingerprint, missing_mode,   int32_t, 0,       0,       1,       "",      "WkNN: 0 = an AP missing on one side takes fill_dbm, 1 = common APs only (RMS over them)") \
+    X(fingerprint, fill_dbm,       double,  -100.0,  -150.0,  -30.0,   "dBm",   "level of an AP not heard (WkNN mode 0; naive Bayes: mean of an AP the map lacks at an RP)") \
+    X(fingerprint, min_common_aps, int32_t, 2,       1,       64,      "APs",   "WkNN mode 1: fewest APs shared with the scan for an RP to be a candidate") \
+    X(fingerprint, min_rssi_dbm,   double,  -90.0,   -150.0,  0.0,     "dBm",   "scan readings weaker than this are ignored") \
+    X(fingerprint, min_aps,        int32_t, 3,       1,       64,      "APs",   "fewest usable APs (at least min_rssi_dbm and in the map) for a fix") \
+    X(fingerprint, average_scans,  int32_t, 1,       1,       4,       "scans", "query = per-BSSID mean over the last n scans that heard it (SmartLocator: 3)") \
+    X(fingerprint, average_max_age_ms, int32_t, 10000, 0,     600000,  "ms",    "scans older than this before the current one are not averaged") \
+    X(fingerprint, sigma_floor_db, double,  4.0,     0.1,     50.0,    "dB",    "naive Bayes: lower bound on an RP's RSSI std") \
+    X(fingerprint, nb_p_min,       double,  0.05,    0.001,   0.5,     "",      "naive Bayes: detection probability clamped to [p, 1-p]; an AP the map lacks at an RP is heard with p") \
+    X(fingerprint, accuracy_floor_m, double, 1.5,    0.0,     100.0,   "m",     "fix accuracy: added in quadrature to the neighbours' spread") \
+    X(fingerprint, accuracy_ref_aps, int32_t, 6,     1,       64,      "APs",   "fix accuracy x sqrt(ref / APs used) when fewer APs are used")
 
 /* sf_fusion.h */
-#define SF_PARAMS_FUSION(X)
+#define SF_PARAMS_FUSION(X)                                                                            \
+    X(fusion, gate_sigma,          double,  3.0,     0.5,     1e3,     "sigma", "innovation gate: reject when |nu|^2 > gate^2 S (2 dof: 3 passes 98.9% of consistent fixes)") \
+    X(fusion, max_rejections,      int32_t, 3,       0,       1000,    "fixes", "consecutive rejections after which the next fix is accepted with alpha = 1 and the variance reset (SmartLocator CONF)") \
+    X(fusion, static_alpha,        double,  0.5,     0.0,     1.0,     "",      "static scheme blend weight (Jaeger et al. baseline: half-way)") \
+    X(fusion, q_step_m2_per_m,     double,  0.05,    0.0,     100.0,   "m2/m",  "position variance added per metre walked, per axis (all schemes; PDR random walk)") \
+    X(fusion, q_time_m2_per_s,     double,  0.005,   0.0,     100.0,   "m2/s",  "position variance added per second, per axis (missed steps, shuffling)") \
+    X(fusion, var_min_m2,          double,  0.01,    1e-6,    1e4,     "m2",    "floor of every scheme position variance (keeps S > 0 and alpha < 1)") \
+    X(fusion, acc_wifi_ap1,        double,  2.0,     0.0,     1000.0,  "APs",   "adaptive: Wi-Fi accuracy-factor knot 1, APs used (knots increasing; flat outside)") \
+    X(fusion, acc_wifi_ap2,        double,  4.0,     0.0,     1000.0,  "APs",   "adaptive: Wi-Fi knot 2, APs used") \
+    X(fusion, acc_wifi_ap3,        double,  6.0,     0.0,     1000.0,  "APs",   "adaptive: Wi-Fi knot 3, APs used") \
+    X(fusion, acc_wifi_ap4,        double,  8.0,     0.0,     1000.0,  "APs",   "adaptive: Wi-Fi knot 4, APs used") \
+    X(fusion, acc_wifi_val1,       double,  0.1,     0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 1 (placeholder, not a paper value)") \
+    X(fusion, acc_wifi_val2,       double,  0.25,    0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 2 (placeholder)") \
+    X(fusion, acc_wifi_val3,       double,  0.45,    0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 3 (placeholder)") \
+    X(fusion, acc_wifi_val4,       double,  0.6,     0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 4 (placeholder)") \
+    X(fusion, acc_gnss_m1,         double,  6.0,     0.0,     1e4,     "m",     "adaptive: GNSS accuracy-factor knot 1, reported accuracy (knots increasing; flat outside)") \
+    X(fusion, acc_gnss_m2,         double,  12.0,    0.0,     1e4,     "m",     "adaptive: GNSS knot 2, reported accuracy") \
+    X(fusion, acc_gnss_m3,         double,  21.0,    0.0,     1e4,     "m",     "adaptive: GNSS knot 3, reported accuracy") \
+    X(fusion, acc_gnss_m4,         double,  30.0,    0.0,     1e4,     "m",     "adaptive: GNSS knot 4, reported accuracy") \
+    X(fusion, acc_gnss_val1,       double,  0.8,     0.0,     1.0,     "",      "adaptive: GNSS accuracy factor at knot 1 (placeholder: min(1 - acc/30 m, 0.8))") \
+    X(fusion, acc_gnss_val2,       double,  0.6,     0.0,     1.0,     "",      "adaptive: GNSS accuracy factor at knot 2 (placeholder)") \
+    X(fusion, acc_gnss_val3,       double,  0.3,     0.0,     1.0,     "",      "adaptive: GNSS accuracy factor at knot 3 (placeholder)") \
+    X(fusion, acc_gnss_val4,       double,  0.0,     0.0,     1.0,     "",      "adaptive: GNSS accuracy factor at knot 4 (placeholder)") \
+    X(fusion, acc_landmark,        double,  1.0,     0.0,     1.0,     "",      "adaptive: landmark accuracy factor (paper: NFC = 1, overwrite)") \
+    X(fusion, drift_per_s,         double,  0.01,    0.0,     10.0,    "1/s",   "adaptive: drift term per second since the last accepted fix (placeholder)") \
+    X(fusion, drift_max,           double,  0.5,     0.0,     1.0,     "",      "adaptive: cap of the drift term (placeholder)")
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \

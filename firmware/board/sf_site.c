@@ -1,0 +1,445 @@
+/* sf_site.c — site file → sf_site_t (see sf_site.h for the format, the checks and the ownership). */
+#include "sf_site.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sf_error.h"
+
+static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
+
+/* "<name>: <formatted text>" into err; returns rc. */
+static int failf(char *const err, const size_t err_size, const char *const name, const int rc,
+                 const char *const fmt, ...)
+{
+    if (err != NULL && err_size > 0) {
+        char what[400];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(what, sizeof what, fmt, ap);
+        va_end(ap);
+        snprintf(err, err_size, "%s: %s", name, what);
+    }
+    return rc;
+}
+
+uint32_t sf_site_crc32(const void *const data, const size_t n)
+{
+    uint32_t table[256]; /* built per call (2 k shifts): no global state, negligible next to I/O */
+    for (uint32_t i = 0; i < 256u; i++) {
+        uint32_t c = i;
+        for (int k = 0; k < 8; k++) {
+            c = (c & 1u) != 0u ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+        }
+        table[i] = c;
+    }
+    const uint8_t *const p = data;
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) {
+        crc = table[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
+    }
+    return crc ^ 0xFFFFFFFFu;
+}
+
+static uint32_t le32(const uint8_t *const p)
+{
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
+}
+
+static int32_t be32(const uint8_t *const p)
+{
+    const uint32_t u = ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
+    return (int32_t)u;
+}
+
+/* --- payload bounds walk -------------------------------------------------------------------------
+ * DEVIATION: this walks the site_t layout by hand (counts and strings only) before the generated
+ * decoder runs, because the LCM C decoder (lcm_coretypes.h, 1.3 and 1.5) computes `int total =
+ * sizeof(T) * count` (overflow for count ≥ 2^28 lets it read past the buffer) and does not check that
+ * strings end with NUL. It must follow site_t.lcm field by field; the type hash check before it and
+ * the round-trip test (tests/c/test_site.c) catch a layout change that is not mirrored here. */
+typedef struct {
+    const uint8_t *p;
+    size_t size;
+    size_t pos;
+    const char *name;
+    char *err;
+    size_t err_size;
+} walk_t;
+
+static int skip(walk_t *const w, const size_t bytes, const char *const field)
+{
+    if (bytes > w->size - w->pos) {
+        return failf(w->err, w->err_size, w->name, SF_ESYNTAX,
+                     "payload ends inside field '%s' (needs %zu bytes at offset %zu, %zu left)", field,
+                     bytes, w->pos, w->size - w->pos);
+    }
+    w->pos += bytes;
+    return SF_OK;
+}
+
+static int walk_string(walk_t *const w, const char *const field)
+{
+    int rc = skip(w, 4, field);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    const int32_t len = be32(w->p + w->pos - 4);
+    if (len < 1) {
+        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: string '%s' has length %d, must be >= 1",
+                     field, (int)len);
+    }
+    rc = skip(w, (size_t)len, field);
+    if (rc == SF_OK && w->p[w->pos - 1] != 0u) {
+        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: string '%s' does not end with NUL",
+                     field);
+    }
+    return rc;
+}
+
+/* A count, then the arrays it sizes (element_bytes = bytes per index over all those arrays). */
+static int walk_count(walk_t *const w, const char *const field, const size_t element_bytes)
+{
+    int rc = skip(w, 4, field);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    const int32_t n = be32(w->p + w->pos - 4);
+    if (n < 0) {
+        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: %s = %d is negative", field, (int)n);
+    }
+    if ((size_t)n > (w->size - w->pos) / element_bytes) {
+        return failf(w->err, w->err_size, w->name, SF_ESYNTAX,
+                     "payload: %s = %d needs %zu bytes of arrays, %zu left", field, (int)n,
+                     (size_t)n * element_bytes, w->size - w->pos);
+    }
+    return skip(w, (size_t)n * element_bytes, field);
+}
+
+static int walk_site(walk_t *const w)
+{
+    int rc = skip(w, 8, "type hash");
+    rc = rc != SF_OK ? rc : walk_string(w, "name");
+    rc = rc != SF_OK ? rc : walk_string(w, "source");
+    rc = rc != SF_OK ? rc : skip(w, 8 + 1 + 8 + 8 + 2, "map_rotation_deg .. lowest_floor");
+    rc = rc != SF_OK ? rc : walk_count(w, "n_floors", 8);
+    rc = rc != SF_OK ? rc : walk_count(w, "n_ap", 8);
+    rc = rc != SF_OK ? rc : skip(w, 4, "cell_size_m");
+    rc = rc != SF_OK ? rc : walk_count(w, "n_rp", 4 + 4 + 2 + 4);
+    rc = rc != SF_OK ? rc : walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
+    if (rc == SF_OK && w->pos != w->size) {
+        rc = failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload has %zu trailing bytes after the site_t",
+                   w->size - w->pos);
+    }
+    return rc;
+}
+
+/* --- field rules (the same order and words as sitefile.validate_site) -------------------------- */
+
+static int check_fields(const stridefix_site_t *const s, const char *const name, char *const err,
+                        const size_t err_size)
+{
+#define BAD(...) failf(err, err_size, name, SF_ERANGE, __VA_ARGS__)
+    if (!isfinite(s->map_rotation_deg)) {
+        return BAD("map_rotation_deg is %g, must be finite", s->map_rotation_deg);
+    }
+    if (s->has_geo) {
+        if (!(isfinite(s->origin_lat_deg) && s->origin_lat_deg >= -90.0 && s->origin_lat_deg <= 90.0)) {
+            return BAD("origin_lat_deg = %g outside -90..90", s->origin_lat_deg);
+        }
+        if (!(isfinite(s->origin_lon_deg) && s->origin_lon_deg >= -180.0 && s->origin_lon_deg <= 180.0)) {
+            return BAD("origin_lon_deg = %g outside -180..180", s->origin_lon_deg);
+        }
+    }
+    if (s->n_floors < 1) {
+        return BAD("n_floors = 0: a site has at least one floor");
+    }
+    const int32_t lowest = s->lowest_floor;
+    const int32_t top = lowest + s->n_floors - 1;
+    if (top > 32767) {
+        return BAD("floors %d..%d overflow int16", (int)lowest, (int)top);
+    }
+    for (int32_t i = 0; i < s->n_floors; i++) {
+        const double h = s->floor_height_m[i];
+        if (!isfinite(h)) {
+            return BAD("floor_height_m[%d] is %g, must be finite", (int)i, h);
+        }
+        if (i > 0 && !(h > s->floor_height_m[i - 1])) {
+            return BAD("floor_height_m[%d] = %g not above floor_height_m[%d] = %g (heights must increase)", (int)i,
+                       h, (int)(i - 1), s->floor_height_m[i - 1]);
+        }
+    }
+    for (int32_t a = 0; a < s->n_ap; a++) {
+        const int64_t b = s->ap_bssid[a];
+        if (b < 0 || b >= ((int64_t)1 << 48)) {
+            return BAD("ap %d: BSSID %lld outside 0..2^48-1", (int)a, (long long)b);
+        }
+        if (a > 0 && !(b > s->ap_bssid[a - 1])) {
+            return BAD("ap %d: BSSID 0x%012llx not above ap %d's 0x%012llx (BSSIDs must be strictly ascending)",
+                       (int)a, (unsigned long long)b, (int)(a - 1), (unsigned long long)s->ap_bssid[a - 1]);
+        }
+    }
+    if (!(isfinite(s->cell_size_m) && s->cell_size_m >= 0.0f)) {
+        return BAD("cell_size_m = %g, must be finite and >= 0", (double)s->cell_size_m);
+    }
+    for (int32_t r = 0; r < s->n_rp; r++) {
+        const float x = s->rp_x_m[r];
+        const float y = s->rp_y_m[r];
+        if (!(isfinite(x) && isfinite(y))) {
+            return BAD("rp %d: position (%g, %g) not finite", (int)r, (double)x, (double)y);
+        }
+        if (s->rp_floor[r] < lowest || s->rp_floor[r] > top) {
+            return BAD("rp %d: floor %d outside %d..%d", (int)r, (int)s->rp_floor[r], (int)lowest, (int)top);
+        }
+        if (s->rp_scans[r] < 1) {
+            return BAD("rp %d: rp_scans = %d, must be >= 1", (int)r, (int)s->rp_scans[r]);
+        }
+    }
+    for (int32_t i = 0; i < s->n_entries; i++) {
+        const int32_t a = s->entry_ap[i];
+        const int32_t r = s->entry_rp[i];
+        if (a < 0 || a >= s->n_ap) {
+            return BAD("entry %d: ap index %d outside 0..%d", (int)i, (int)a, (int)(s->n_ap - 1));
+        }
+        if (r < 0 || r >= s->n_rp) {
+            return BAD("entry %d: rp index %d outside 0..%d", (int)i, (int)r, (int)(s->n_rp - 1));
+        }
+        if (i > 0) {
+            const int32_t pa = s->entry_ap[i - 1];
+            const int32_t pr = s->entry_rp[i - 1];
+            if (!(a > pa || (a == pa && r > pr))) {
+                return BAD("entry %d: (ap %d, rp %d) not after entry %d's (ap %d, rp %d) (entries must be sorted "
+                           "by (ap, rp), no duplicates)",
+                           (int)i, (int)a, (int)r, (int)(i - 1), (int)pa, (int)pr);
+            }
+        }
+        const float mean = s->entry_mean_dbm[i];
+        const float std = s->entry_std_db[i];
+        const int32_t count = s->entry_count[i];
+        if (!isfinite(mean)) {
+            return BAD("entry %d: entry_mean_dbm is %g, must be finite", (int)i, (double)mean);
+        }
+        if (!(isfinite(std) && std >= 0.0f)) {
+            return BAD("entry %d: entry_std_db = %g, must be finite and >= 0", (int)i, (double)std);
+        }
+        if (count < 1 || count > s->rp_scans[r]) {
+            return BAD("entry %d: count %d outside 1..%d (rp_scans of rp %d)", (int)i, (int)count,
+                       (int)s->rp_scans[r], (int)r);
+        }
+    }
+    return SF_OK;
+#undef BAD
+}
+
+/* --- loading -------------------------------------------------------------------------------------- */
+
+void sf_site_store_free(sf_site_store_t *const store)
+{
+    if (store == NULL) {
+        return;
+    }
+    if (store->loaded) {
+        stridefix_site_t_decode_cleanup(&store->msg);
+    }
+    free(store->ap_first);
+    memset(store, 0, sizeof *store);
+}
+
+static int check_header(const uint8_t *const data, const size_t size, const char *const name, char *const err,
+                        const size_t err_size)
+{
+    if (size < SF_SITE_HEADER_SIZE) {
+        return failf(err, err_size, name, SF_ESYNTAX,
+                     "file has only %zu bytes; a site file starts with a %d-byte header", size,
+                     SF_SITE_HEADER_SIZE);
+    }
+    if (memcmp(data, magic, sizeof magic) != 0) {
+        return failf(err, err_size, name, SF_ESYNTAX,
+                     "bad magic %02x %02x %02x %02x %02x %02x %02x %02x, expected 53 46 53 49 54 45 00 01 "
+                     "(not a StrideFix site file)",
+                     data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]);
+    }
+    const uint32_t version = le32(data + 8);
+    const uint32_t length = le32(data + 12);
+    const uint32_t crc = le32(data + 16);
+    const uint32_t reserved = le32(data + 20);
+    if (version != SF_SITE_FORMAT_VERSION) {
+        return failf(err, err_size, name, SF_ESYNTAX, "format version %lu, this reader supports %u",
+                     (unsigned long)version, SF_SITE_FORMAT_VERSION);
+    }
+    if (reserved != 0u) {
+        return failf(err, err_size, name, SF_ESYNTAX, "reserved header field is 0x%08lx, must be 0",
+                     (unsigned long)reserved);
+    }
+    const size_t have = size - SF_SITE_HEADER_SIZE;
+    if ((size_t)length != have) {
+        return failf(err, err_size, name, SF_ESYNTAX,
+                     "length mismatch (%s): header says %lu payload bytes, file has %zu",
+                     (size_t)length > have ? "truncated" : "trailing bytes", (unsigned long)length, have);
+    }
+    if (length > SF_SITE_MAX_PAYLOAD) {
+        return failf(err, err_size, name, SF_ESYNTAX, "payload of %lu bytes exceeds the limit of %u",
+                     (unsigned long)length, SF_SITE_MAX_PAYLOAD);
+    }
+    const uint32_t actual = sf_site_crc32(data + SF_SITE_HEADER_SIZE, have);
+    if (actual != crc) {
+        return failf(err, err_size, name, SF_ESYNTAX, "CRC-32 mismatch: header says 0x%08lx, payload has 0x%08lx",
+                     (unsigned long)crc, (unsigned long)actual);
+    }
+    return SF_OK;
+}
+
+/* The core view of a decoded, checked site; builds store->ap_first. */
+static int build_view(sf_site_store_t *const store, sf_site_t *const site, const char *const name,
+                      char *const err, const size_t err_size)
+{
+    const stridefix_site_t *const s = &store->msg;
+    store->ap_first = malloc(sizeof(int32_t) * ((size_t)s->n_ap + 1u));
+    if (store->ap_first == NULL) {
+        return failf(err, err_size, name, SF_EIO, "out of memory for the AP index (%d APs)", (int)s->n_ap);
+    }
+    /* entry_ap is sorted (checked): ap_first[a] = first entry whose ap is ≥ a */
+    int32_t i = 0;
+    for (int32_t a = 0; a <= s->n_ap; a++) {
+        while (i < s->n_entries && s->entry_ap[i] < a) {
+            i++;
+        }
+        store->ap_first[a] = i;
+    }
+    site->map_rotation_deg = s->map_rotation_deg;
+    site->lowest_floor = s->lowest_floor;
+    site->n_floors = s->n_floors;
+    site->floor_height_m = s->floor_height_m;
+    sf_radiomap_t *const m = &site->radiomap;
+    m->n_ap = s->n_ap;
+    m->ap_bssid = s->ap_bssid;
+    m->ap_first = store->ap_first;
+    m->n_rp = s->n_rp;
+    m->rp_x_m = s->rp_x_m;
+    m->rp_y_m = s->rp_y_m;
+    m->rp_floor = s->rp_floor;
+    m->rp_scans = s->rp_scans;
+    m->n_entries = s->n_entries;
+    m->entry_rp = s->entry_rp;
+    m->entry_mean_dbm = s->entry_mean_dbm;
+    m->entry_std_db = s->entry_std_db;
+    m->entry_count = s->entry_count;
+    const char *what = NULL;
+    if (sf_radiomap_check(m, &what) != SF_OK) {
+        return failf(err, err_size, name, SF_ERANGE, "radio map check failed: %s", what != NULL ? what : "?");
+    }
+    return SF_OK;
+}
+
+int sf_site_parse(const uint8_t *const data, const size_t size, const char *const name,
+                  sf_site_store_t *const store, sf_site_t *const site, char *const err, const size_t err_size)
+{
+    if (err != NULL && err_size > 0) {
+        err[0] = '\0';
+    }
+    const char *const label = name != NULL ? name : "<site>";
+    if ((data == NULL && size > 0) || store == NULL || site == NULL) {
+        return failf(err, err_size, label, SF_EINVAL, "sf_site_parse: NULL argument");
+    }
+    memset(store, 0, sizeof *store);
+    memset(site, 0, sizeof *site);
+    int rc = check_header(data, size, label, err, err_size);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    const uint8_t *const payload = data + SF_SITE_HEADER_SIZE;
+    const size_t length = size - SF_SITE_HEADER_SIZE;
+    const int64_t want_hash = __stridefix_site_t_get_hash();
+    if (length >= 8) {
+        const int64_t got_hash = (int64_t)(((uint64_t)(uint32_t)be32(payload) << 32) | (uint32_t)be32(payload + 4));
+        if (got_hash != want_hash) {
+            return failf(err, err_size, label, SF_ESYNTAX,
+                         "payload is not a stridefix.site_t: LCM type hash 0x%016llx, expected 0x%016llx "
+                         "(written with another version of site_t?)",
+                         (unsigned long long)got_hash, (unsigned long long)want_hash);
+        }
+    }
+    walk_t w = {payload, length, 0, label, err, err_size};
+    rc = walk_site(&w);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    const int used = stridefix_site_t_decode(payload, 0, (int)length, &store->msg);
+    if (used < 0) {
+        stridefix_site_t_decode_cleanup(&store->msg); /* frees what was allocated before the failure */
+        memset(store, 0, sizeof *store);
+        return failf(err, err_size, label, SF_ESYNTAX, "LCM decode of site_t failed (code %d)", used);
+    }
+    store->loaded = 1;
+    if ((size_t)used != length) {
+        sf_site_store_free(store);
+        return failf(err, err_size, label, SF_ESYNTAX, "LCM decode used %d of %zu payload bytes", used, length);
+    }
+    rc = check_fields(&store->msg, label, err, err_size);
+    if (rc == SF_OK) {
+        rc = build_view(store, site, label, err, err_size);
+    }
+    if (rc != SF_OK) {
+        sf_site_store_free(store);
+        memset(site, 0, sizeof *site);
+    }
+    return rc;
+}
+
+int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t *const site, char *const err,
+                 const size_t err_size)
+{
+    if (err != NULL && err_size > 0) {
+        err[0] = '\0';
+    }
+    if (path == NULL || store == NULL || site == NULL) {
+        return failf(err, err_size, path != NULL ? path : "<site>", SF_EINVAL, "sf_site_load: NULL argument");
+    }
+    memset(store, 0, sizeof *store);
+    memset(site, 0, sizeof *site);
+    FILE *const f = fopen(path, "rb");
+    if (f == NULL) {
+        const int e = errno;
+        return failf(err, err_size, path, e == ENOENT ? SF_ENOENT : SF_EIO, "cannot open site file: %s",
+                     strerror(e));
+    }
+    /* read the whole file, growing the buffer, up to one byte more than the largest valid file */
+    const size_t limit = (size_t)SF_SITE_HEADER_SIZE + SF_SITE_MAX_PAYLOAD + 1u;
+    size_t cap = 1u << 16;
+    size_t size = 0;
+    uint8_t *buf = NULL;
+    int rc = SF_OK;
+    for (;;) {
+        uint8_t *const bigger = realloc(buf, cap);
+        if (bigger == NULL) {
+            rc = failf(err, err_size, path, SF_EIO, "out of memory reading the site file (%zu bytes)", cap);
+            break;
+        }
+        buf = bigger;
+        size += fread(buf + size, 1, cap - size, f);
+        if (ferror(f)) {
+            const int e = errno;
+            rc = failf(err, err_size, path, SF_EIO, "cannot read site file: %s", strerror(e));
+            break;
+        }
+        if (size < cap || cap >= limit) {
+            break; /* end of file, or more than any valid site file (check_header says so) */
+        }
+        cap = cap * 2u < limit ? cap * 2u : limit;
+    }
+    fclose(f);
+    if (rc == SF_OK) {
+        if (size >= limit) {
+            rc = failf(err, err_size, path, SF_ESYNTAX, "file is larger than the %zu-byte limit of a site file",
+                       limit - 1u);
+        } else {
+            rc = sf_site_parse(buf, size, path, store, site, err, err_size);
+        }
+    }
+    free(buf);
+    return rc;
+}

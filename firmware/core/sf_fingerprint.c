@@ -1,0 +1,422 @@
+/* sf_fingerprint.c — see sf_fingerprint.h for the model. */
+#include "sf_fingerprint.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sf_error.h"
+
+#define HALF_LOG_2PI 0.91893853320467274178
+
+/* log N(x; mu, sigma) */
+static double log_normal(const double x, const double mu, const double sigma)
+{
+    const double z = (x - mu) / sigma;
+    return -0.5 * z * z - log(sigma) - HALF_LOG_2PI;
+}
+
+/* Detection probability of a map entry, clamped to [p, 1 - p]. */
+static double detection(const sf_radiomap_t *const map, const int32_t entry, const double p_min)
+{
+    const double q = (double)map->entry_count[entry] / (double)map->rp_scans[map->entry_rp[entry]];
+    return q < p_min ? p_min : (q > 1.0 - p_min ? 1.0 - p_min : q);
+}
+
+void sf_fingerprint_init(sf_fingerprint_t *const fp)
+{
+    memset(fp, 0, sizeof *fp);
+}
+
+int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
+                           const sf_params_t *const p)
+{
+    if (ws == NULL || map == NULL || p == NULL || map->n_rp <= 0 || map->n_ap <= 0 || ws->n_rp < map->n_rp ||
+        ws->rp_fill_sq_db2 == NULL || ws->rp_miss_loglik == NULL || ws->acc == NULL || ws->n_common == NULL ||
+        ws->touched == NULL) {
+        return SF_EINVAL;
+    }
+    ws->prepared = false;
+    if (sf_radiomap_check(map, NULL) != SF_OK) {
+        return SF_ERANGE;
+    }
+    const double fill = p->fingerprint_fill_dbm;
+    const double p_min = p->fingerprint_nb_p_min;
+    const double log_not_p = log(1.0 - p_min);
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        ws->rp_fill_sq_db2[r] = 0.0;
+        ws->rp_miss_loglik[r] = (double)map->n_ap * log_not_p; /* every AP a phantom, corrected below */
+        ws->acc[r] = 0.0;
+        ws->n_common[r] = 0;
+        ws->touched[r] = 0;
+    }
+    for (int32_t i = 0; i < map->n_entries; i++) {
+        const int32_t r = map->entry_rp[i];
+        const double v = (double)map->entry_mean_dbm[i] - fill;
+        ws->rp_fill_sq_db2[r] += v * v;
+        ws->rp_miss_loglik[r] += log(1.0 - detection(map, i, p_min)) - log_not_p;
+    }
+    ws->map_n_ap = map->n_ap;
+    ws->map_n_rp = map->n_rp;
+    ws->map_n_entries = map->n_entries;
+    ws->fill_dbm = fill;
+    ws->nb_p_min = p_min;
+    ws->prepared = true;
+    return SF_OK;
+}
+
+/* ---- query ---------------------------------------------------------------------------------------- */
+
+/* Stores a scan in the ring; returns the number of weak readings dropped. */
+static int32_t store_scan(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_wifi_scan_t *const scan)
+{
+    if (fp->count > 0 && scan->t_us < fp->ring[fp->newest].t_us) {
+        fp->count = 0;
+        fp->backwards++;
+    }
+    const int32_t slot_i = fp->count == 0 ? 0 : (fp->newest + 1) % SF_FINGERPRINT_RING_SCANS;
+    sf_fingerprint_scan_slot_t *const slot = &fp->ring[slot_i];
+    slot->t_us = scan->t_us;
+    slot->n = 0;
+    int32_t weak = 0;
+    for (int32_t i = 0; i < scan->n_ap; i++) {
+        const float v = scan->rssi_dbm[i];
+        if (!isfinite(v)) {
+            fp->readings_bad++;
+            continue;
+        }
+        if ((double)v < p->fingerprint_min_rssi_dbm) {
+            weak++;
+            continue;
+        }
+        int32_t j = 0;
+        while (j < slot->n && slot->bssid[j] != scan->bssid[i]) {
+            j++;
+        }
+        if (j < slot->n) { /* repeated BSSID: keep the strongest */
+            if (v > slot->rssi_dbm[j]) {
+                slot->rssi_dbm[j] = v;
+            }
+            continue;
+        }
+        if (slot->n < SF_FINGERPRINT_SCAN_APS) {
+            slot->bssid[slot->n] = scan->bssid[i];
+            slot->rssi_dbm[slot->n] = v;
+            slot->n++;
+            continue;
+        }
+        fp->readings_truncated++; /* full: the weakest reading goes */
+        int32_t w = 0;
+        for (int32_t m = 1; m < slot->n; m++) {
+            if (slot->rssi_dbm[m] < slot->rssi_dbm[w]) {
+                w = m;
+            }
+        }
+        if (v > slot->rssi_dbm[w]) {
+            slot->bssid[w] = scan->bssid[i];
+            slot->rssi_dbm[w] = v;
+        }
+    }
+    fp->readings_weak += (uint32_t)weak;
+    fp->newest = slot_i;
+    if (fp->count < SF_FINGERPRINT_RING_SCANS) {
+        fp->count++;
+    }
+    return weak;
+}
+
+typedef struct {
+    int64_t bssid;
+    int32_t age; /* 0 = newest scan */
+    float rssi_dbm;
+} reading_t;
+
+static int reading_cmp(const void *const a, const void *const b)
+{
+    const reading_t *const x = a;
+    const reading_t *const y = b;
+    if (x->bssid != y->bssid) {
+        return x->bssid < y->bssid ? -1 : 1;
+    }
+    return x->age < y->age ? -1 : (x->age > y->age ? 1 : 0);
+}
+
+/* Builds fp->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
+static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map)
+{
+    reading_t readings[SF_FINGERPRINT_QUERY_APS]; /* 4 kB of stack */
+    int32_t n = 0;
+    int32_t n_scans = 0;
+    int32_t want = p->fingerprint_average_scans;
+    want = want < 1 ? 1 : (want > SF_FINGERPRINT_RING_SCANS ? SF_FINGERPRINT_RING_SCANS : want);
+    if (want > fp->count) {
+        want = fp->count;
+    }
+    const int64_t t_now = fp->ring[fp->newest].t_us;
+    const int64_t max_age_us = (int64_t)p->fingerprint_average_max_age_ms * 1000;
+    for (int32_t age = 0; age < want; age++) {
+        const int32_t slot_i = (fp->newest - age + SF_FINGERPRINT_RING_SCANS) % SF_FINGERPRINT_RING_SCANS;
+        const sf_fingerprint_scan_slot_t *const slot = &fp->ring[slot_i];
+        if (age > 0 && t_now - slot->t_us > max_age_us) {
+            break;
+        }
+        for (int32_t j = 0; j < slot->n; j++) {
+            readings[n++] = (reading_t){slot->bssid[j], age, slot->rssi_dbm[j]};
+        }
+        n_scans++;
+    }
+    qsort(readings, (size_t)n, sizeof readings[0], reading_cmp);
+    fp->n_query = 0;
+    fp->audit.n_scans_averaged = n_scans;
+    for (int32_t i = 0; i < n;) {
+        double sum = 0.0;
+        int32_t j = i;
+        while (j < n && readings[j].bssid == readings[i].bssid) {
+            sum += (double)readings[j].rssi_dbm;
+            j++;
+        }
+        fp->audit.n_heard++;
+        const int32_t a = sf_radiomap_find_ap(map, readings[i].bssid);
+        if (a < 0) {
+            fp->audit.n_unknown++;
+            fp->readings_unknown++;
+        } else {
+            fp->query_ap[fp->n_query] = a;
+            fp->query_rssi_dbm[fp->n_query] = sum / (double)(j - i);
+            fp->n_query++;
+        }
+        i = j;
+    }
+    fp->audit.n_used = fp->n_query;
+}
+
+/* ---- matching ------------------------------------------------------------------------------------- */
+
+/* Adds term to RP r's partial sum, registering r on first touch. */
+static void touch(sf_fingerprint_workspace_t *const ws, int32_t *const n_touched, const int32_t r, const double term)
+{
+    if (ws->n_common[r] == 0) {
+        ws->touched[(*n_touched)++] = r;
+        ws->acc[r] = 0.0;
+    }
+    ws->n_common[r]++;
+    ws->acc[r] += term;
+}
+
+typedef struct {
+    double key; /* lower is better: WkNN d, naive Bayes −L */
+    int32_t rp;
+} ranked_t;
+
+static void insert_best(ranked_t *const best, int32_t *const n_best, const int32_t k, const double key, const int32_t rp)
+{
+    int32_t pos = *n_best;
+    while (pos > 0 && (key < best[pos - 1].key || (key == best[pos - 1].key && rp < best[pos - 1].rp))) {
+        pos--;
+    }
+    if (pos >= k) {
+        return;
+    }
+    const int32_t last = *n_best < k ? *n_best : k - 1;
+    for (int32_t i = last; i > pos; i--) {
+        best[i] = best[i - 1];
+    }
+    best[pos] = (ranked_t){key, rp};
+    if (*n_best < k) {
+        (*n_best)++;
+    }
+}
+
+int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map,
+                         sf_fingerprint_workspace_t *const ws, const sf_wifi_scan_t *const scan,
+                         const int16_t floor_hint, const bool any_floor, sf_fix_t *const fix)
+{
+    if (fp == NULL || p == NULL || map == NULL || ws == NULL || scan == NULL || fix == NULL) {
+        return SF_EINVAL;
+    }
+    if (map->n_rp <= 0 || map->n_ap <= 0 || scan->n_ap < 0 ||
+        (scan->n_ap > 0 && (scan->bssid == NULL || scan->rssi_dbm == NULL))) {
+        return SF_EINVAL;
+    }
+    if (!ws->prepared || ws->map_n_ap != map->n_ap || ws->map_n_rp != map->n_rp ||
+        ws->map_n_entries != map->n_entries || ws->fill_dbm != p->fingerprint_fill_dbm ||
+        ws->nb_p_min != p->fingerprint_nb_p_min) {
+        return SF_EINVAL;
+    }
+    fp->scans++;
+    const int32_t weak = store_scan(fp, p, scan);
+    sf_fingerprint_audit_t *const au = &fp->audit;
+    memset(au, 0, sizeof *au);
+    au->t_us = scan->t_us;
+    au->method = (int8_t)p->fingerprint_method;
+    au->missing_mode = (int8_t)p->fingerprint_missing_mode;
+    au->n_readings_weak = weak;
+    for (int32_t i = 0; i < SF_FINGERPRINT_K_MAX; i++) {
+        au->winner_rp[i] = -1;
+    }
+    build_query(fp, p, map);
+    if (fp->n_query < p->fingerprint_min_aps) {
+        au->reason = sf_fp_too_few_aps;
+        fp->rejected_too_few_aps++;
+        return SF_ERANGE;
+    }
+
+    /* Accumulate over the entries of the used APs only. */
+    const bool bayes = p->fingerprint_method == 1;
+    const bool common_only = !bayes && p->fingerprint_missing_mode == 1;
+    const double fill = p->fingerprint_fill_dbm;
+    const double p_min = p->fingerprint_nb_p_min;
+    const double log_p = log(p_min);
+    const double log_not_p = log(1.0 - p_min);
+    const double sigma_floor = p->fingerprint_sigma_floor_db;
+    double scan_sum = 0.0; /* WkNN fill: Σ (s − f)²; naive Bayes: Σ C_a */
+    int32_t n_touched = 0;
+    for (int32_t qi = 0; qi < fp->n_query; qi++) {
+        const int32_t a = fp->query_ap[qi];
+        const double s = fp->query_rssi_dbm[qi];
+        const double u = s - fill;
+        const double c_a = bayes ? log_p + log_normal(s, fill, sigma_floor) - log_not_p : 0.0;
+        scan_sum += bayes ? c_a : u * u;
+        const int32_t end = map->ap_first[a + 1];
+        au->n_entries_visited += end - map->ap_first[a];
+        for (int32_t i = map->ap_first[a]; i < end; i++) {
+            const int32_t r = map->entry_rp[i];
+            if (!any_floor && map->rp_floor[r] != floor_hint) {
+                continue;
+            }
+            const double mu = (double)map->entry_mean_dbm[i];
+            double term;
+            if (bayes) {
+                const double q = detection(map, i, p_min);
+                const double sd = (double)map->entry_std_db[i];
+                term = log(q) + log_normal(s, mu, sd > sigma_floor ? sd : sigma_floor) - log(1.0 - q) - c_a;
+            } else if (common_only) {
+                term = (s - mu) * (s - mu);
+            } else {
+                term = -2.0 * u * (mu - fill);
+            }
+            touch(ws, &n_touched, r, term);
+        }
+    }
+    au->n_touched = n_touched;
+
+    /* Score the candidates and keep the k best. */
+    int32_t k = p->fingerprint_k;
+    k = k < 1 ? 1 : (k > SF_FINGERPRINT_K_MAX ? SF_FINGERPRINT_K_MAX : k);
+    ranked_t best[SF_FINGERPRINT_K_MAX];
+    int32_t n_best = 0;
+    for (int32_t t = 0; t < n_touched; t++) {
+        const int32_t r = ws->touched[t];
+        double key;
+        if (bayes) {
+            ws->acc[r] += ws->rp_miss_loglik[r] + scan_sum; /* now L_r */
+            key = -ws->acc[r];
+        } else if (common_only) {
+            if (ws->n_common[r] < p->fingerprint_min_common_aps) {
+                continue;
+            }
+            key = sqrt(ws->acc[r] / (double)ws->n_common[r]);
+        } else {
+            const double d2 = ws->rp_fill_sq_db2[r] + scan_sum + ws->acc[r];
+            key = sqrt(d2 > 0.0 ? d2 : 0.0);
+        }
+        ws->acc[r] = bayes ? ws->acc[r] : key; /* acc now holds the score: L or d */
+        au->n_candidates++;
+        insert_best(best, &n_best, k, key, r);
+    }
+
+    int result = SF_OK;
+    if (n_best == 0) {
+        au->reason = sf_fp_no_candidate;
+        fp->rejected_no_candidate++;
+        result = SF_ERANGE;
+    } else {
+        /* Weights. */
+        double z = 1.0; /* naive Bayes: Σ over candidates of exp(L − L_max) */
+        const double l_max = -best[0].key;
+        if (bayes) {
+            z = 0.0;
+            for (int32_t t = 0; t < n_touched; t++) {
+                z += exp(ws->acc[ws->touched[t]] - l_max);
+            }
+        }
+        au->k_used = n_best;
+        for (int32_t i = 0; i < n_best; i++) {
+            const int32_t r = best[i].rp;
+            au->winner_rp[i] = r;
+            au->winner_score[i] = bayes ? -best[i].key : best[i].key;
+            au->winner_weight[i] = bayes ? exp(-best[i].key - l_max) / z
+                                         : 1.0 / (best[i].key > SF_FINGERPRINT_D_MIN_DB ? best[i].key
+                                                                                        : SF_FINGERPRINT_D_MIN_DB);
+        }
+        /* Floor: largest summed weight; ties go to the better winner. */
+        int16_t floor = map->rp_floor[best[0].rp];
+        double floor_weight = -1.0;
+        for (int32_t i = 0; i < n_best; i++) {
+            const int16_t fl = map->rp_floor[best[i].rp];
+            double total = 0.0;
+            for (int32_t j = 0; j < n_best; j++) {
+                total += map->rp_floor[best[j].rp] == fl ? au->winner_weight[j] : 0.0;
+            }
+            if (total > floor_weight) {
+                floor_weight = total;
+                floor = fl;
+            }
+        }
+        /* Position: weighted mean of the winners on that floor. */
+        double sw = 0.0, sx = 0.0, sy = 0.0;
+        for (int32_t i = 0; i < n_best; i++) {
+            const int32_t r = best[i].rp;
+            if (map->rp_floor[r] == floor) {
+                sw += au->winner_weight[i];
+                sx += au->winner_weight[i] * (double)map->rp_x_m[r];
+                sy += au->winner_weight[i] * (double)map->rp_y_m[r];
+            }
+        }
+        const double x = sx / sw;
+        const double y = sy / sw;
+        /* Spread: WkNN over the winners, naive Bayes over the whole posterior, on that floor. */
+        double ss = 0.0, sws = 0.0;
+        if (bayes) {
+            for (int32_t t = 0; t < n_touched; t++) {
+                const int32_t r = ws->touched[t];
+                if (map->rp_floor[r] == floor) {
+                    const double w = exp(ws->acc[r] - l_max) / z;
+                    const double dx = (double)map->rp_x_m[r] - x;
+                    const double dy = (double)map->rp_y_m[r] - y;
+                    ss += w * (dx * dx + dy * dy);
+                    sws += w;
+                }
+            }
+        } else {
+            for (int32_t i = 0; i < n_best; i++) {
+                const int32_t r = best[i].rp;
+                if (map->rp_floor[r] == floor) {
+                    const double dx = (double)map->rp_x_m[r] - x;
+                    const double dy = (double)map->rp_y_m[r] - y;
+                    ss += au->winner_weight[i] * (dx * dx + dy * dy);
+                    sws += au->winner_weight[i];
+                }
+            }
+        }
+        const double spread = sws > 0.0 ? sqrt(ss / sws) : 0.0;
+        const double acc_floor = p->fingerprint_accuracy_floor_m;
+        const double ratio = (double)p->fingerprint_accuracy_ref_aps / (double)fp->n_query;
+        au->spread_m = spread;
+        fix->t_us = scan->t_us;
+        fix->method = sf_fix_wifi;
+        fix->x_m = x;
+        fix->y_m = y;
+        fix->floor = floor;
+        fix->accuracy_m = sqrt(spread * spread + acc_floor * acc_floor) * (ratio > 1.0 ? sqrt(ratio) : 1.0);
+        fix->n_ap_used = (int16_t)fp->n_query;
+        fp->fixes++;
+    }
+
+    /* Leave the scratch as found. */
+    for (int32_t t = 0; t < n_touched; t++) {
+        ws->n_common[ws->touched[t]] = 0;
+    }
+    return result;
+}

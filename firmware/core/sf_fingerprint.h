@@ -1,0 +1,161 @@
+/* sf_fingerprint.h — Wi-Fi fingerprint matching: a scan against the radio map (sf_radiomap.h) gives a
+ * position fix (sf_fix_t, method sf_fix_wifi) with a 1σ accuracy, or no fix and a reason.
+ *
+ * Query. Each scan passed to sf_fingerprint_match goes into a ring of the last SF_FINGERPRINT_RING_SCANS
+ * scans. On the way in, readings that are not finite (`bad`) or weaker than fingerprint_min_rssi_dbm
+ * (`weak`, Ramadhan 2016: −90 dBm) are dropped, a BSSID repeated within one scan keeps its strongest
+ * reading, and a scan with more than SF_FINGERPRINT_SCAN_APS readings keeps the strongest ones
+ * (`truncated`). The query is the per-BSSID mean over the last fingerprint_average_scans scans that heard
+ * it (SmartLocator: mean of 3 scans), among those no older than fingerprint_average_max_age_ms before the
+ * current one; a scan earlier than the previous one empties the ring (`backwards`). Query BSSIDs not in
+ * the map are ignored (audit.n_unknown); the rest are the APs used, s_a [dBm] for map AP a. Fewer than
+ * fingerprint_min_aps of them: no fix, SF_ERANGE, audit.reason = sf_fp_too_few_aps.
+ *
+ * Candidates (cost follows the APs heard). Only the map entries of the used APs are visited: for each
+ * used AP a, entries ap_first[a] … ap_first[a+1]−1 (audit.n_entries_visited counts them), accumulating
+ * per-RP partial sums in the caller's workspace. Reference points (RPs) that heard none of the used APs
+ * are not candidates. Unless any_floor, entries of RPs on floors other than floor_hint are skipped.
+ * Below, R_r is the set of APs the map has at RP r (mean μ, std σ, detection rate q = count/rp_scans).
+ *
+ * WkNN (fingerprint_method 0; Ramadhan 2016, Couceiro 2017). Distance in signal space [dB]:
+ *   missing_mode 0 (fill, f = fingerprint_fill_dbm, −100): an AP missing on one side takes the level f,
+ *     d_r² = Σ_{a∈Q∩R} (s_a − μ_ra)² + Σ_{a∈Q∖R} (s_a − f)² + Σ_{a∈R∖Q} (μ_ra − f)²
+ *          = F_r + Σ_{a∈Q} (s_a − f)² − 2 Σ_{a∈Q∩R} (s_a − f)(μ_ra − f),
+ *     F_r = Σ_{a∈R} (μ_ra − f)² is precomputed per RP by sf_fingerprint_prepare, so only Q∩R is visited.
+ *   missing_mode 1 (common APs only): d_r = √(Σ_{a∈Q∩R} (s_a − μ_ra)² / n_r), n_r = |Q∩R|; an RP with
+ *     n_r < fingerprint_min_common_aps is not a candidate.
+ *   The k = fingerprint_k nearest win (ties: lower RP index), weights w = 1/max(d, SF_FINGERPRINT_D_MIN_DB)
+ *   (the guard makes a perfect match dominate without dividing by zero).
+ *
+ * Gaussian naive Bayes (fingerprint_method 1; Jäger, Süß, Becker). Every map AP is modelled at every RP:
+ * heard at level s with probability q'·N(s; μ, σ'), not heard with probability 1 − q', where
+ * q' = clamp(q, p, 1 − p), p = fingerprint_nb_p_min, and σ' = max(σ, fingerprint_sigma_floor_db). An AP
+ * the map lacks at r is a phantom entry q' = p, μ = fingerprint_fill_dbm, σ' = sigma_floor_db: so an AP
+ * heard in the scan but unknown at the RP costs log p + log N(s; f, σ_floor) (the stronger it is heard, the
+ * more), and an AP of the RP missing from the scan costs log(1 − q'), i.e. log p for an AP the RP always
+ * heard (the detection-rate choice the brief left open; the fixed fill enters only through μ of phantoms).
+ * The log-likelihood over all n_ap map APs,
+ *     L_r = B_r + Σ_{a∈Q} C_a + Σ_{a∈Q∩R} [log q' + log N(s_a; μ, σ') − log(1 − q') − C_a],
+ *     B_r = Σ_{a∈R} log(1 − q'_ra) + (n_ap − |R_r|)·log(1 − p)                      (prepared),
+ *     C_a = log p + log N(s_a; f, σ_floor) − log(1 − p)                              (per scan AP),
+ * is exact, not an approximation, and again only Q∩R is visited. Posterior P(r|s) = softmax of L over
+ * the candidates (uniform prior); the k most probable win, weighted by their posterior (paper: k = 3).
+ *
+ * Fix. Floor = the floor with the largest summed weight among the k winners (tie: the best winner's
+ * floor); x, y = the weighted mean of the winners on that floor; n_ap_used = APs used. Accuracy (1σ, m):
+ *     accuracy_m = √(spread² + fingerprint_accuracy_floor_m²) · max(1, √(fingerprint_accuracy_ref_aps / n_used)),
+ * spread = weighted RMS distance from the fix of the winners on its floor (WkNN, weights 1/d), or of all
+ * candidates on its floor with their posterior (naive Bayes: the posterior's own spread, so a split
+ * posterior reads as poor accuracy even when the k best agree). It feeds the fusion's α and gate.
+ *
+ * Memory. sf_fingerprint_t ≈ 7 kB (ring of 4 × 64 readings, the last query of up to 256 APs, audit).
+ * Workspace: caller-owned arrays of n_rp each, SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
+ * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
+ * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
+ * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
+ * fingerprint_fill_dbm or fingerprint_nb_p_min change). sf_fingerprint_match: O(n_scan·64) to store the
+ * scan, O(m log m) (m ≤ 256) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
+ * (E_Q = total entries of the used APs; one log and one division per entry for naive Bayes), and
+ * O(T·k) to select among the T touched RPs — independent of the map size beyond E_Q and T ≤ n_rp.
+ * No heap, no I/O, no clock; deterministic (fixed summation order: APs by BSSID, entries by RP).
+ *
+ * Errors. sf_fingerprint_prepare: SF_EINVAL (NULL, empty map n_rp = 0 or n_ap = 0, workspace smaller than
+ * the map), SF_ERANGE (sf_radiomap_check fails). sf_fingerprint_match: SF_EINVAL (NULL, empty map, bad
+ * scan arrays, workspace not prepared for this map or these parameters; the scan is not stored),
+ * SF_ERANGE (no fix: too few usable APs, or no candidate RP — audit.reason says which; the scan is
+ * stored). Bad readings are not errors: they are counted and skipped. */
+#ifndef SF_FINGERPRINT_H
+#define SF_FINGERPRINT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_params.h"
+#include "sf_radiomap.h"
+#include "sf_types.h"
+
+#define SF_FINGERPRINT_RING_SCANS 4  /* scans kept for averaging: fingerprint_average_scans ≤ this */
+#define SF_FINGERPRINT_SCAN_APS 64   /* readings kept per scan (the strongest) */
+#define SF_FINGERPRINT_QUERY_APS (SF_FINGERPRINT_RING_SCANS * SF_FINGERPRINT_SCAN_APS)
+#define SF_FINGERPRINT_K_MAX 16      /* fingerprint_k ≤ this */
+#define SF_FINGERPRINT_D_MIN_DB 0.01 /* WkNN weight guard: w = 1/max(d, this) */
+#define SF_FINGERPRINT_WS_BYTES_PER_RP (3 * sizeof(double) + 2 * sizeof(int32_t))
+_Static_assert(SF_FINGERPRINT_RING_SCANS >= 3, "SmartLocator averages 3 scans");
+_Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used is int16");
+_Static_assert(SF_FINGERPRINT_K_MAX >= 3, "the papers use k = 3");
+
+/* Why the last match gave no fix. */
+enum { sf_fp_ok = 0, sf_fp_too_few_aps = 1, sf_fp_no_candidate = 2 };
+
+/* Caller-owned memory sized to the map: set the pointers and n_rp, then call sf_fingerprint_prepare. */
+typedef struct {
+    int32_t n_rp;             /* capacity of each array, ≥ map->n_rp */
+    double *rp_fill_sq_db2;   /* [n_rp] prepared: F_r (WkNN, fill mode) [dB²] */
+    double *rp_miss_loglik;   /* [n_rp] prepared: B_r (naive Bayes) */
+    double *acc;              /* [n_rp] scratch: per-RP partial sum */
+    int32_t *n_common;        /* [n_rp] scratch: |Q∩R_r|; all 0 between calls */
+    int32_t *touched;         /* [n_rp] scratch: RPs with n_common > 0, in order of first touch */
+    /* set by sf_fingerprint_prepare */
+    bool prepared;
+    int32_t map_n_ap, map_n_rp, map_n_entries; /* the map it was prepared for */
+    double fill_dbm, nb_p_min;                  /* the parameters it was prepared with */
+} sf_fingerprint_workspace_t;
+
+/* The record of the last match (published with the FIX message). */
+typedef struct {
+    int64_t t_us;
+    int8_t method;              /* fingerprint_method used */
+    int8_t missing_mode;        /* WkNN: fingerprint_missing_mode used */
+    int8_t reason;              /* sf_fp_* */
+    int32_t n_scans_averaged;   /* scans in the query (≥ 1) */
+    int32_t n_readings_weak;    /* of the current scan: below min_rssi_dbm */
+    int32_t n_heard;            /* distinct BSSIDs in the query */
+    int32_t n_unknown;          /* of them, not in the map */
+    int32_t n_used;             /* of them, in the map: |Q| */
+    int32_t n_entries_visited;  /* map entries visited (Σ entries of the used APs) */
+    int32_t n_touched;          /* RPs sharing at least one used AP (on the allowed floor) */
+    int32_t n_candidates;       /* of them, eligible */
+    int32_t k_used;             /* min(k, n_candidates) */
+    int32_t winner_rp[SF_FINGERPRINT_K_MAX];    /* best first */
+    double winner_score[SF_FINGERPRINT_K_MAX];  /* WkNN: d [dB]; naive Bayes: L [log-likelihood] */
+    double winner_weight[SF_FINGERPRINT_K_MAX]; /* WkNN: 1/d; naive Bayes: posterior P(r|s) */
+    double spread_m;            /* accuracy before the floor and the AP scaling */
+} sf_fingerprint_audit_t;
+
+/* One stored scan (filtered, deduplicated, at most SF_FINGERPRINT_SCAN_APS readings). */
+typedef struct {
+    int64_t t_us;
+    int32_t n;
+    int64_t bssid[SF_FINGERPRINT_SCAN_APS];
+    float rssi_dbm[SF_FINGERPRINT_SCAN_APS];
+} sf_fingerprint_scan_slot_t;
+
+typedef struct {
+    sf_fingerprint_scan_slot_t ring[SF_FINGERPRINT_RING_SCANS];
+    int32_t newest; /* ring index of the newest scan */
+    int32_t count;  /* scans in the ring */
+    /* the last query: used APs (map indices ascending) and their mean levels */
+    int32_t n_query;
+    int32_t query_ap[SF_FINGERPRINT_QUERY_APS];
+    double query_rssi_dbm[SF_FINGERPRINT_QUERY_APS];
+    sf_fingerprint_audit_t audit;
+    /* counters, never decrease */
+    uint32_t scans, fixes, rejected_too_few_aps, rejected_no_candidate;
+    uint32_t readings_bad, readings_weak, readings_truncated, readings_unknown, backwards;
+} sf_fingerprint_t;
+
+/* Empty ring, zero counters. */
+void sf_fingerprint_init(sf_fingerprint_t *fp);
+
+/* Checks the map (sf_radiomap_check), fills the workspace's prepared arrays for it and for
+ * fingerprint_fill_dbm / fingerprint_nb_p_min, and zeroes the scratch. */
+int sf_fingerprint_prepare(sf_fingerprint_workspace_t *ws, const sf_radiomap_t *map, const sf_params_t *p);
+
+/* Stores the scan, builds the query and matches it. On SF_OK, *fix is the fix (t_us = scan->t_us);
+ * otherwise *fix is untouched. Candidates are restricted to floor_hint unless any_floor. fp->audit
+ * describes the match on SF_OK and SF_ERANGE. */
+int sf_fingerprint_match(sf_fingerprint_t *fp, const sf_params_t *p, const sf_radiomap_t *map,
+                         sf_fingerprint_workspace_t *ws, const sf_wifi_scan_t *scan, int16_t floor_hint,
+                         bool any_floor, sf_fix_t *fix);
+
+#endif

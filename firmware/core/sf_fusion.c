@@ -1,0 +1,366 @@
+/* sf_fusion.c — see sf_fusion.h for the model. Layout: the fusion math (prediction, innovation, α,
+ * blend) first, then the control (judge), then the public calls; sf_fusion_fix() reads top to bottom
+ * like PX4's aid-source update(): predict, innovate, judge, apply, record. */
+#include "sf_fusion.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#include "sf_error.h"
+
+_Static_assert(sf_scheme_count == 6, "sf_fusion handles exactly the six schemes of sf_types.h");
+_Static_assert(sf_fix_reason_count == 9, "reasons mirror fix_t.REASON_*");
+
+static double clamp(const double v, const double lo, const double hi)
+{
+    return v < lo ? lo : (v > hi ? hi : v);
+}
+
+static double us_to_s(const int64_t dt_us)
+{
+    return (double)dt_us * 1e-6;
+}
+
+static int16_t to_floor(const int32_t v)
+{
+    return (int16_t)(v < INT16_MIN ? INT16_MIN : (v > INT16_MAX ? INT16_MAX : v));
+}
+
+static bool blends(const sf_fusion_t *const f)
+{
+    return f->scheme != sf_scheme_pdr_only && f->scheme != sf_scheme_wifi_only;
+}
+
+static bool predicts(const sf_fusion_t *const f)
+{
+    return f->scheme != sf_scheme_wifi_only;
+}
+
+static int16_t scheme_floor(const sf_fusion_t *const f, const int16_t baro_floor)
+{
+    if (f->scheme == sf_scheme_wifi_only) {
+        return to_floor(f->floor_offset);
+    }
+    return to_floor((int32_t)baro_floor + f->floor_offset);
+}
+
+/* Piecewise-linear over four knots, flat outside. Reaching segment i means xs[i] < x ≤ xs[i+1], so the
+ * width is positive: badly ordered knots make a jump, never a division by zero. NaN gives vs[0]. */
+static double interp4(const double xs[4], const double vs[4], const double x)
+{
+    if (!(x > xs[0])) {
+        return vs[0];
+    }
+    for (int i = 0; i < 3; i++) {
+        if (x <= xs[i + 1]) {
+            return vs[i] + (x - xs[i]) / (xs[i + 1] - xs[i]) * (vs[i + 1] - vs[i]);
+        }
+    }
+    return vs[3];
+}
+
+/* ---- fusion: the math ---------------------------------------------------------------------------- */
+
+/* Time update of the variance up to t_us (Δt < 0 counts as backwards and adds nothing). */
+static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us)
+{
+    if (t_us < f->t_us) {
+        f->backwards++;
+        return;
+    }
+    if (f->initialised && predicts(f)) {
+        f->var_m2 += p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us);
+    }
+    f->t_us = t_us;
+}
+
+/* The scheme's blend weight for an accepted fix; records the adaptive terms. */
+static double scheme_alpha(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const double r_m2, sf_fix_audit_t *const audit)
+{
+    switch (f->scheme) {
+    case sf_scheme_static:
+        return p->fusion_static_alpha;
+    case sf_scheme_adaptive: {
+        const double dt_s = us_to_s(fix->t_us - f->last_fix_t_us);
+        audit->accuracy_factor = sf_fusion_accuracy_factor(p, fix);
+        audit->drift = sf_fusion_drift(p, dt_s);
+        return clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
+    }
+    case sf_scheme_kalman:
+        return f->var_m2 / (f->var_m2 + r_m2);
+    default: /* overwrite (pdr_only and wifi_only never blend) */
+        return 1.0;
+    }
+}
+
+/* position ← position + α·ν; variance of the blend (Kalman form for kalman, Joseph form otherwise). */
+static void blend(sf_fusion_t *const f, const sf_params_t *const p, const double alpha, const double nu_x,
+                  const double nu_y, const double r_m2)
+{
+    f->x_m += alpha * nu_x;
+    f->y_m += alpha * nu_y;
+    const double keep = 1.0 - alpha;
+    const double var = f->scheme == sf_scheme_kalman ? keep * f->var_m2 : keep * keep * f->var_m2 + alpha * alpha * r_m2;
+    f->var_m2 = fmax(var, p->fusion_var_min_m2);
+}
+
+/* position ← fix, variance ← R, floor from the fix: initialisation, recovery, wifi_only. */
+static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                         const double r_m2, const int16_t baro_floor)
+{
+    f->initialised = true;
+    f->x_m = fix->x_m;
+    f->y_m = fix->y_m;
+    f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
+    f->floor_offset = f->scheme == sf_scheme_wifi_only ? (int32_t)fix->floor : (int32_t)fix->floor - baro_floor;
+}
+
+/* ---- control: which fixes to fuse ---------------------------------------------------------------- */
+
+/* The decision for an initialised scheme, from the named conditions of the header. */
+static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                    const double test_ratio, const int16_t baro_floor)
+{
+    if (f->scheme == sf_scheme_pdr_only) {
+        return sf_fix_reason_scheme_ignores;
+    }
+    if (f->scheme == sf_scheme_wifi_only) {
+        return sf_fix_reason_accepted; /* no gate: the scheme is the fixes */
+    }
+    const bool floor_ok = fix->floor == scheme_floor(f, baro_floor);
+    const bool gate_ok = test_ratio <= 1.0;
+    if (floor_ok && gate_ok) {
+        return sf_fix_reason_accepted;
+    }
+    if (f->rejections >= p->fusion_max_rejections) {
+        return sf_fix_reason_recovery;
+    }
+    return floor_ok ? sf_fix_reason_gate : sf_fix_reason_floor_mismatch;
+}
+
+static bool fix_usable(const sf_fix_t *const fix)
+{
+    const bool method_ok =
+        fix->method == sf_fix_wifi || fix->method == sf_fix_gnss || fix->method == sf_fix_landmark;
+    return method_ok && isfinite(fix->x_m) && isfinite(fix->y_m) && isfinite(fix->accuracy_m) &&
+           fix->accuracy_m >= 0.0;
+}
+
+static void audit_begin(sf_fix_audit_t *const a, const sf_fusion_t *const f, const sf_fix_t *const fix)
+{
+    *a = (sf_fix_audit_t){
+        .t_us = fix->t_us,
+        .method = fix->method,
+        .x_m = fix->x_m,
+        .y_m = fix->y_m,
+        .floor = fix->floor,
+        .accuracy_m = fix->accuracy_m,
+        .n_ap_used = fix->n_ap_used,
+        .scheme = f->scheme,
+        .accepted = false,
+        .reason = sf_fix_reason_gate,
+    };
+}
+
+/* ---- public -------------------------------------------------------------------------------------- */
+
+int sf_fusion_init(sf_fusion_t *const f, const int8_t scheme)
+{
+    if (f == NULL || scheme < 0 || scheme >= sf_scheme_count) {
+        return SF_EINVAL;
+    }
+    *f = (sf_fusion_t){.scheme = scheme, .initialised = false, .var_m2 = 0.0};
+    return SF_OK;
+}
+
+int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us, const double x_m,
+                      const double y_m, const int16_t floor, const double sigma_m, const int16_t baro_floor)
+{
+    if (!(isfinite(x_m) && isfinite(y_m) && isfinite(sigma_m) && sigma_m >= 0.0)) {
+        return SF_EINVAL;
+    }
+    f->initialised = true;
+    f->x_m = x_m;
+    f->y_m = y_m;
+    f->var_m2 = fmax(sigma_m * sigma_m, p->fusion_var_min_m2);
+    f->floor_offset = f->scheme == sf_scheme_wifi_only ? (int32_t)floor : (int32_t)floor - baro_floor;
+    f->t_us = t_us;
+    f->last_fix_t_us = t_us;
+    f->rejections = 0;
+    f->initialisations++;
+    return SF_OK;
+}
+
+void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us, const double dx_m,
+                    const double dy_m, const double length_m)
+{
+    if (!predicts(f)) {
+        return; /* wifi_only ignores steps */
+    }
+    if (!(isfinite(dx_m) && isfinite(dy_m) && isfinite(length_m) && length_m >= 0.0)) {
+        f->bad_steps++;
+        return;
+    }
+    predict_to(f, p, t_us);
+    if (!f->initialised) {
+        return; /* nothing to move yet */
+    }
+    f->x_m += dx_m;
+    f->y_m += dy_m;
+    f->var_m2 += p->fusion_q_step_m2_per_m * length_m;
+    f->steps++;
+}
+
+int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                  const int16_t baro_floor, sf_fix_audit_t *const audit)
+{
+    audit_begin(audit, f, fix);
+    f->fixes++;
+    if (!fix_usable(fix)) {
+        f->bad_fixes++;
+        audit->test_ratio = INFINITY; /* no accuracy, no pass */
+        return SF_ERANGE;
+    }
+    const double r_m2 = fix->accuracy_m * fix->accuracy_m;
+
+    /* fusion: predict to the fix's time */
+    predict_to(f, p, fix->t_us);
+
+    /* control: start */
+    if (!f->initialised) {
+        reset_to_fix(f, p, fix, r_m2, baro_floor);
+        f->last_fix_t_us = fix->t_us;
+        f->rejections = 0;
+        f->initialisations++;
+        audit->innovation_var_m2 = r_m2;
+        audit->alpha = 1.0;
+        audit->accepted = true;
+        audit->reason = sf_fix_reason_initialised;
+        return SF_OK;
+    }
+
+    /* fusion: innovation, its variance, the test ratio */
+    const double nu_x = fix->x_m - f->x_m;
+    const double nu_y = fix->y_m - f->y_m;
+    const double s_m2 = f->var_m2 + r_m2;
+    const double gate = p->fusion_gate_sigma;
+    audit->innovation_m[0] = nu_x;
+    audit->innovation_m[1] = nu_y;
+    audit->innovation_var_m2 = s_m2;
+    audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
+
+    /* control: judge, then apply */
+    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor);
+    audit->reason = reason;
+    switch (reason) {
+    case sf_fix_reason_accepted:
+        if (blends(f)) {
+            audit->alpha = scheme_alpha(f, p, fix, r_m2, audit);
+            blend(f, p, audit->alpha, nu_x, nu_y, r_m2);
+        } else { /* wifi_only */
+            audit->alpha = 1.0;
+            reset_to_fix(f, p, fix, r_m2, baro_floor);
+        }
+        f->accepted++;
+        break;
+    case sf_fix_reason_recovery:
+        audit->alpha = 1.0;
+        reset_to_fix(f, p, fix, r_m2, baro_floor);
+        f->recoveries++;
+        break;
+    case sf_fix_reason_gate:
+        f->rejected_gate++;
+        f->rejections++;
+        return SF_OK;
+    case sf_fix_reason_floor_mismatch:
+        f->rejected_floor++;
+        f->rejections++;
+        return SF_OK;
+    default: /* scheme_ignores: pdr_only keeps its dead reckoning */
+        return SF_OK;
+    }
+    audit->accepted = true;
+    f->last_fix_t_us = fix->t_us;
+    f->rejections = 0;
+    return SF_OK;
+}
+
+bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us,
+                    const int16_t baro_floor, sf_pose_t *const pose)
+{
+    pose->scheme = f->scheme;
+    if (!f->initialised) {
+        pose->x_m = 0.0;
+        pose->y_m = 0.0;
+        pose->floor = baro_floor;
+        pose->sigma_m = SF_FUSION_SIGMA_UNKNOWN_M;
+        return false;
+    }
+    double var = f->var_m2;
+    if (predicts(f) && t_us > f->t_us) {
+        var += p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us);
+    }
+    pose->x_m = f->x_m;
+    pose->y_m = f->y_m;
+    pose->floor = scheme_floor(f, baro_floor);
+    pose->sigma_m = sqrt(var);
+    return true;
+}
+
+double sf_fusion_accuracy_factor(const sf_params_t *const p, const sf_fix_t *const fix)
+{
+    switch (fix->method) {
+    case sf_fix_wifi: {
+        const double xs[4] = {p->fusion_acc_wifi_ap1, p->fusion_acc_wifi_ap2, p->fusion_acc_wifi_ap3,
+                              p->fusion_acc_wifi_ap4};
+        const double vs[4] = {p->fusion_acc_wifi_val1, p->fusion_acc_wifi_val2, p->fusion_acc_wifi_val3,
+                              p->fusion_acc_wifi_val4};
+        return interp4(xs, vs, (double)fix->n_ap_used);
+    }
+    case sf_fix_gnss: {
+        const double xs[4] = {p->fusion_acc_gnss_m1, p->fusion_acc_gnss_m2, p->fusion_acc_gnss_m3,
+                              p->fusion_acc_gnss_m4};
+        const double vs[4] = {p->fusion_acc_gnss_val1, p->fusion_acc_gnss_val2, p->fusion_acc_gnss_val3,
+                              p->fusion_acc_gnss_val4};
+        return interp4(xs, vs, fix->accuracy_m);
+    }
+    case sf_fix_landmark:
+        return p->fusion_acc_landmark;
+    default:
+        return 0.0;
+    }
+}
+
+double sf_fusion_drift(const sf_params_t *const p, const double dt_s)
+{
+    return dt_s > 0.0 ? fmin(p->fusion_drift_per_s * dt_s, p->fusion_drift_max) : 0.0;
+}
+
+double sf_fusion_adaptive_alpha(const sf_params_t *const p, const sf_fix_t *const fix, const double dt_s)
+{
+    return clamp(sf_fusion_accuracy_factor(p, fix) + sf_fusion_drift(p, dt_s), 0.0, 1.0);
+}
+
+void sf_fusion_audit_refused(const sf_fusion_t *const f, const sf_fix_t *const fix, const int8_t reason,
+                             sf_fix_audit_t *const audit)
+{
+    audit_begin(audit, f, fix);
+    audit->reason = reason;
+}
+
+const char *sf_fix_reason_text(const int reason)
+{
+    static const char *const text[sf_fix_reason_count] = {
+        [sf_fix_reason_accepted] = "accepted",
+        [sf_fix_reason_gate] = "rejected: outside the innovation gate",
+        [sf_fix_reason_too_few_aps] = "rejected: too few access points",
+        [sf_fix_reason_no_map] = "rejected: no radio map",
+        [sf_fix_reason_floor_mismatch] = "rejected: floor differs from the scheme's floor",
+        [sf_fix_reason_not_initialised] = "rejected: scheme not initialised",
+        [sf_fix_reason_initialised] = "accepted: initialised the scheme",
+        [sf_fix_reason_recovery] = "accepted: recovery after consecutive rejections",
+        [sf_fix_reason_scheme_ignores] = "ignored: the scheme does not use fixes",
+    };
+    return reason >= 0 && reason < sf_fix_reason_count ? text[reason] : "unknown reason";
+}

@@ -1,0 +1,183 @@
+/* sf_fusion.h — PDR + absolute-fix fusion: six schemes run side by side on the same inputs.
+ *
+ * Ownership. One sf_fusion_t is one scheme. The estimator owns an array
+ *     sf_fusion_t fusion[sf_scheme_count];   sf_fusion_init(&fusion[s], (int8_t)s) for each s,
+ * and feeds every scheme the same steps and fixes, so one log compares all of them (DESIGN.md,
+ * evaluation protocol). A scheme never looks at another; there is no shared state.
+ *
+ * Frame and units: map frame x, y [m], floors as int16 indices, times int64 µs carried by the inputs
+ * (no clock). Position uncertainty is isotropic: `var_m2` is the variance of each axis [m²], the fix's
+ * accuracy_m is its per-axis 1σ, R = accuracy_m², and the pose's sigma_m = √var_m2.
+ *
+ * Process model (prediction), the same for every scheme that has one, so the gate is identical across
+ * schemes and only α differs: each step moves the position by the caller's (dx_m, dy_m) and adds
+ *     var += fusion_q_step_m2_per_m · length_m + fusion_q_time_m2_per_s · Δt
+ * (a random walk per metre walked, plus per second for missed steps); the time term is also added up
+ * to each fix's time. wifi_only has no prediction (it ignores steps).
+ *
+ * Fusion (the math). Innovation ν = fix − predicted position (2-D), S = var + R, test ratio
+ * τ = |ν|² / (gate² · S) with gate = fusion_gate_sigma; |ν|²/S is χ² with 2 dof, so gate 3 passes
+ * 98.9 % of consistent fixes. An accepted fix blends
+ *     position ← position + α·ν   (= α·fix + (1−α)·pdr)
+ * with α per scheme:
+ *   pdr_only   never blends after initialisation (reason SCHEME_IGNORES; ν, S, τ still recorded, so
+ *              the log shows the PDR drift against each fix).
+ *   wifi_only  position = the latest fix, var = R: every fix accepted, no gate (τ recorded against the
+ *              previous fix, S = var + R, for information only).
+ *   overwrite  α = 1 (traditional dead reckoning).
+ *   static     α = fusion_static_alpha (0.5: Jäger et al.'s baseline).
+ *   adaptive   α = clamp(accuracy(fix) + drift(Δt), 0, 1) (Jäger, Süß, Becker eq. 9, with the printed
+ *              max(…, 1) read as min), Δt = time since this scheme's last accepted fix [s]:
+ *                accuracy: Wi-Fi  piecewise-linear in n_ap_used over the knots
+ *                                 (fusion_acc_wifi_ap1..4, fusion_acc_wifi_val1..4), flat outside;
+ *                          GNSS   piecewise-linear in accuracy_m over (fusion_acc_gnss_m1..4,
+ *                                 fusion_acc_gnss_val1..4), falling, flat outside;
+ *                          landmark fusion_acc_landmark (1: overwrite, as NFC in the paper);
+ *                drift = min(fusion_drift_per_s · Δt, fusion_drift_max).
+ *              The paper prints no numbers; the defaults are placeholders to tune in SIL (sf_params.h).
+ *              Knots must increase; if not, the value jumps at the first knot reached (no division by 0).
+ *   kalman     (ours) α = var / (var + R), the Kalman gain of the random-walk model above.
+ * Variance after an accepted fix: kalman var ← (1 − α)·var; the fixed-gain schemes take the Joseph form
+ * var ← (1 − α)²·var + α²·R (the true variance of a blend with an arbitrary gain; equal to the Kalman
+ * form when α is the Kalman gain). Every variance is floored at fusion_var_min_m2.
+ *
+ * Control (when to fuse), for the blending schemes overwrite/static/adaptive/kalman, in this order:
+ *   start        uninitialised: the first fix initialises (α = 1, var = R, floor from the fix;
+ *                reason INITIALISED), or sf_fusion_init_at() initialises from a known pose (truth-
+ *                initialised runs; the caller decides). Before that the pose is not valid.
+ *   floor        the fix's floor ≠ the scheme's floor → rejected, FLOOR_MISMATCH.
+ *   gate         τ > 1 → rejected, GATE.
+ *   continue     otherwise accepted (reason ACCEPTED) with the scheme's α.
+ *   recovery     a fix that would be rejected while `rejections` ≥ fusion_max_rejections (consecutive
+ *                rejections before it) is accepted with α = 1, var = R, floor from the fix (RECOVERY):
+ *                SmartLocator's confidence counter, so a diverged scheme comes back. Any accepted fix
+ *                clears the count. fusion_max_rejections = 0 means never reject.
+ * Floors. The barometer owns floor *changes*, the fixes own the floor *number*: a scheme stores
+ * floor_offset = its floor − the barometric floor at its last (re)initialisation, and its floor is
+ * baro_floor + floor_offset, with baro_floor passed by the caller on every fix and pose read (floor
+ * changes happen in lifts, without steps). So a wrong init_floor, or a baro reference off by one, is
+ * corrected by the first fix (or by a recovery after max_rejections fixes on another floor), while one
+ * Wi-Fi fix on the wrong floor is rejected. wifi_only takes the floor of the latest fix; pdr_only keeps
+ * the offset of its initialisation.
+ *
+ * Audit. Every fix offered to every scheme fills one sf_fix_audit_t, which is the LCM FIX message
+ * (lcmtypes/stridefix/fix_t.lcm): the fix, ν, S, τ, α applied (0 when rejected), accepted, reason
+ * (sf_fix_reason_*, identical to fix_t.REASON_*), scheme; plus the adaptive terms for analysis. For an
+ * initialising fix ν = 0, S = R, τ = 0. TOO_FEW_APS and NO_MAP are the fingerprint matcher's reasons
+ * (no position exists): the caller writes those records itself (sf_fusion_audit_refused helps);
+ * NOT_INITIALISED is not produced here (a fix always initialises).
+ *
+ * Bad data (not an error of the caller, counted in the scheme's counters and skipped): a step with a
+ * non-finite or negative length or non-finite displacement (`bad_steps`); a fix with a non-finite
+ * position, a non-finite or negative accuracy, or an unknown method (`bad_fixes`: state unchanged,
+ * audit rejected with reason GATE and τ = +∞, and sf_fusion_fix returns SF_ERANGE so the caller can
+ * count it in HEALTH; it does not count toward recovery); an input time before the scheme's latest
+ * (`backwards`: Δt taken as 0).
+ *
+ * Errors: sf_fusion_init returns SF_OK or SF_EINVAL (NULL, scheme outside [0, sf_scheme_count));
+ * sf_fusion_init_at SF_OK or SF_EINVAL (non-finite x, y or sigma, negative sigma; state unchanged);
+ * sf_fusion_fix SF_OK or SF_ERANGE (bad fix, see above). Everything else cannot fail.
+ * Cost: O(1), a few tens of flops and one sqrt per call. Memory: sizeof(sf_fusion_t) ≈ 100 B per
+ * scheme. No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs. */
+#ifndef SF_FUSION_H
+#define SF_FUSION_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_params.h"
+#include "sf_types.h"
+
+/* Reasons, identical to fix_t.REASON_* in lcmtypes/stridefix/fix_t.lcm. */
+enum {
+    sf_fix_reason_accepted = 0,
+    sf_fix_reason_gate = 1,
+    sf_fix_reason_too_few_aps = 2,
+    sf_fix_reason_no_map = 3,
+    sf_fix_reason_floor_mismatch = 4,
+    sf_fix_reason_not_initialised = 5,
+    sf_fix_reason_initialised = 6,
+    sf_fix_reason_recovery = 7,
+    sf_fix_reason_scheme_ignores = 8,
+    sf_fix_reason_count = 9
+};
+
+/* σ reported by sf_fusion_pose for a scheme that has no position yet [m]. */
+#define SF_FUSION_SIGMA_UNKNOWN_M 1.0e6
+
+/* The audit record of one fix judged by one scheme: the FIX message. */
+typedef struct {
+    /* the fix as offered */
+    int64_t t_us;
+    int8_t method;
+    double x_m;
+    double y_m;
+    int16_t floor;
+    double accuracy_m;
+    int16_t n_ap_used;
+    /* the judgement */
+    int8_t scheme;
+    double innovation_m[2];   /* fix − predicted position [m] */
+    double innovation_var_m2; /* S = var + R [m²] */
+    double test_ratio;        /* |ν|² / (gate² · S); ≤ 1 passes */
+    double alpha;             /* blend weight applied; 0 when not applied */
+    bool accepted;
+    int8_t reason;            /* sf_fix_reason_* */
+    /* adaptive scheme's terms (0 for the others), for analysis */
+    double accuracy_factor;
+    double drift;
+} sf_fix_audit_t;
+
+typedef struct {
+    int8_t scheme; /* sf_scheme_* */
+    bool initialised;
+    double x_m;
+    double y_m;
+    double var_m2;          /* per-axis position variance [m²] */
+    int16_t floor_offset;   /* floor = baro_floor + floor_offset (wifi_only: the fix's floor) */
+    int64_t t_us;           /* latest input time seen (prediction is up to here) */
+    int64_t last_fix_t_us;  /* time of the last accepted fix or initialisation (adaptive drift) */
+    int32_t rejections;     /* consecutive rejected fixes (control: recovery) */
+    /* counters, never decrease */
+    uint32_t steps, bad_steps, fixes, accepted, rejected_gate, rejected_floor, recoveries,
+        initialisations, bad_fixes, backwards;
+} sf_fusion_t;
+
+/* An uninitialised scheme. SF_OK, or SF_EINVAL for NULL or an unknown scheme. */
+int sf_fusion_init(sf_fusion_t *f, int8_t scheme);
+
+/* Initialises (or re-initialises) at a known pose: position (x_m, y_m), floor, per-axis σ [m] at
+ * t_us, while the barometer says baro_floor. For truth-initialised runs (the `init` params).
+ * SF_OK, or SF_EINVAL (state unchanged) for a non-finite value or a negative sigma. */
+int sf_fusion_init_at(sf_fusion_t *f, const sf_params_t *p, int64_t t_us, double x_m, double y_m, int16_t floor,
+                      double sigma_m, int16_t baro_floor);
+
+/* One accepted PDR step at t_us: displacement (dx_m, dy_m) in the map frame, its length [m]. Moves
+ * every initialised scheme except wifi_only. */
+void sf_fusion_step(sf_fusion_t *f, const sf_params_t *p, int64_t t_us, double dx_m, double dy_m, double length_m);
+
+/* One absolute fix, judged by this scheme while the barometer says baro_floor; fills *audit (always).
+ * SF_OK, or SF_ERANGE for a bad fix (see the header's "Bad data"). */
+int sf_fusion_fix(sf_fusion_t *f, const sf_params_t *p, const sf_fix_t *fix, int16_t baro_floor,
+                  sf_fix_audit_t *audit);
+
+/* Overlays the scheme's x_m, y_m, floor, sigma_m (including the time term up to t_us) and scheme on
+ * *pose; t_us, heading and step_count are left as the caller set them. Returns whether the scheme is
+ * initialised; if not, x = y = 0, floor = baro_floor and sigma = SF_FUSION_SIGMA_UNKNOWN_M. */
+bool sf_fusion_pose(const sf_fusion_t *f, const sf_params_t *p, int64_t t_us, int16_t baro_floor, sf_pose_t *pose);
+
+/* The adaptive law, exposed for tests and the analyzer. accuracy factor of a fix by its method (0 for
+ * an unknown method), drift after dt_s seconds (0 for dt_s ≤ 0), and α = clamp(sum, 0, 1). */
+double sf_fusion_accuracy_factor(const sf_params_t *p, const sf_fix_t *fix);
+double sf_fusion_drift(const sf_params_t *p, double dt_s);
+double sf_fusion_adaptive_alpha(const sf_params_t *p, const sf_fix_t *fix, double dt_s);
+
+/* A record for a scan the matcher refused before any position existed (reason TOO_FEW_APS or
+ * NO_MAP, or any reason the caller decides): the fix fields from *fix, ν = 0, S = 0, τ = 0, α = 0,
+ * rejected. Does not touch the scheme. */
+void sf_fusion_audit_refused(const sf_fusion_t *f, const sf_fix_t *fix, int8_t reason, sf_fix_audit_t *audit);
+
+/* Short English text for a reason (fix_t.reason_text); never NULL. */
+const char *sf_fix_reason_text(int reason);
+
+#endif
