@@ -191,6 +191,9 @@ def write_site(path: str | os.PathLike, site: site_t) -> int:
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)   # mkstemp makes 0600; a site file is an ordinary file
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

@@ -21,9 +21,11 @@
 #include "sf_lcm_input.h"
 #include "sf_lcm_out.h"
 #include "sf_params.h"
+#include "sf_site.h"
 #include "sf_estimator.h"
 #include "stridefix_baro_t.h"
 #include "stridefix_config_t.h"
+#include "stridefix_fix_t.h"
 #include "stridefix_gnss_t.h"
 #include "stridefix_health_t.h"
 #include "stridefix_imu_t.h"
@@ -50,6 +52,7 @@ typedef struct {
     const char *log_dir;
     bool no_log;
     const char *lcm_url;
+    const char *site_path;
     const char *config_paths[MAX_SETS];
     int n_configs;
     const char *sets[MAX_SETS];
@@ -66,6 +69,11 @@ typedef struct {
     sf_lcm_out_t *out;
     sf_board_rx_t rx;
     sf_estimator_t est;
+    sf_site_store_t site_store;
+    sf_site_t site;
+    sf_fingerprint_workspace_t ws;
+    void *ws_memory;
+    uint64_t fixes_published;
     char log_path[4096];
     uint64_t bad_syntax;
     long messages_printed;
@@ -95,6 +103,10 @@ static void usage(FILE *const f)
             "  -d, --log-dir DIR      directory for the default log name (default: .)\n"
             "      --no-log           write no log (live publishing only)\n"
             "  -u, --lcm-url URL      also publish live to this LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0\n"
+            "Site\n"
+            "      --site FILE        site file (floors, map rotation, radio map) from `stridefix radiomap build`:\n"
+            "                         enables Wi-Fi fixes and the fusion schemes; without it PDR starts at\n"
+            "                         the config pose (init.*)\n"
             "Configuration\n"
             "  -c, --config FILE      INI file of [section] key = value (every key: --print-config);\n"
             "                         repeatable, later files override earlier ones\n"
@@ -106,7 +118,8 @@ static void usage(FILE *const f)
             "  -h, --help             this text\n"
             "  -V, --version          version and the DBC it was built from\n"
             "\n"
-            "Channels written: IMU MAG BARO WIFI GNSS (inputs), STEP POSE (estimator), HEALTH (every\n"
+            "Channels written: IMU MAG BARO WIFI GNSS (inputs), STEP, POSE (one per fusion scheme),\n"
+            "FIX (with a site: every scheme's verdict on every Wi-Fi fix), HEALTH (every\n"
             "output.health_period_ms of board time, and at exit), CONFIG (once, first).\n"
             "Exit status: 0 done (bad frames are counted and skipped, not fatal); 1 the log could not be\n"
             "written; 2 bad usage, or an input or config that cannot be read.\n");
@@ -129,7 +142,7 @@ static void print_config(const sf_params_t *const p)
 
 static int parse_options(const int argc, char **const argv, options_t *const o, sf_params_t *const params)
 {
-    enum { opt_no_log = 1000, opt_print_config, opt_max_messages };
+    enum { opt_no_log = 1000, opt_print_config, opt_max_messages, opt_site };
     static const struct option longs[] = {
         {"input", required_argument, NULL, 'i'},   {"log", required_argument, NULL, 'l'},
         {"log-dir", required_argument, NULL, 'd'}, {"no-log", no_argument, NULL, opt_no_log},
@@ -137,6 +150,7 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
         {"set", required_argument, NULL, 's'},     {"print-config", no_argument, NULL, opt_print_config},
         {"quiet", no_argument, NULL, 'q'},         {"max-messages", required_argument, NULL, opt_max_messages},
         {"help", no_argument, NULL, 'h'},          {"version", no_argument, NULL, 'V'},
+        {"site", required_argument, NULL, opt_site},
         {NULL, 0, NULL, 0}};
     *o = (options_t){.log_dir = ".", .max_messages = 20};
     bool want_print_config = false;
@@ -148,6 +162,7 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
         case 'd': o->log_dir = optarg; break;
         case opt_no_log: o->no_log = true; break;
         case 'u': o->lcm_url = optarg; break;
+        case opt_site: o->site_path = optarg; break;
         case 'c':
             if (o->n_configs == MAX_SETS) {
                 fprintf(stderr, "stridefixd: at most %d --config options\n", MAX_SETS);
@@ -275,21 +290,59 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
+/* One POSE per fusion scheme that has a position (a scheme waiting for its first fix has none). */
 static void write_pose(daemon_t *const d)
 {
-    sf_pose_t p;
-    sf_estimator_pose(&d->est, &p);
-    stridefix_pose_t msg = {.t_us = p.t_us,
-                            .x_m = p.x_m,
-                            .y_m = p.y_m,
-                            .floor = p.floor,
-                            .heading_rad = (float)p.heading_rad,
-                            .sigma_m = (float)p.sigma_m,
-                            .step_count = p.step_count,
-                            .scheme = p.scheme};
-    SF_LCM_WRITE(d->out, "POSE", d->host_t_us, stridefix_pose_t, &msg);
-    d->last_pose_t_us = p.t_us;
-    d->last_pose_floor = p.floor;
+    for (int scheme = 0; scheme < sf_scheme_count; scheme++) {
+        sf_pose_t p;
+        if (!sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
+            continue;
+        }
+        stridefix_pose_t msg = {.t_us = p.t_us,
+                                .x_m = p.x_m,
+                                .y_m = p.y_m,
+                                .floor = p.floor,
+                                .heading_rad = (float)p.heading_rad,
+                                .sigma_m = (float)p.sigma_m,
+                                .step_count = p.step_count,
+                                .scheme = p.scheme};
+        SF_LCM_WRITE(d->out, "POSE", d->host_t_us, stridefix_pose_t, &msg);
+    }
+    d->last_pose_t_us = d->est.t_us;
+    d->last_pose_floor = sf_floor_current(&d->est.floor);
+}
+
+/* The FIX audit records of one scan: every scheme's verdict. */
+static void on_wifi_fix(daemon_t *const d, const sf_rx_wifi_t *const w)
+{
+    const sf_wifi_scan_t scan = {.t_us = w->t_us, .n_ap = w->n_ap, .bssid = w->bssid, .rssi_dbm = w->rssi_dbm};
+    sf_fix_t fix;
+    bool has_fix = false;
+    sf_fix_audit_t audits[sf_scheme_count];
+    const int n = sf_estimator_wifi(&d->est, &d->params, &scan, &fix, &has_fix, audits);
+    for (int i = 0; i < n; i++) {
+        const sf_fix_audit_t *const a = &audits[i];
+        stridefix_fix_t msg = {.t_us = a->t_us,
+                               .method = a->method,
+                               .scheme = a->scheme,
+                               .x_m = a->x_m,
+                               .y_m = a->y_m,
+                               .floor = a->floor,
+                               .accuracy_m = (float)a->accuracy_m,
+                               .n_ap_used = a->n_ap_used,
+                               .innovation_m = {(float)a->innovation_m[0], (float)a->innovation_m[1]},
+                               .innovation_var_m2 = (float)a->innovation_var_m2,
+                               .test_ratio = (float)a->test_ratio,
+                               .alpha = (float)a->alpha,
+                               .accepted = a->accepted,
+                               .reason = a->reason,
+                               .reason_text = (char *)sf_fix_reason_text(a->reason)};
+        SF_LCM_WRITE(d->out, "FIX", d->host_t_us, stridefix_fix_t, &msg);
+        d->fixes_published++;
+    }
+    if (n > 0) {
+        write_pose(d); /* the fix moved the fused schemes: say so now, not at the next step */
+    }
 }
 
 static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
@@ -359,6 +412,7 @@ static void on_event(daemon_t *const d, const sf_rx_event_t *const ev)
                                      .rssi_dbm = (float *)s->rssi_dbm,
                                      .freq_mhz = (int32_t *)s->freq_mhz};
         SF_LCM_WRITE(d->out, "WIFI", d->host_t_us, stridefix_wifi_scan_t, &msg);
+        on_wifi_fix(d, s);
         break;
     }
     case sf_rx_gnss: {
@@ -524,6 +578,39 @@ static void default_log_path(daemon_t *const d)
     snprintf(d->log_path, sizeof d->log_path, "%s/%s", d->opt.log_dir, name);
 }
 
+/* Loads --site: the site's map rotation replaces heading.map_rotation_deg (a fact of the site, not a
+ * tuning), and the matcher's workspace is sized to its radio map. The only allocation besides the
+ * log queue. */
+static int load_site(daemon_t *const d)
+{
+    if (d->opt.site_path == NULL) {
+        return 0;
+    }
+    char err[512];
+    if (sf_site_load(d->opt.site_path, &d->site_store, &d->site, err, sizeof err) != SF_OK) {
+        fprintf(stderr, "stridefixd: %s\n", err);
+        return -1;
+    }
+    d->params.heading_map_rotation_deg = d->site.map_rotation_deg;
+    const size_t n = (size_t)(d->site.radiomap.n_rp > 0 ? d->site.radiomap.n_rp : 1);
+    d->ws_memory = calloc(n, SF_FINGERPRINT_WS_BYTES_PER_RP);
+    if (d->ws_memory == NULL) {
+        fprintf(stderr, "stridefixd: out of memory for the radio map workspace\n");
+        return -1;
+    }
+    unsigned char *m = d->ws_memory;
+    d->ws.n_rp = (int32_t)n;
+    d->ws.rp_fill_sq_db2 = (double *)(void *)m;
+    d->ws.rp_miss_loglik = (double *)(void *)(m + n * sizeof(double));
+    d->ws.acc = (double *)(void *)(m + 2 * n * sizeof(double));
+    d->ws.n_common = (int32_t *)(void *)(m + 3 * n * sizeof(double));
+    d->ws.touched = (int32_t *)(void *)(m + 3 * n * sizeof(double) + n * sizeof(int32_t));
+    fprintf(stderr, "stridefixd: site %s: %d floors, %d APs, %d reference points, map rotation %.1f deg\n",
+            d->opt.site_path, (int)d->site.n_floors, (int)d->site.radiomap.n_ap, (int)d->site.radiomap.n_rp,
+            d->site.map_rotation_deg);
+    return 0;
+}
+
 static void close_input(daemon_t *const d)
 {
     if (d->lcm_in != NULL) {
@@ -559,7 +646,21 @@ int main(int argc, char **argv)
         return 1;
     }
     sf_board_rx_init(&d.rx);
+    if (load_site(&d) != 0) {
+        close_input(&d);
+        (void)sf_lcm_out_close(d.out, NULL);
+        return EXIT_USAGE;
+    }
     sf_estimator_init(&d.est, &d.params);
+    if (d.opt.site_path != NULL) {
+        const int rc = sf_estimator_attach_site(&d.est, &d.params, &d.site, &d.ws);
+        if (rc != SF_OK) {
+            fprintf(stderr, "stridefixd: %s: the site cannot be used: %s\n", d.opt.site_path, sf_strerror(rc));
+            close_input(&d);
+            (void)sf_lcm_out_close(d.out, NULL);
+            return EXIT_USAGE;
+        }
+    }
     d.last_pose_t_us = INT64_MIN / 2;
     const double t0 = monotonic_us();
     int status = run(&d);
@@ -570,5 +671,7 @@ int main(int argc, char **argv)
         status = 1;
     }
     summary(&d, &oc, (monotonic_us() - t0) * 1e-6);
+    sf_site_store_free(&d.site_store);
+    free(d.ws_memory);
     return status;
 }

@@ -3,9 +3,20 @@
 
 #include <math.h>
 
+#include "sf_error.h"
+
 static double wrap_pi(const double a)
 {
     return atan2(sin(a), cos(a));
+}
+
+/* Every scheme starts at the config pose (truth-initialised runs, and runs without a site). */
+static void start_at_config(sf_estimator_t *const e, const sf_params_t *const p)
+{
+    for (int s = 0; s < sf_scheme_count; s++) {
+        (void)sf_fusion_init_at(&e->fusion[s], p, 0, p->init_x_m, p->init_y_m, (int16_t)p->init_floor,
+                                p->init_sigma_m, (int16_t)p->init_floor);
+    }
 }
 
 void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
@@ -21,6 +32,37 @@ void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
     e->x_m = p->init_x_m;
     e->y_m = p->init_y_m;
     e->heading_rad = p->init_heading_rad;
+    sf_fingerprint_init(&e->fingerprint);
+    for (int s = 0; s < sf_scheme_count; s++) {
+        (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
+    }
+    start_at_config(e, p);
+}
+
+int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p, const sf_site_t *const site,
+                             sf_fingerprint_workspace_t *const ws)
+{
+    if (site == NULL || ws == NULL) {
+        return SF_EINVAL;
+    }
+    int rc = SF_OK;
+    if (site->n_floors > 0) {
+        rc = sf_floor_set_heights(&e->floor, site->floor_height_m, site->n_floors, site->lowest_floor);
+    }
+    if (rc == SF_OK && site->radiomap.n_rp > 0) {
+        rc = sf_fingerprint_prepare(ws, &site->radiomap, p);
+    }
+    if (rc != SF_OK) {
+        return rc;
+    }
+    e->site = site;
+    e->ws = ws;
+    if (!p->init_use_config_pose) { /* with a site, schemes start at their first fix */
+        for (int s = 0; s < sf_scheme_count; s++) {
+            (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
+        }
+    }
+    return SF_OK;
 }
 
 /* Walking direction in the map frame for the current device yaw. */
@@ -41,9 +83,14 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
     e->step_count++;
     e->x_m += length_m * cos(e->heading_rad);
     e->y_m += length_m * sin(e->heading_rad);
+    /* (the fusion schemes move by the same displacement below) */
     e->distance_m += length_m;
     e->sigma_m += p->estimator_sigma_per_m * length_m;
     e->weinberg_sum += sf_stride_weinberg_term(ev);
+    const double dx_m = length_m * cos(e->heading_rad), dy_m = length_m * sin(e->heading_rad);
+    for (int s = 0; s < sf_scheme_count; s++) {
+        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
+    }
 
     step->t_us = now_us; /* published when known (causal); ev->t_us is the extremum, earlier */
     step->index = e->step_count;
@@ -124,4 +171,39 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->sigma_m = e->sigma_m;
     pose->step_count = e->step_count;
     pose->scheme = sf_scheme_pdr_only;
+}
+
+int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
+                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    if (e->site == NULL || e->site->radiomap.n_rp == 0) {
+        return 0;
+    }
+    const int16_t baro_floor = sf_floor_current(&e->floor);
+    const int rc = sf_fingerprint_match(&e->fingerprint, p, &e->site->radiomap, e->ws, scan, baro_floor, true, fix);
+    if (rc != SF_OK) {
+        /* no usable fix: each scheme records the refusal, nothing moves */
+        const sf_fix_t none = {.t_us = scan->t_us, .method = sf_fix_wifi, .floor = baro_floor,
+                               .n_ap_used = (int16_t)e->fingerprint.audit.n_used};
+        for (int s = 0; s < sf_scheme_count; s++) {
+            sf_fusion_audit_refused(&e->fusion[s], &none, sf_fix_reason_too_few_aps, &audits[s]);
+        }
+        return sf_scheme_count;
+    }
+    *has_fix = true;
+    for (int s = 0; s < sf_scheme_count; s++) {
+        (void)sf_fusion_fix(&e->fusion[s], p, fix, baro_floor, &audits[s]);
+    }
+    return sf_scheme_count;
+}
+
+bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
+                              sf_pose_t *const pose)
+{
+    if (scheme < 0 || scheme >= sf_scheme_count) {
+        return false;
+    }
+    sf_estimator_pose(e, pose);
+    return sf_fusion_pose(&e->fusion[scheme], p, e->t_us, sf_floor_current(&e->floor), pose);
 }

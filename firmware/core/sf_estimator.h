@@ -17,8 +17,11 @@
  * direction is init_heading_rad + yaw + offset; once a magnetometer sample is accepted the yaw is
  * magnetic and the map rotation applies.
  *
- * Position uncertainty: σ grows by estimator_sigma_per_m per metre walked (stride scale and heading
- * errors make PDR error proportional to distance); absolute fixes (issue 4) will shrink it.
+ * Absolute fixes: Wi-Fi scans are matched against the site's radio map (sf_fingerprint) and every
+ * fix is offered to each of the six fusion schemes (sf_fusion: pdr_only, wifi_only, overwrite,
+ * static, adaptive, kalman), which all run side by side on the same steps and fixes, so one log
+ * compares them all. Each scheme's pose is sf_estimator_scheme_pose; sf_estimator_pose is the PDR
+ * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
  * Memory: sizeof(sf_estimator_t) ≈ 4.5 KiB. Cost per IMU sample: a few hundred flops; per MAG sample
@@ -31,10 +34,13 @@
 
 #include "sf_activity.h"
 #include "sf_attitude.h"
+#include "sf_fingerprint.h"
 #include "sf_floor.h"
+#include "sf_fusion.h"
 #include "sf_heading.h"
 #include "sf_magcal.h"
 #include "sf_params.h"
+#include "sf_radiomap.h"
 #include "sf_steps.h"
 #include "sf_stride.h"
 #include "sf_types.h"
@@ -60,6 +66,11 @@ typedef struct {
     int32_t step_count;
     uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
     sf_step_event_t held_event; /* the held first step of a bout (sf_activity.h) */
+    /* absolute fixes (issue 4): the site and the matcher's workspace are the caller's */
+    const sf_site_t *site;          /* NULL: no site, no Wi-Fi fixes */
+    sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
+    sf_fingerprint_t fingerprint;
+    sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
 } sf_estimator_t;
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);
@@ -79,7 +90,25 @@ void sf_estimator_mag(sf_estimator_t *est, const sf_params_t *p, int64_t t_us, c
 /* One barometer sample [Pa]. */
 void sf_estimator_baro(sf_estimator_t *est, const sf_params_t *p, int64_t t_us, double pressure_pa);
 
-/* The current pose (time = newest input time). */
+/* The PDR track from the config start (time = newest input time). */
 void sf_estimator_pose(const sf_estimator_t *est, sf_pose_t *pose);
+
+/* Gives the estimator a site (floors and radio map; caller-owned, must outlive the estimator) and a
+ * workspace sized to its map (sf_fingerprint.h). Call once, right after sf_estimator_init, before any
+ * input. Without a site there are no Wi-Fi fixes and every scheme starts at the config pose; with
+ * one, schemes start at their first fix unless init_use_config_pose (truth-initialised).
+ * SF_OK, or the error of sf_floor_set_heights / sf_fingerprint_prepare (bad site). */
+int sf_estimator_attach_site(sf_estimator_t *est, const sf_params_t *p, const sf_site_t *site,
+                             sf_fingerprint_workspace_t *ws);
+
+/* One Wi-Fi scan. With a site, matches it and offers the fix to every scheme; fills *fix (when the
+ * match succeeded, *has_fix) and one audit per scheme (audits[s] for scheme s), and returns the
+ * number of audits (sf_scheme_count), or 0 without a site. A scan with too few usable APs gives
+ * audits with reason too_few_aps and no fix. */
+int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_scan_t *scan, sf_fix_t *fix,
+                      bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
+
+/* The pose of one scheme; false while that scheme has no position yet (waiting for its first fix). */
+bool sf_estimator_scheme_pose(const sf_estimator_t *est, const sf_params_t *p, int scheme, sf_pose_t *pose);
 
 #endif

@@ -41,6 +41,10 @@
  * is exact, not an approximation, and again only Q∩R is visited. Posterior P(r|s) = softmax of L over
  * the candidates (uniform prior); the k most probable win, weighted by their posterior (paper: k = 3).
  *
+ * Map entries weaker than fingerprint_min_rssi_dbm are used as they are, but a scan never reports such
+ * levels, so the map builder should drop them (as Ramadhan stores < −90 dBm as missing) — otherwise an
+ * RP pays (μ − f)² (WkNN) or log(1 − q') (naive Bayes) for an AP the scan could not have kept.
+ *
  * Fix. Floor = the floor with the largest summed weight among the k winners (tie: the best winner's
  * floor); x, y = the weighted mean of the winners on that floor; n_ap_used = APs used. Accuracy (1σ, m):
  *     accuracy_m = √(spread² + fingerprint_accuracy_floor_m²) · max(1, √(fingerprint_accuracy_ref_aps / n_used)),
@@ -48,7 +52,8 @@
  * candidates on its floor with their posterior (naive Bayes: the posterior's own spread, so a split
  * posterior reads as poor accuracy even when the k best agree). It feeds the fusion's α and gate.
  *
- * Memory. sf_fingerprint_t ≈ 7 kB (ring of 4 × 64 readings, the last query of up to 256 APs, audit).
+ * Memory. sf_fingerprint_t ≈ 6.6 kB (ring of 4 × 64 readings, the last query of up to 256 APs, audit);
+ * 4 kB of stack while the query is built.
  * Workspace: caller-owned arrays of n_rp each, SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
  * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
  * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.

@@ -18,7 +18,7 @@ static double clamp(const double v, const double lo, const double hi)
 
 static double us_to_s(const int64_t dt_us)
 {
-    return (double)dt_us * 1e-6;
+    return (double)dt_us / 1e6; /* correctly rounded: whole seconds come out exact */
 }
 
 static int16_t to_floor(const int32_t v)

@@ -17,7 +17,9 @@
     X(init,   x_m,                 double,  0.0,     -1e6,    1e6,     "m",     "start position x, map frame")  \
     X(init,   y_m,                 double,  0.0,     -1e6,    1e6,     "m",     "start position y, map frame")  \
     X(init,   heading_rad,         double,  0.0,     -7.0,    7.0,     "rad",   "start walking direction, CCW from +x") \
-    X(init,   floor,               int32_t, 0,       -20,     200,     "",      "start floor index")
+    X(init,   floor,               int32_t, 0,       -20,     200,     "",      "start floor index")            \
+    X(init,   use_config_pose,     int32_t, 0,       0,       1,       "",      "1 = every scheme starts at init.x_m/y_m (truth-initialised); 0 = from the first fix (always 1 without a site)") \
+    X(init,   sigma_m,             double,  1.0,     0.0,     1e3,     "m",     "position sigma of a config start")
 
 /* sf_estimator.h */
 #define SF_PARAMS_ESTIMATOR(X)                                                                         \

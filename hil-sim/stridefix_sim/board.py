@@ -171,6 +171,40 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
     return ev
 
 
+def _digits(v: np.ndarray, width: int) -> np.ndarray:
+    """(n, width) ASCII digits of non-negative integers, zero-padded."""
+    p = 10 ** np.arange(width - 1, -1, -1, dtype=np.int64)
+    return (48 + (v[:, None] // p) % 10).astype(np.uint8)
+
+
+def _candump_lines(host_us: np.ndarray, code: np.ndarray, word: np.ndarray, db) -> list[str]:
+    """``(sssssssssss.uuuuuu) can0 III#DDDDDDDDDDDDDDDD`` lines (candump -L), built as one byte array."""
+    msgs = db.messages
+    n = len(host_us)
+    sec, usec = host_us // 1_000_000, host_us % 1_000_000
+    if n == 0:
+        return []
+    if any(m.length != 8 for m in msgs) or sec.min() < 10**9 or sec.max() >= 10**10:  # general (slow) path
+        data = word.astype("<u8").view(np.uint8).reshape(-1, 8)
+        return [f"({h // 1_000_000}.{h % 1_000_000:06d}) can0 {msgs[c].frame_id:03X}#"
+                f"{bytes(d[:msgs[c].length]).hex().upper()}" for h, c, d in zip(host_us.tolist(), code.tolist(), data)]
+    hexd = np.frombuffer(b"0123456789ABCDEF", dtype=np.uint8)
+    ids = np.array([list(f"{m.frame_id:03X}".encode()) for m in msgs], dtype=np.uint8)
+    data = word.astype("<u8").view(np.uint8).reshape(-1, 8)
+    row = np.empty((n, 45), dtype=np.uint8)
+    row[:, 0] = ord("(")
+    row[:, 1:11] = _digits(sec, 10)
+    row[:, 11] = ord(".")
+    row[:, 12:18] = _digits(usec, 6)
+    row[:, 18:25] = np.frombuffer(b") can0 ", dtype=np.uint8)
+    row[:, 25:28] = ids[code]
+    row[:, 28] = ord("#")
+    row[:, 29:45:2] = hexd[data >> 4]
+    row[:, 30:46:2] = hexd[data & 15]
+    text = row.tobytes().decode("ascii")
+    return [text[i:i + 45] for i in range(0, len(text), 45)]
+
+
 def emulate_board(sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict,
                   rng: np.random.Generator, dbc_path: Path | str = DBC_PATH) -> BoardOutput:
     db = load_dbc(dbc_path)
@@ -202,18 +236,7 @@ def emulate_board(sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict,
     imu_samples = int(np.sum(is_gyr & ~lost & acc_sent))
 
     keep = ~lost
-    nbytes = np.array([m.length for m in db.messages])
-    data = word[keep].astype("<u8").view(np.uint8).reshape(-1, 8)
-    hexd = np.frombuffer(b"0123456789ABCDEF", dtype=np.uint8)
-    chars = np.empty((len(data), 16), dtype=np.uint8)
-    chars[:, 0::2] = hexd[data >> 4]
-    chars[:, 1::2] = hexd[data & 15]
-    text = chars.tobytes().decode("ascii")
-    ids = [f"{m.frame_id:03X}" for m in db.messages]
-    kept_name = name[keep].tolist()
-    kept_host = host[keep].tolist()
-    lines = [f"({h // 1_000_000}.{h % 1_000_000:06d}) can0 {ids[c]}#{text[16 * r:16 * r + 2 * nbytes[c]]}"
-             for r, (h, c) in enumerate(zip(kept_host, kept_name))]
+    lines = _candump_lines(host[keep], name[keep], word[keep], db)
     sent = np.bincount(name[keep], minlength=len(names))
     dropped = np.bincount(name[lost], minlength=len(names))
     sent_by_name = {nm: int(sent[c]) for c, nm in enumerate(names)}

@@ -22,6 +22,19 @@ centre the local field is the earth field with its intensity multiplied by 1 + w
 azimuth turned by w·azimuth_deg and its inclination changed by w·dip_deg, with the weight
 w = (1 − (d/R)²)² (1 at the centre, 0 from R on: outside every zone the field is undisturbed).
 
+Survey geometry (``survey_points``): calibration points lie on a grid (``grid_origin_m`` + spacing ·
+(i, j)) inside the world's walkable rectangles (``walkable_m``; for the office the 2 m corridor band),
+at least a margin away from every wall and outside solid blocks (``blocked_m``: a concrete core, pillars);
+or a world gives an explicit list (``survey_points_m``).
+
+A second built-in world, ``aadr2015`` (``aadr2015_world``), replicates the experiment of Jäger, Süß and
+Becker (a foyer, 8 access points, 67 calibration points on a 2 m grid, a ~70 m track with 14 reference
+points): one floor, 20 m × 14 m (280 m²), open, with a concrete core (a lift and service shaft, 2 m × 6 m,
+x 12-14 m, y 6-12 m; its walls attenuate 15 dB each, so the spot east of it, ``poor_coverage_m``, hears
+most access points only through the core), two concrete pillars and a drywall cloakroom in the
+north-west corner; a steel staircase next to the poor-coverage spot disturbs the magnetic field.
+Walls may carry their own loss (``walls_loss_db``, NaN = the scenario's ``radio.wall_loss_db``).
+
 Map frame: x east-ish, y north-ish, metres; heading counter-clockwise from +x [rad]. The map is rotated
 from magnetic axes by ``map_rotation_deg``: the map frame is the magnetic east-north frame turned
 counter-clockwise by that angle, so magnetic north lies along map heading ``90 deg - map_rotation_deg``.
@@ -29,6 +42,7 @@ Heights: metres above the floor-0 walking surface; floor f's surface is at f · 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -123,6 +137,65 @@ class World:
     tour_start_y_m: float = 13.0      # the ``tour`` route starts at (loop x0, this), heading south
     tour_end_y_m: float = 15.0        # and ends at (loop x1, this)
     extra: dict = field(default_factory=dict)
+    walls_loss_db: np.ndarray | None = None     # (n_wall,) own loss per wall [dB]; NaN/None = radio.wall_loss_db
+    walkable_m: np.ndarray | None = None        # (k, 4) x0, y0, x1, y1: where calibration points may lie
+    blocked_m: np.ndarray | None = None         # (k, 4) solid blocks (no calibration point inside)
+    grid_origin_m: tuple[float, float] = (0.0, 0.0)   # the survey grid passes through this point
+    survey_points_m: np.ndarray | None = None   # (n, 3) x, y, floor: the world's own calibration points
+    track_m: tuple | None = None                # waypoints of the ``track`` route (starts at the first)
+    reference_points_m: np.ndarray | None = None   # (n, 2) surveyed reference points on the track
+    poor_coverage_m: tuple | None = None        # (x0, y0, x1, y1) the spot of poor Wi-Fi coverage
+    description: str = ""
+
+    @property
+    def area_m2(self) -> float:
+        return self.floor_w_m * self.floor_h_m
+
+
+def _point_segment_distance(p: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """(n,) distance of each point (n, 2) to the nearest wall segment."""
+    if len(walls) == 0:
+        return np.full(len(p), np.inf)
+    a, b = walls[None, :, 0:2], walls[None, :, 2:4]
+    ab = b - a
+    q = p[:, None, :]
+    u = np.clip(np.sum((q - a) * ab, axis=-1) / np.maximum(np.sum(ab * ab, axis=-1), 1e-12), 0.0, 1.0)
+    d = np.hypot(*(q - (a + u[..., None] * ab)).transpose(2, 0, 1))
+    return d.min(axis=1)
+
+
+def survey_points(world: World, spacing_m: float, margin_m: float, floors, layout: str = "grid") -> np.ndarray:
+    """Calibration points (n, 3: x, y, floor) of ``floors``: the world's own list (``layout`` "world") or a
+    grid of ``spacing_m`` through ``grid_origin_m``, inside a walkable rectangle shrunk by ``margin_m``, at
+    least ``margin_m`` from every wall and outside every solid block grown by ``margin_m``. Ordered by
+    floor, then y, then x."""
+    floors = list(floors)
+    if layout == "world":
+        if world.survey_points_m is None:
+            raise ValueError(f"world {world.name!r} has no calibration point list (use survey.layout = 'grid')")
+        pts = np.asarray(world.survey_points_m, float)
+        pts = pts[np.isin(pts[:, 2], floors)]
+    else:
+        ox, oy = world.grid_origin_m
+        xs = ox + spacing_m * np.arange(math.floor(-ox / spacing_m), math.ceil((world.floor_w_m - ox) / spacing_m) + 1)
+        ys = oy + spacing_m * np.arange(math.floor(-oy / spacing_m), math.ceil((world.floor_h_m - oy) / spacing_m) + 1)
+        gx, gy = np.meshgrid(np.round(xs, 9), np.round(ys, 9))
+        xy = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        walk = world.walkable_m if world.walkable_m is not None else \
+            np.array([[0.0, 0.0, world.floor_w_m, world.floor_h_m]])
+        inside = np.zeros(len(xy), bool)
+        for x0, y0, x1, y1 in walk:
+            inside |= ((xy[:, 0] >= x0 + margin_m - 1e-9) & (xy[:, 0] <= x1 - margin_m + 1e-9)
+                       & (xy[:, 1] >= y0 + margin_m - 1e-9) & (xy[:, 1] <= y1 - margin_m + 1e-9))
+        for x0, y0, x1, y1 in (world.blocked_m if world.blocked_m is not None else []):
+            inside &= ~((xy[:, 0] > x0 - margin_m) & (xy[:, 0] < x1 + margin_m)
+                        & (xy[:, 1] > y0 - margin_m) & (xy[:, 1] < y1 + margin_m))
+        inside &= _point_segment_distance(xy, world.walls_m) >= margin_m - 1e-9
+        xy = xy[inside]
+        pts = np.concatenate([np.column_stack([xy, np.full(len(xy), f, float)]) for f in floors]) \
+            if floors else np.zeros((0, 3))
+    order = np.lexsort((pts[:, 0], pts[:, 1], pts[:, 2]))
+    return pts[order]
 
 
 def _rect(x0: float, y0: float, x1: float, y1: float, doors=()) -> list:
@@ -209,6 +282,15 @@ def _default_mag_zones() -> tuple[MagZone, ...]:
     )
 
 
+def _corridor_band() -> np.ndarray:
+    """The office's walkable corridor: four 2 m wide rectangles around the loop's centre line."""
+    h = CORRIDOR_HALF_W_M
+    return np.array([[LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y0_M + h],
+                     [LOOP_X0_M - h, LOOP_Y1_M - h, LOOP_X1_M + h, LOOP_Y1_M + h],
+                     [LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X0_M + h, LOOP_Y1_M + h],
+                     [LOOP_X1_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y1_M + h]])
+
+
 def default_world(map_rotation_deg: float = 20.0) -> World:
     corners = np.array([[LOOP_X0_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y0_M],
                         [LOOP_X1_M, LOOP_Y1_M], [LOOP_X0_M, LOOP_Y1_M]])
@@ -226,10 +308,82 @@ def default_world(map_rotation_deg: float = 20.0) -> World:
         stairs=stairs,
         elevator=Elevator(x_m=4.25, door_y_m=22.5),
         mag_zones=_default_mag_zones(),
+        walkable_m=_corridor_band(),
+        grid_origin_m=(LOOP_X0_M, LOOP_Y0_M),
+        description="two-floor office, 60 m x 30 m, corridor loop, stairs and elevator",
     )
 
 
-WORLDS = {"default": default_world}
+# --- the aadr2015 foyer (Jäger, Süß, Becker: 8 APs, 67 calibration points, 70 m track, 14 reference points)
+FOYER_W_M, FOYER_H_M = 20.0, 14.0
+FOYER_CORE_M = (12.0, 6.0, 14.0, 12.0)          # concrete core (lift and service shaft)
+FOYER_PILLARS_M = ((6.0, 10.0), (14.0, 4.0))     # 0.5 m concrete pillars (between grid lines)
+CONCRETE_LOSS_DB = 15.0                          # per concrete wall (core), cf. ITU-R P.2040 ~10-20 dB
+PILLAR_LOSS_DB = 10.0
+# the track: from the entrance (south doors) round the foyer, past the steel staircase and through the
+# poor-coverage spot east of the core, back west; corners are filleted by the route (radius <= 1 m)
+FOYER_TRACK_M = ((10.0, 1.0), (10.0, 4.0), (2.0, 4.0), (2.0, 8.5), (10.5, 8.5), (10.5, 13.0), (16.0, 13.0),
+                 (16.0, 4.5), (18.5, 4.5), (18.5, 1.5), (4.5, 1.5), (4.5, 6.3), (11.2, 6.3))
+# 14 reference points on straight stretches of the track (>= 1.2 m from every corner), in walking order,
+# about 5 m apart; (16, 11.8) is beside the steel staircase, (16, 7.1) in the poor-coverage spot
+FOYER_REFERENCE_M = ((10.0, 2.8), (5.3, 4.0), (2.0, 6.1), (4.9, 8.5), (9.3, 8.5), (11.7, 13.0), (16.0, 11.8),
+                     (16.0, 7.1), (18.5, 3.3), (15.8, 1.5), (10.4, 1.5), (5.7, 1.5), (5.7, 6.3), (9.9, 6.3))
+
+
+def _foyer_walls() -> tuple[np.ndarray, np.ndarray]:
+    walls, loss = [], []
+
+    def add(segments, db=np.nan):
+        for seg in segments:
+            walls.append(seg)
+            loss.append(db)
+
+    add(_rect(0.0, 0.0, FOYER_W_M, FOYER_H_M, [("bottom", 10.0, 2.4)]))   # facade, glass entrance doors
+    add(_rect(*FOYER_CORE_M), CONCRETE_LOSS_DB)
+    for x, y in FOYER_PILLARS_M:
+        add(_rect(x - 0.25, y - 0.25, x + 0.25, y + 0.25), PILLAR_LOSS_DB)
+    add([(0.0, 10.0, 4.0, 10.0), (4.0, 10.0, 4.0, 12.6)])               # cloakroom (drywall), door north-east
+    return np.asarray(walls, float), np.asarray(loss, float)
+
+
+def _foyer_aps() -> tuple[AccessPoint, ...]:
+    # (x_m, y_m, channel, tx_power_dbm): on the facade and walls, one on the ceiling west of the core;
+    # none in the north-east, so the spot east of the core hears most APs through the core only
+    spec = [(1.0, 1.0, 1, 17.0), (7.0, 0.5, 36, 20.0), (0.5, 7.0, 6, 17.0), (6.0, 13.5, 11, 17.0),
+            (10.0, 13.5, 44, 20.0), (10.0, 7.0, 6, 16.0), (17.0, 0.5, 1, 17.0), (19.5, 5.0, 149, 20.0)]
+    return tuple(AccessPoint(bssid=0x00_1A_2B_30_00_00 + (i << 4) + (1 if ch > 14 else 0), channel=ch,
+                             x_m=x, y_m=y, tx_power_dbm=p, floor=0) for i, (x, y, ch, p) in enumerate(spec))
+
+
+def aadr2015_world(map_rotation_deg: float = 20.0) -> World:
+    walls, loss = _foyer_walls()
+    blocked = [FOYER_CORE_M] + [(x - 0.25, y - 0.25, x + 0.25, y + 0.25) for x, y in FOYER_PILLARS_M]
+    # the paper's 67 calibration points: the 2 m grid (1, 1) .. (19, 13) without the 3 inside the core
+    cal = [(x, y, 0.0) for y in range(1, 14, 2) for x in range(1, 20, 2)
+           if not (FOYER_CORE_M[0] < x < FOYER_CORE_M[2] and FOYER_CORE_M[1] < y < FOYER_CORE_M[3])]
+    return World(
+        name="aadr2015",
+        floor_w_m=FOYER_W_M,
+        floor_h_m=FOYER_H_M,
+        walls_m=walls,
+        walls_loss_db=loss,
+        aps=_foyer_aps(),
+        loop_corners_m=np.array([[5.0, 2.5], [18.0, 2.5], [18.0, 12.8], [5.0, 12.8]]),
+        start_xy_m=(8.0, 2.5),
+        map_rotation_deg=map_rotation_deg,
+        n_floors=1,
+        mag_zones=(MagZone("steel staircase", 16.5, 12.2, 2.5, (0,), gain=1.5, azimuth_deg=45.0, dip_deg=-15.0),),
+        blocked_m=np.asarray(blocked, float),
+        grid_origin_m=(1.0, 1.0),
+        survey_points_m=np.asarray(cal, float),
+        track_m=FOYER_TRACK_M,
+        reference_points_m=np.asarray(FOYER_REFERENCE_M, float),
+        poor_coverage_m=(14.5, 6.0, 18.0, 10.5),
+        description="aadr2015 foyer, 20 m x 14 m, concrete core, 8 APs (Jäger, Süß, Becker)",
+    )
+
+
+WORLDS = {"default": default_world, "aadr2015": aadr2015_world}
 
 
 def load_world(name: str, map_rotation_deg: float) -> World:

@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""Writes site-file test vectors with the analyzer's writer (the reference) for tests/c/test_site.c.
+
+Usage: gen_site_vectors.py OUT_DIR [IMPORT_DIR ...]
+
+IMPORT_DIRs are put first on sys.path (the build's lcmtypes/python and the source analyzer/), so the
+script runs from a fresh build without an installed package. Writes into OUT_DIR:
+
+* ``site.sfsite`` — the small known site of :func:`vector_site`, written by ``sitefile.write_site``;
+* ``site.txt`` — its values as read back by ``sitefile.read_site``, one field per line:
+  ``<field> <value> [<value> ...]`` (strings: the rest of the line; floats by repr(), which round-trips
+  a double, and float32 values are exact doubles);
+* ``variants/<name>.sfsite`` — corrupted or invalid files, and ``variants.txt`` with one line each:
+  ``<name>\\t<kind>\\t<exact|contains>\\t<text>``: the reader must reject the file with the ``kind``
+  (``field`` → SF_ERANGE, any other → SF_ESYNTAX) and a message equal to (``exact``) or containing
+  (``contains``) ``<path>: <text>``. ``exact`` texts are the Python reader's own messages, so the C
+  and Python readers are held to the same words.
+
+tests/python/sitefile/ imports this module for the same variants.
+"""
+from __future__ import annotations
+
+import os
+import struct
+import sys
+import zlib
+
+if __name__ == "__main__":
+    for _d in reversed(sys.argv[2:]):
+        sys.path.insert(0, _d)
+
+from stridefix import site_t, truth_t  # noqa: E402
+from stridefix_analyzer import sitefile  # noqa: E402
+
+_SCALAR_FIELDS = ("name", "source", "map_rotation_deg", "has_geo", "origin_lat_deg", "origin_lon_deg",
+                  "lowest_floor", "cell_size_m")
+_ARRAY_FIELDS = ("floor_height_m", "ap_bssid", "rp_x_m", "rp_y_m", "rp_floor", "rp_scans", "entry_ap",
+                 "entry_rp", "entry_mean_dbm", "entry_std_db", "entry_count")
+
+
+def vector_site() -> site_t:
+    """A small site touching every corner: a negative lowest floor, geo-reference, BSSIDs at both
+    ends of the 48-bit range, an AP with no entry (AP 2) and an RP with none (RP 5)."""
+    return sitefile.new_site(
+        name="vector site \u00fc", source="tests/vectors/gen_site_vectors.py", map_rotation_deg=12.5,
+        has_geo=True, origin_lat_deg=47.3769, origin_lon_deg=8.5417, lowest_floor=-1,
+        floor_height_m=[-3.5, 0.0, 4.25],
+        ap_bssid=[0x000000000001, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFE, 0xFFFFFFFFFFFF], cell_size_m=2.0,
+        rp_x_m=[0.5, 2.25, -1.75, 10.125, 3.3, 7.0], rp_y_m=[1.0, -4.5, 0.0, 6.75, 2.2, -2.0],
+        rp_floor=[-1, 0, 0, 1, 1, 1], rp_scans=[3, 4, 1, 2, 5, 2],
+        entry_ap=[0, 0, 0, 1, 1, 3, 3], entry_rp=[0, 1, 3, 1, 4, 2, 4],
+        entry_mean_dbm=[-45.5, -60.25, -70.1, -80.0, -55.5, -90.0, -33.3],
+        entry_std_db=[1.25, 0.0, 2.5, 3.0, 0.5, 0.0, 1.1], entry_count=[3, 4, 1, 2, 5, 1, 5])
+
+
+def frame(payload: bytes, magic=sitefile.MAGIC, version=sitefile.FORMAT_VERSION, length=None, crc=None,
+          reserved=0) -> bytes:
+    """Header (any field overridable) + payload."""
+    length = len(payload) if length is None else length
+    crc = zlib.crc32(payload) if crc is None else crc
+    return sitefile.HEADER.pack(magic, version, length, crc, reserved) + payload
+
+
+def _edited(**changes) -> bytes:
+    """The vector site with fields changed, framed with a valid header (bypassing validation)."""
+    s = vector_site()
+    for name, value in changes.items():
+        setattr(s, name, value)
+    sitefile.set_counts(s)
+    return frame(s.encode())
+
+
+def _count_offset(s: site_t, field: str) -> int:
+    """Byte offset of the int32 count ``field`` in ``s.encode()`` (site_t.lcm field order)."""
+    at = 8 + 4 + len(s.name.encode()) + 1 + 4 + len(s.source.encode()) + 1 + 8 + 1 + 8 + 8 + 2
+    if field == "n_floors":
+        return at
+    at += 4 + 8 * s.n_floors
+    if field == "n_ap":
+        return at
+    at += 4 + 8 * s.n_ap + 4
+    if field == "n_rp":
+        return at
+    at += 4 + 14 * s.n_rp
+    if field == "n_entries":
+        return at
+    raise KeyError(field)
+
+
+def _with_count(field: str, value: int) -> bytes:
+    """The vector site's payload with the int32 count ``field`` overwritten (valid CRC)."""
+    s = vector_site()
+    payload = bytearray(s.encode())
+    at = _count_offset(s, field)
+    assert struct.unpack_from(">i", payload, at)[0] == getattr(s, field)
+    payload[at:at + 4] = struct.pack(">i", value)
+    return frame(bytes(payload))
+
+
+def variants() -> list[tuple[str, bytes, str, str | None]]:
+    """(name, file bytes, kind, C-only text or None) of every invalid file.
+
+    For C-only text None, the expected message is the Python reader's (``exact``); otherwise the C
+    message must contain that text and the Python reader must fail with ``kind``.
+    """
+    good = sitefile.encode_site_file(vector_site())
+    payload = good[sitefile.HEADER_SIZE:]
+    flipped = bytearray(good)
+    flipped[sitefile.HEADER_SIZE + len(payload) // 2] ^= 0x10
+    truth = truth_t()
+    out = [
+        ("magic", frame(payload, magic=b"SFSITX\0\x01"), "magic", None),
+        ("magic_zero", frame(payload, magic=bytes(8)), "magic", None),
+        ("version", frame(payload, version=2), "version", None),
+        ("reserved", frame(payload, reserved=7), "reserved", None),
+        ("length_long", frame(payload, length=len(payload) + 1), "length", None),
+        ("length_short", frame(payload, length=len(payload) - 3), "length", None),
+        ("length_huge", frame(payload, length=0xFFFFFFFF), "length", None),
+        ("crc_header", frame(payload, crc=zlib.crc32(payload) ^ 1), "crc", None),
+        ("crc_payload_flip", bytes(flipped), "crc", None),
+        ("wrong_type", frame(truth.encode()), "decode", None),
+        ("trailing_payload", frame(payload + b"\0\0\0\0"), "decode", None),
+        ("huge_count", _with_count("n_rp", 0x20000000), "decode", "n_rp = 536870912 needs"),
+        ("negative_count", _with_count("n_entries", -1), "decode", "n_entries = -1 is negative"),
+        ("rp_index", _edited(entry_rp=[0, 1, 300, 1, 4, 2, 4]), "field", None),
+        ("ap_index", _edited(entry_ap=[0, 0, 0, 1, 1, 3, 4]), "field", None),
+        ("ap_index_negative", _edited(entry_ap=[-1, 0, 0, 1, 1, 3, 3]), "field", None),
+        ("entries_unsorted", _edited(entry_ap=[0, 0, 1, 0, 1, 3, 3]), "field", None),
+        ("entries_duplicate", _edited(entry_rp=[0, 1, 1, 1, 4, 2, 4]), "field", None),
+        ("count_above_scans", _edited(entry_count=[3, 5, 1, 2, 5, 1, 5]), "field", None),
+        ("count_zero", _edited(entry_count=[3, 4, 1, 0, 5, 1, 5]), "field", None),
+        ("mean_inf", _edited(entry_mean_dbm=[-45.5, float("inf"), -70.1, -80, -55.5, -90, -33.3]),
+         "field", None),
+        ("std_negative", _edited(entry_std_db=[1.25, 0.0, -2.5, 3.0, 0.5, 0.0, 1.1]), "field", None),
+        ("bssid_order", _edited(ap_bssid=[1, 0xFFFFFFFFFFFE, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFF]),
+         "field", None),
+        ("bssid_range", _edited(ap_bssid=[1, 2, 3, 1 << 48]), "field", None),
+        ("floor_heights", _edited(floor_height_m=[-3.5, 0.0, 0.0]), "field", None),
+        ("no_floors", _edited(floor_height_m=[]), "field", None),
+        ("rp_floor", _edited(rp_floor=[-1, 0, 0, 1, 2, 1]), "field", None),
+        ("rp_scans_zero", _edited(rp_scans=[3, 4, 1, 2, 5, 0]), "field", None),
+        ("rp_position_inf", _edited(rp_x_m=[0.5, 2.25, float("-inf"), 10.125, 3.3, 7.0]), "field", None),
+        ("cell_negative", _edited(cell_size_m=-1.0), "field", None),
+        ("rotation_inf", _edited(map_rotation_deg=float("inf")), "field", None),
+        ("latitude", _edited(origin_lat_deg=91.0), "field", None),
+    ]
+    return out
+
+
+def dump(site: site_t) -> str:
+    lines = []
+    for name in _SCALAR_FIELDS:
+        v = getattr(site, name)
+        lines.append(f"{name} {int(v) if isinstance(v, bool) else v!r}" if not isinstance(v, str)
+                     else f"{name} {v}")
+    for name in _ARRAY_FIELDS:
+        lines.append(" ".join([name, *(repr(v) for v in getattr(site, name))]))
+    return "\n".join(lines) + "\n"
+
+
+def main(out_dir: str) -> int:
+    os.makedirs(os.path.join(out_dir, "variants"), exist_ok=True)
+    path = os.path.join(out_dir, "site.sfsite")
+    sitefile.write_site(path, vector_site())
+    with open(os.path.join(out_dir, "site.txt"), "w", encoding="utf-8") as f:
+        f.write(dump(sitefile.read_site(path)))
+    rows = []
+    for name, data, kind, c_text in variants():
+        vpath = os.path.join(out_dir, "variants", name + ".sfsite")
+        with open(vpath, "wb") as f:
+            f.write(data)
+        try:
+            sitefile.decode_site_file(data, vpath)
+        except sitefile.SiteFileError as exc:
+            if exc.kind != kind:
+                raise SystemExit(f"variant {name}: Python reader says {exc.kind} ({exc}), want {kind}")
+            text = exc.reason if c_text is None else c_text
+        else:
+            raise SystemExit(f"variant {name}: the Python reader accepted it")
+        rows.append(f"{name}\t{kind}\t{'exact' if c_text is None else 'contains'}\t{text}\n")
+    with open(os.path.join(out_dir, "variants.txt"), "w", encoding="utf-8") as f:
+        f.writelines(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    sys.exit(main(sys.argv[1]))
