@@ -25,7 +25,8 @@ Modes (``--mode``, default ``auto``):
 Per (RP, AP): mean RSSI [dBm] and population standard deviation (ddof = 0) [dB] over the scans of the
 RP that heard the AP, ``count`` = those scans, ``rp_scans`` = all scans placed at the RP. A BSSID heard
 twice in one scan counts once, at its strongest RSSI; incomplete scans (AP frames lost) are skipped;
-entries with ``count < min_count`` are dropped; the AP table keeps the BSSIDs with an entry left.
+entries with ``count < min_count`` are dropped, then the RPs and APs left without an entry (an RP
+with no entry tells a matcher nothing).
 
 Floors: ``lowest_floor`` .. highest RP floor (``--lowest-floor`` may extend it down); heights
 ``floor × floor_height_m`` or the explicit ``--floor-heights-m`` list (one per floor from the lowest).
@@ -71,8 +72,9 @@ class RadioMapInputError(Exception):
 class Recording:
     """One set of logs on one clock: WIFI scans, their APs and TRUTH, sorted by time."""
 
-    def __init__(self, name: str, wifi: Table, wifi_ap: Table, truth: Table):
-        self.name, self.wifi, self.wifi_ap, self.truth = name, wifi, wifi_ap, truth
+    def __init__(self, files: list[str], wifi: Table, wifi_ap: Table, truth: Table):
+        self.files, self.wifi, self.wifi_ap, self.truth = list(files), wifi, wifi_ap, truth
+        self.name = " + ".join(self.files)
 
 
 def _read_one(path: str) -> LogData:
@@ -81,8 +83,9 @@ def _read_one(path: str) -> LogData:
         return read_logs([path], decode=("WIFI", "TRUTH"))
 
 
-def _merge(name: str, datas: list[LogData]) -> Recording:
+def _merge(files: list[str], datas: list[LogData]) -> Recording:
     """Merge the WIFI / WIFI_AP / TRUTH tables of several files into one Recording."""
+    name = " + ".join(files)
     missing = [ch for ch in ("WIFI", "TRUTH") if not any(d.table(ch) for d in datas)]
     if missing:
         raise RadioMapInputError(f"{name}: no {' and no '.join(missing)} messages (a radio map "
@@ -109,7 +112,7 @@ def _merge(name: str, datas: list[LogData]) -> Recording:
     wifi = wifi.rows(order)
     cols = wifi_ap.to_dict()
     cols["scan_row"] = renumber[cols["scan_row"]]
-    return Recording(name, wifi, Table(cols), truth)
+    return Recording(files, wifi, Table(cols), truth)
 
 
 def load_recordings(args: list[str]) -> list[Recording]:
@@ -121,14 +124,12 @@ def load_recordings(args: list[str]) -> list[Recording]:
     for arg in args:
         files = [f for f in str(arg).split(",") if f]
         datas = [_read_one(f) for f in files]
-        if len(files) > 1:
-            recordings.append(_merge(",".join(files), datas))
-        elif datas[0].table("WIFI") and datas[0].table("TRUTH"):
-            recordings.append(_merge(files[0], datas))
+        if len(files) > 1 or (datas[0].table("WIFI") and datas[0].table("TRUTH")):
+            recordings.append(_merge(files, datas))
         else:
             rest.append((files[0], datas[0]))
     if rest:
-        recordings.append(_merge(" + ".join(f for f, _ in rest), [d for _, d in rest]))
+        recordings.append(_merge([f for f, _ in rest], [d for _, d in rest]))
     return recordings
 
 
@@ -311,10 +312,18 @@ def build_site(recordings: list[Recording], mode: str = "auto",
         / np.maximum(count, 1)
     kept = count >= min_count
     keys, count, mean, std = keys[kept], count[kept], mean[kept], np.sqrt(var[kept])
+    if len(keys) == 0:
+        raise RadioMapInputError(f"no access point was heard in {min_count} or more scans at any "
+                                 f"of the {n_rp} reference points (lower --min-count?)")
+    # 5. an RP with no entry left tells a matcher nothing: drop it, renumber the rest in order
+    has_entry = np.zeros(n_rp, dtype=bool)
+    has_entry[keys[:, 1]] = True
+    keys[:, 1] = (np.cumsum(has_entry) - 1)[keys[:, 1]]
+    rp_x, rp_y, rp_floor, rp_scans = (v[has_entry] for v in (rp_x, rp_y, rp_floor, rp_scans))
     bssids, entry_ap = np.unique(keys[:, 0], return_inverse=True) if len(keys) else \
         (np.zeros(0, np.int64), np.zeros(0, np.int64))
     lo, heights = _floors(rp_floor, lowest_floor, floor_height_m, floor_heights_m)
-    files = ", ".join(os.path.basename(r.name) for r in recordings)
+    files = "; ".join(" + ".join(os.path.basename(f) for f in r.files) for r in recordings)
     site = new_site(
         name=name, source=f"stridefix {TOOL_VERSION}: {chosen} mode from {len(recordings)} "
                           f"recording(s) [{files}]; cell {cell_size_m:g} m; min count {min_count}",
@@ -335,7 +344,8 @@ def build_site(recordings: list[Recording], mode: str = "auto",
         scans={"total": n_total, "used": int(use.sum()), **{f"skipped_{k}": v
                                                             for k, v in skipped.items()}},
         ap_rows={"used": int(len(a_scan)), "duplicate_in_scan": duplicates, "invalid": bad_rows},
-        entries_below_min_count=int(np.sum(~kept)), min_count=min_count)
+        entries_below_min_count=int(np.sum(~kept)), min_count=min_count,
+        rps_dropped_no_entry=int(np.sum(~has_entry)))
     return site, summary
 
 
@@ -385,7 +395,8 @@ def format_summary(s: dict) -> str:
     else:
         lines.append(f"source      {s['source']}")
     lines.append(f"radio map   {s['n_rp']} RPs, {s['n_ap']} APs, {s['n_entries']} entries"
-                 + (f" ({s['entries_below_min_count']} below min count {s['min_count']} dropped)"
+                 + (f" ({s['entries_below_min_count']} below min count {s['min_count']} dropped"
+                    f", and {s['rps_dropped_no_entry']} RPs left without one)"
                     if "min_count" in s else "")
                  + (f"; {s['rps_without_ap']} RP(s) with no AP" if s["rps_without_ap"] else ""))
     cell = f"cell {s['cell_size_m']:g} m" if s["cell_size_m"] > 0 else "surveyed points"

@@ -290,10 +290,12 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
-/* One POSE per fusion scheme that has a position (a scheme waiting for its first fix has none). */
+/* One POSE per fusion scheme that has a position (a scheme waiting for its first fix has none).
+ * Without a site there are no fixes, so only pdr_only is published (the others would repeat it). */
 static void write_pose(daemon_t *const d)
 {
-    for (int scheme = 0; scheme < sf_scheme_count; scheme++) {
+    const int n_schemes = d->est.site != NULL ? sf_scheme_count : sf_scheme_pdr_only + 1;
+    for (int scheme = 0; scheme < n_schemes; scheme++) {
         sf_pose_t p;
         if (!sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
             continue;
