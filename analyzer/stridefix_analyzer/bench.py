@@ -179,10 +179,16 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "bench", help="SIL benchmarks: simulate, replay through stridefixd, score against targets",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("which", choices=["sil-pdr"], help="the benchmark to run")
+    p.add_argument("which", choices=["sil-pdr", "aadr2015", "office-wifi"],
+                   help="sil-pdr: PDR targets at each pace; aadr2015: the auto-adaptive DR paper's "
+                        "experiment (fusion schemes at the reference points); office-wifi: the fusion "
+                        "schemes on the default office walk with a surveyed radio map")
+    p.add_argument("--paces", default="slow,normal,fast", metavar="LIST",
+                   help="aadr2015: comma-separated paces (default: slow,normal,fast)")
     p.add_argument("--scenarios", default=",".join(DEFAULT_SCENARIOS), metavar="LIST",
                    help=f"comma-separated scenario names (default: {','.join(DEFAULT_SCENARIOS)})")
-    p.add_argument("--seeds", default="1,2,3", metavar="LIST", help="comma-separated seeds (default: 1,2,3)")
+    p.add_argument("--seeds", default=None, metavar="LIST",
+                   help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5)")
     p.add_argument("--stridefixd", default=str(DEFAULT_STRIDEFIXD), metavar="PATH",
                    help=f"the firmware binary (default: {DEFAULT_STRIDEFIXD})")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default: {DEFAULT_OUT})")
@@ -194,22 +200,40 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    from stridefix_analyzer import bench_fusion
+
     stridefixd = Path(args.stridefixd)
     if not stridefixd.is_file():
         print(f"stridefix bench: error: {stridefixd}: no such binary (run `make build`)", file=sys.stderr)
         return 2
+    default_seeds = "1,2,3,4,5" if args.which == "aadr2015" else "1,2,3"
     try:
-        seeds = [int(s) for s in args.seeds.split(",") if s]
+        seeds = [int(s) for s in (args.seeds or default_seeds).split(",") if s]
     except ValueError:
         print(f"stridefix bench: error: --seeds {args.seeds!r}: expected integers", file=sys.stderr)
         return 2
-    scenarios = [s for s in args.scenarios.split(",") if s]
+    out = Path(args.out)
     try:
-        doc = run_sil_pdr(scenarios, seeds, stridefixd, Path(args.out), calibrate=not args.no_calibration,
-                          sets=args.sets)
-    except BenchError as exc:
+        if args.which == "sil-pdr":
+            scenarios = [s for s in args.scenarios.split(",") if s]
+            doc = run_sil_pdr(scenarios, seeds, stridefixd, out, calibrate=not args.no_calibration,
+                              sets=args.sets)
+            print(format_table(doc["runs"]))
+            print(f"wrote {os.path.join(args.out, 'sil_pdr.json')}")
+        elif args.which == "aadr2015":
+            paces = [p for p in args.paces.split(",") if p]
+            doc = bench_fusion.run_aadr2015(seeds, paces, stridefixd, out / "aadr2015", args.sets)
+            print(bench_fusion.format_table(doc["table"], paper=True))
+            red = doc["adaptive_reduction_pct"]
+            print(f"adaptive vs Wi-Fi only: mean error {'-' if red is None else f'{red:.1f} %'} lower "
+                  f"(paper: 43 %); targets met: {doc['targets_met']}")
+            print(f"wrote {out / 'aadr2015' / 'aadr2015.json'} ({doc['run_s']:.0f} s)")
+        else:
+            doc = bench_fusion.run_office(seeds, stridefixd, out / "office_wifi", args.sets)
+            print(bench_fusion.format_table(doc["table"], paper=False))
+            print(f"targets (kalman mean <= 2.0 m, p95 <= 4.5 m) met: {doc['targets_met']}")
+            print(f"wrote {out / 'office_wifi' / 'office_wifi.json'} ({doc['run_s']:.0f} s)")
+    except (BenchError, bench_fusion.BenchError) as exc:
         print(f"stridefix bench: error: {exc}", file=sys.stderr)
         return 1
-    print(format_table(doc["runs"]))
-    print(f"wrote {os.path.join(args.out, 'sil_pdr.json')}")
     return 0

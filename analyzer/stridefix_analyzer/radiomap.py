@@ -425,7 +425,8 @@ def plot_site(site: site_t, png_path: str) -> None:
     n_aps = np.bincount(np.asarray(site.entry_rp, dtype=np.int64), minlength=site.n_rp)
     floors = [site.lowest_floor + i for i in range(site.n_floors)
               if np.any(rp_floor == site.lowest_floor + i)] or [site.lowest_floor]
-    fig, axes = plt.subplots(1, len(floors), figsize=(5 * len(floors), 4.5), squeeze=False)
+    fig, axes = plt.subplots(1, len(floors), figsize=(5 * len(floors), 4.5), squeeze=False,
+                             constrained_layout=True)
     vmax = max(1, int(n_aps.max())) if site.n_rp else 1
     for ax, f in zip(axes[0], floors):
         sel = rp_floor == f

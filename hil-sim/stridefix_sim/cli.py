@@ -29,6 +29,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--duration-s", type=float, metavar="S", help="simulated duration [s] (0: until the walk ends)")
     p.add_argument("--loss-rate", type=float, metavar="R", help="CAN frame loss probability 0..1")
     p.add_argument("--board-time-start-ms", type=int, metavar="MS", help="board time of the first frame [ms], 0..2**32-1")
+    p.add_argument("--survey", action="store_true",
+                   help="survey mode: stand at each calibration point of the world, scan in 4 orientations "
+                        "(scenario [survey] keys), instead of walking the route")
     return p
 
 
@@ -41,6 +44,7 @@ def run(args) -> int:
             "duration_s": None if args.duration_s is None else float(args.duration_s),
             "can.loss_rate": None if args.loss_rate is None else float(args.loss_rate),
             "can.board_time_start_ms": args.board_time_start_ms,
+            "survey.enabled": True if getattr(args, "survey", False) else None,
         })
     except ScenarioError as e:
         print(f"stridefix sim: error: {e}", file=sys.stderr)
@@ -57,6 +61,10 @@ def run(args) -> int:
     print(f"stridefix sim: seed {summary['seed']}, {summary['duration_s']:.1f} s simulated, "
           f"{summary['steps']} steps, {summary['distance_m']:.1f} m, floors {summary['floors_visited']}, "
           f"{summary['frames_total']} frames written to {where} ({summary['frames_dropped']} dropped), "
-          f"{summary['imu_samples']} IMU samples, {summary['wifi_scans']} Wi-Fi scans; "
+          f"{summary['imu_samples']} IMU samples, {summary['wifi_scans']} Wi-Fi scans"
+          + (f", {summary['n_points']} calibration points x {summary['scans_per_point']} scans"
+             if "n_points" in summary else "")
+          + (f", {summary['n_reference_points']} reference points" if "n_reference_points" in summary else "")
+          + "; "
           f"outputs in {out_dir}; {elapsed:.2f} s", file=sys.stderr)
     return 0

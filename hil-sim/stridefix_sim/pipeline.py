@@ -7,8 +7,11 @@ same scenario and seed give byte-identical outputs.
 
 Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
 10 Hz, t_us = unwrapped board time in µs, also the event timestamp; x, y, the true floor, the true
-heading = walking direction in the map frame, steps so far), ``sim_summary.json`` and
-``init_truth.ini`` (the true start pose for the firmware).
+heading = walking direction in the map frame, steps so far; source SIMULATION), ``sim_summary.json``
+and ``init_truth.ini`` (the true start pose for the firmware). On a route with reference points (the
+``track``), one extra TRUTH with source WAYPOINT at the moment the walker passes each reference point
+(time interpolated to the µs between walker samples; x, y = the surveyed point), in time order
+with the 10 Hz messages (a SIMULATION message first when both fall on the same µs).
 """
 from __future__ import annotations
 
@@ -65,8 +68,51 @@ class SimResult:
         counts = np.bincount(self.walk.activity[:-1], minlength=len(ACTIVITIES))
         return {name: round(float(c) * IMU_PERIOD_MS / 1000.0, 2) for name, c in zip(ACTIVITIES, counts)}
 
+    def reference_passes(self) -> list[dict]:
+        """When the walker passes each reference point of the route: index, x, y, floor, s_m, t_s, heading."""
+        w = self.walk
+        out = []
+        for k, (s_ref, x, y) in enumerate(w.route.marks):
+            i = int(np.searchsorted(w.s_m, s_ref - 1e-9, side="left"))
+            if i >= len(w.s_m):
+                continue            # the run ended before this point
+            if i == 0:
+                t = float(w.t_s[0])
+            else:
+                ds = float(w.s_m[i] - w.s_m[i - 1])
+                f = (s_ref - float(w.s_m[i - 1])) / ds if ds > 0 else 1.0
+                t = float(w.t_s[i - 1] + min(max(f, 0.0), 1.0) * (w.t_s[i] - w.t_s[i - 1]))
+            out.append({"index": k, "x_m": x, "y_m": y, "floor": int(w.floor[i]), "s_m": round(float(s_ref), 6),
+                        "t_s": round(t, 6), "heading_rad": _wrap(float(w.heading_rad[i]))})
+        return out
+
+    def survey_summary(self) -> dict:
+        w, sv = self.walk, self.scenario["survey"]
+        per_point = np.bincount([p[1] for p in w.scan_plan], minlength=len(w.stops)) if w.stops else []
+        return {
+            "n_points": len(w.stops),
+            "scans_per_point": int(sv["orientations"] * sv["scans_per_orientation"]),
+            "scans_per_orientation": int(sv["scans_per_orientation"]),
+            "orientations": [round(360.0 * k / sv["orientations"], 6) for k in range(int(sv["orientations"]))],
+            "spacing_m": sv["spacing_m"],
+            "survey_points": [{"index": st["index"], "x_m": st["x_m"], "y_m": st["y_m"], "floor": st["floor"],
+                               "scans": int(per_point[st["index"]]),
+                               "t_arrive_s": round(st["t_arrive"], 3)} for st in w.stops],
+        }
+
     def summary(self) -> dict:
         c = self.board.counts
+        extra = {}
+        if self.walk.stops:
+            extra.update(self.survey_summary())
+        if self.walk.route.marks:
+            refs = self.reference_passes()
+            extra["n_reference_points"] = len(refs)
+            extra["reference_points"] = [{k: r[k] for k in ("index", "x_m", "y_m", "floor", "s_m", "t_s")}
+                                         for r in refs]
+        if self.world.name != "default":
+            extra["world"] = {"name": self.world.name, "area_m2": self.world.area_m2, "n_aps": len(self.world.aps),
+                              "description": self.world.description}
         return {
             "seed": self.scenario.seed,
             "scenario_source": self.scenario.source,
@@ -97,6 +143,7 @@ class SimResult:
             "elevator_rides": len([r for r in self.walk.rides if r[0] <= self.duration_s]),
             "init": self.init_pose(),
             "scenario": self.scenario.data,
+            **extra,
         }
 
 
@@ -129,21 +176,36 @@ def write_truth_log(result: SimResult, path: Path) -> int:
     idx = result.truth_indices()
     steps = result.steps_until(w.t_s[idx])
     start_us = result.board_time_start_ms * 1000
+    msgs = []
+    for i, n_steps in zip(idx.tolist(), steps.tolist()):
+        msg = truth_t()
+        msg.t_us = start_us + i * IMU_PERIOD_MS * 1000
+        msg.x_m = float(w.x_m[i])
+        msg.y_m = float(w.y_m[i])
+        msg.floor = int(w.floor[i])
+        msg.heading_rad = _wrap(float(w.heading_rad[i]))
+        msg.step_count = int(n_steps)
+        msg.source = truth_t.SOURCE_SIMULATION
+        msgs.append(msg)
+    t_end_us = start_us + int(idx[-1]) * IMU_PERIOD_MS * 1000 if len(idx) else start_us
+    for ref in result.reference_passes():
+        msg = truth_t()
+        msg.t_us = start_us + int(round(ref["t_s"] * 1e6))
+        if msg.t_us > t_end_us:
+            continue
+        msg.x_m, msg.y_m, msg.floor = ref["x_m"], ref["y_m"], ref["floor"]
+        msg.heading_rad = ref["heading_rad"]
+        msg.step_count = int(result.steps_until(np.array([ref["t_s"]]))[0])
+        msg.source = truth_t.SOURCE_WAYPOINT
+        msgs.append(msg)
+    msgs.sort(key=lambda m: (m.t_us, m.source))   # stable: the 10 Hz stream keeps its order
     log = lcm.EventLog(str(path), "w", overwrite=True)
     try:
-        for i, n_steps in zip(idx.tolist(), steps.tolist()):
-            msg = truth_t()
-            msg.t_us = start_us + i * IMU_PERIOD_MS * 1000
-            msg.x_m = float(w.x_m[i])
-            msg.y_m = float(w.y_m[i])
-            msg.floor = int(w.floor[i])
-            msg.heading_rad = _wrap(float(w.heading_rad[i]))
-            msg.step_count = int(n_steps)
-            msg.source = truth_t.SOURCE_SIMULATION
+        for msg in msgs:
             log.write_event(msg.t_us, TRUTH_CHANNEL, msg.encode())
     finally:
         log.close()
-    return len(idx)
+    return len(msgs)
 
 
 def write_init_ini(result: SimResult, path: Path) -> None:

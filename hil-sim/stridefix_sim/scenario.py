@@ -9,7 +9,16 @@ with 3 pauses, about 5 minutes). A file only needs the keys it changes. An unkno
 an out-of-range value raises :class:`ScenarioError` naming the file and the key.
 
 Built-in named scenarios (``BUILTIN``, ``stridefix sim --scenario NAME``): ``default`` and
-``pace_slow`` / ``pace_normal`` / ``pace_fast``: two laps of the floor-0 loop at one pace, two pauses.
+``pace_slow`` / ``pace_normal`` / ``pace_fast``: two laps of the floor-0 loop at one pace, two pauses;
+``office_survey``: the survey of the office's calibration points (2 m along the corridors, both
+floors, the elevator between them); ``aadr2015_slow`` / ``aadr2015`` / ``aadr2015_fast``: the 70 m
+track with 14 reference points through the aadr2015 foyer (world ``aadr2015``) at one pace;
+``aadr2015_survey``: the survey of the foyer's 67 calibration points.
+
+Survey mode (``[survey] enabled = true`` or ``stridefix sim --survey``): instead of ``walk.route`` the
+person walks from calibration point to calibration point, and at each stands still, faces
+``orientations`` headings (k·360°/n in the map frame, turning in place) and takes
+``scans_per_orientation`` Wi-Fi scans in each; Wi-Fi scans happen only then (``walker.py``).
 """
 from __future__ import annotations
 
@@ -101,6 +110,18 @@ DEFAULTS: dict[str, Any] = {
         "scan_interval_min_s": 2.0,
         "scan_interval_max_s": 4.0,
         "scan_duration_ms": 120,     # results are sent this long after the scan started
+        "body_loss_db": 0.0,         # body shadowing: + this x (1 - cos(AP bearing - facing)) / 2 dB loss
+    },
+    "survey": {
+        "enabled": False,            # true: survey the calibration points instead of walking walk.route
+        "layout": "grid",            # "grid": spacing_m grid in the walkable area; "world": the world's own list
+        "spacing_m": 2.0,            # grid spacing (and the longest move between neighbouring points)
+        "margin_m": 0.5,             # calibration points keep this far from walls and block edges
+        "floor": -1,                 # -1: every floor of the world, else that floor only
+        "orientations": 4,           # headings per point: k x 360/n deg (0, 90, 180, 270), map frame
+        "scans_per_orientation": 3,
+        "scan_interval_s": 1.0,      # between scan starts while facing one way
+        "settle_s": 0.5,             # standing after a turn before the first scan
     },
     "can": {
         "loss_rate": 0.0,            # probability that a frame is lost between board and logger
@@ -180,6 +201,10 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
                     or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
                 raise ScenarioError(source, f"key '{name}' must be a list of {len(dflt)} numbers")
             out[key] = [float(v) for v in value]
+        elif isinstance(dflt, bool):
+            if not isinstance(value, bool):
+                raise ScenarioError(source, f"key '{name}' must be true or false")
+            out[key] = value
         elif isinstance(dflt, str):  # (strings are checked against their choices in _validate_values)
             if not isinstance(value, str):
                 raise ScenarioError(source, f"key '{name}' must be a string")
@@ -200,10 +225,31 @@ def _validate_values(d: dict, source: str) -> None:
         if not ok:
             raise ScenarioError(source, f"key '{key}' {what}")
 
+    from .world import WORLDS
+
     w, c, r, p, st, el = d["walk"], d["can"], d["radio"], d["person"], d["stairs"], d["elevator"]
-    check(d["world"]["name"] == "default", "world.name", "must be 'default' (the only built-in world)")
+    sv = d["survey"]
+    check(d["world"]["name"] in WORLDS, "world.name", f"must be one of {', '.join(repr(k) for k in WORLDS)}")
+    world = WORLDS[d["world"]["name"]]()
     check(d["duration_s"] >= 0, "duration_s", "must be >= 0")
-    check(w["route"] in ("tour", "loop"), "walk.route", "must be 'tour' or 'loop'")
+    check(w["route"] in ("tour", "loop", "track"), "walk.route", "must be 'tour', 'loop' or 'track'")
+    if not sv["enabled"]:
+        check(w["route"] != "tour" or (world.stairs is not None and world.elevator is not None), "walk.route",
+              f"'tour' needs stairs and an elevator (world {world.name!r} has none)")
+        check(w["route"] != "track" or world.track_m is not None, "walk.route",
+              f"'track' needs a world with a track (world {world.name!r} has none)")
+    check(sv["layout"] in ("grid", "world"), "survey.layout", "must be 'grid' or 'world'")
+    check(sv["layout"] != "world" or world.survey_points_m is not None, "survey.layout",
+          f"'world' needs a world with its own calibration points (world {world.name!r} has none)")
+    check(0.5 <= sv["spacing_m"] <= 20.0, "survey.spacing_m", "must be in 0.5..20")
+    check(0 <= sv["margin_m"] <= 2.0, "survey.margin_m", "must be in 0..2")
+    check(-1 <= sv["floor"] < world.n_floors, "survey.floor", f"must be -1 (all) or 0..{world.n_floors - 1}")
+    check(1 <= sv["orientations"] <= 8, "survey.orientations", "must be in 1..8")
+    check(1 <= sv["scans_per_orientation"] <= 20, "survey.scans_per_orientation", "must be in 1..20")
+    check(sv["settle_s"] >= 0, "survey.settle_s", "must be >= 0")
+    check(sv["scan_interval_s"] * 1000 > r["scan_duration_ms"], "survey.scan_interval_s",
+          "must be longer than radio.scan_duration_ms")
+    check(0 <= r["body_loss_db"] <= 30, "radio.body_loss_db", "must be in 0..30")
     check(w["pace"] in ("slow", "normal", "fast"), "walk.pace", "must be 'slow', 'normal' or 'fast'")
     check(w["laps"] > 0, "walk.laps", "must be > 0")
     check(w["cadence_hz"] == 0 or 0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be 0 or in 0.5..3.0")
@@ -247,12 +293,28 @@ def _pace_scenario(pace: str) -> dict:
                      "pause": [{"at_m": 60.0, "duration_s": 4.0}, {"at_m": 170.0, "duration_s": 5.0}]}}
 
 
+def _aadr2015_scenario(pace: str | None = None, survey: bool = False) -> dict:
+    """The aadr2015 foyer: the track at one pace, or the survey of its 67 calibration points."""
+    out = {"world": {"name": "aadr2015"}, "radio": {"body_loss_db": 3.0}}
+    if survey:
+        out["walk"] = {"pause": []}
+        out["survey"] = {"enabled": True, "layout": "world"}
+    else:
+        out["walk"] = {"route": "track", "pace": pace, "pause": []}
+    return out
+
+
 # name -> TOML-like overrides of DEFAULTS
 BUILTIN: dict[str, dict] = {
     "default": {},
     "pace_slow": _pace_scenario("slow"),
     "pace_normal": _pace_scenario("normal"),
     "pace_fast": _pace_scenario("fast"),
+    "office_survey": {"walk": {"pause": []}, "survey": {"enabled": True}},
+    "aadr2015_slow": _aadr2015_scenario("slow"),
+    "aadr2015": _aadr2015_scenario("normal"),
+    "aadr2015_fast": _aadr2015_scenario("fast"),
+    "aadr2015_survey": _aadr2015_scenario(survey=True),
 }
 
 

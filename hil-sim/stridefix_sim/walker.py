@@ -53,8 +53,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .route import Route, make_route
-from .world import World
+from .route import Route, SurveyStop, make_route, survey_route
+from .world import World, survey_points
 
 G_MPS2 = 9.80665
 PACES = {"slow": (1.5, 0.55), "normal": (1.8, 0.70), "fast": (2.1, 0.85)}  # cadence Hz, stride m
@@ -65,6 +65,9 @@ STAIRS_PENDULUM_FACTOR = 1.0 / 7.0
 SLOW_CADENCE, SLOW_STRIDE = 0.9, 0.85   # around a staircase
 TAIL_M = 5.0                 # the last metres of a bout absorb the distance correction
 TURN_RATE_DPS = 90.0         # mean turn rate in place
+SURVEY_TURN_LEAD_S = 0.2     # survey: standing before a turn in place starts
+SURVEY_TURN_MIN_S = 0.8      # survey: shortest turn in place
+SURVEY_AFTER_SCAN_S = 0.2    # survey: standing after the last scan's results before turning on
 
 
 def _gait_shape(n: int = 2048):
@@ -149,6 +152,8 @@ class Walk:
     route: Route
     person: Person
     rides: list = field(default_factory=list)   # (t_start, t_end, dz_m, break index) of the elevator rides
+    stops: list = field(default_factory=list)   # survey: one dict per calibration point (see plan_walk)
+    scan_plan: list = field(default_factory=list)  # survey: (t_ms, stop index, orientation_deg, k) per scan
 
 
 def _smoothstep(x):
@@ -229,7 +234,7 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     total = route.length_m
     leg_s = route.leg_starts_m
     cuts = {}
-    for p in w["pause"]:
+    for p in (w["pause"] if route.name != "survey" else []):
         if 0 < p["at_m"] < total:
             cuts.setdefault(round(p["at_m"], 9), []).append(("pause", p["duration_s"]))
     for i, br in enumerate(route.breaks):
@@ -242,7 +247,9 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
 
     t = w["start_still_s"]
     steps = {k: [] for k in ("t0", "T", "v", "mode", "bout", "Lplan", "first", "last")}
-    switches, turns, rides = [], [], []
+    switches, turns, rides, stops, scan_plan = [], [], [], [], []
+    if route.start_stop is not None:
+        t = _plan_stop(sc, route.start_stop, None, hd_start[0], t, 0, turns, stops, scan_plan, t_arrive=0.0)
     for b, (s0, s1) in enumerate(zip(bounds[:-1], bounds[1:])):
         d = s1 - s0
         if d > 0.3 * person.stride_m:
@@ -274,11 +281,15 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
                 t += arg
                 continue
             i = arg
+            if route.breaks[i].kind == "survey":
+                t = _plan_stop(sc, route.breaks[i].stop, hd_end[i], hd_start[i + 1], t, i, turns, stops, scan_plan)
+                switches.append(t)
+                continue
             dpsi = math.atan2(math.sin(hd_start[i + 1] - hd_end[i]), math.cos(hd_start[i + 1] - hd_end[i]))
             if abs(abs(dpsi) - math.pi) < 1e-6:
                 dpsi = math.pi
             t_turn = max(1.0, math.degrees(abs(dpsi)) / TURN_RATE_DPS) if abs(dpsi) > 1e-6 else 0.0
-            turns.append((t + 0.5, t_turn, dpsi))
+            turns.append((t + 0.5, t_turn, dpsi, i))
             t_free = t + 0.5 + t_turn + 0.5
             br = route.breaks[i]
             if br.kind == "elevator" and abs(br.dz_m) > 1e-9:
@@ -289,6 +300,9 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
             else:
                 t = t_free
             switches.append(t)
+    if route.end_stop is not None:
+        t = _plan_stop(sc, route.end_stop, hd_end[-1], None, t, len(route.legs) - 1, turns, stops, scan_plan)
+        stops[-1]["t_leave"] = math.inf
     cat = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in steps.items()}
     cat["mode"] = cat["mode"].astype(int)
     cat["bout"] = cat["bout"].astype(int)
@@ -303,8 +317,73 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     cat["va"], cat["vb"] = va, vb
     cat["d"] = cat["T"] * (va + vb) / 2
     bout_len = np.diff(np.asarray(bounds))
+    start_turns = [tr[2] for tr in turns if tr[3] == 0 and route.start_stop is not None
+                   and tr[0] < (stops[0]["t_leave"] if stops else 0.0)]
     return {"steps": cat, "bout_len": bout_len, "walk_end": t, "switches": switches, "turns": turns,
-            "rides": rides, "hd_start": hd_start, "hd_end": hd_end}
+            "rides": rides, "hd_start": hd_start, "hd_end": hd_end, "stops": stops, "scan_plan": scan_plan,
+            "hd_offset0": -_fsum_exact(start_turns) if start_turns else 0.0}
+
+
+def _fsum_exact(values) -> float:
+    """Sum in order, starting from the first value (a single value comes back bit for bit)."""
+    out = None
+    for v in values:
+        out = v if out is None else out + v
+    return 0.0 if out is None else out
+
+
+def _plan_stop(sc: dict, stop: SurveyStop, arrive: float | None, depart: float | None, t: float, leg: int,
+               turns: list, stops: list, scan_plan: list, t_arrive: float | None = None) -> float:
+    """A survey stop from time ``t`` (standing at the point, facing ``arrive``; None = the start): turn in
+    place to each of the ``survey.orientations`` headings k·360°/n (map frame; first the one nearest the
+    arrival heading, then round in the direction that ends nearest the next leg's heading), take
+    ``scans_per_orientation`` scans in each (``settle_s`` after the turn, then every ``scan_interval_s``),
+    finally turn to ``depart`` (None = the end). Appends turns (t0, duration, dpsi, leg), the stop and its
+    scans; returns the time the surveyor walks on."""
+    sv = sc["survey"]
+    n = int(sv["orientations"])
+    o = [2.0 * math.pi * k / n for k in range(n)]
+
+    def wrap(a):
+        a = math.atan2(math.sin(a), math.cos(a))
+        return math.pi if abs(abs(a) - math.pi) < 1e-9 else a
+
+    def nearest(h):
+        return min(range(n), key=lambda k: (round(abs(wrap(o[k] - h)), 9), k))
+
+    if arrive is None:
+        i0, step = (nearest(depart) + 1) % n, 1                 # round CCW, ending at the departure heading
+    else:
+        i0 = nearest(arrive)
+        step = 1
+        if depart is not None and n > 2:
+            ccw, cw = o[(i0 - 1) % n], o[(i0 + 1) % n]
+            step = -1 if abs(wrap(depart - cw)) < abs(wrap(depart - ccw)) - 1e-9 else 1
+    seq = [o[(i0 + step * k) % n] for k in range(n)]
+    cur = seq[0] if arrive is None else arrive
+    t_arr = t if t_arrive is None else t_arrive
+
+    def turn(dpsi: float, t: float) -> float:
+        if abs(dpsi) < 1e-9:
+            return t
+        dur = max(SURVEY_TURN_MIN_S, math.degrees(abs(dpsi)) / TURN_RATE_DPS)
+        turns.append((t + SURVEY_TURN_LEAD_S, dur, dpsi, leg))
+        return t + SURVEY_TURN_LEAD_S + dur
+
+    scan_s = sc["radio"]["scan_duration_ms"] / 1000.0
+    for h in seq:
+        t = turn(wrap(h - cur), t)
+        cur = h
+        for k in range(int(sv["scans_per_orientation"])):
+            t_ms = int(math.ceil((t + sv["settle_s"] + k * sv["scan_interval_s"]) * 1000.0 - 1e-6))
+            scan_plan.append((t_ms, stop.index, round(math.degrees(h) % 360.0, 6), k))
+        t = t_ms / 1000.0 + scan_s + SURVEY_AFTER_SCAN_S
+    if depart is not None:
+        t = turn(wrap(depart - cur), t)
+    stops.append({"index": stop.index, "x_m": stop.x_m, "y_m": stop.y_m, "floor": stop.floor,
+                  "t_arrive": t_arr, "t_leave": t,
+                  "orientations_deg": [round(math.degrees(h) % 360.0, 6) for h in seq]})
+    return t
 
 
 def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: float = 100.0,
@@ -315,7 +394,7 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
         person = make_person(sc, np.random.default_rng(0))
     v_peak = person.stride_m * person.cadence_hz * 1.3
     radius = min(1.0, max(w["turn_radius_m"], v_peak / math.radians(w["max_yaw_rate_dps"])))
-    route = make_route(world, w["route"], w["laps"], radius)
+    route = make_walk_route(sc, world, radius)
     plan = plan_walk(sc, route, person, rng)
     stp = plan["steps"]
     t0, T, va, vb, mode = stp["t0"], stp["T"], stp["va"], stp["vb"], stp["mode"]
@@ -382,26 +461,40 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
     d = s - leg_s[leg]
     x, y, hd, kap = (np.zeros(n_full) for _ in range(4))
     lvl, dlvl, d2lvl = (np.zeros(n_full) for _ in range(3))
-    off = 0.0
+    off = plan["hd_offset0"]          # 0 unless a survey stop turns the walker before the first leg
     offsets = []
+    turn_sum: dict[int, list] = {}
+    for tr in plan["turns"]:
+        turn_sum.setdefault(tr[3], []).append(tr[2])
     for i, lg in enumerate(route.legs):
         if i > 0:
-            off = plan["hd_end"][i - 1] + offsets[-1] + plan["turns"][i - 1][2] - plan["hd_start"][i]
+            off = plan["hd_end"][i - 1] + offsets[-1] + _fsum_exact(turn_sum.get(i - 1, [])) - plan["hd_start"][i]
         offsets.append(off)
-        m = leg == i
-        if not m.any():
+        m = slice(*np.searchsorted(leg, [i, i + 1]))   # ``leg`` never decreases: leg i is one run
+        if m.start == m.stop:
             continue
         dd = np.clip(d[m], 0.0, lg.length_m)
         x[m], y[m], hd[m], kap[m] = lg.path.pose(dd)
         hd[m] += off
         lvl[m], dlvl[m], d2lvl[m] = lg.height(dd)
     yaw_rate = kap * v
-    for i, (ts, dur, dpsi) in enumerate(plan["turns"]):
-        before = t < switches[i]
+    for ts, dur, dpsi, i in plan["turns"]:
+        if route.name == "survey" and dur > 0:
+            # hundreds of turns: only the samples from the turn's start to the leg switch
+            a = int(np.searchsorted(t, ts))
+            b = int(np.searchsorted(t, switches[i])) if i < len(switches) else n_full
+            r, dr = _smoothstep((t[a:b] - ts) / dur)
+            hd[a:b] += dpsi * r
+            yaw_rate[a:b] += dpsi * dr / dur
+            continue
+        before = t < switches[i] if i < len(switches) else np.ones(n_full, bool)
         if dur > 0:
             r, dr = _smoothstep((t - ts) / dur)
             hd += np.where(before, dpsi * r, 0.0)
             yaw_rate += np.where(before, dpsi * dr / dur, 0.0)
+    for st in plan["stops"]:        # survey: exactly at the calibration point while standing there
+        m = slice(int(np.searchsorted(t, st["t_arrive"] - 1e-9)), int(np.searchsorted(t, st["t_leave"])))
+        x[m], y[m] = st["x_m"], st["y_m"]
     vz_lvl = dlvl * v
     az_lvl = d2lvl * v * v + dlvl * dv
     riding = np.zeros(n_full, bool)
@@ -432,4 +525,16 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
                 yaw_rate_radps=yaw_rate[sl], accel_body_mps2=acc[sl], height_m=(lvl + zb)[sl],
                 level_m=lvl[sl], vz_mps=(vz_lvl + vzb)[sl], floor=floor[sl], activity=activity[sl],
                 s_m=s[sl], step_t_s=t0 + GAIT_U_PEAK * T, step_len_m=d_scaled, step_p2p_mps2=A,
-                step_mode=mode, walk_end_s=walk_end, route=route, person=person, rides=plan["rides"])
+                step_mode=mode, walk_end_s=walk_end, route=route, person=person, rides=plan["rides"],
+                stops=plan["stops"], scan_plan=plan["scan_plan"])
+
+
+def make_walk_route(sc: dict, world: World, radius_m: float) -> Route:
+    """The scenario's route: the survey of calibration points when ``survey.enabled``, else ``walk.route``."""
+    sv = sc["survey"]
+    if sv["enabled"]:
+        floors = range(world.n_floors) if sv["floor"] < 0 else [sv["floor"]]
+        pts = survey_points(world, sv["spacing_m"], sv["margin_m"], floors, sv["layout"])
+        return survey_route(world, pts, sv["spacing_m"], radius_m)
+    w = sc["walk"]
+    return make_route(world, w["route"], w["laps"], radius_m)

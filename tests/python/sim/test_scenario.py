@@ -75,7 +75,8 @@ def test_cli_bad_override_exits_2(tmp_path, sim_cli, capsys):
 
 
 def test_builtin_named_scenarios():
-    assert set(BUILTIN) == {"default", "pace_slow", "pace_normal", "pace_fast"}
+    assert set(BUILTIN) == {"default", "pace_slow", "pace_normal", "pace_fast", "office_survey",
+                            "aadr2015_slow", "aadr2015", "aadr2015_fast", "aadr2015_survey"}
     assert resolve_scenario(None).data == resolve_scenario("default").data == DEFAULTS
     assert DEFAULTS["walk"]["route"] == "tour" and DEFAULTS["walk"]["pace"] == "normal"
     for pace in ("slow", "normal", "fast"):
