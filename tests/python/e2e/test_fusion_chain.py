@@ -1,0 +1,108 @@
+"""End to end with a site: survey -> radio map -> site file -> walk -> stridefixd --site -> FIX and
+POSE for every fusion scheme, scored at the reference points.
+
+GIVEN the aadr2015 foyer surveyed (a recording of its own) and turned into a site file by
+`stridefix radiomap build`, WHEN stridefixd replays a walk of the track with that site, THEN every
+scheme judges every Wi-Fi scan (FIX audit records), every scheme publishes POSE from its first fix
+on, and the fused schemes beat Wi-Fi alone at the reference points."""
+from __future__ import annotations
+
+import json
+import subprocess
+from collections import Counter
+from pathlib import Path
+
+import lcm
+import numpy as np
+import pytest
+from stridefix import fix_t, pose_t, wifi_scan_t
+
+
+def run_fw(stridefixd: Path, walk: Path, log: Path, *extra: str) -> subprocess.CompletedProcess:
+    return subprocess.run([str(stridefixd), "--input", str(walk / "board.candump"), "--log", str(log), "-q",
+                           *extra], capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def site(stridefixd, cli, tmp_path_factory) -> Path:
+    """The surveyed foyer as a site file (survey seed 1000, never a scored walk)."""
+    out = tmp_path_factory.mktemp("survey")
+    assert cli("sim", "--scenario", "aadr2015_survey", "--seed", "1000", "--out", str(out)).returncode == 0
+    summary = json.loads((out / "sim_summary.json").read_text())
+    assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
+    site = out / "site.sfsite"
+    proc = cli("radiomap", "build", str(out / "fw.lcmlog"), str(out / "truth.lcmlog"), "--mode", "survey",
+               "--out", str(site), "--map-rotation-deg", str(summary["map_rotation_deg"]))
+    assert proc.returncode == 0, proc.stderr
+    return site
+
+
+@pytest.fixture(scope="module")
+def walk(stridefixd, cli, site, tmp_path_factory) -> dict:
+    out = tmp_path_factory.mktemp("walk")
+    assert cli("sim", "--scenario", "aadr2015", "--seed", "1", "--out", str(out)).returncode == 0
+    log = out / "fw.lcmlog"
+    proc = run_fw(stridefixd, out, log, "--site", str(site))
+    assert proc.returncode == 0, proc.stderr
+    events = list(lcm.EventLog(str(log), "r"))
+    return {"dir": out, "log": log, "events": events, "stderr": proc.stderr}
+
+
+def test_every_scheme_judges_every_scan(walk):
+    scans = [e for e in walk["events"] if e.channel == "WIFI"]
+    fixes = [fix_t.decode(e.data) for e in walk["events"] if e.channel == "FIX"]
+    assert len(scans) > 10
+    assert len(fixes) == 6 * len(scans)
+    per_scheme = Counter(f.scheme for f in fixes)
+    assert sorted(per_scheme) == [0, 1, 2, 3, 4, 5] and set(per_scheme.values()) == {len(scans)}
+    for scheme in range(6):
+        first = next(f for f in fixes if f.scheme == scheme)
+        assert first.reason == fix_t.REASON_INITIALISED and first.accepted and first.alpha == 1.0
+    for f in fixes:
+        assert f.reason_text and 0.0 <= f.alpha <= 1.0
+        assert f.accepted == (f.reason in (fix_t.REASON_ACCEPTED, fix_t.REASON_INITIALISED,
+                                           fix_t.REASON_RECOVERY)) or f.reason == fix_t.REASON_SCHEME_IGNORES
+
+
+def test_every_scheme_publishes_pose_after_its_first_fix(walk):
+    first_scan_t = min(wifi_scan_t.decode(e.data).t_us for e in walk["events"] if e.channel == "WIFI")
+    poses = [pose_t.decode(e.data) for e in walk["events"] if e.channel == "POSE"]
+    assert sorted({p.scheme for p in poses}) == [0, 1, 2, 3, 4, 5]
+    assert min(p.t_us for p in poses) >= first_scan_t  # nobody has a position before the first fix
+
+
+def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
+    proc = cli("analyze", str(walk["log"]), str(walk["dir"] / "truth.lcmlog"), "--truth-source", "waypoint",
+               "--out", str(tmp_path))
+    assert proc.returncode == 0, proc.stderr
+    per = json.loads((tmp_path / "metrics.json").read_text())["per_scheme"]
+    n = {k: v["position_error_m"]["n"] for k, v in per.items()}
+    assert n["kalman"] == 14  # the track's 14 reference points
+    mean = {k: v["position_error_m"]["mean"] for k, v in per.items()}
+    assert mean["wifi_only"] < 5.0
+    assert mean["kalman"] < mean["wifi_only"]
+    assert mean["adaptive"] < mean["wifi_only"]
+
+
+def test_same_input_same_fix_and_pose_records(walk, stridefixd, site, tmp_path):
+    log = tmp_path / "again.lcmlog"
+    assert run_fw(stridefixd, walk["dir"], log, "--site", str(site)).returncode == 0
+    def records(events):
+        return [(e.timestamp, e.channel, e.data) for e in events if e.channel in ("FIX", "POSE", "STEP")]
+    assert records(lcm.EventLog(str(log), "r")) == records(walk["events"])
+
+
+@pytest.mark.parametrize("damage", ["missing", "truncated", "crc"])
+def test_bad_site_file_stops_startup(stridefixd, walk, site, tmp_path, damage):
+    bad = tmp_path / "bad.sfsite"
+    data = bytearray(site.read_bytes())
+    if damage == "truncated":
+        bad.write_bytes(bytes(data[: len(data) // 2]))
+    elif damage == "crc":
+        data[40] ^= 0xFF
+        bad.write_bytes(bytes(data))
+    proc = run_fw(stridefixd, walk["dir"], tmp_path / "x.lcmlog", "--site", str(bad))
+    assert proc.returncode == 2
+    assert "bad.sfsite" in proc.stderr
+    if damage == "crc":
+        assert "CRC" in proc.stderr
