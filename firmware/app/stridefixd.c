@@ -53,6 +53,7 @@ typedef struct {
     bool no_log;
     const char *lcm_url;
     const char *site_path;
+    const char *fusion;
     const char *config_paths[MAX_SETS];
     int n_configs;
     const char *sets[MAX_SETS];
@@ -107,6 +108,9 @@ static void usage(FILE *const f)
             "      --site FILE        site file (floors, map rotation, radio map) from `stridefix radiomap build`:\n"
             "                         enables Wi-Fi fixes and the fusion schemes; without it PDR starts at\n"
             "                         the config pose (init.*)\n"
+            "      --fusion MODE      publish one scheme's POSE and FIX: pdr_only, wifi_only, overwrite,\n"
+            "                         static, adaptive, kalman; or all (default: every scheme side by side,\n"
+            "                         one log compares them all). Same as --set output.scheme=N\n"
             "Configuration\n"
             "  -c, --config FILE      INI file of [section] key = value (every key: --print-config);\n"
             "                         repeatable, later files override earlier ones\n"
@@ -142,7 +146,7 @@ static void print_config(const sf_params_t *const p)
 
 static int parse_options(const int argc, char **const argv, options_t *const o, sf_params_t *const params)
 {
-    enum { opt_no_log = 1000, opt_print_config, opt_max_messages, opt_site };
+    enum { opt_no_log = 1000, opt_print_config, opt_max_messages, opt_site, opt_fusion };
     static const struct option longs[] = {
         {"input", required_argument, NULL, 'i'},   {"log", required_argument, NULL, 'l'},
         {"log-dir", required_argument, NULL, 'd'}, {"no-log", no_argument, NULL, opt_no_log},
@@ -151,6 +155,7 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
         {"quiet", no_argument, NULL, 'q'},         {"max-messages", required_argument, NULL, opt_max_messages},
         {"help", no_argument, NULL, 'h'},          {"version", no_argument, NULL, 'V'},
         {"site", required_argument, NULL, opt_site},
+        {"fusion", required_argument, NULL, opt_fusion},
         {NULL, 0, NULL, 0}};
     *o = (options_t){.log_dir = ".", .max_messages = 20};
     bool want_print_config = false;
@@ -163,6 +168,7 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
         case opt_no_log: o->no_log = true; break;
         case 'u': o->lcm_url = optarg; break;
         case opt_site: o->site_path = optarg; break;
+        case opt_fusion: o->fusion = optarg; break;
         case 'c':
             if (o->n_configs == MAX_SETS) {
                 fprintf(stderr, "stridefixd: at most %d --config options\n", MAX_SETS);
@@ -202,6 +208,21 @@ static int parse_options(const int argc, char **const argv, options_t *const o, 
             fprintf(stderr, "stridefixd: %s\n", err);
             return EXIT_USAGE;
         }
+    }
+    if (o->fusion != NULL) {
+        static const char *const names[] = {"pdr_only", "wifi_only", "overwrite", "static", "adaptive", "kalman"};
+        int code = strcmp(o->fusion, "all") == 0 ? -1 : -2;
+        for (int i = 0; i < (int)(sizeof names / sizeof names[0]); i++) {
+            if (strcmp(o->fusion, names[i]) == 0) {
+                code = i;
+            }
+        }
+        if (code == -2) {
+            fprintf(stderr, "stridefixd: --fusion %s: expected all, pdr_only, wifi_only, overwrite, static, "
+                            "adaptive or kalman\n", o->fusion);
+            return EXIT_USAGE;
+        }
+        params->output_scheme = code;
     }
     if (want_print_config) {
         print_config(params);
@@ -296,6 +317,9 @@ static void write_pose(daemon_t *const d)
 {
     const int n_schemes = d->est.site != NULL ? sf_scheme_count : sf_scheme_pdr_only + 1;
     for (int scheme = 0; scheme < n_schemes; scheme++) {
+        if (d->params.output_scheme >= 0 && scheme != d->params.output_scheme) {
+            continue;
+        }
         sf_pose_t p;
         if (!sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
             continue;
@@ -324,6 +348,9 @@ static void on_wifi_fix(daemon_t *const d, const sf_rx_wifi_t *const w)
     const int n = sf_estimator_wifi(&d->est, &d->params, &scan, &fix, &has_fix, audits);
     for (int i = 0; i < n; i++) {
         const sf_fix_audit_t *const a = &audits[i];
+        if (d->params.output_scheme >= 0 && a->scheme != d->params.output_scheme) {
+            continue;
+        }
         stridefix_fix_t msg = {.t_us = a->t_us,
                                .method = a->method,
                                .scheme = a->scheme,
