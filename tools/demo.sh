@@ -1,19 +1,27 @@
 #!/usr/bin/env bash
 # The default SIL walk, end to end, timing each step:
-#   simulator -> candump log -> stridefixd -> LCM log -> analyzer -> metrics.json + report.html
+#   1. survey: the simulator surveys the office (both floors) -> candump -> stridefixd -> LCM log
+#      -> `stridefix radiomap build` -> out/demo/site.sfsite (floors, map rotation, radio map)
+#   2. walk: the default two-floor tour -> candump -> stridefixd --site -> LCM log with every fusion
+#      scheme side by side (POSE per scheme, FIX audit records) -> analyzer -> metrics.json + report.html
+# The survey is its own recording (seed 1000); the walk never trains its own map. Every scheme starts
+# at its first Wi-Fi fix: nothing is truth-initialised.
 set -euo pipefail
 out=${1:-out/demo}; stridefixd=${2:-build/firmware/stridefixd}; venv=${3:-.venv}
-mkdir -p "$out"
+mkdir -p "$out/survey"
 step() { local name=$1; shift; local t0 t1; t0=$(date +%s%N); "$@"; t1=$(date +%s%N);
          local ms=$(( (t1 - t0) / 1000000 ))
-         printf 'demo: %-10s %4d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000)) | tee -a "$out/timings.txt"; }
+         printf 'demo: %-12s %4d.%03d s\n' "$name" $((ms / 1000)) $((ms % 1000)) | tee -a "$out/timings.txt"; }
 : > "$out/timings.txt"
-step sim       "$venv/bin/stridefix" sim --out "$out"
-# The map's rotation from magnetic north is a fact of the site (the site file will carry it).
-rotation=$("$venv/bin/python" -c 'import json,sys; print(json.load(open(sys.argv[1]))["map_rotation_deg"])' "$out/sim_summary.json")
-step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --config "$out/init_truth.ini" \
-               --set "heading.map_rotation_deg=$rotation"
-step analyze   "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" \
-               --label "default SIL walk, PDR only, truth-initialised start (init_truth.ini)"
-step report    "$venv/bin/stridefix" report "$out"
+step survey-sim "$venv/bin/stridefix" sim --scenario office_survey --seed 1000 --out "$out/survey"
+step survey-fw  "$stridefixd" --input "$out/survey/board.candump" --log "$out/survey/stridefixd.lcmlog" -q
+rotation=$("$venv/bin/python" -c 'import json,sys; print(json.load(open(sys.argv[1]))["map_rotation_deg"])' \
+           "$out/survey/sim_summary.json")
+step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcmlog" "$out/survey/truth.lcmlog" \
+                --mode survey --name office --map-rotation-deg "$rotation" --out "$out/site.sfsite"
+step sim        "$venv/bin/stridefix" sim --out "$out"
+step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
+step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" \
+                --scheme kalman --label "default SIL walk, office radio map, every scheme from its first fix"
+step report     "$venv/bin/stridefix" report "$out"
 echo "demo: wrote $out/report.html and $out/metrics.json"

@@ -131,7 +131,7 @@
     X(fusion, gate_sigma,          double,  3.0,     0.5,     1e3,     "sigma", "innovation gate: reject when |nu|^2 > gate^2 S (2 dof: 3 passes 98.9% of consistent fixes)") \
     X(fusion, max_rejections,      int32_t, 3,       0,       1000,    "fixes", "consecutive rejections after which the next fix is accepted with alpha = 1 and the variance reset (SmartLocator CONF)") \
     X(fusion, static_alpha,        double,  0.5,     0.0,     1.0,     "",      "static scheme blend weight (Jaeger et al. baseline: half-way)") \
-    X(fusion, q_step_m2_per_m,     double,  0.05,    0.0,     100.0,   "m2/m",  "position variance added per metre walked, per axis (all schemes; PDR random walk)") \
+    X(fusion, q_step_m2_per_m,     double,  0.2,    0.0,     100.0,   "m2/m",  "position variance added per metre walked; PDR errors are mostly systematic (stride scale, heading bias), so a random walk needs more than the noise: 0.2 chosen on the SIL benches") \
     X(fusion, q_time_m2_per_s,     double,  0.005,   0.0,     100.0,   "m2/s",  "position variance added per second, per axis (missed steps, shuffling)") \
     X(fusion, var_min_m2,          double,  0.01,    1e-6,    1e4,     "m2",    "floor of every scheme position variance (keeps S > 0 and alpha < 1)") \
     X(fusion, acc_wifi_ap1,        double,  2.0,     0.0,     1000.0,  "APs",   "adaptive: Wi-Fi accuracy-factor knot 1, APs used (knots increasing; flat outside)") \

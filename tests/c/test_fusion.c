@@ -181,6 +181,7 @@ static void test_schemes_by_hand(void **state)
     sf_params_t p;
     sf_params_default(&p);
     p.fusion_q_time_m2_per_s = 0.0;
+    p.fusion_q_step_m2_per_m = 0.05; /* the hand computation's value, whatever the default */
     sf_fusion_t f[sf_scheme_count];
     init_all(f);
     for (int s = 0; s < sf_scheme_count; s++) {
