@@ -173,6 +173,33 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->scheme = sf_scheme_pdr_only;
 }
 
+/* A Kalman-accepted fix: recalibrate K over the walk since the previous one (see sf_estimator.h). */
+static void calibrate_stride(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix)
+{
+    if (!p->stride_calib_enable) {
+        return;
+    }
+    if (e->calib_anchor_valid) {
+        const double walked_m = e->distance_m - e->calib_distance_m;
+        if (walked_m < p->stride_min_calib_distance_m) {
+            return; /* keep the anchor: the walk is still too short */
+        }
+        const double d_fix_m = hypot(fix->x_m - e->calib_fix_x_m, fix->y_m - e->calib_fix_y_m);
+        const double d_pdr_m = hypot(e->x_m - e->calib_pdr_x_m, e->y_m - e->calib_pdr_y_m);
+        if (d_pdr_m >= p->stride_calib_straightness * walked_m && d_pdr_m > 0.0 &&
+            sf_stride_calibrate(&e->stride, p, walked_m * d_fix_m / d_pdr_m, e->weinberg_sum) == SF_OK) {
+            e->stride_calibrations++;
+        }
+    }
+    e->calib_anchor_valid = true;
+    e->calib_fix_x_m = fix->x_m;
+    e->calib_fix_y_m = fix->y_m;
+    e->calib_pdr_x_m = e->x_m;
+    e->calib_pdr_y_m = e->y_m;
+    e->calib_distance_m = e->distance_m;
+    e->weinberg_sum = 0.0;
+}
+
 int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
                       sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
 {
@@ -194,6 +221,9 @@ int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const
     *has_fix = true;
     for (int s = 0; s < sf_scheme_count; s++) {
         (void)sf_fusion_fix(&e->fusion[s], p, fix, baro_floor, &audits[s]);
+    }
+    if (audits[sf_scheme_kalman].accepted) {
+        calibrate_stride(e, p, fix);
     }
     return sf_scheme_count;
 }

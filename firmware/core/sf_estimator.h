@@ -17,6 +17,12 @@
  * direction is init_heading_rad + yaw + offset; once a magnetometer sample is accepted the yaw is
  * magnetic and the map rotation applies.
  *
+ * Stride calibration from fixes (the paper leaves it as future work): between two Kalman-accepted
+ * fixes at least stride_min_calib_distance_m of walking apart, over a walk straight enough that the
+ * PDR displacement is ≥ stride_calib_straightness × the distance walked, the true distance walked is
+ * taken as walked × |Δfix| / |ΔPDR|, and sf_stride_calibrate moves K toward it (gain, per-update
+ * clamp and bounds there), so one bad fix cannot wreck it.
+ *
  * Absolute fixes: Wi-Fi scans are matched against the site's radio map (sf_fingerprint) and every
  * fix is offered to each of the six fusion schemes (sf_fusion: pdr_only, wifi_only, overwrite,
  * static, adaptive, kalman), which all run side by side on the same steps and fixes, so one log
@@ -71,6 +77,12 @@ typedef struct {
     sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
     sf_fingerprint_t fingerprint;
     sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
+    /* online stride calibration: the anchor is the last accepted Kalman fix */
+    bool calib_anchor_valid;
+    double calib_fix_x_m, calib_fix_y_m;   /* the anchor fix */
+    double calib_pdr_x_m, calib_pdr_y_m;   /* the PDR track at the anchor */
+    double calib_distance_m;               /* distance walked at the anchor */
+    uint32_t stride_calibrations;
 } sf_estimator_t;
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);

@@ -84,7 +84,9 @@
     X(stride, k_max,               double,  0.80,    0.05,    2.0,     "m/(m/s2)^0.25", "highest K that calibration may reach") \
     X(stride, k_gain,              double,  0.3,     0.0,     1.0,     "",      "fraction of the way K moves toward distance/sum per calibration") \
     X(stride, k_max_change,        double,  0.10,    0.0,     1.0,     "",      "bound on |K_new/K - 1| per calibration") \
-    X(stride, min_calib_distance_m, double, 10.0,    1.0,     10000.0, "m",     "shortest fix-to-fix distance used for calibration")
+    X(stride, min_calib_distance_m, double, 20.0,    1.0,     10000.0, "m",     "shortest fix-to-fix walk used for calibration") \
+    X(stride, calib_straightness,  double,  0.9,     0.0,     1.0,     "",      "calibrate only over walks whose PDR displacement is at least this x distance walked") \
+    X(stride, calib_enable,        int32_t, 1,       0,       1,       "",      "1 = recalibrate K online from accepted Kalman fixes (needs a site)")
 
 /* sf_activity.h, sf_floor.h */
 #define SF_PARAMS_ACTIVITY(X)                                                                          \

@@ -92,6 +92,7 @@ static void test_absurd_fix_is_clamped(void **state)
     (void)state;
     sf_params_t p;
     sf_params_default(&p);
+    p.stride_min_calib_distance_m = 10.0; /* the distances below were chosen for this value */
     sf_stride_t st;
     sf_stride_init(&st, &p);
     const double sum = 100.0, true_d = 0.47 * sum;
@@ -119,6 +120,7 @@ static void test_k_bounds(void **state)
     (void)state;
     sf_params_t p;
     sf_params_default(&p);
+    p.stride_min_calib_distance_m = 10.0; /* the distances below were chosen for this value */
     sf_stride_t st;
     sf_stride_init(&st, &p);
     for (int i = 0; i < 100; i++) {

@@ -106,3 +106,34 @@ def test_bad_site_file_stops_startup(stridefixd, walk, site, tmp_path, damage):
     assert "bad.sfsite" in proc.stderr
     if damage == "crc":
         assert "CRC" in proc.stderr
+
+
+
+@pytest.fixture(scope="module")
+def office_walk(stridefixd, cli, default_walk, tmp_path_factory) -> list:
+    """The default office walk replayed with a site from a survey of the office (seed 1000)."""
+    out = tmp_path_factory.mktemp("office_survey")
+    assert cli("sim", "--scenario", "office_survey", "--seed", "1000", "--out", str(out)).returncode == 0
+    assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
+    site = out / "site.sfsite"
+    proc = cli("radiomap", "build", str(out / "fw.lcmlog"), str(out / "truth.lcmlog"), "--mode", "survey",
+               "--out", str(site), "--map-rotation-deg", "20")
+    assert proc.returncode == 0, proc.stderr
+    log = out / "walk.lcmlog"
+    proc = run_fw(stridefixd, default_walk["dir"], log, "--site", str(site))
+    assert proc.returncode == 0, proc.stderr
+    return list(lcm.EventLog(str(log), "r"))
+
+
+def test_stride_is_recalibrated_from_fixes(office_walk):
+    """Weinberg's K (length / range^¼ of each STEP) starts at the configured 0.47 and is moved by
+    Kalman-accepted fixes over the corridors' straight stretches, within its bounds and by at most
+    10 % a time."""
+    from stridefix import step_t
+    steps = [step_t.decode(e.data) for e in office_walk if e.channel == "STEP"]
+    k = np.array([s.length_m / s.accel_range_mps2 ** 0.25 for s in steps if s.accel_range_mps2 > 0])
+    assert abs(k[0] - 0.47) < 1e-3
+    changes = np.flatnonzero(np.abs(np.diff(k)) > 1e-4)
+    assert len(changes) >= 2
+    assert np.all(np.abs(np.diff(k)) <= 0.1 * k[:-1] + 1e-4)
+    assert 0.25 <= k.min() and k.max() <= 0.80
