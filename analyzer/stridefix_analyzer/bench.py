@@ -233,7 +233,7 @@ def run(args: argparse.Namespace) -> int:
             print(bench_fusion.format_table(doc["table"], paper=False))
             print(f"targets (kalman mean <= 2.0 m, p95 <= 4.5 m) met: {doc['targets_met']}")
             print(f"wrote {out / 'office_wifi' / 'office_wifi.json'} ({doc['run_s']:.0f} s)")
-    except (BenchError, bench_fusion.BenchError) as exc:
+    except BenchError as exc:
         print(f"stridefix bench: error: {exc}", file=sys.stderr)
         return 1
     return 0

@@ -18,7 +18,6 @@ walks use different seeds: the map is never built from the walk it scores.
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -26,26 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from stridefix_analyzer.analyze import run_analyze
+from stridefix_analyzer.bench import BenchError, _run, _stridefix
 from stridefix_analyzer.metrics import SCHEME_NAMES
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
 SCHEME_ORDER = ["wifi_only", "overwrite", "static", "adaptive", "kalman", "pdr_only"]
 SURVEY_SEED = 1000  # the survey is its own recording, never one of the scored walks
-
-
-class BenchError(RuntimeError):
-    """A stage of the chain failed; the message names the stage and its output."""
-
-
-def _run(cmd: list[str], what: str) -> subprocess.CompletedProcess:
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise BenchError(f"{what} failed (exit {proc.returncode}): {' '.join(cmd)}\n{proc.stderr[-2000:]}")
-    return proc
-
-
-def _stridefix() -> str:
-    return str(Path(sys.executable).with_name("stridefix"))
 
 
 def simulate_and_log(scenario: str, seed: int, stridefixd: Path, out: Path, site: Path | None,
