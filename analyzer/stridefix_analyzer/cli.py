@@ -19,6 +19,7 @@ SUBCOMMANDS = {
     "import": "stridefix_sim.importers.cli",
     "realbench": "stridefix_analyzer.realbench",
     "radiomap": "stridefix_analyzer.radiomap",
+    "crowd": "stridefix_analyzer.crowd",
 }
 
 
@@ -29,13 +30,29 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, module_name in SUBCOMMANDS.items():
-        module = importlib.import_module(module_name)
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError as exc:
+            # One broken sub-command must not take the others down: it reports itself when used.
+            p = sub.add_parser(name, help=f"(unavailable: {exc})")
+            p.set_defaults(_run=_unavailable(name, exc))
+            continue
         p = module.add_parser(sub)
         p.set_defaults(_run=module.run)
     return parser
 
 
+def _unavailable(name: str, exc: ImportError):
+    def run(_args) -> int:
+        print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
+        return 1
+    return run
+
+
 def main(argv: list[str] | None = None) -> int:
+    from .realbench import with_default_bench   # `realbench --format ...` = `realbench fusion ...`
+
+    argv = with_default_bench(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(argv)
     return int(args._run(args) or 0)
 

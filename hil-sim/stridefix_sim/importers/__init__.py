@@ -4,6 +4,7 @@ lcmlog:FILE`` replays and the analyzer reads.
 
 ========  =====================================================================================
 msindoor  Microsoft Indoor Location Competition 2.0 sample traces (``msindoor.py``)
+gsd       GetSensorData logfiles, the IPIN competition Track 3 format (``gsd.py``)
 ========  =====================================================================================
 
 ``cli.py`` is the ``stridefix import FORMAT ...`` sub-command; a new format is one module plus one

@@ -42,8 +42,9 @@ import numpy as np
 
 #: Bump when the log content for the same input changes (caches compare it).
 IMPORTER_VERSION = 1
-#: Default age beyond which a Wi-Fi entry counts as cached [s].
-DEFAULT_MAX_WIFI_AGE_S = 3.0
+#: Default age beyond which a Wi-Fi entry counts as cached [s] (issue 5: "more than ~2 s older than
+#: its scan is a cached entry").
+DEFAULT_MAX_WIFI_AGE_S = 2.0
 #: Malformed lines reported one by one per file; the rest are summed up in one warning.
 MAX_LINE_WARNINGS = 20
 
@@ -444,13 +445,15 @@ def format_summary(s: dict) -> str:
 
 def add_parser(subparsers):
     """Declare ``stridefix import msindoor``."""
+    from .cli import add_output_arguments
+
     p = subparsers.add_parser(
         "msindoor", help="Microsoft Indoor Location Competition 2.0 traces (*.txt)",
         description="Import Indoor Location Competition 2.0 traces: one raw-sensor LCM log "
-                    "DIR/<trace-stem>.lcmlog per trace (IMU, MAG, WIFI, TRUTH from waypoints), "
-                    "for `stridefixd --input lcmlog:FILE`.")
+                    "DIR/<trace-stem>.lcmlog per trace, or FILE (-o) for a single trace (IMU, MAG, "
+                    "WIFI, TRUTH from waypoints), for `stridefixd --input lcmlog:FILE`.")
     p.add_argument("traces", nargs="+", metavar="TRACE.txt", help="trace file(s)")
-    p.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
+    add_output_arguments(p)
     p.add_argument("--max-wifi-age-s", type=float, default=DEFAULT_MAX_WIFI_AGE_S, metavar="S",
                    help="drop Wi-Fi entries last seen more than S before the scan time "
                         f"(cached results; default {DEFAULT_MAX_WIFI_AGE_S:g})")
@@ -466,11 +469,15 @@ def run(args) -> int:
     import sys
     import time
 
+    from .cli import output_paths
+
+    outs = output_paths(args.traces, args, "stridefix import msindoor")
+    if outs is None:
+        return 2
     status, summaries = 0, []
     n = len(args.traces)
-    for i, trace in enumerate(args.traces, 1):
+    for i, (trace, out) in enumerate(zip(args.traces, outs), 1):
         t0 = time.perf_counter()
-        out = Path(args.out) / (Path(trace).stem + ".lcmlog")
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("always", MalformedLineWarning)
@@ -491,7 +498,8 @@ def run(args) -> int:
                                             "duration_s", "waypoints")}))
     if args.json:
         Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
-    print(f"stridefix import msindoor: {len(summaries)}/{n} trace(s) imported into {args.out}",
+    where = args.output if args.output else args.out
+    print(f"stridefix import msindoor: {len(summaries)}/{n} trace(s) imported into {where}",
           file=sys.stderr)
     return status
 

@@ -176,3 +176,16 @@ def test_real_trace(real_trace, tmp_path):
     # accelerometer magnitude of a phone held flat: about g on average
     acc = np.linalg.norm(np.column_stack([imu[f"accel_{a}_mps2"] for a in "xyz"]), axis=1)
     assert 9.0 < acc.mean() < 10.6
+
+
+def test_default_wifi_age_limit_is_2_s(tmp_path):
+    # issue 5: an entry last seen more than ~2 s before its scan is cached and dropped (was 3 s)
+    assert msindoor.DEFAULT_MAX_WIFI_AGE_S == 2.0
+    path = tmp_path / "ages.txt"
+    path.write_text("#\tFloorName:F1\n"
+                    "5000\tTYPE_WIFI\ta\taa:bb:cc:dd:ee:01\t-50\t2412\t3100\n"    # 1.9 s: kept
+                    "5000\tTYPE_WIFI\tb\taa:bb:cc:dd:ee:02\t-60\t2412\t2500\n",   # 2.5 s: cached
+                    encoding="utf-8")
+    trace = msindoor.read_trace(path)
+    assert trace.scans[0].bssid.tolist() == [0xAABBCCDDEE01]
+    assert trace.stats["wifi_aps_stale_dropped"] == 1
