@@ -50,9 +50,13 @@ def _unavailable(name: str, exc: ImportError):
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .realbench import with_default_bench   # `realbench --format ...` = `realbench fusion ...`
-
-    argv = with_default_bench(sys.argv[1:] if argv is None else argv)
+    argv = sys.argv[1:] if argv is None else argv
+    try:
+        from .realbench import with_default_bench   # `realbench --format ...` = `realbench fusion ...`
+    except ImportError:
+        pass
+    else:
+        argv = with_default_bench(argv)
     args = build_parser().parse_args(argv)
     return int(args._run(args) or 0)
 
