@@ -55,6 +55,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--label", default=None, metavar="TEXT",
                    help="what this run is (e.g. 'PDR only, truth-initialised start'); kept in "
                         "metrics.json and shown as the report's title")
+    p.add_argument("--tum", default=None, metavar="DIR",
+                   help="also write TUM trajectories into DIR: truth.tum and <scheme>.tum with the "
+                        "POSE matched causally to each scored truth time (for evo)")
     p.add_argument("--all-channels", action="store_true",
                    help=f"decode every known channel ({', '.join(KNOWN_CHANNELS)}) to check their "
                         "payloads, not only those the analysis needs (slower on long logs)")
@@ -158,8 +161,8 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
-        summary, _ = run_analyze(args.logs, args.out, args.scheme, args.all_channels, args.label,
-                                 args.truth_source)
+        summary, metrics = run_analyze(args.logs, args.out, args.scheme, args.all_channels,
+                                       args.label, args.truth_source)
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return 2
@@ -167,6 +170,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
+    if getattr(args, "tum", None):
+        from .tum import write_tum
+        paths = write_tum(metrics, args.tum)
+        print(f"wrote {len(paths)} TUM trajectories into {args.tum}")
     if summary["position_error_m"]["n"] == 0:
         print("stridefix analyze: error: no truth sample could be scored (all precede the first "
               "POSE of the primary scheme)", file=sys.stderr)

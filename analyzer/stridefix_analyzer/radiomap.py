@@ -228,6 +228,97 @@ def _floors(rp_floor: np.ndarray, lowest_floor, floor_height_m, floor_heights_m)
     return lo, [f * float(floor_height_m) for f in range(lo, hi + 1)]
 
 
+def _collect_scans(recordings: list[Recording], scan_duration_ms: float,
+                   static_tol_m: float) -> dict:
+    """Place every scan of every recording (:func:`place_scans`) and pool their AP rows.
+
+    Returns
+    -------
+    dict
+        Per scan (n,): ``x_m``, ``y_m``, ``floor``, ``static``, ``ok`` (placed), ``rec`` (index of
+        its recording); per AP row (a,): ``ap_scan`` (pooled scan index), ``ap_bssid``,
+        ``ap_rssi``; ``skipped`` (count per :data:`SKIP_REASONS`), ``n_total`` (scans).
+    """
+    xs, ys, fs, st, scan_ok, recs, ap_scan, ap_bssid, ap_rssi = ([] for _ in range(9))
+    skipped = dict.fromkeys(SKIP_REASONS, 0)
+    n_total, base = 0, 0
+    for r, rec in enumerate(recordings):
+        p = place_scans(rec, int(round(scan_duration_ms * 1000)), static_tol_m)
+        for i, reason in enumerate(SKIP_REASONS):
+            skipped[reason] += int(np.sum(p["skip"] == i + 1))
+        xs.append(p["x_m"]), ys.append(p["y_m"]), fs.append(p["floor"]), st.append(p["static"])
+        scan_ok.append(p["skip"] == 0)
+        recs.append(np.full(len(rec.wifi), r, dtype=np.int64))
+        ap_scan.append(rec.wifi_ap["scan_row"] + base)
+        ap_bssid.append(rec.wifi_ap["bssid"]), ap_rssi.append(rec.wifi_ap["rssi_dbm"])
+        base += len(rec.wifi)
+        n_total += len(rec.wifi)
+
+    def cat(parts, dtype):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype)
+
+    return {"x_m": cat(xs, float), "y_m": cat(ys, float), "floor": cat(fs, np.int64),
+            "static": cat(st, bool), "ok": cat(scan_ok, bool), "rec": cat(recs, np.int64),
+            "ap_scan": cat(ap_scan, np.int64), "ap_bssid": cat(ap_bssid, np.int64),
+            "ap_rssi": cat(ap_rssi, float), "skipped": skipped, "n_total": n_total}
+
+
+def _ap_rows(placed: dict, scan_used: np.ndarray):
+    """AP rows of the used scans, one per (scan, BSSID) at the strongest RSSI, sorted by (scan,
+    BSSID); rows with a non-finite RSSI or a BSSID outside 0..2⁴⁸−1 are dropped.
+
+    Returns (a_scan, a_bssid, a_rssi, invalid rows, duplicate rows).
+    """
+    a_scan, a_bssid, a_rssi = placed["ap_scan"], placed["ap_bssid"], placed["ap_rssi"]
+    used = scan_used[a_scan]
+    keep = used & np.isfinite(a_rssi) & (a_bssid >= 0) & (a_bssid < _BSSID_LIMIT)
+    bad_rows = int(np.sum(used & ~keep))
+    a_scan, a_bssid, a_rssi = a_scan[keep], a_bssid[keep], a_rssi[keep]
+    order = np.lexsort((-a_rssi, a_bssid, a_scan))
+    a_scan, a_bssid, a_rssi = a_scan[order], a_bssid[order], a_rssi[order]
+    first = np.ones(len(a_scan), dtype=bool)
+    first[1:] = (a_scan[1:] != a_scan[:-1]) | (a_bssid[1:] != a_bssid[:-1])
+    duplicates = int(np.sum(~first))
+    return a_scan[first], a_bssid[first], a_rssi[first], bad_rows, duplicates
+
+
+def _assemble_site(keys, count, mean, std, rp_x, rp_y, rp_floor, rp_scans, *, min_count: int,
+                   source: str, name: str, map_rotation_deg: float, cell_size_m: float,
+                   floor_height_m: float, floor_heights_m, lowest_floor: int | None,
+                   origin_deg) -> tuple[site_t, np.ndarray, np.ndarray]:
+    """The site of per-(BSSID, RP) statistics: drop entries below ``min_count``, then the RPs left
+    without an entry (the rest renumbered in order), and pack everything into a ``site_t``.
+
+    ``keys`` (e, 2) int64 rows (BSSID, RP index) sorted lexicographically; ``count``, ``mean``,
+    ``std`` (e,); ``rp_*`` (n_rp,). Returns (site, kept entries (e,) bool, RPs kept (n_rp,) bool).
+    """
+    n_rp = len(rp_x)
+    kept = count >= min_count
+    keys, count, mean, std = keys[kept].copy(), count[kept], mean[kept], std[kept]
+    if len(keys) == 0:
+        raise RadioMapInputError(f"no access point was heard in {min_count} or more scans at any "
+                                 f"of the {n_rp} reference points (lower --min-count?)")
+    # an RP with no entry left tells a matcher nothing: drop it, renumber the rest in order
+    has_entry = np.zeros(n_rp, dtype=bool)
+    has_entry[keys[:, 1]] = True
+    keys[:, 1] = (np.cumsum(has_entry) - 1)[keys[:, 1]]
+    rp_x, rp_y, rp_floor, rp_scans = (v[has_entry] for v in (rp_x, rp_y, rp_floor, rp_scans))
+    bssids, entry_ap = np.unique(keys[:, 0], return_inverse=True)
+    lo, heights = _floors(rp_floor, lowest_floor, floor_height_m, floor_heights_m)
+    site = new_site(
+        name=name, source=source,
+        map_rotation_deg=float(map_rotation_deg), has_geo=origin_deg is not None,
+        origin_lat_deg=float(origin_deg[0]) if origin_deg else 0.0,
+        origin_lon_deg=float(origin_deg[1]) if origin_deg else 0.0,
+        lowest_floor=lo, floor_height_m=heights, ap_bssid=bssids.astype(np.int64),
+        cell_size_m=float(cell_size_m),
+        rp_x_m=rp_x.astype(np.float32), rp_y_m=rp_y.astype(np.float32), rp_floor=rp_floor,
+        rp_scans=rp_scans, entry_ap=np.asarray(entry_ap).reshape(-1), entry_rp=keys[:, 1],
+        entry_mean_dbm=mean.astype(np.float32), entry_std_db=std.astype(np.float32),
+        entry_count=count)
+    return site, kept, has_entry
+
+
 def build_site(recordings: list[Recording], mode: str = "auto",
                cell_size_m: float = DEFAULT_CELL_SIZE_M, min_count: int = DEFAULT_MIN_COUNT,
                name: str = "", map_rotation_deg: float = 0.0,
@@ -246,21 +337,9 @@ def build_site(recordings: list[Recording], mode: str = "auto",
     if min_count < 1:
         raise RadioMapInputError(f"min count {min_count} must be >= 1")
     # 1. place every scan of every recording
-    xs, ys, fs, st, scan_ok, ap_scan, ap_bssid, ap_rssi = [], [], [], [], [], [], [], []
-    skipped = dict.fromkeys(SKIP_REASONS, 0)
-    n_total, base = 0, 0
-    for rec in recordings:
-        p = place_scans(rec, int(round(scan_duration_ms * 1000)), static_tol_m)
-        for i, reason in enumerate(SKIP_REASONS):
-            skipped[reason] += int(np.sum(p["skip"] == i + 1))
-        xs.append(p["x_m"]), ys.append(p["y_m"]), fs.append(p["floor"]), st.append(p["static"])
-        scan_ok.append(p["skip"] == 0)
-        ap_scan.append(rec.wifi_ap["scan_row"] + base)
-        ap_bssid.append(rec.wifi_ap["bssid"]), ap_rssi.append(rec.wifi_ap["rssi_dbm"])
-        base += len(rec.wifi)
-        n_total += len(rec.wifi)
-    x, y, floor, static = (np.concatenate(v) for v in (xs, ys, fs, st))
-    ok = np.concatenate(scan_ok)
+    placed = _collect_scans(recordings, scan_duration_ms, static_tol_m)
+    x, y, floor, static, ok = (placed[k] for k in ("x_m", "y_m", "floor", "static", "ok"))
+    skipped, n_total = placed["skipped"], placed["n_total"]
     n_placed = int(ok.sum())
     if n_placed == 0:
         raise RadioMapInputError(f"none of the {n_total} scan(s) could be placed on the truth "
@@ -292,16 +371,7 @@ def build_site(recordings: list[Recording], mode: str = "auto",
     rp_floor = np.zeros(n_rp, dtype=np.int64)
     rp_floor[scan_rp[used]] = floor[used]
     # 3. AP rows of the used scans; one per (scan, BSSID) at the strongest RSSI
-    a_scan, a_bssid, a_rssi = (np.concatenate(v) for v in (ap_scan, ap_bssid, ap_rssi))
-    keep = (scan_rp[a_scan] >= 0) & np.isfinite(a_rssi) & (a_bssid >= 0) & (a_bssid < _BSSID_LIMIT)
-    bad_rows = int(np.sum((scan_rp[a_scan] >= 0) & ~keep))
-    a_scan, a_bssid, a_rssi = a_scan[keep], a_bssid[keep], a_rssi[keep]
-    order = np.lexsort((-a_rssi, a_bssid, a_scan))
-    a_scan, a_bssid, a_rssi = a_scan[order], a_bssid[order], a_rssi[order]
-    first = np.ones(len(a_scan), dtype=bool)
-    first[1:] = (a_scan[1:] != a_scan[:-1]) | (a_bssid[1:] != a_bssid[:-1])
-    duplicates = int(np.sum(~first))
-    a_scan, a_bssid, a_rssi = a_scan[first], a_bssid[first], a_rssi[first]
+    a_scan, a_bssid, a_rssi, bad_rows, duplicates = _ap_rows(placed, scan_rp >= 0)
     a_rp = scan_rp[a_scan]
     # 4. per (BSSID, RP): count, mean, std (two-pass)
     keys, inverse = np.unique(np.stack([a_bssid, a_rp], axis=1), axis=0, return_inverse=True)
@@ -310,32 +380,15 @@ def build_site(recordings: list[Recording], mode: str = "auto",
     mean = np.bincount(inverse, weights=a_rssi, minlength=len(keys)) / np.maximum(count, 1)
     var = np.bincount(inverse, weights=(a_rssi - mean[inverse]) ** 2, minlength=len(keys)) \
         / np.maximum(count, 1)
-    kept = count >= min_count
-    keys, count, mean, std = keys[kept], count[kept], mean[kept], np.sqrt(var[kept])
-    if len(keys) == 0:
-        raise RadioMapInputError(f"no access point was heard in {min_count} or more scans at any "
-                                 f"of the {n_rp} reference points (lower --min-count?)")
-    # 5. an RP with no entry left tells a matcher nothing: drop it, renumber the rest in order
-    has_entry = np.zeros(n_rp, dtype=bool)
-    has_entry[keys[:, 1]] = True
-    keys[:, 1] = (np.cumsum(has_entry) - 1)[keys[:, 1]]
-    rp_x, rp_y, rp_floor, rp_scans = (v[has_entry] for v in (rp_x, rp_y, rp_floor, rp_scans))
-    bssids, entry_ap = np.unique(keys[:, 0], return_inverse=True) if len(keys) else \
-        (np.zeros(0, np.int64), np.zeros(0, np.int64))
-    lo, heights = _floors(rp_floor, lowest_floor, floor_height_m, floor_heights_m)
     files = "; ".join(" + ".join(os.path.basename(f) for f in r.files) for r in recordings)
-    site = new_site(
-        name=name, source=f"stridefix {TOOL_VERSION}: {chosen} mode from {len(recordings)} "
-                          f"recording(s) [{files}]; cell {cell_size_m:g} m; min count {min_count}",
-        map_rotation_deg=float(map_rotation_deg), has_geo=origin_deg is not None,
-        origin_lat_deg=float(origin_deg[0]) if origin_deg else 0.0,
-        origin_lon_deg=float(origin_deg[1]) if origin_deg else 0.0,
-        lowest_floor=lo, floor_height_m=heights, ap_bssid=bssids.astype(np.int64),
+    site, kept, has_entry = _assemble_site(
+        keys, count, mean, np.sqrt(var), rp_x, rp_y, rp_floor, rp_scans, min_count=min_count,
+        source=f"stridefix {TOOL_VERSION}: {chosen} mode from {len(recordings)} "
+               f"recording(s) [{files}]; cell {cell_size_m:g} m; min count {min_count}",
+        name=name, map_rotation_deg=map_rotation_deg,
         cell_size_m=float(cell_size_m) if chosen == "walk" else 0.0,
-        rp_x_m=rp_x.astype(np.float32), rp_y_m=rp_y.astype(np.float32), rp_floor=rp_floor,
-        rp_scans=rp_scans, entry_ap=np.asarray(entry_ap).reshape(-1), entry_rp=keys[:, 1],
-        entry_mean_dbm=mean.astype(np.float32), entry_std_db=std.astype(np.float32),
-        entry_count=count)
+        floor_height_m=floor_height_m, floor_heights_m=floor_heights_m,
+        lowest_floor=lowest_floor, origin_deg=origin_deg)
     summary = site_summary(site)
     summary.update(
         mode=chosen, mode_reason=reason if mode == "auto" else f"--mode {mode} ({reason})",
@@ -347,6 +400,185 @@ def build_site(recordings: list[Recording], mode: str = "auto",
         entries_below_min_count=int(np.sum(~kept)), min_count=min_count,
         rps_dropped_no_entry=int(np.sum(~has_entry)))
     return site, summary
+
+
+# --- walk-mode sufficient statistics (leave-one-walk-out maps) -----------------------------------
+
+def _group_sum(keys: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``keys`` (n, k) int64 made unique (sorted lexicographically, as ``np.unique(...,
+    axis=0)`` sorts them) and ``values`` (n, m) summed per unique row."""
+    if len(keys) == 0:
+        return keys.reshape(0, keys.shape[1]), values.reshape(0, values.shape[1])
+    # (floor, iy, ix) packed into one order-preserving code: fewer sort keys
+    cols = [_row_codes(keys[:, :3])] + [keys[:, j] for j in range(3, keys.shape[1])] \
+        if keys.shape[1] >= 3 else [keys[:, j] for j in range(keys.shape[1])]
+    order = np.lexsort(cols[::-1])
+    sorted_cols = [c[order] for c in cols]
+    diff = np.zeros(len(order), dtype=bool)
+    diff[0] = True
+    for c in sorted_cols:
+        diff[1:] |= c[1:] != c[:-1]
+    first = np.flatnonzero(diff)
+    return keys[order[first]], np.add.reduceat(values[order], first, axis=0)
+
+
+class WalkStats:
+    """Sufficient statistics of a walk-mode radio map, which add and subtract.
+
+    A walk-mode map is a function of per-cell and per-(cell, AP) sums, so the map of a set of
+    recordings is the sum of their statistics, and the map of all recordings but one is
+    ``total - that one`` (leave one walk out without rebuilding). Counts are integers and RSSI sums
+    of integer dBm are exact in float64, so subtraction gives the same entries as a build from
+    scratch; position sums differ from it by rounding only (~1e-12 m).
+
+    Attributes
+    ----------
+    cell_size_m : float
+        Grid cell [m].
+    cell_key : (c, 3) int64
+        (floor, iy, ix) of each cell, sorted lexicographically (= the RP order of :func:`build_site`).
+    cell_scans : (c,) int64
+        Scans placed in the cell.
+    cell_sum_xy_m : (c, 2) float64
+        Σx, Σy of those scans' positions [m].
+    entry_key : (e, 4) int64
+        (floor, iy, ix, BSSID), sorted.
+    entry_count : (e,) int64
+        Scans of the cell that heard the AP (once per scan, strongest reading).
+    entry_sum_dbm, entry_sum2_dbm2 : (e,) float64
+        Σ RSSI [dBm] and Σ RSSI² [dBm²] over those scans.
+    scans : dict
+        ``total``, ``used`` and ``skipped_<reason>`` counts (add and subtract like the rest).
+    """
+
+    def __init__(self, cell_size_m, cell_key, cell_scans, cell_sum_xy_m, entry_key, entry_count,
+                 entry_sum_dbm, entry_sum2_dbm2, scans):
+        self.cell_size_m = float(cell_size_m)
+        self.cell_key, self.cell_scans, self.cell_sum_xy_m = cell_key, cell_scans, cell_sum_xy_m
+        self.entry_key, self.entry_count = entry_key, entry_count
+        self.entry_sum_dbm, self.entry_sum2_dbm2 = entry_sum_dbm, entry_sum2_dbm2
+        self.scans = dict(scans)
+
+    @classmethod
+    def from_recordings(cls, recordings: list[Recording],
+                        cell_size_m: float = DEFAULT_CELL_SIZE_M,
+                        scan_duration_ms: float = DEFAULT_SCAN_DURATION_MS,
+                        static_tol_m: float = DEFAULT_STATIC_TOL_M) -> "WalkStats":
+        """Statistics of ``recordings`` placed and deduplicated exactly as :func:`build_site` does
+        in walk mode. A recording with no placeable scan contributes nothing (no error)."""
+        if not (cell_size_m > 0 and math.isfinite(cell_size_m)):
+            raise RadioMapInputError(f"cell size {cell_size_m} m must be > 0")
+        placed = _collect_scans(recordings, scan_duration_ms, static_tol_m)
+        ok = placed["ok"]
+        x, y, floor = placed["x_m"], placed["y_m"], placed["floor"]
+        key = np.zeros((len(x), 3), dtype=np.int64)
+        key[ok] = np.stack([floor[ok], np.floor(y[ok] / cell_size_m).astype(np.int64),
+                            np.floor(x[ok] / cell_size_m).astype(np.int64)], axis=1)
+        cell_key, cell_vals = _group_sum(
+            key[ok], np.column_stack([np.ones(int(ok.sum())), x[ok], y[ok]]))
+        a_scan, a_bssid, a_rssi, _, _ = _ap_rows(placed, ok)
+        ekey = np.column_stack([key[a_scan], a_bssid]) if len(a_scan) else np.zeros((0, 4), np.int64)
+        entry_key, evals = _group_sum(
+            ekey, np.column_stack([np.ones(len(a_rssi)), a_rssi, a_rssi ** 2]))
+        scans = {"total": placed["n_total"], "used": int(ok.sum()),
+                 **{f"skipped_{k}": v for k, v in placed["skipped"].items() if k != "moving"}}
+        return cls(cell_size_m, cell_key, np.rint(cell_vals[:, 0]).astype(np.int64),
+                   cell_vals[:, 1:].copy(), entry_key, np.rint(evals[:, 0]).astype(np.int64),
+                   evals[:, 1].copy(), evals[:, 2].copy(), scans)
+
+    @classmethod
+    def empty(cls, cell_size_m: float = DEFAULT_CELL_SIZE_M) -> "WalkStats":
+        return cls(cell_size_m, np.zeros((0, 3), np.int64), np.zeros(0, np.int64),
+                   np.zeros((0, 2)), np.zeros((0, 4), np.int64), np.zeros(0, np.int64),
+                   np.zeros(0), np.zeros(0), {})
+
+    @classmethod
+    def total(cls, parts: list["WalkStats"]) -> "WalkStats":
+        """The sum of many statistics at once (one sort instead of one per addition)."""
+        if not parts:
+            raise RadioMapInputError("no radio-map statistics to add")
+        acc = cls(parts[0].cell_size_m, np.concatenate([p.cell_key for p in parts]),
+                  np.concatenate([p.cell_scans for p in parts]),
+                  np.concatenate([p.cell_sum_xy_m for p in parts]),
+                  np.concatenate([p.entry_key for p in parts]),
+                  np.concatenate([p.entry_count for p in parts]),
+                  np.concatenate([p.entry_sum_dbm for p in parts]),
+                  np.concatenate([p.entry_sum2_dbm2 for p in parts]), {})
+        if any(p.cell_size_m != acc.cell_size_m for p in parts):
+            raise RadioMapInputError("cannot add radio-map statistics of different cell sizes")
+        out = acc._combine(cls.empty(acc.cell_size_m), +1)
+        out.scans = {k: sum(p.scans.get(k, 0) for p in parts)
+                     for k in set().union(*(p.scans for p in parts))}
+        return out
+
+    def _combine(self, other: "WalkStats", sign: int) -> "WalkStats":
+        if other.cell_size_m != self.cell_size_m:
+            raise RadioMapInputError(f"cannot combine radio-map statistics of cell "
+                                     f"{self.cell_size_m:g} m and {other.cell_size_m:g} m")
+        ck, cv = _group_sum(np.concatenate([self.cell_key, other.cell_key]), np.concatenate([
+            np.column_stack([self.cell_scans, self.cell_sum_xy_m]),
+            sign * np.column_stack([other.cell_scans, other.cell_sum_xy_m])]))
+        ek, ev = _group_sum(np.concatenate([self.entry_key, other.entry_key]), np.concatenate([
+            np.column_stack([self.entry_count, self.entry_sum_dbm, self.entry_sum2_dbm2]),
+            sign * np.column_stack([other.entry_count, other.entry_sum_dbm,
+                                    other.entry_sum2_dbm2])]))
+        c_n, e_n = np.rint(cv[:, 0]).astype(np.int64), np.rint(ev[:, 0]).astype(np.int64)
+        if (c_n < 0).any() or (e_n < 0).any():
+            raise RadioMapInputError("radio-map statistics: subtracted more than the total holds")
+        c_keep, e_keep = c_n > 0, e_n > 0
+        scans = {k: self.scans.get(k, 0) + sign * other.scans.get(k, 0)
+                 for k in set(self.scans) | set(other.scans)}
+        return WalkStats(self.cell_size_m, ck[c_keep], c_n[c_keep], cv[c_keep, 1:], ek[e_keep],
+                         e_n[e_keep], ev[e_keep, 1], ev[e_keep, 2], scans)
+
+    def __add__(self, other: "WalkStats") -> "WalkStats":
+        return self._combine(other, +1)
+
+    def __sub__(self, other: "WalkStats") -> "WalkStats":
+        """``self`` without ``other``, which must be part of it (e.g. total − one walk)."""
+        return self._combine(other, -1)
+
+    def to_site(self, min_count: int = DEFAULT_MIN_COUNT, name: str = "",
+                map_rotation_deg: float = 0.0, floor_height_m: float = DEFAULT_FLOOR_HEIGHT_M,
+                floor_heights_m=None, lowest_floor: int | None = None,
+                origin_deg: tuple[float, float] | None = None,
+                source: str = "") -> tuple[site_t, dict]:
+        """The walk-mode site of these statistics, as :func:`build_site` would build it from the
+        same recordings; returns (site, summary)."""
+        if min_count < 1:
+            raise RadioMapInputError(f"min count {min_count} must be >= 1")
+        if len(self.cell_key) == 0:
+            raise RadioMapInputError("no scan could be placed on the truth (empty statistics)")
+        n = self.cell_scans
+        rp_x, rp_y = self.cell_sum_xy_m[:, 0] / n, self.cell_sum_xy_m[:, 1] / n
+        rp_floor = self.cell_key[:, 0].copy()
+        # entry -> RP index: entry keys are sorted by (floor, iy, ix, bssid), cells by (f, iy, ix)
+        cell_code = _row_codes(self.cell_key)
+        rp = np.searchsorted(cell_code, _row_codes(self.entry_key[:, :3]))
+        keys = np.column_stack([self.entry_key[:, 3], rp])
+        order = np.lexsort((keys[:, 1], keys[:, 0]))
+        keys = keys[order]
+        count = self.entry_count[order]
+        mean = self.entry_sum_dbm[order] / count
+        var = np.maximum(self.entry_sum2_dbm2[order] / count - mean ** 2, 0.0)
+        site, kept, has_entry = _assemble_site(
+            keys, count, mean, np.sqrt(var), rp_x, rp_y, rp_floor, n.copy(), min_count=min_count,
+            source=source or f"stridefix {TOOL_VERSION}: walk mode from sufficient statistics; "
+                             f"cell {self.cell_size_m:g} m; min count {min_count}",
+            name=name, map_rotation_deg=map_rotation_deg, cell_size_m=self.cell_size_m,
+            floor_height_m=floor_height_m, floor_heights_m=floor_heights_m,
+            lowest_floor=lowest_floor, origin_deg=origin_deg)
+        summary = site_summary(site)
+        summary.update(mode="walk", mode_reason="sufficient statistics", scans=dict(self.scans),
+                       entries_below_min_count=int(np.sum(~kept)), min_count=min_count,
+                       rps_dropped_no_entry=int(np.sum(~has_entry)))
+        return site, summary
+
+
+def _row_codes(rows: np.ndarray) -> np.ndarray:
+    """A sortable code per (floor, iy, ix) row, order-preserving (lexicographic)."""
+    r = rows.astype(np.int64)
+    return ((r[:, 0] + (1 << 15)) << 42) + ((r[:, 1] + (1 << 20)) << 21) + (r[:, 2] + (1 << 20))
 
 
 # --- summaries and plots -------------------------------------------------------------------------

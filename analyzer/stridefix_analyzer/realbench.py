@@ -1,5 +1,8 @@
 """``stridefix realbench``: benchmarks of the real firmware on real public data.
 
+``fusion`` (the default: ``stridefix realbench --format msindoor|gsd DIR... --out results.json``):
+every fusion scheme, leave one walk out; see :mod:`stridefix_analyzer.realbench_fusion`.
+
 ``pdr-distance``: how well step detection + Weinberg step length measure distance walked, on the
 Microsoft Indoor Location Competition 2.0 traces of one floor.
 
@@ -91,15 +94,29 @@ def find_traces(floor_dir) -> tuple[str, list[Path]]:
     return f"{floor.parent.name}/{floor.name}", traces
 
 
-def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport: bool) -> dict:
-    """Import ``trace`` into ``cache_dir/<stem>.lcmlog`` unless an up-to-date copy is there."""
-    from stridefix_sim.importers import msindoor
+def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport: bool,
+                   importer=None, import_kwargs: dict | None = None) -> dict:
+    """Import ``trace`` into ``cache_dir/<stem>.lcmlog`` unless an up-to-date copy is there.
+
+    ``importer``: the importer module (default ``stridefix_sim.importers.msindoor``); it provides
+    ``import_trace(path, out_path[, max_wifi_age_s=], **import_kwargs)`` and ``IMPORTER_VERSION``.
+    ``import_kwargs`` (JSON-able values) are part of the cache key.
+    """
+    import inspect
+
+    if importer is None:
+        from stridefix_sim.importers import msindoor as importer
 
     log = cache_dir / f"{trace.stem}.lcmlog"
     meta = cache_dir / f"{trace.stem}.import.json"
     st = trace.stat()
     key = {"trace": str(trace.resolve()), "size": st.st_size, "mtime_ns": st.st_mtime_ns,
-           "importer_version": msindoor.IMPORTER_VERSION, "max_wifi_age_s": max_wifi_age_s}
+           "importer_version": getattr(importer, "IMPORTER_VERSION", None),
+           "max_wifi_age_s": max_wifi_age_s}
+    if importer.__name__.rsplit(".", 1)[-1] != "msindoor":
+        key["importer"] = importer.__name__
+    if import_kwargs:
+        key["import_kwargs"] = json.loads(json.dumps(import_kwargs))
     if not reimport and log.is_file() and meta.is_file():
         try:
             cached = json.loads(meta.read_text(encoding="utf-8"))
@@ -107,12 +124,17 @@ def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport
                 return cached
         except (OSError, ValueError):
             pass
+    kwargs = dict(import_kwargs or {})
+    if "max_wifi_age_s" in inspect.signature(importer.import_trace).parameters:
+        kwargs["max_wifi_age_s"] = max_wifi_age_s
     with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", msindoor.MalformedLineWarning)
-        summary = msindoor.import_trace(trace, log, max_wifi_age_s=max_wifi_age_s)
+        warnings.simplefilter("always", getattr(importer, "MalformedLineWarning", UserWarning))
+        summary = importer.import_trace(trace, log, **kwargs)
+    summary = dict(summary)
+    summary.setdefault("out", str(log))
     summary["warnings"] = [str(w.message) for w in caught]
     summary["cache_key"] = key
-    meta.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
+    meta.write_text(json.dumps(_json_ready(summary), indent=1) + "\n", encoding="utf-8")
     return summary
 
 
@@ -575,12 +597,29 @@ def plot_pdr_distance(seg: Table, title: str) -> bytes:
 
 # --- CLI -------------------------------------------------------------------------------------------
 
+BENCHES = ("fusion", "pdr-distance")
+
+
+def with_default_bench(argv: list[str]) -> list[str]:
+    """``stridefix realbench --format ...`` means ``stridefix realbench fusion --format ...``:
+    insert the default benchmark when the word after ``realbench`` names none (and is no help)."""
+    argv = list(argv)
+    if argv and argv[0] == "realbench" and (len(argv) == 1 or argv[1] not in
+                                            (*BENCHES, "-h", "--help")):
+        argv.insert(1, "fusion")
+    return argv
+
+
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Declare ``stridefix realbench`` and its benchmarks."""
+    """Declare ``stridefix realbench`` and its benchmarks (``fusion`` is the default)."""
     p = subparsers.add_parser(
-        "realbench", help="benchmarks of stridefixd on real public data (msindoor traces)",
-        description="Benchmarks of the real firmware on real data sets.")
+        "realbench", help="benchmarks of stridefixd on real public data (msindoor, gsd)",
+        description="Benchmarks of the real firmware on real data sets. Without a benchmark name "
+                    "the fusion benchmark runs: stridefix realbench --format msindoor DIR [DIR...] "
+                    "--out results.json")
     sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+    from .realbench_fusion import add_fusion_parser
+    add_fusion_parser(sub)
     d = sub.add_parser(
         "pdr-distance", help="segment distance from steps + Weinberg length, K leave-one-walk-out",
         description="For every trace of a floor: import, replay through stridefixd, and compare "
