@@ -311,8 +311,9 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     const double deg = PI / 180.0;
     if (!att->mag_ref_set) {
         att->mag_ref_set = true;
-        att->mag_ref_field_ut = p->attitude_mag_field_ut;
-        att->mag_ref_dip_rad = p->attitude_mag_dip_deg * deg;
+        att->mag_ref_field_ut = att->mag_anchor_field_ut = p->attitude_mag_field_ut;
+        att->mag_ref_dip_rad = att->mag_anchor_dip_rad = p->attitude_mag_dip_deg * deg;
+        att->mag_acquire_start_t_us = t_us;
     }
     const double dt_s = att->mag_seen ? clamp((double)(t_us - att->last_mag_t_us) * 1e-6, 0.0, MAG_DT_MAX_S) : 0.0;
     att->mag_seen = true;
@@ -335,6 +336,19 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     const double dip = asin(clamp(-m_nav[2] / f, -1.0, 1.0));
     audit->dip_rad = dip;
     audit->yaw_innov_rad = wrap_pi(0.5 * PI - atan2(m_nav[1], m_nav[0]));
+
+    /* control: acquisition. The expected field and dip depend on the site (48 µT / 60° in central
+     * Europe, 45 µT / 45° in southern China, less indoors near steel): during the first
+     * attitude_mag_acquire_s the references follow the data (exponential average, 2 s), starting at
+     * the first sample; afterwards they are the anchor of the bounded learning below. */
+    const double since_start_s = (double)(t_us - att->mag_acquire_start_t_us) * 1e-6;
+    if (p->attitude_mag_acquire_s > 0.0 && since_start_s <= p->attitude_mag_acquire_s) {
+        const double k = att->mag_accepted + att->mag_rejected == 0 && dt_s == 0.0 ? 1.0 : dt_s / (2.0 + dt_s);
+        att->mag_ref_field_ut += k * (f - att->mag_ref_field_ut);
+        att->mag_ref_dip_rad += k * (dip - att->mag_ref_dip_rad);
+        att->mag_anchor_field_ut = att->mag_ref_field_ut;
+        att->mag_anchor_dip_rad = att->mag_ref_dip_rad;
+    }
 
     /* control: disturbance tests, then the settle hysteresis */
     const bool field_ok = fabs(f - att->mag_ref_field_ut) <= p->attitude_mag_field_tol_ut;
@@ -387,8 +401,8 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     /* control: learn the undisturbed references, bounded to configured ± tolerance */
     if (p->attitude_mag_learn_tau_s > 0.0) {
         const double k = dt_s / (p->attitude_mag_learn_tau_s + dt_s);
-        const double f0 = p->attitude_mag_field_ut, ft = p->attitude_mag_field_tol_ut;
-        const double d0 = p->attitude_mag_dip_deg * deg, dtol = p->attitude_mag_dip_tol_deg * deg;
+        const double f0 = att->mag_anchor_field_ut, ft = p->attitude_mag_field_tol_ut;
+        const double d0 = att->mag_anchor_dip_rad, dtol = p->attitude_mag_dip_tol_deg * deg;
         att->mag_ref_field_ut = clamp(att->mag_ref_field_ut + k * (f - att->mag_ref_field_ut), f0 - ft, f0 + ft);
         att->mag_ref_dip_rad = clamp(att->mag_ref_dip_rad + k * (dip - att->mag_ref_dip_rad), d0 - dtol, d0 + dtol);
     }

@@ -119,6 +119,11 @@ typedef struct {
     bool mag_ref_set;
     double mag_ref_field_ut;
     double mag_ref_dip_rad;
+    /* acquisition of the site's field (attitude_mag_acquire_s): the references follow the data,
+     * then the bounded learning stays within ± tolerance of what was acquired */
+    int64_t mag_acquire_start_t_us;
+    double mag_anchor_field_ut;
+    double mag_anchor_dip_rad;
 
     /* health: counters never decrease */
     uint32_t mag_accepted;

@@ -45,6 +45,7 @@
     X(attitude, mag_field_tol_ut,    double,  8.0,     0.1,     1e6,     "uT",    "accepted | |m| - field | (huge = rejection off)") \
     X(attitude, mag_dip_tol_deg,     double,  8.0,     0.1,     360.0,   "deg",   "accepted | dip - expected dip | (>= 180 = off)") \
     X(attitude, mag_settle_s,        double,  1.0,     0.0,     60.0,    "s",     "field consistent this long before use after a rejection") \
+    X(attitude, mag_acquire_s,       double,  10.0,    0.0,     600.0,   "s",     "first seconds of magnetometer data: field/dip references follow the data (the site's field, unknown a priori); 0 = use mag_field_ut/mag_dip_deg") \
     X(attitude, mag_learn_tau_s,     double,  60.0,    0.0,     3600.0,  "s",     "learn field/dip from accepted samples (0 = off); bounded to +-tol") \
     X(heading,  map_rotation_deg,    double,  0.0,     -360.0,  360.0,   "deg",   "map heading = ENU heading - rotation (set by the site file)") \
     X(heading,  mount_offset_deg,    double,  0.0,     -180.0,  180.0,   "deg",   "walking direction minus device yaw, until estimated") \
