@@ -3,12 +3,13 @@
 #  1. Debian packages (apt-get update first, only when something is missing).
 #  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
 #     re-installed only when requirements.txt or pyproject.toml changed.
-#  3. A .pth file so the venv imports the LCM Python bindings that the build generates.
+#  3. A .pth file so the venv imports what the build generates: the LCM Python bindings and the native
+#     solver module (stridefix_native, with its scipy reference beside it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
 BUILD=${BUILD:-build}
-DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev cmake g++ gcc make pkg-config)
+DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev python3-dev cmake g++ gcc make pkg-config)
 
 missing=()
 for p in "${DEBS[@]}"; do
@@ -35,4 +36,4 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "$want" > "$stamp"
 fi
 site=$("$VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-echo "$(pwd)/$BUILD/lcmtypes/python" > "$site/stridefix_lcmtypes.pth"
+printf '%s\n' "$(pwd)/$BUILD/lcmtypes/python" "$(pwd)/$BUILD/analyzer/native" > "$site/stridefix_lcmtypes.pth"
