@@ -46,6 +46,7 @@ bench: build
 	$(PY) -m stridefix_analyzer.cli bench sil-pdr --stridefixd $(STRIDEFIXD) --out out/bench
 	$(PY) -m stridefix_analyzer.cli bench aadr2015 --stridefixd $(STRIDEFIXD) --out out/bench
 	$(PY) -m stridefix_analyzer.cli bench office-wifi --stridefixd $(STRIDEFIXD) --out out/bench
+	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json
 	@for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
 		if [ -d "$$floor" ]; then \
 			$(PY) -m stridefix_analyzer.cli realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
