@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .analyze import _json_ready
 from .logread import LogReadError, LogTruncatedWarning, Table, read_logs
 
 REPO = Path(__file__).resolve().parents[2]
@@ -495,18 +496,6 @@ def _median(x) -> float:
     return float(np.median(x)) if len(x) else math.nan
 
 
-def _json_ready(value):
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_ready(value.tolist())
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def format_table(doc: dict) -> str:
