@@ -58,3 +58,51 @@ def output_paths(inputs: list, args, prog: str) -> list[Path] | None:
             return None
         return [Path(args.output)]
     return [Path(args.out) / (Path(i).stem + ".lcmlog") for i in inputs]
+
+
+def run_imports(args, prog: str, inputs: list, do_import, read_error: type, format_summary,
+                json_keys: tuple, noun: str) -> int:
+    """The import loop every format shares: one input at a time, malformed-line warnings on stderr,
+    a progress line and a JSON summary line per input, ``--json`` with all summaries.
+
+    ``do_import(input, out) -> summary dict``; ``read_error`` is the format's missing/unreadable-input
+    exception. Returns 0, or 2 when an input was missing/unreadable or its output failed.
+    """
+    import json
+    import time
+    import warnings
+
+    from .msindoor import MalformedLineWarning
+
+    outs = output_paths(inputs, args, prog)
+    if outs is None:
+        return 2
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"{prog}: warning: {message}", file=sys.stderr)
+
+    status, summaries = 0, []
+    for i, (item, out) in enumerate(zip(inputs, outs), 1):
+        t0 = time.perf_counter()
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("always", MalformedLineWarning)
+                warnings.showwarning = show
+                s = do_import(item, out)
+        except read_error as exc:
+            print(f"{prog}: error: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        except OSError as exc:
+            print(f"{prog}: error: cannot write {out}: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        summaries.append(s)
+        print(f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
+              file=sys.stderr)
+        print(json.dumps({k: s[k] for k in json_keys}))
+    if args.json:
+        Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
+    where = args.output if args.output else args.out
+    print(f"{prog}: {len(summaries)}/{len(inputs)} {noun}(s) imported into {where}", file=sys.stderr)
+    return status

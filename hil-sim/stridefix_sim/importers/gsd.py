@@ -635,46 +635,11 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Import every logfile; exit 0, or 2 when one was missing/unreadable or output failed."""
-    import json
-    import sys
-    import time
+    from .cli import run_imports
 
-    from .cli import output_paths
+    return run_imports(args, "stridefix import gsd", args.logs,
+                       lambda log, out: import_log(log, out, args.origin, args.max_wifi_age_s),
+                       LogReadError, format_summary,
+                       ("trace", "out", "messages", "skipped_lines", "duration_s", "waypoints",
+                        "building_id", "floors", "origin"), "logfile")
 
-    prog = "stridefix import gsd"
-    outs = output_paths(args.logs, args, prog)
-    if outs is None:
-        return 2
-    status, summaries = 0, []
-    n = len(args.logs)
-    for i, (log, out) in enumerate(zip(args.logs, outs), 1):
-        t0 = time.perf_counter()
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("always", MalformedLineWarning)
-                warnings.showwarning = _show_on_stderr
-                s = import_log(log, out, args.origin, args.max_wifi_age_s)
-        except LogReadError as exc:
-            print(f"{prog}: error: {exc}", file=sys.stderr)
-            status = 2
-            continue
-        except OSError as exc:
-            print(f"{prog}: error: cannot write {out}: {exc}", file=sys.stderr)
-            status = 2
-            continue
-        summaries.append(s)
-        print(f"[{i}/{n}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
-              file=sys.stderr)
-        print(json.dumps({k: s[k] for k in ("trace", "out", "messages", "skipped_lines",
-                                            "duration_s", "waypoints", "building_id", "floors",
-                                            "origin")}))
-    if args.json:
-        Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
-    where = args.output if args.output else args.out
-    print(f"{prog}: {len(summaries)}/{n} logfile(s) imported into {where}", file=sys.stderr)
-    return status
-
-
-def _show_on_stderr(message, category, filename, lineno, file=None, line=None):
-    import sys
-    print(f"stridefix import gsd: warning: {message}", file=sys.stderr)

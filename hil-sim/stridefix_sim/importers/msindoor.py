@@ -465,45 +465,10 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Import every trace; exit 0, or 2 when a trace was missing/unreadable or output failed."""
-    import json
-    import sys
-    import time
+    from .cli import run_imports
 
-    from .cli import output_paths
+    return run_imports(args, "stridefix import msindoor", args.traces,
+                       lambda trace, out: import_trace(trace, out, args.max_wifi_age_s, args.floor),
+                       TraceReadError, format_summary,
+                       ("trace", "out", "messages", "skipped_lines", "duration_s", "waypoints"), "trace")
 
-    outs = output_paths(args.traces, args, "stridefix import msindoor")
-    if outs is None:
-        return 2
-    status, summaries = 0, []
-    n = len(args.traces)
-    for i, (trace, out) in enumerate(zip(args.traces, outs), 1):
-        t0 = time.perf_counter()
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("always", MalformedLineWarning)
-                warnings.showwarning = _show_on_stderr
-                s = import_trace(trace, out, args.max_wifi_age_s, args.floor)
-        except TraceReadError as exc:
-            print(f"stridefix import msindoor: error: {exc}", file=sys.stderr)
-            status = 2
-            continue
-        except OSError as exc:
-            print(f"stridefix import msindoor: error: cannot write {out}: {exc}", file=sys.stderr)
-            status = 2
-            continue
-        summaries.append(s)
-        print(f"[{i}/{n}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
-              file=sys.stderr)
-        print(json.dumps({k: s[k] for k in ("trace", "out", "messages", "skipped_lines",
-                                            "duration_s", "waypoints")}))
-    if args.json:
-        Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
-    where = args.output if args.output else args.out
-    print(f"stridefix import msindoor: {len(summaries)}/{n} trace(s) imported into {where}",
-          file=sys.stderr)
-    return status
-
-
-def _show_on_stderr(message, category, filename, lineno, file=None, line=None):
-    import sys
-    print(f"stridefix import msindoor: warning: {message}", file=sys.stderr)
