@@ -17,6 +17,21 @@ static double log_normal(const double x, const double mu, const double sigma)
     return -0.5 * z * z - log(sigma) - HALF_LOG_2PI;
 }
 
+/* The level WkNN compares with a scan reading [dBm]: map_level 1 averages over every scan of the RP,
+ * the misses at fill (the RP's fingerprint in the same terms as the query's missing APs); map_level 0
+ * is the mean of the scans that heard the AP, as stored (one lucky detection looks as strong as a
+ * steady one). */
+static double entry_level(const sf_radiomap_t *const map, const int32_t entry, const sf_params_t *const p)
+{
+    const double mu = (double)map->entry_mean_dbm[entry];
+    if (p->fingerprint_map_level == 0) {
+        return mu;
+    }
+    const double n = (double)map->rp_scans[map->entry_rp[entry]];
+    const double c = (double)map->entry_count[entry];
+    return (c * mu + (n - c) * p->fingerprint_fill_dbm) / n;
+}
+
 /* Detection probability of a map entry, clamped to [p, 1 - p]. */
 static double detection(const sf_radiomap_t *const map, const int32_t entry, const double p_min)
 {
@@ -53,8 +68,11 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     }
     for (int32_t i = 0; i < map->n_entries; i++) {
         const int32_t r = map->entry_rp[i];
-        const double v = (double)map->entry_mean_dbm[i] - fill;
-        ws->rp_fill_sq_db2[r] += v * v;
+        const double level = entry_level(map, i, p);
+        if (level >= p->fingerprint_min_rssi_dbm) { /* censored like the scan: see the header */
+            const double v = level - fill;
+            ws->rp_fill_sq_db2[r] += v * v;
+        }
         ws->rp_miss_loglik[r] += log(1.0 - detection(map, i, p_min)) - log_not_p;
     }
     ws->map_n_ap = map->n_ap;
@@ -62,6 +80,8 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     ws->map_n_entries = map->n_entries;
     ws->fill_dbm = fill;
     ws->nb_p_min = p_min;
+    ws->min_rssi_dbm = p->fingerprint_min_rssi_dbm;
+    ws->map_level = p->fingerprint_map_level;
     ws->prepared = true;
     return SF_OK;
 }
@@ -145,7 +165,7 @@ static int reading_cmp(const void *const a, const void *const b)
 /* Builds fp->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
 static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map)
 {
-    reading_t readings[SF_FINGERPRINT_QUERY_APS]; /* 4 kB of stack */
+    reading_t readings[SF_FINGERPRINT_QUERY_APS]; /* 16 kB of stack */
     int32_t n = 0;
     int32_t n_scans = 0;
     int32_t want = p->fingerprint_average_scans;
@@ -241,7 +261,8 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     }
     if (!ws->prepared || ws->map_n_ap != map->n_ap || ws->map_n_rp != map->n_rp ||
         ws->map_n_entries != map->n_entries || ws->fill_dbm != p->fingerprint_fill_dbm ||
-        ws->nb_p_min != p->fingerprint_nb_p_min) {
+        ws->nb_p_min != p->fingerprint_nb_p_min || ws->min_rssi_dbm != p->fingerprint_min_rssi_dbm ||
+        ws->map_level != p->fingerprint_map_level) {
         return SF_EINVAL;
     }
     fp->scans++;
@@ -285,16 +306,18 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
             if (!any_floor && map->rp_floor[r] != floor_hint) {
                 continue;
             }
-            const double mu = (double)map->entry_mean_dbm[i];
             double term;
             if (bayes) {
+                const double mu = (double)map->entry_mean_dbm[i];
                 const double q = detection(map, i, p_min);
                 const double sd = (double)map->entry_std_db[i];
                 term = log(q) + log_normal(s, mu, sd > sigma_floor ? sd : sigma_floor) - log(1.0 - q) - c_a;
-            } else if (common_only) {
-                term = (s - mu) * (s - mu);
             } else {
-                term = -2.0 * u * (mu - fill);
+                const double mu = entry_level(map, i, p);
+                if (mu < p->fingerprint_min_rssi_dbm) {
+                    continue; /* censored: the RP "does not hear" it, as a scan could not report it */
+                }
+                term = common_only ? (s - mu) * (s - mu) : -2.0 * u * (mu - fill);
             }
             touch(ws, &n_touched, r, term);
         }

@@ -41,9 +41,15 @@
  * is exact, not an approximation, and again only Q∩R is visited. Posterior P(r|s) = softmax of L over
  * the candidates (uniform prior); the k most probable win, weighted by their posterior (paper: k = 3).
  *
- * Map entries weaker than fingerprint_min_rssi_dbm are used as they are, but a scan never reports such
- * levels, so the map builder should drop them (as Ramadhan stores < −90 dBm as missing) — otherwise an
- * RP pays (μ − f)² (WkNN) or log(1 − q') (naive Bayes) for an AP the scan could not have kept.
+ * WkNN map levels. μ_ra above is entry_level: with fingerprint_map_level 1 (default) the mean over all
+ * rp_scans of the RP with the misses at f, (count·mean + (rp_scans − count)·f) / rp_scans, i.e. the RP's
+ * fingerprint in the same terms as the query; with 0 the stored mean of the scans that heard the AP.
+ * Censoring: a scan never reports a level below fingerprint_min_rssi_dbm, so a map level below it is
+ * treated as not heard (an entry at f) in both WkNN modes, in F_r as in the visited entries — otherwise
+ * an RP pays (μ − f)² for an AP the scan could not have kept. On the real msindoor site1/F2 walks (1,511
+ * scans, leave one walk out, 2 m cells) censoring and map_level 1 together took the per-scan WkNN error
+ * from 8.2 to 5.8 m mean (the query's former 64-reading cap did the same harm as the missing censoring:
+ * half of the scans there hear more than 64 APs above −90 dBm). Naive Bayes uses the stored entries.
  *
  * Fix. Floor = the floor with the largest summed weight among the k winners (tie: the best winner's
  * floor); x, y = the weighted mean of the winners on that floor; n_ap_used = APs used. Accuracy (1σ, m):
@@ -52,14 +58,14 @@
  * candidates on its floor with their posterior (naive Bayes: the posterior's own spread, so a split
  * posterior reads as poor accuracy even when the k best agree). It feeds the fusion's α and gate.
  *
- * Memory. sf_fingerprint_t ≈ 6.6 kB (ring of 4 × 64 readings, the last query of up to 256 APs, audit);
- * 4 kB of stack while the query is built.
+ * Memory. sf_fingerprint_t ≈ 24 kB (ring of 4 × 255 readings, the last query of up to 1020 APs, audit);
+ * 16 kB of stack while the query is built.
  * Workspace: caller-owned arrays of n_rp each, SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
  * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
  * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
- * fingerprint_fill_dbm or fingerprint_nb_p_min change). sf_fingerprint_match: O(n_scan·64) to store the
- * scan, O(m log m) (m ≤ 256) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
+ * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm or _map_level change). sf_fingerprint_match: O(n_scan·255) to store the
+ * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
  * (E_Q = total entries of the used APs; one log and one division per entry for naive Bayes), and
  * O(T·k) to select among the T touched RPs — independent of the map size beyond E_Q and T ≤ n_rp.
  * No heap, no I/O, no clock; deterministic (fixed summation order: APs by BSSID, entries by RP).
@@ -80,7 +86,7 @@
 #include "sf_types.h"
 
 #define SF_FINGERPRINT_RING_SCANS 4  /* scans kept for averaging: fingerprint_average_scans ≤ this */
-#define SF_FINGERPRINT_SCAN_APS 64   /* readings kept per scan (the strongest) */
+#define SF_FINGERPRINT_SCAN_APS 255  /* readings kept per scan (the strongest); = the CAN scan's limit */
 #define SF_FINGERPRINT_QUERY_APS (SF_FINGERPRINT_RING_SCANS * SF_FINGERPRINT_SCAN_APS)
 #define SF_FINGERPRINT_K_MAX 16      /* fingerprint_k ≤ this */
 #define SF_FINGERPRINT_D_MIN_DB 0.01 /* WkNN weight guard: w = 1/max(d, this) */
@@ -103,7 +109,8 @@ typedef struct {
     /* set by sf_fingerprint_prepare */
     bool prepared;
     int32_t map_n_ap, map_n_rp, map_n_entries; /* the map it was prepared for */
-    double fill_dbm, nb_p_min;                  /* the parameters it was prepared with */
+    double fill_dbm, nb_p_min, min_rssi_dbm;    /* the parameters it was prepared with */
+    int32_t map_level;
 } sf_fingerprint_workspace_t;
 
 /* The record of the last match (published with the FIX message). */

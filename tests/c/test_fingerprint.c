@@ -74,6 +74,7 @@ static sf_params_t params(const int32_t method, const int32_t missing_mode)
     sf_params_default(&p);
     p.fingerprint_method = method;
     p.fingerprint_missing_mode = missing_mode;
+    p.fingerprint_map_level = 0; /* the hand computations below use the stored means; level 1: its own test */
     return p;
 }
 
@@ -305,7 +306,8 @@ static void test_min_rssi_and_too_few(void **state)
     assert_int_equal(fp.audit.n_entries_visited, 0);
     assert_int_equal(fp.rejected_too_few_aps, 1);
     assert_near(fix.x_m, 123.0, 0.0); /* untouched */
-    p.fingerprint_min_rssi_dbm = -95.0;
+    p.fingerprint_min_rssi_dbm = -95.0; /* the map's censoring changes too: prepare again */
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
     assert_int_equal(match3(&fp, &p, &map, &m, 2, 3, k_bssid, r, &fix), SF_OK);
     assert_int_equal(fp.audit.n_used, 3);
     /* An empty scan, and a scan of unknown APs only. */
@@ -417,7 +419,7 @@ static void test_averaging(void **state)
     assert_near(fp.query_rssi_dbm[0], -42.5, 0.0);
 }
 
-/* A repeated BSSID keeps its strongest reading; more than 64 readings keep the 64 strongest. */
+/* A repeated BSSID keeps its strongest reading; more than SF_FINGERPRINT_SCAN_APS readings keep the strongest. */
 static void test_duplicates_and_truncation(void **state)
 {
     (void)state;
@@ -428,19 +430,20 @@ static void test_duplicates_and_truncation(void **state)
     assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
     sf_fingerprint_t fp;
     sf_fingerprint_init(&fp);
-    int64_t b[80];
-    float r[80];
-    for (int i = 0; i < 77; i++) { /* 77 unknown APs at −80 */
+    enum { n_unknown = SF_FINGERPRINT_SCAN_APS + 13, n_all = n_unknown + 3 };
+    static int64_t b[n_all];
+    static float r[n_all];
+    for (int i = 0; i < n_unknown; i++) { /* unknown APs at −80: 16 of them must go */
         b[i] = 0x1000 + i;
         r[i] = -80.0f;
     }
-    b[77] = 0x100, r[77] = -45.0f;
-    b[78] = 0x200, r[78] = -62.0f;
-    b[79] = 0x300, r[79] = -60.0f;
+    b[n_unknown] = 0x100, r[n_unknown] = -45.0f;
+    b[n_unknown + 1] = 0x200, r[n_unknown + 1] = -62.0f;
+    b[n_unknown + 2] = 0x300, r[n_unknown + 2] = -60.0f;
     sf_fix_t fix = {0};
-    assert_int_equal(match3(&fp, &p, &map, &m, 1, 80, b, r, &fix), SF_OK);
+    assert_int_equal(match3(&fp, &p, &map, &m, 1, n_all, b, r, &fix), SF_OK);
     assert_int_equal(fp.readings_truncated, 16);
-    assert_int_equal(fp.audit.n_heard, 64);
+    assert_int_equal(fp.audit.n_heard, SF_FINGERPRINT_SCAN_APS);
     assert_int_equal(fp.audit.n_used, 3);
     assert_near(fix.x_m, 0.6294865025, 1e-9);
     const int64_t bd[4] = {0x100, 0x200, 0x100, 0x300};
@@ -448,6 +451,51 @@ static void test_duplicates_and_truncation(void **state)
     assert_int_equal(match3(&fp, &p, &map, &m, 2, 4, bd, rd, &fix), SF_OK);
     assert_near(fp.query_rssi_dbm[0], -45.0, 0.0);
     assert_near(fix.y_m, 1.5248295278, 1e-9);
+}
+
+/* map_level 1: the level of an entry is the mean over all 10 scans of its RP, misses at −100:
+ *   r0: a0 −40, a1 (8·−60 + 2·−100)/10 = −68, a2 (5·−70 + 5·−100)/10 = −85
+ *   r1: a0 −60, a1 −40, a2 (2·−80 + 8·−100)/10 = −96 < −90 (min_rssi): censored, i.e. −100
+ *   r2: a0 −50, a1 (6·−70 + 4·−100)/10 = −82, a2 −50          r3: a0 −48, a1 −52, a2 not heard
+ * Scan −45, −62, −60: d² r0 = 5² + 6² + 25² = 686, r1 = 15² + 22² + 40² = 2309, r2 = 5² + 20² + 10² = 525,
+ * r3 = 3² + 10² + 40² = 1709 → winners r2, r0, r3. F_r1 = 40² + 60² = 5200 (the censored a2 left out).
+ * Censoring with the stored means (map_level 0) and min_rssi −75: r1's a2 (−80) is censored, so
+ * d²(r1) = 15² + 22² + 40² = 2309 instead of 1109, and the winners become r0, r2, r3. */
+static void test_map_level_and_censoring(void **state)
+{
+    (void)state;
+    const sf_radiomap_t map = tiny_map(k_floor0);
+    sf_params_t p = params(0, 0);
+    p.fingerprint_map_level = 1;
+    ws_mem_t m;
+    ws_setup(&m, 4);
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_near(m.fill[1], 5200.0, TOL);
+    sf_fingerprint_t fp;
+    sf_fingerprint_init(&fp);
+    sf_fix_t fix = {0};
+    assert_int_equal(match3(&fp, &p, &map, &m, 1, 3, k_bssid, k_scan_rssi, &fix), SF_OK);
+    assert_int_equal(fp.audit.winner_rp[0], 2);
+    assert_int_equal(fp.audit.winner_rp[1], 0);
+    assert_int_equal(fp.audit.winner_rp[2], 3);
+    assert_near(fp.audit.winner_score[0], sqrt(525.0), TOL);
+    assert_near(fp.audit.winner_score[1], sqrt(686.0), TOL);
+    assert_near(fp.audit.winner_score[2], sqrt(1709.0), TOL);
+
+    /* Changing a parameter the workspace was prepared with is misuse until prepared again. */
+    p.fingerprint_map_level = 0;
+    p.fingerprint_min_rssi_dbm = -75.0;
+    assert_int_equal(match3(&fp, &p, &map, &m, 2, 3, k_bssid, k_scan_rssi, &fix), SF_EINVAL);
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_near(m.fill[1], 5200.0, TOL);
+    sf_fingerprint_init(&fp);
+    assert_int_equal(match3(&fp, &p, &map, &m, 3, 3, k_bssid, k_scan_rssi, &fix), SF_OK);
+    assert_int_equal(fp.audit.winner_rp[0], 0);
+    assert_int_equal(fp.audit.winner_rp[1], 2);
+    assert_int_equal(fp.audit.winner_rp[2], 3);
+    assert_near(fp.audit.winner_score[1], sqrt(189.0), TOL);
+    assert_near(fp.audit.winner_score[2], sqrt(1709.0), TOL);
+    assert_scratch_clean(&m, 4);
 }
 
 /* ---- floors ------------------------------------------------------------------------------------------
@@ -773,6 +821,7 @@ int main(void)
         cmocka_unit_test(test_misuse),
         cmocka_unit_test(test_averaging),
         cmocka_unit_test(test_duplicates_and_truncation),
+        cmocka_unit_test(test_map_level_and_censoring),
         cmocka_unit_test(test_floor_restriction),
         cmocka_unit_test(test_grid_wknn_fill),
         cmocka_unit_test(test_grid_wknn_common),
