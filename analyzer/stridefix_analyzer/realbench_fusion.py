@@ -63,7 +63,12 @@ ROT_MIN_SEGMENT_M = 4.0
 ROT_MIN_RESULTANT = 0.95
 ROT_MIN_STEPS = 3
 DEFAULT_CELL_SIZE_M = 2.0
-DEFAULT_MIN_COUNT = 2
+#: heading variants tried on the training walks of each fold: the one whose STEP headings agree best
+#: with the truth directions (largest pooled resultant length of heading − direction) is used
+HEADING_VARIANTS = {"learned": [], "fixed": ["heading.learn_offset=0"]}
+#: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
+#: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
+DEFAULT_MIN_COUNT = 1
 STATS_KEYS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
 
 
@@ -191,6 +196,30 @@ def learn_rotation_deg(stats: list[dict], exclude: int | None = None) -> float:
     return math.degrees(math.atan2(s_, c)) if n else math.nan
 
 
+def heading_variants(param_sets) -> dict[str, list[str]]:
+    """The heading variants to try: :data:`HEADING_VARIANTS`, or only the user's own choice when
+    ``--set heading.learn_offset=…`` is given."""
+    if any(kv.split("=", 1)[0].strip() == "heading.learn_offset" for kv in param_sets or []):
+        return {"given": []}
+    return dict(HEADING_VARIANTS)
+
+
+def choose_heading_variant(per_walk: list[dict], exclude: int | None = None) -> tuple[str, dict]:
+    """The variant whose STEP headings agree best with the truth directions over the walks but
+    ``exclude``: the largest pooled mean resultant length of (heading − direction), i.e. the
+    tightest heading error once the constant part (the map rotation) is taken out. Returns the name
+    and the resultant length of every variant (NaN without straight segments)."""
+    score = {}
+    for name in per_walk[0]:
+        c = sum(w[name]["sum_cos"] for j, w in enumerate(per_walk) if j != exclude)
+        s_ = sum(w[name]["sum_sin"] for j, w in enumerate(per_walk) if j != exclude)
+        n = sum(w[name]["n_steps"] for j, w in enumerate(per_walk) if j != exclude)
+        score[name] = math.hypot(c, s_) / n if n else math.nan
+    finite = {k: v for k, v in score.items() if math.isfinite(v)}
+    best = max(finite, key=finite.get) if finite else next(iter(score))
+    return best, score
+
+
 def pressure_to_height_m(pressure_pa):
     """Barometric height [m], the firmware's formula (sf_floor_pressure_to_height_m)."""
     return 44330.77 * (1.0 - (np.asarray(pressure_pa, float) / 101325.0) ** 0.190263)
@@ -259,7 +288,7 @@ def learn_floor_heights(per_walk: list[dict[int, float]], floors: list[int],
 
 def prepare(trace, fmt: str, work_dir, cache_dir, stridefixd, max_wifi_age_s: float | None = None,
             reimport: bool = False, cell_size_m: float = DEFAULT_CELL_SIZE_M,
-            import_kwargs: dict | None = None) -> dict:
+            import_kwargs: dict | None = None, param_sets: list[str] | None = None) -> dict:
     """Phase 1 of one walk: import (cached), replay without a site, and its sufficient statistics.
 
     Returns
@@ -290,12 +319,22 @@ def prepare(trace, fmt: str, work_dir, cache_dir, stridefixd, max_wifi_age_s: fl
     walk["import"] = summary
     walk["import_log"] = imp = summary["out"]
     walk["warnings"] += summary.get("warnings", [])[:5]
-    fw_log = fw_dir / f"{trace.stem}.lcmlog"
-    cmd = [str(stridefixd), "--input", f"lcmlog:{imp}", "--log", str(fw_log), "-q"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        walk["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
-        return walk
+    variants = heading_variants(param_sets)
+    headings = {}
+    for name, sets in variants.items():  # the first variant's STEP stream also gives K and steps
+        fw_log = fw_dir / f"{trace.stem}.{name}.lcmlog"
+        cmd = [str(stridefixd), "--input", f"lcmlog:{imp}", "--log", str(fw_log), "-q"]
+        cmd += [a for kv in list(param_sets or []) + sets for a in ("--set", kv)]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            walk["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
+            return walk
+        if name != next(iter(variants)):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", LogTruncatedWarning)
+                st = read_logs([fw_log], decode=("STEP",)).table("STEP")
+            headings[name] = (st["t_us"], st["heading_rad"]) if st is not None else None
+    fw_log = fw_dir / f"{trace.stem}.{next(iter(variants))}.lcmlog"
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", LogTruncatedWarning)
@@ -324,8 +363,11 @@ def prepare(trace, fmt: str, work_dir, cache_dir, stridefixd, max_wifi_age_s: fl
     walk["step_length_m"] = steps["length_m"] if steps is not None else z
     walk["step_heading_rad"] = steps["heading_rad"] if steps is not None else z
     walk["stats"] = WalkStats.from_recordings(recs, cell_size_m=cell_size_m)
-    walk["rotation"] = rotation_stats(walk["step_t_us"], walk["step_heading_rad"],
-                                      walk["waypoint_t_us"], walk["waypoint_xy_m"])
+    walk["rotation"] = {next(iter(variants)): rotation_stats(
+        walk["step_t_us"], walk["step_heading_rad"], walk["waypoint_t_us"], walk["waypoint_xy_m"])}
+    for name, th in headings.items():
+        walk["rotation"][name] = rotation_stats(th[0] if th else [], th[1] if th else [],
+                                                walk["waypoint_t_us"], walk["waypoint_xy_m"])
     walk["floor_heights"] = (floor_heights_of_walk(baro["t_us"], baro["pressure_pa"], truth["t_us"],
                                                    truth["floor"])
                              if baro is not None and len(baro) else {})
@@ -386,13 +428,15 @@ def run_fold(job: dict) -> dict:
         return out
     site_path = wdir / "site.sfsite"
     write_site(site_path, site)
-    out["fold"] = {"K": job["K"], "rotation_deg": job["rotation_deg"], "n_rp": site.n_rp,
+    out["fold"] = {"K": job["K"], "rotation_deg": job["rotation_deg"],
+                   "heading_variant": job.get("heading_variant"),
+                   "heading_resultant": job.get("heading_resultant"), "n_rp": site.n_rp,
                    "n_ap": site.n_ap, "n_entries": site.n_entries, "n_floors": site.n_floors,
                    "lowest_floor": site.lowest_floor,
                    "floor_heights_m": [float(h) for h in site.floor_height_m],
                    "floor_heights_source": job["floor_heights_source"],
                    "scans_used": summ["scans"].get("used")}
-    sets = []
+    sets = [a for kv in job.get("param_sets", []) for a in ("--set", kv)]
     if math.isfinite(job["K"]):
         sets += ["--set", f"stride.weinberg_k={job['K']:.6f}"]
     base = [job["stridefixd"], "--input", f"lcmlog:{job['import_log']}", "--site", str(site_path),
@@ -511,7 +555,7 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
                jobs: int = 2, reimport: bool = False, true_start: bool = False,
                max_wifi_age_s: float | None = None, cell_size_m: float = DEFAULT_CELL_SIZE_M,
                min_count: int = DEFAULT_MIN_COUNT, cache_dir=None, report: bool = True,
-               quiet: bool = False) -> dict:
+               quiet: bool = False, param_sets: list[str] | None = None) -> dict:
     """Run the leave-one-walk-out fusion benchmark; write ``out_json`` (+ the HTML report).
 
     Returns the JSON document (non-finite numbers still NaN).
@@ -521,6 +565,12 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
     if not (stridefixd.is_file() and os.access(stridefixd, os.X_OK)):
         raise FusionBenchError(f"{stridefixd}: stridefixd not found or not executable "
                                "(build it: cmake --build build)")
+    if param_sets:  # a bad KEY=VALUE fails here once, not in every fold
+        probe = subprocess.run([str(stridefixd), "--print-config"]
+                               + [a for kv in param_sets for a in ("--set", kv)],
+                               capture_output=True, text=True)
+        if probe.returncode != 0:
+            raise FusionBenchError(f"--set: {probe.stderr.strip()[-300:]}")
     if max_wifi_age_s is None:
         max_wifi_age_s = getattr(importer_module(fmt), "DEFAULT_MAX_WIFI_AGE_S", 3.0)
     out_json = Path(out_json)
@@ -545,7 +595,7 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
     prog = _Progress("prepare", len(tasks), stream)
     with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) as pool:
         futs = {pool.submit(prepare, tr, fmt, g["work"], g["cache"], stridefixd, max_wifi_age_s,
-                            reimport, cell_size_m, g.get("import_kwargs")): i
+                            reimport, cell_size_m, g.get("import_kwargs"), param_sets): i
                 for i, (tr, g) in enumerate(tasks)}
         for fut in concurrent.futures.as_completed(futs):
             i = futs[fut]
@@ -577,10 +627,14 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
         rot_stats = [w["rotation"] for w in sub]
         info["K_all_walks"] = float(seg["true_m"][used].sum() / seg["weinberg"][used].sum()) \
             if seg["weinberg"][used].sum() > 0 else math.nan
-        info["rotation_all_walks_deg"] = learn_rotation_deg(rot_stats)
+        best_all, score_all = choose_heading_variant(rot_stats)
+        info["heading_variant_all_walks"] = best_all
+        info["heading_resultant_all_walks"] = score_all
+        info["rotation_all_walks_deg"] = learn_rotation_deg([r[best_all] for r in rot_stats])
         for j, i in enumerate(ok):
             others = [w for jj, w in enumerate(sub) if jj != j]
-            rot = learn_rotation_deg(rot_stats, exclude=j)
+            variant, variant_score = choose_heading_variant(rot_stats, exclude=j)
+            rot = learn_rotation_deg([r[variant] for r in rot_stats], exclude=j)
             floors = sorted({f for w in others for f in w["floors"]})
             if not floors:
                 floors = list(sub[j]["floors"])
@@ -597,6 +651,8 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
                 "rotation_learned": math.isfinite(rot),
                 "floor_heights_m": heights, "floor_heights_source": src, "lowest_floor": fl[0],
                 "min_count": min_count, "true_start": true_start,
+                "param_sets": list(param_sets or []) + heading_variants(param_sets)[variant],
+                "heading_variant": variant, "heading_resultant": variant_score,
                 "first_waypoint": walks[i]["first_waypoint"]})
     # phase 3: the folds, in parallel
     state = {"total": totals, "stats": {i: walks[i]["stats"] for i in range(len(walks))
@@ -618,6 +674,7 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
     job_of = {j["walk"]: j for j in fold_jobs}
     doc = build_doc(fmt, dirs, groups, group_info, walks, results, job_of, limit, true_start)
     doc["params"] = {"cell_size_m": cell_size_m, "min_count": min_count,
+                     "firmware_sets": list(param_sets or []),
                      "max_wifi_age_s": max_wifi_age_s, "limit": limit, "jobs": jobs,
                      "robust_mean_m": ROBUST_MEAN_M, "ipin_floor_penalty_m": IPIN_FLOOR_PENALTY_M,
                      "rotation": {"min_segment_m": ROT_MIN_SEGMENT_M,
@@ -661,7 +718,9 @@ def build_doc(fmt, dirs, groups, group_info, walks, results, job_of, limit, true
             "K": _spread([f["K"] for f in folds]),
             "rotation_deg": _spread([f["rotation_deg"] for f in folds]),
             "n_rp": _spread([f["n_rp"] for f in folds]),
-            "n_ap": _spread([f["n_ap"] for f in folds])}
+            "n_ap": _spread([f["n_ap"] for f in folds]),
+            "heading_variant": {v: sum(1 for f in folds if f.get("heading_variant") == v)
+                                for v in sorted({f.get("heading_variant") for f in folds} - {None})}}
         entry["walk_rows"] = []
         for r in rs:
             j = job_of[r["walk"]]
@@ -716,6 +775,9 @@ def format_tables(doc: dict) -> str:
                      f"K {f(c['K']['mean'], 3)} ({f(c['K']['min'], 3)}..{f(c['K']['max'], 3)}), "
                      f"rotation {f(c['rotation_deg']['mean'], 1)} deg "
                      f"({f(c['rotation_deg']['min'], 1)}..{f(c['rotation_deg']['max'], 1)}), "
+                     f"mounting offset "
+                     + ", ".join(f"{v} in {n} folds" for v, n in c.get("heading_variant", {}).items())
+                     + ", "
                      f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs")
         for key, title in (("summary", "every scheme from its first fix"),
                            ("summary_true_start", "TRUTH-INITIALISED start")):
@@ -773,6 +835,9 @@ def add_fusion_parser(sub) -> None:
     d.add_argument("--max-wifi-age-s", type=float, default=None,
                    help="importer: drop cached Wi-Fi entries older than this [s] (default: the "
                         "importer's)")
+    d.add_argument("--set", dest="param_sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="firmware parameter for every replay (stridefixd --set; repeatable): what-if "
+                        "runs; recorded in results.json")
     d.add_argument("--cache", default=None, metavar="DIR",
                    help="import cache (default: <folder of results.json>/cache)")
     d.add_argument("--reimport", action="store_true", help="ignore the cached imports")
@@ -785,7 +850,8 @@ def _run_fusion_cli(args) -> int:
     try:
         doc = run_fusion(args.format, args.dirs, args.out, args.stridefixd, args.limit, args.jobs,
                          args.reimport, args.true_start, args.max_wifi_age_s, args.cell_size_m,
-                         args.min_count, args.cache, not args.no_report, args.quiet)
+                         args.min_count, args.cache, not args.no_report, args.quiet,
+                         args.param_sets)
     except rb.RealbenchError as exc:
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return 2

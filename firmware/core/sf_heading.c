@@ -9,7 +9,6 @@
 #define WINDOW_MIN_US 200000
 #define WINDOW_MAX_US 2000000
 #define WINDOW_MIN_SAMPLES 4
-#define MIN_RESULTANT 0.5
 
 static double wrap_pi(const double a)
 {
@@ -154,7 +153,7 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
     h->mean_w = (1.0 - beta) * h->mean_w + beta;
     h->good_steps++;
     const double resultant = sqrt(h->mean_c * h->mean_c + h->mean_s * h->mean_s) / h->mean_w;
-    if (h->good_steps >= p->heading_min_steps && resultant >= MIN_RESULTANT) {
+    if (h->good_steps >= p->heading_min_steps && resultant >= p->heading_min_resultant) {
         h->confident = true; /* stays: a later scattered spell holds the last estimate */
         h->offset_rad = atan2(h->mean_s, h->mean_c);
     }
@@ -162,7 +161,7 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
 
 double sf_heading_offset_rad(const sf_heading_t *const h, const sf_params_t *const p)
 {
-    return h->confident ? h->offset_rad : wrap_pi(p->heading_mount_offset_deg * DEG);
+    return h->confident && p->heading_learn_offset ? h->offset_rad : wrap_pi(p->heading_mount_offset_deg * DEG);
 }
 
 double sf_heading_walk_rad(const sf_heading_t *const h, const sf_params_t *const p, const double device_yaw_rad)

@@ -49,9 +49,11 @@
     X(attitude, mag_learn_tau_s,     double,  60.0,    0.0,     3600.0,  "s",     "learn field/dip from accepted samples (0 = off); bounded to +-tol") \
     X(heading,  map_rotation_deg,    double,  0.0,     -360.0,  360.0,   "deg",   "map heading = ENU heading - rotation (set by the site file)") \
     X(heading,  mount_offset_deg,    double,  0.0,     -180.0,  180.0,   "deg",   "walking direction minus device yaw, until estimated") \
+    X(heading,  learn_offset,        int32_t, 1,       0,       1,       "",      "1 = estimate the mounting offset from the gait (body-worn board); 0 = keep mount_offset_deg (a hand-held phone, whose gait estimate wanders: realbench picks per fold from the training walks)") \
     X(heading,  window_steps,        double,  4.0,     1.0,     50.0,    "steps", "memory of the acceleration covariances, in steps") \
     X(heading,  smooth_steps,        double,  6.0,     1.0,     200.0,   "steps", "memory of the circular mean of the offset") \
     X(heading,  min_steps,           int32_t, 10,      1,       1000,    "steps", "good steps before the estimated offset is used") \
+    X(heading,  min_resultant,       double,  0.5,     0.0,     1.0,     "",      "mean resultant length of the smoothed offset samples needed to adopt (and keep updating) the estimate") \
     X(heading,  pca_min_ratio,       double,  2.0,     1.0,     1000.0,  "",      "unused since the axis comes from cov(a_h, v_up); kept for configs") \
     X(heading,  min_corr,            double,  0.2,     0.0,     1.0,     "",      "|corr(a_forward, v_up)| for a good step") \
     X(heading,  vz_tau_s,            double,  1.0,     0.1,     20.0,    "s",     "leak of the vertical-velocity integrator")

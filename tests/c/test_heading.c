@@ -200,7 +200,7 @@ static void test_sign_comes_from_the_pendulum(void **state)
 
 /* GIVEN map rotation 30° and fallback offset 12° WHEN fewer than min_steps steps THEN the walking
  * direction is yaw + 12° − 30° (to 1e-12 rad); WHEN 20 steps THEN it is the true walking direction − 30°,
- * within 5°. */
+ * within 5°; WHEN learn_offset is 0 THEN it is yaw + 12° − 30° again. */
 static void test_map_rotation_and_fallback(void **state)
 {
     (void)state;
@@ -221,6 +221,13 @@ static void test_map_rotation_and_fallback(void **state)
     printf("  map rotation 30: walk map %.2f deg, want %.2f (err %.2f)\n", walk_map / DEG,
            r.last_walk_nav / DEG - 30.0, e);
     assert_true(e < 5.0);
+
+    /* learn_offset 0: the same confident estimate is not used; the fallback 12° is. */
+    gait_result_t fixed = r;
+    fixed.p.heading_learn_offset = 0;
+    assert_true(fixed.h.confident);
+    const double want_fixed = wrap(r.last_yaw + (12.0 - 30.0) * DEG);
+    assert_true(fabs(wrap(sf_heading_walk_rad(&fixed.h, &fixed.p, r.last_yaw) - want_fixed)) < 1e-12);
 }
 
 /* GIVEN standing still with step calls 3 s apart THEN windows are rejected and nothing is learned. */
