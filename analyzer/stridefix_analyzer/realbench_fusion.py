@@ -64,8 +64,15 @@ ROT_MIN_RESULTANT = 0.95
 ROT_MIN_STEPS = 3
 DEFAULT_CELL_SIZE_M = 2.0
 #: heading variants tried on the training walks of each fold: the one whose STEP headings agree best
-#: with the truth directions (largest pooled resultant length of heading − direction) is used
-HEADING_VARIANTS = {"learned": [], "fixed": ["heading.learn_offset=0"]}
+#: with the truth directions (largest pooled resultant length of heading − direction) is used. Two
+#: questions the firmware defaults answer for a body-worn board, not for every device: is the
+#: gait-learned mounting offset better than a fixed one (a hand-held phone: no), and does a
+#: magnetometer gate twice as wide keep more good samples than disturbed ones?
+_WIDE_MAG_GATE = ["attitude.mag_field_tol_ut=16", "attitude.mag_dip_tol_deg=16"]
+HEADING_VARIANTS = {"learned": [], "fixed": ["heading.learn_offset=0"],
+                    "learned, wide mag gate": _WIDE_MAG_GATE,
+                    "fixed, wide mag gate": ["heading.learn_offset=0"] + _WIDE_MAG_GATE}
+_HEADING_KEYS = {kv.split("=", 1)[0] for v in HEADING_VARIANTS.values() for kv in v}
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
 #: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
 DEFAULT_MIN_COUNT = 1
@@ -198,8 +205,8 @@ def learn_rotation_deg(stats: list[dict], exclude: int | None = None) -> float:
 
 def heading_variants(param_sets) -> dict[str, list[str]]:
     """The heading variants to try: :data:`HEADING_VARIANTS`, or only the user's own choice when
-    ``--set heading.learn_offset=…`` is given."""
-    if any(kv.split("=", 1)[0].strip() == "heading.learn_offset" for kv in param_sets or []):
+    any of their keys is given with ``--set``."""
+    if any(kv.split("=", 1)[0].strip() in _HEADING_KEYS for kv in param_sets or []):
         return {"given": []}
     return dict(HEADING_VARIANTS)
 
@@ -775,7 +782,7 @@ def format_tables(doc: dict) -> str:
                      f"K {f(c['K']['mean'], 3)} ({f(c['K']['min'], 3)}..{f(c['K']['max'], 3)}), "
                      f"rotation {f(c['rotation_deg']['mean'], 1)} deg "
                      f"({f(c['rotation_deg']['min'], 1)}..{f(c['rotation_deg']['max'], 1)}), "
-                     f"mounting offset "
+                     f"heading variant "
                      + ", ".join(f"{v} in {n} folds" for v, n in c.get("heading_variant", {}).items())
                      + ", "
                      f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs")
