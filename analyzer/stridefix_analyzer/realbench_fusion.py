@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from . import realbench as rb
+from . import realbench_select as rs
 from .logread import LogReadError, LogTruncatedWarning, read_logs
 from .radiomap import WalkStats
 
@@ -437,6 +438,7 @@ def run_fold(job: dict) -> dict:
     write_site(site_path, site)
     out["fold"] = {"K": job["K"], "rotation_deg": job["rotation_deg"],
                    "heading_variant": job.get("heading_variant"),
+                   "matcher_variant": job.get("matcher_variant"),
                    "heading_resultant": job.get("heading_resultant"), "n_rp": site.n_rp,
                    "n_ap": site.n_ap, "n_entries": site.n_entries, "n_floors": site.n_floors,
                    "lowest_floor": site.lowest_floor,
@@ -638,28 +640,35 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
         info["heading_variant_all_walks"] = best_all
         info["heading_resultant_all_walks"] = score_all
         info["rotation_all_walks_deg"] = learn_rotation_deg([r[best_all] for r in rot_stats])
+        candidates = rs.matcher_variants(param_sets)
+        sel_prog = _Progress("choose matcher", rs.n_tasks(len(sub), len(candidates)), stream)
+
+        def build_site(removed, others, name, total=total):
+            heights, _, lowest = fold_floors(others, [])
+            return fold_site(total, removed, name=name, rotation_deg=0.0, floor_heights_m=heights,
+                             lowest_floor=lowest, min_count=min_count)[0]
+
+        matcher, info["matcher_selection"] = rs.select(
+            sub, total, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
+            base_sets=list(param_sets or []), candidates=candidates, jobs=jobs,
+            progress=lambda: sel_prog.step())
         for j, i in enumerate(ok):
             others = [w for jj, w in enumerate(sub) if jj != j]
             variant, variant_score = choose_heading_variant(rot_stats, exclude=j)
             rot = learn_rotation_deg([r[variant] for r in rot_stats], exclude=j)
-            floors = sorted({f for w in others for f in w["floors"]})
-            if not floors:
-                floors = list(sub[j]["floors"])
-            fl = list(range(floors[0], floors[-1] + 1))
-            if len(fl) > 1:
-                heights, src = learn_floor_heights([w["floor_heights"] for w in others], fl)
-            else:
-                heights, src = [fl[0] * rb_default_height()], "single floor"
+            heights, src, lowest = fold_floors(others, sub[j]["floors"])
             fold_jobs.append({
                 "index": i, "walk": walks[i]["walk"], "group": g["label"],
                 "dir": str(g["work"] / walks[i]["walk"]), "import_log": walks[i]["import_log"],
                 "stridefixd": str(stridefixd), "K": float(ks[j]),
                 "rotation_deg": 0.0 if not math.isfinite(rot) else rot,
                 "rotation_learned": math.isfinite(rot),
-                "floor_heights_m": heights, "floor_heights_source": src, "lowest_floor": fl[0],
+                "floor_heights_m": heights, "floor_heights_source": src, "lowest_floor": lowest,
                 "min_count": min_count, "true_start": true_start,
-                "param_sets": list(param_sets or []) + heading_variants(param_sets)[variant],
+                "param_sets": list(param_sets or []) + heading_variants(param_sets)[variant]
+                + candidates[matcher[j]],
                 "heading_variant": variant, "heading_resultant": variant_score,
+                "matcher_variant": matcher[j],
                 "first_waypoint": walks[i]["first_waypoint"]})
     # phase 3: the folds, in parallel
     state = {"total": totals, "stats": {i: walks[i]["stats"] for i in range(len(walks))
@@ -704,6 +713,18 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
     return doc
 
 
+def fold_floors(others: list[dict], own_floors) -> tuple[list[float], str, int]:
+    """Floor heights [m], their source and the lowest floor for a site learned from ``others``
+    (the floors they visit, or ``own_floors`` when they carry none)."""
+    floors = sorted({f for w in others for f in w["floors"]}) or sorted(own_floors)
+    fl = list(range(floors[0], floors[-1] + 1))
+    if len(fl) > 1:
+        heights, src = learn_floor_heights([w["floor_heights"] for w in others], fl)
+    else:
+        heights, src = [fl[0] * rb_default_height()], "single floor"
+    return heights, src, fl[0]
+
+
 def rb_default_height() -> float:
     """Storey height of a one-floor site [m] (the radio map's default; only its index matters)."""
     from .radiomap import DEFAULT_FLOOR_HEIGHT_M
@@ -726,8 +747,9 @@ def build_doc(fmt, dirs, groups, group_info, walks, results, job_of, limit, true
             "rotation_deg": _spread([f["rotation_deg"] for f in folds]),
             "n_rp": _spread([f["n_rp"] for f in folds]),
             "n_ap": _spread([f["n_ap"] for f in folds]),
-            "heading_variant": {v: sum(1 for f in folds if f.get("heading_variant") == v)
-                                for v in sorted({f.get("heading_variant") for f in folds} - {None})}}
+            **{key: {v: sum(1 for f in folds if f.get(key) == v)
+                     for v in sorted({f.get(key) for f in folds} - {None})}
+               for key in ("heading_variant", "matcher_variant")}}
         entry["walk_rows"] = []
         for r in rs:
             j = job_of[r["walk"]]
@@ -784,6 +806,8 @@ def format_tables(doc: dict) -> str:
                      f"({f(c['rotation_deg']['min'], 1)}..{f(c['rotation_deg']['max'], 1)}), "
                      f"heading variant "
                      + ", ".join(f"{v} in {n} folds" for v, n in c.get("heading_variant", {}).items())
+                     + ", matcher "
+                     + ", ".join(f"{v} in {n} folds" for v, n in c.get("matcher_variant", {}).items())
                      + ", "
                      f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs")
         for key, title in (("summary", "every scheme from its first fix"),

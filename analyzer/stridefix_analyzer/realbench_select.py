@@ -1,0 +1,143 @@
+"""Per-fold choice of the matcher configuration by cross-validation inside the training walks.
+
+``stridefix realbench`` may learn anything from the other walks of a fold, never from the held-out
+one. Some constants cannot be learned in closed form — e.g. whether averaging two consecutive scans
+(``fingerprint.average_scans=2``) beats single scans depends on the scan rate, the walking speed and
+the map. They are chosen by measuring the candidates on the training walks themselves:
+
+* the walks of a group are dealt into ``n_blocks`` blocks (walk index mod n_blocks);
+* for every ordered pair of blocks (a, b), a ≠ b, a radio map is built from the walks outside a and b
+  (sufficient statistics: total − block a − block b), and every walk of block b is replayed with it
+  through the real ``stridefixd`` (``--fusion wifi_only``) once per candidate;
+* the error of each Wi-Fi fix against the truth (linear between waypoints, inside the truth span)
+  is pooled per (a, candidate): these are out-of-sample errors on walks other than block a, from maps
+  that never saw block a;
+* every held-out walk of block a gets the candidate with the lowest pooled mean fix error.
+
+So the held-out walk's data never enter its own choice. Cost: n_blocks·(n_blocks − 1) maps and
+(n_blocks − 1) replays of every walk per candidate.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import math
+import subprocess
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .logread import LogTruncatedWarning, read_logs
+
+#: candidates, as stridefixd --set arguments; the first is the firmware default
+MATCHER_VARIANTS = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
+_MATCHER_KEYS = {kv.split("=", 1)[0] for v in MATCHER_VARIANTS.values() for kv in v}
+DEFAULT_BLOCKS = 4
+#: fewest walks in a group for a choice (fewer: the firmware default)
+MIN_WALKS = 6
+
+
+def matcher_variants(param_sets) -> dict[str, list[str]]:
+    """The candidates, or only the user's own choice when ``--set`` gives one of their keys."""
+    if any(kv.split("=", 1)[0].strip() in _MATCHER_KEYS for kv in param_sets or []):
+        return {"given": []}
+    return dict(MATCHER_VARIANTS)
+
+
+def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
+    """2-D error [m] of every Wi-Fi fix of a stridefixd log (one per scan) against the truth
+    interpolated linearly between waypoints; fixes outside the truth span are left out."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LogTruncatedWarning)
+        fix = read_logs([fw_log], decode=("FIX",)).table("FIX")
+    wp_t_us = np.asarray(wp_t_us, np.int64)
+    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
+    if fix is None or not len(fix) or len(wp_t_us) < 2:
+        return np.zeros(0)
+    t, first = np.unique(fix["t_us"], return_index=True)  # one row per scan (schemes repeat it)
+    keep = (t >= wp_t_us[0]) & (t <= wp_t_us[-1]) & (fix["accuracy_m"][first] > 0)
+    t, first = t[keep], first[keep]
+    x = np.interp(t, wp_t_us, wp[:, 0])
+    y = np.interp(t, wp_t_us, wp[:, 1])
+    return np.hypot(fix["x_m"][first] - x, fix["y_m"][first] - y)
+
+
+def _replay(job: dict) -> dict:
+    cmd = [job["stridefixd"], "--input", f"lcmlog:{job['import_log']}", "--site", job["site"],
+           "--fusion", "wifi_only", "--log", job["log"], "-q"]
+    cmd += [a for kv in job["sets"] for a in ("--set", kv)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
+    err = fix_errors_m(job["log"], job["wp_t_us"], job["wp_xy_m"])
+    Path(job["log"]).unlink(missing_ok=True)  # only the numbers are kept
+    return {**job, "errors": err, "failure": None}
+
+
+def select(sub: list[dict], total, build_site, *, stridefixd, work_dir, base_sets: list[str],
+           candidates: dict[str, list[str]], jobs: int = 2, n_blocks: int = DEFAULT_BLOCKS,
+           progress=None) -> tuple[list[str], dict]:
+    """Choose a candidate for every walk of ``sub`` (the prepared walks of one group).
+
+    ``total`` is the group's summed :class:`~.radiomap.WalkStats`; ``build_site(stats_removed,
+    others, name)`` returns the site for the map ``total − stats_removed`` learned from the walks
+    ``others``. Returns (the candidate name per walk, a report for results.json).
+    """
+    names = list(candidates)
+    n_blocks = min(n_blocks, len(sub))
+    if len(names) < 2 or len(sub) < MIN_WALKS:
+        why = "one candidate" if len(names) < 2 else f"fewer than {MIN_WALKS} walks"
+        return [names[0]] * len(sub), {"chosen_by": f"default ({why})", "blocks": {}}
+    from .sitefile import write_site
+
+    work_dir = Path(work_dir)
+    work_dir.mkdir(parents=True, exist_ok=True)
+    block = [i % n_blocks for i in range(len(sub))]
+    tasks = []
+    for a in range(n_blocks):
+        for b in range(n_blocks):
+            if a == b:
+                continue
+            inside = [i for i in range(len(sub)) if block[i] in (a, b)]
+            removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
+            others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
+            site_path = work_dir / f"site_{a}_{b}.sfsite"
+            write_site(site_path, build_site(removed, others, f"select {a}/{b}"))
+            for i in (i for i in range(len(sub)) if block[i] == b):
+                for name in names:
+                    tasks.append({"a": a, "name": name, "walk": sub[i]["walk"],
+                                  "stridefixd": str(stridefixd), "import_log": sub[i]["import_log"],
+                                  "site": str(site_path), "sets": base_sets + candidates[name],
+                                  "log": str(work_dir / f"{a}_{b}_{i}_{names.index(name)}.lcmlog"),
+                                  "wp_t_us": sub[i]["waypoint_t_us"],
+                                  "wp_xy_m": sub[i]["waypoint_xy_m"]})
+    pooled = {a: {n: [] for n in names} for a in range(n_blocks)}
+    failures = []
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) as pool:
+        for r in pool.map(_replay, tasks, chunksize=4):
+            if r["errors"] is None:
+                failures.append(f"{r['walk']} ({r['name']}): {r['failure']}")
+            else:
+                pooled[r["a"]][r["name"]].append(r["errors"])
+            if progress:
+                progress()
+    report = {"chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, mean Wi-Fi "
+                           "fix error)", "blocks": {}, "failures": failures[:10]}
+    choice_of_block = {}
+    for a in range(n_blocks):
+        means = {}
+        for n in names:
+            e = np.concatenate(pooled[a][n]) if pooled[a][n] else np.zeros(0)
+            means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, "fixes": int(len(e))}
+        finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
+        choice_of_block[a] = min(finite, key=finite.get) if finite else names[0]
+        report["blocks"][str(a)] = {"candidates": means, "chosen": choice_of_block[a]}
+    return [choice_of_block[block[i]] for i in range(len(sub))], report
+
+
+def n_tasks(n_walks: int, n_candidates: int, n_blocks: int = DEFAULT_BLOCKS) -> int:
+    """Replays :func:`select` will run (for the progress bar)."""
+    if n_candidates < 2 or n_walks < MIN_WALKS:
+        return 0
+    n_blocks = min(n_blocks, n_walks)
+    return (n_blocks - 1) * n_walks * n_candidates
