@@ -643,13 +643,15 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
         candidates = rs.matcher_variants(param_sets)
         sel_prog = _Progress("choose matcher", rs.n_tasks(len(sub), len(candidates)), stream)
 
-        def build_site(removed, others, name, total=total):
+        def build_site(removed, others, name, path, total=total):
+            from .sitefile import write_site
             heights, _, lowest = fold_floors(others, [])
-            return fold_site(total, removed, name=name, rotation_deg=0.0, floor_heights_m=heights,
-                             lowest_floor=lowest, min_count=min_count)[0]
+            write_site(path, fold_site(total, removed, name=name, rotation_deg=0.0,
+                                       floor_heights_m=heights, lowest_floor=lowest,
+                                       min_count=min_count)[0])
 
         matcher, info["matcher_selection"] = rs.select(
-            sub, total, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
+            sub, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
             base_sets=list(param_sets or []), candidates=candidates, jobs=jobs,
             progress=lambda: sel_prog.step())
         for j, i in enumerate(ok):

@@ -74,22 +74,22 @@ def _replay(job: dict) -> dict:
     return {**job, "errors": err, "failure": None}
 
 
-def select(sub: list[dict], total, build_site, *, stridefixd, work_dir, base_sets: list[str],
+def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list[str],
            candidates: dict[str, list[str]], jobs: int = 2, n_blocks: int = DEFAULT_BLOCKS,
-           progress=None) -> tuple[list[str], dict]:
+           progress=None, replay=None) -> tuple[list[str], dict]:
     """Choose a candidate for every walk of ``sub`` (the prepared walks of one group).
 
-    ``total`` is the group's summed :class:`~.radiomap.WalkStats`; ``build_site(stats_removed,
-    others, name)`` returns the site for the map ``total − stats_removed`` learned from the walks
-    ``others``. Returns (the candidate name per walk, a report for results.json).
+    ``build_site(stats_removed, others, name, path)`` writes to ``path`` the site whose radio map is
+    the group's total minus ``stats_removed`` (the summed ``stats`` of the excluded walks), learned
+    from the walks ``others``. ``replay(task) -> task + {"errors", "failure"}`` runs one walk (default:
+    stridefixd; in this process when ``jobs`` ≤ 1). Returns (the candidate per walk, a report).
     """
     names = list(candidates)
     n_blocks = min(n_blocks, len(sub))
     if len(names) < 2 or len(sub) < MIN_WALKS:
         why = "one candidate" if len(names) < 2 else f"fewer than {MIN_WALKS} walks"
         return [names[0]] * len(sub), {"chosen_by": f"default ({why})", "blocks": {}}
-    from .sitefile import write_site
-
+    replay = replay or _replay
     work_dir = Path(work_dir)
     work_dir.mkdir(parents=True, exist_ok=True)
     block = [i % n_blocks for i in range(len(sub))]
@@ -102,7 +102,7 @@ def select(sub: list[dict], total, build_site, *, stridefixd, work_dir, base_set
             removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
             others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
             site_path = work_dir / f"site_{a}_{b}.sfsite"
-            write_site(site_path, build_site(removed, others, f"select {a}/{b}"))
+            build_site(removed, others, f"select {a}/{b}", site_path)
             for i in (i for i in range(len(sub)) if block[i] == b):
                 for name in names:
                     tasks.append({"a": a, "name": name, "walk": sub[i]["walk"],
@@ -113,8 +113,9 @@ def select(sub: list[dict], total, build_site, *, stridefixd, work_dir, base_set
                                   "wp_xy_m": sub[i]["waypoint_xy_m"]})
     pooled = {a: {n: [] for n in names} for a in range(n_blocks)}
     failures = []
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) as pool:
-        for r in pool.map(_replay, tasks, chunksize=4):
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) if jobs > 1 else \
+            _InProcess() as pool:
+        for r in pool.map(replay, tasks, chunksize=4):
             if r["errors"] is None:
                 failures.append(f"{r['walk']} ({r['name']}): {r['failure']}")
             else:
@@ -133,6 +134,20 @@ def select(sub: list[dict], total, build_site, *, stridefixd, work_dir, base_set
         choice_of_block[a] = min(finite, key=finite.get) if finite else names[0]
         report["blocks"][str(a)] = {"candidates": means, "chosen": choice_of_block[a]}
     return [choice_of_block[block[i]] for i in range(len(sub))], report
+
+
+class _InProcess:
+    """The part of an executor :func:`select` uses, without processes (jobs ≤ 1, tests)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    @staticmethod
+    def map(fn, items, chunksize=1):
+        return map(fn, items)
 
 
 def n_tasks(n_walks: int, n_candidates: int, n_blocks: int = DEFAULT_BLOCKS) -> int:

@@ -1,0 +1,134 @@
+"""realbench's per-fold matcher choice by cross-validation inside the training walks
+(``stridefix_analyzer.realbench_select``): the fix-error arithmetic, the user's override, and a real
+run on 8 msindoor walks checked for the choice rule and for leakage of the held-out block."""
+from __future__ import annotations
+
+import json
+
+import lcm
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from stridefix import fix_t
+from stridefix_analyzer import realbench_select as rs
+from stridefix_analyzer.sitefile import read_site
+
+from .conftest import MSINDOOR
+
+
+def _fix(t_us, x, y, scheme, accuracy=3.0):
+    m = fix_t()
+    m.t_us, m.method, m.scheme, m.x_m, m.y_m, m.accuracy_m = t_us, 1, scheme, x, y, accuracy
+    m.reason_text = ""
+    return m
+
+
+def test_fix_errors_against_interpolated_truth(tmp_path):
+    # truth: (0,0) at 0 s → (10,0) at 10 s. Fixes at 2 s (2 schemes repeat it), 5 s, 12 s (outside).
+    path = tmp_path / "fw.lcmlog"
+    log = lcm.EventLog(str(path), "w", overwrite=True)
+    for m in (_fix(2_000_000, 2.0, 3.0, 1), _fix(2_000_000, 2.0, 3.0, 5),
+              _fix(5_000_000, 9.0, 0.0, 1), _fix(12_000_000, 0.0, 0.0, 1)):
+        log.write_event(m.t_us, "FIX", m.encode())
+    log.close()
+    err = rs.fix_errors_m(path, [0, 10_000_000], [[0.0, 0.0], [10.0, 0.0]])
+    # at 2 s the truth is (2, 0): error 3; at 5 s (5, 0): error 4; 12 s is outside the truth span
+    assert_allclose(err, [3.0, 4.0])
+
+
+def test_a_user_setting_replaces_the_candidates():
+    assert rs.matcher_variants([]) == rs.MATCHER_VARIANTS
+    assert rs.matcher_variants(["fingerprint.average_scans=3"]) == {"given": []}
+    assert rs.matcher_variants(["fusion.gate_sigma=4"]) == rs.MATCHER_VARIANTS
+
+
+def test_too_few_walks_keep_the_firmware_default():
+    walks = [{"walk": str(i)} for i in range(rs.MIN_WALKS - 1)]
+    choice, report = rs.select(walks, None, stridefixd="x", work_dir="unused", base_sets=[],
+                               candidates=rs.MATCHER_VARIANTS)
+    assert choice == [next(iter(rs.MATCHER_VARIANTS))] * len(walks)
+    assert report["chosen_by"].startswith("default")
+    assert rs.n_tasks(rs.MIN_WALKS - 1, 2) == 0
+    assert rs.n_tasks(8, 2) == 3 * 8 * 2
+
+
+def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
+    """10 synthetic walks, 4 blocks (walk i in block i mod 4). Each walk's ``stats`` is a bit, so the
+    removed statistics say exactly which walks a map left out. Fake replays report an error that
+    favours "2 scans" only when block a is 1, so the choice must follow the block."""
+    walks = [{"walk": f"w{i}", "stats": 1 << i, "import_log": "-", "waypoint_t_us": [],
+              "waypoint_xy_m": []} for i in range(10)]
+    sites = {}
+
+    def build_site(removed, others, name, path):
+        sites[str(path)] = (removed, {w["walk"] for w in others})
+        path.write_bytes(b"")
+
+    replays = []
+
+    def replay(task):
+        replays.append(task)
+        better = "2 scans" if task["a"] == 1 else "1 scan"
+        return {**task, "errors": np.array([1.0 if task["name"] == better else 2.0]),
+                "failure": None}
+
+    choice, report = rs.select(walks, build_site, stridefixd="x", work_dir=tmp_path, base_sets=["k=v"],
+                               candidates=rs.MATCHER_VARIANTS, jobs=1, replay=replay)
+    assert choice == ["2 scans" if i % 4 == 1 else "1 scan" for i in range(10)]
+    assert len(replays) == rs.n_tasks(10, 2) == 3 * 10 * 2
+    for t in replays:
+        removed, others = sites[t["site"]]
+        a = t["a"]
+        walk = int(t["walk"][1:])
+        assert walk % 4 != a                                  # never a walk of the scored block
+        left_out = {i for i in range(10) if removed >> i & 1}
+        assert {i for i in range(10) if i % 4 == a} <= left_out  # the map never saw block a
+        assert walk in left_out                               # nor the replayed walk
+        assert not {int(w[1:]) for w in others} & left_out
+        assert t["sets"][0] == "k=v"                          # the user's settings come first
+    for b in report["blocks"].values():
+        assert b["candidates"]["1 scan"]["fixes"] > 0
+
+
+@pytest.fixture(scope="module")
+def realbench_eight(request, tmp_path_factory, cli) -> dict:
+    """GIVEN `stridefix realbench --format msindoor site1/F2 --limit 8` (enough walks for a choice)."""
+    floor = MSINDOOR / "site1" / "F2"
+    if not floor.is_dir():
+        pytest.skip(f"real msindoor data not found at {floor}")
+    stridefixd = request.getfixturevalue("stridefixd")
+    out = tmp_path_factory.mktemp("realbench_select")
+    results = out / "results.json"
+    proc = cli("realbench", "--format", "msindoor", str(floor), "--limit", "8", "--no-report",
+               "--stridefixd", str(stridefixd), "--out", str(results), "--quiet")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return {"doc": json.loads(results.read_text()), "out": out}
+
+
+def test_each_block_takes_the_candidate_with_the_lowest_pooled_error(realbench_eight):
+    (g,) = realbench_eight["doc"]["groups"]
+    sel = g["matcher_selection"]
+    assert sel["chosen_by"].startswith("cross-validation") and not sel["failures"]
+    assert set(sel["blocks"]) == {"0", "1", "2", "3"}
+    for b in sel["blocks"].values():
+        c = b["candidates"]
+        assert set(c) == set(rs.MATCHER_VARIANTS)
+        for v in c.values():
+            assert v["fixes"] > 20 and 0.5 < v["mean_m"] < 50.0  # real fixes, plausible errors
+        assert b["chosen"] == min(c, key=lambda n: c[n]["mean_m"])
+    # walk i (sorted by name) is in block i mod 4 and replays with that block's choice
+    for i, row in enumerate(g["walk_rows"]):
+        assert row["fold"]["matcher_variant"] == sel["blocks"][str(i % 4)]["chosen"]
+
+
+def test_selection_maps_are_smaller_than_fold_maps(realbench_eight):
+    """site_a_b leaves out two blocks (4 of 8 walks): fewer scans than a fold's map (7 of 8)."""
+    (g,) = realbench_eight["doc"]["groups"]
+    work = realbench_eight["out"] / "realbench_work" / "site1-F2"
+    fold = read_site(work / g["walk_rows"][0]["walk"] / "site.sfsite")
+    for a in range(4):
+        for b in range(4):
+            if a != b:
+                site = read_site(work / "select" / f"site_{a}_{b}.sfsite")
+                assert 0 < int(np.sum(site.rp_scans)) < int(np.sum(fold.rp_scans))
