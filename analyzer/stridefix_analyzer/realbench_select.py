@@ -3,7 +3,8 @@
 ``stridefix realbench`` may learn anything from the other walks of a fold, never from the held-out
 one. Some constants cannot be learned in closed form — e.g. whether averaging two consecutive scans
 (``fingerprint.average_scans=2``) beats single scans depends on the scan rate, the walking speed and
-the map. They are chosen by measuring the candidates on the training walks themselves:
+the map, and which signal representation WkNN should compare (dBm or "powed") depends on the
+devices and the building. They are chosen by measuring the candidates on the training walks:
 
 * the walks of a group are dealt into ``n_blocks`` blocks (walk index mod n_blocks);
 * for every ordered pair of blocks (a, b), a ≠ b, a radio map is built from the walks outside a and b
@@ -29,8 +30,13 @@ import numpy as np
 
 from .logread import LogTruncatedWarning, read_logs
 
-#: candidates, as stridefixd --set arguments; the first is the firmware default
-MATCHER_VARIANTS = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
+#: candidates, as stridefixd --set arguments; the first is the firmware default. Scans averaged
+#: (1 or 2) × WkNN representation (dBm, or "powed" with beta 2 or e — Torres-Sospedra 2015's choice)
+_AVERAGE = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
+_REPRESENTATION = {"dBm": [], "powed 2": ["fingerprint.powed_beta=2"],
+                   "powed e": ["fingerprint.powed_beta=2.718281828"]}
+MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items()
+                    for r, sr in _REPRESENTATION.items()}
 _MATCHER_KEYS = {kv.split("=", 1)[0] for v in MATCHER_VARIANTS.values() for kv in v}
 DEFAULT_BLOCKS = 4
 #: fewest walks in a group for a choice (fewer: the firmware default)

@@ -32,6 +32,23 @@ static double entry_level(const sf_radiomap_t *const map, const int32_t entry, c
     return (c * mu + (n - c) * p->fingerprint_fill_dbm) / n;
 }
 
+/* The WkNN signal representation of a level [dBm]: v − f (beta 1, plain dBm above the fill level),
+ * or the "powed" form |f|·((v − f)/|f|)^beta of Torres-Sospedra et al. (2015), which stretches the
+ * strong levels (near APs: position-specific) and squeezes the weak ones (far APs: noisy). A level
+ * at or below f is 0 in both, so an AP missing on one side still costs the other side's value². */
+static double represent(const double v, const double fill, const double beta)
+{
+    const double u = v - fill;
+    if (!(u > 0.0)) {
+        return 0.0;
+    }
+    if (beta == 1.0) {
+        return u;
+    }
+    const double scale = fabs(fill) > 1.0 ? fabs(fill) : 1.0;
+    return scale * pow(u / scale, beta);
+}
+
 /* Detection probability of a map entry, clamped to [p, 1 - p]. */
 static double detection(const sf_radiomap_t *const map, const int32_t entry, const double p_min)
 {
@@ -70,7 +87,7 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
         const int32_t r = map->entry_rp[i];
         const double level = entry_level(map, i, p);
         if (level >= p->fingerprint_min_rssi_dbm) { /* censored like the scan: see the header */
-            const double v = level - fill;
+            const double v = represent(level, fill, p->fingerprint_powed_beta);
             ws->rp_fill_sq_db2[r] += v * v;
         }
         ws->rp_miss_loglik[r] += log(1.0 - detection(map, i, p_min)) - log_not_p;
@@ -82,6 +99,7 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     ws->nb_p_min = p_min;
     ws->min_rssi_dbm = p->fingerprint_min_rssi_dbm;
     ws->map_level = p->fingerprint_map_level;
+    ws->powed_beta = p->fingerprint_powed_beta;
     ws->prepared = true;
     return SF_OK;
 }
@@ -262,7 +280,7 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     if (!ws->prepared || ws->map_n_ap != map->n_ap || ws->map_n_rp != map->n_rp ||
         ws->map_n_entries != map->n_entries || ws->fill_dbm != p->fingerprint_fill_dbm ||
         ws->nb_p_min != p->fingerprint_nb_p_min || ws->min_rssi_dbm != p->fingerprint_min_rssi_dbm ||
-        ws->map_level != p->fingerprint_map_level) {
+        ws->map_level != p->fingerprint_map_level || ws->powed_beta != p->fingerprint_powed_beta) {
         return SF_EINVAL;
     }
     fp->scans++;
@@ -296,7 +314,7 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     for (int32_t qi = 0; qi < fp->n_query; qi++) {
         const int32_t a = fp->query_ap[qi];
         const double s = fp->query_rssi_dbm[qi];
-        const double u = s - fill;
+        const double u = bayes ? s - fill : represent(s, fill, p->fingerprint_powed_beta);
         const double c_a = bayes ? log_p + log_normal(s, fill, sigma_floor) - log_not_p : 0.0;
         scan_sum += bayes ? c_a : u * u;
         const int32_t end = map->ap_first[a + 1];
@@ -317,7 +335,8 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
                 if (mu < p->fingerprint_min_rssi_dbm) {
                     continue; /* censored: the RP "does not hear" it, as a scan could not report it */
                 }
-                term = common_only ? (s - mu) * (s - mu) : -2.0 * u * (mu - fill);
+                const double v = represent(mu, fill, p->fingerprint_powed_beta);
+                term = common_only ? (u - v) * (u - v) : -2.0 * u * v;
             }
             touch(ws, &n_touched, r, term);
         }

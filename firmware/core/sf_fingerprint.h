@@ -41,6 +41,11 @@
  * is exact, not an approximation, and again only Q∩R is visited. Posterior P(r|s) = softmax of L over
  * the candidates (uniform prior); the k most probable win, weighted by their posterior (paper: k = 3).
  *
+ * Representation. WkNN compares levels through g(v) = v − f (fingerprint_powed_beta 1: the formulas
+ * above as written) or the "powed" g(v) = |f|·((v − f)/|f|)^β of Torres-Sospedra et al. (2015; they
+ * found β = e best on their data sets): every s and μ above is replaced by g(s), g(μ) and f by g(f) = 0,
+ * so F_r and the visited-entry sums keep their form. stridefix realbench chooses β per fold by
+ * cross-validation in the training walks.
  * WkNN map levels. μ_ra above is entry_level: with fingerprint_map_level 1 (default) the mean over all
  * rp_scans of the RP with the misses at f, (count·mean + (rp_scans − count)·f) / rp_scans, i.e. the RP's
  * fingerprint in the same terms as the query; with 0 the stored mean of the scans that heard the AP.
@@ -64,7 +69,7 @@
  * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
  * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
- * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm or _map_level change). sf_fingerprint_match: O(n_scan·255) to store the
+ * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm, _map_level or _powed_beta change). sf_fingerprint_match: O(n_scan·255) to store the
  * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
  * (E_Q = total entries of the used APs; one log and one division per entry for naive Bayes), and
  * O(T·k) to select among the T touched RPs — independent of the map size beyond E_Q and T ≤ n_rp.
@@ -111,6 +116,7 @@ typedef struct {
     int32_t map_n_ap, map_n_rp, map_n_entries; /* the map it was prepared for */
     double fill_dbm, nb_p_min, min_rssi_dbm;    /* the parameters it was prepared with */
     int32_t map_level;
+    double powed_beta;
 } sf_fingerprint_workspace_t;
 
 /* The record of the last match (published with the FIX message). */

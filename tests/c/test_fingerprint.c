@@ -498,6 +498,37 @@ static void test_map_level_and_censoring(void **state)
     assert_scratch_clean(&m, 4);
 }
 
+/* Powed representation, beta 2 (fill −100): g(v) = (v + 100)²/100. Scan −45, −62, −60 → 30.25, 14.44,
+ * 16. Map (stored means): r0 36, 16, 9; r1 16, 36, 4; r2 25, 9, 25; r3 27.04, 23.04, (missing: 0).
+ *   d² r0 = 5.75² + 1.56² + 7² = 84.4961      r1 = 14.25² + 21.56² + 12² = 811.8961
+ *   d² r2 = 5.25² + 5.44² + 9² = 138.1561     r3 = 3.21² + 8.6² + 16² = 340.2641
+ * → winners r0, r2, r3 (in dBm r1 came third: the far AP a2 weighs less once squeezed). */
+static void test_powed_representation(void **state)
+{
+    (void)state;
+    const sf_radiomap_t map = tiny_map(k_floor0);
+    sf_params_t p = params(0, 0);
+    p.fingerprint_powed_beta = 2.0;
+    ws_mem_t m;
+    ws_setup(&m, 4);
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_near(m.fill[3], 27.04 * 27.04 + 23.04 * 23.04, 1e-9);
+    sf_fingerprint_t fp;
+    sf_fingerprint_init(&fp);
+    sf_fix_t fix = {0};
+    assert_int_equal(match3(&fp, &p, &map, &m, 1, 3, k_bssid, k_scan_rssi, &fix), SF_OK);
+    assert_int_equal(fp.audit.winner_rp[0], 0);
+    assert_int_equal(fp.audit.winner_rp[1], 2);
+    assert_int_equal(fp.audit.winner_rp[2], 3);
+    assert_near(fp.audit.winner_score[0], sqrt(84.4961), 1e-9);
+    assert_near(fp.audit.winner_score[1], sqrt(138.1561), 1e-9);
+    assert_near(fp.audit.winner_score[2], sqrt(340.2641), 1e-9);
+    /* a workspace prepared for another beta is refused */
+    p.fingerprint_powed_beta = 1.0;
+    assert_int_equal(match3(&fp, &p, &map, &m, 2, 3, k_bssid, k_scan_rssi, &fix), SF_EINVAL);
+    assert_scratch_clean(&m, 4);
+}
+
 /* ---- floors ------------------------------------------------------------------------------------------
  * r2 moved to floor 1. Fill-mode distances as in test_wknn_fill.
  * floor_hint 0: candidates r0, r1, r3 → winners r0 (√129), r1 (√1109), r3 (√1709); floor 0.
@@ -822,6 +853,7 @@ int main(void)
         cmocka_unit_test(test_averaging),
         cmocka_unit_test(test_duplicates_and_truncation),
         cmocka_unit_test(test_map_level_and_censoring),
+        cmocka_unit_test(test_powed_representation),
         cmocka_unit_test(test_floor_restriction),
         cmocka_unit_test(test_grid_wknn_fill),
         cmocka_unit_test(test_grid_wknn_common),

@@ -40,6 +40,7 @@ def test_fix_errors_against_interpolated_truth(tmp_path):
 def test_a_user_setting_replaces_the_candidates():
     assert rs.matcher_variants([]) == rs.MATCHER_VARIANTS
     assert rs.matcher_variants(["fingerprint.average_scans=3"]) == {"given": []}
+    assert rs.matcher_variants(["fingerprint.powed_beta=3"]) == {"given": []}
     assert rs.matcher_variants(["fusion.gate_sigma=4"]) == rs.MATCHER_VARIANTS
 
 
@@ -69,14 +70,14 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
 
     def replay(task):
         replays.append(task)
-        better = "2 scans" if task["a"] == 1 else "1 scan"
+        better = "2 scans, dBm" if task["a"] == 1 else "1 scan, dBm"
         return {**task, "errors": np.array([1.0 if task["name"] == better else 2.0]),
                 "failure": None}
 
     choice, report = rs.select(walks, build_site, stridefixd="x", work_dir=tmp_path, base_sets=["k=v"],
                                candidates=rs.MATCHER_VARIANTS, jobs=1, replay=replay)
-    assert choice == ["2 scans" if i % 4 == 1 else "1 scan" for i in range(10)]
-    assert len(replays) == rs.n_tasks(10, 2) == 3 * 10 * 2
+    assert choice == ["2 scans, dBm" if i % 4 == 1 else "1 scan, dBm" for i in range(10)]
+    assert len(replays) == rs.n_tasks(10, len(rs.MATCHER_VARIANTS)) == 3 * 10 * 6
     for t in replays:
         removed, others = sites[t["site"]]
         a = t["a"]
@@ -88,7 +89,7 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
         assert not {int(w[1:]) for w in others} & left_out
         assert t["sets"][0] == "k=v"                          # the user's settings come first
     for b in report["blocks"].values():
-        assert b["candidates"]["1 scan"]["fixes"] > 0
+        assert b["candidates"]["1 scan, dBm"]["fixes"] > 0
 
 
 @pytest.fixture(scope="module")
