@@ -439,6 +439,7 @@ def run_fold(job: dict) -> dict:
     out["fold"] = {"K": job["K"], "rotation_deg": job["rotation_deg"],
                    "heading_variant": job.get("heading_variant"),
                    "matcher_variant": job.get("matcher_variant"),
+                   "adaptive_variant": job.get("adaptive_variant"),
                    "heading_resultant": job.get("heading_resultant"), "n_rp": site.n_rp,
                    "n_ap": site.n_ap, "n_entries": site.n_entries, "n_floors": site.n_floors,
                    "lowest_floor": site.lowest_floor,
@@ -643,17 +644,37 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
         candidates = rs.matcher_variants(param_sets)
         sel_prog = _Progress("choose matcher", rs.n_tasks(len(sub), len(candidates)), stream)
 
-        def build_site(removed, others, name, path, total=total):
+        def build_site(removed, others, name, path, total=total, sub=sub, seg=seg, used=used,
+                       rot_stats=rot_stats):
+            """A selection site and the settings learned with it, from ``others`` only."""
             from .sitefile import write_site
+            idx = [j for j, w in enumerate(sub) if any(w is o for o in others)]
             heights, _, lowest = fold_floors(others, [])
-            write_site(path, fold_site(total, removed, name=name, rotation_deg=0.0,
+            stats = [rot_stats[j] for j in idx]
+            variant, _ = choose_heading_variant(stats)
+            rot = learn_rotation_deg([r[variant] for r in stats])
+            write_site(path, fold_site(total, removed, name=name,
+                                       rotation_deg=rot if math.isfinite(rot) else 0.0,
                                        floor_heights_m=heights, lowest_floor=lowest,
                                        min_count=min_count)[0])
+            mine = used & np.isin(seg["walk"], idx)
+            k = seg["true_m"][mine].sum() / seg["weinberg"][mine].sum() \
+                if seg["weinberg"][mine].sum() > 0 else math.nan
+            return heading_variants(param_sets)[variant] + \
+                ([f"stride.weinberg_k={k:.6f}"] if math.isfinite(k) else [])
 
         matcher, info["matcher_selection"] = rs.select(
             sub, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
             base_sets=list(param_sets or []), candidates=candidates, jobs=jobs,
             progress=lambda: sel_prog.step())
+        adaptive_cands = rs.adaptive_variants(param_sets)
+        ad_prog = _Progress("choose adaptive", rs.n_tasks(len(sub), len(adaptive_cands)), stream)
+        chosen = info["matcher_selection"].get("choice_of_block", {})
+        adaptive, info["adaptive_selection"] = rs.select(
+            sub, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
+            base_sets=list(param_sets or []), candidates=adaptive_cands, jobs=jobs,
+            progress=lambda: ad_prog.step(), stage="adaptive",
+            block_sets={a: candidates[n] for a, n in chosen.items()})
         for j, i in enumerate(ok):
             others = [w for jj, w in enumerate(sub) if jj != j]
             variant, variant_score = choose_heading_variant(rot_stats, exclude=j)
@@ -668,9 +689,9 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
                 "floor_heights_m": heights, "floor_heights_source": src, "lowest_floor": lowest,
                 "min_count": min_count, "true_start": true_start,
                 "param_sets": list(param_sets or []) + heading_variants(param_sets)[variant]
-                + candidates[matcher[j]],
+                + candidates[matcher[j]] + adaptive_cands[adaptive[j]],
                 "heading_variant": variant, "heading_resultant": variant_score,
-                "matcher_variant": matcher[j],
+                "matcher_variant": matcher[j], "adaptive_variant": adaptive[j],
                 "first_waypoint": walks[i]["first_waypoint"]})
     # phase 3: the folds, in parallel
     state = {"total": totals, "stats": {i: walks[i]["stats"] for i in range(len(walks))
@@ -751,7 +772,7 @@ def build_doc(fmt, dirs, groups, group_info, walks, results, job_of, limit, true
             "n_ap": _spread([f["n_ap"] for f in folds]),
             **{key: {v: sum(1 for f in folds if f.get(key) == v)
                      for v in sorted({f.get(key) for f in folds} - {None})}
-               for key in ("heading_variant", "matcher_variant")}}
+               for key in ("heading_variant", "matcher_variant", "adaptive_variant")}}
         entry["walk_rows"] = []
         for r in rs:
             j = job_of[r["walk"]]
@@ -810,6 +831,8 @@ def format_tables(doc: dict) -> str:
                      + ", ".join(f"{v} in {n} folds" for v, n in c.get("heading_variant", {}).items())
                      + ", matcher "
                      + ", ".join(f"{v} in {n} folds" for v, n in c.get("matcher_variant", {}).items())
+                     + ", adaptive "
+                     + ", ".join(f"{v} in {n} folds" for v, n in c.get("adaptive_variant", {}).items())
                      + ", "
                      f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs")
         for key, title in (("summary", "every scheme from its first fix"),

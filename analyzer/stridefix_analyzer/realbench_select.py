@@ -15,6 +15,10 @@ devices and the building. They are chosen by measuring the candidates on the tra
   that never saw block a;
 * every held-out walk of block a gets the candidate with the lowest pooled mean fix error.
 
+A second stage does the same for the adaptive scheme's Wi-Fi accuracy-factor scale (with block a's
+matcher, on the adaptive scheme's POSE error at the waypoints): the AADR 2015 table is on the AP
+count, which says little when every scan hears ~100 APs.
+
 So the held-out walk's data never enter its own choice. Cost: n_blocks·(n_blocks − 1) maps and
 (n_blocks − 1) replays of every walk per candidate.
 """
@@ -38,16 +42,32 @@ _REPRESENTATION = {"dBm": [], "powed 2": ["fingerprint.powed_beta=2"],
 MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items()
                     for r, sr in _REPRESENTATION.items()}
 _MATCHER_KEYS = {kv.split("=", 1)[0] for v in MATCHER_VARIANTS.values() for kv in v}
+#: the adaptive scheme's Wi-Fi accuracy factors (a table on the AP count, AADR 2015) times a scale:
+#: chosen second, with the block's matcher, on the adaptive POSE error at the waypoints
+ADAPTIVE_VARIANTS = {"table x 1": [], "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
+                     "table x 0.25": ["fusion.acc_wifi_scale=0.25"]}
+_ADAPTIVE_KEYS = {"fusion.acc_wifi_scale"}
+#: what each stage replays (--fusion) and scores
+STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
 DEFAULT_BLOCKS = 4
 #: fewest walks in a group for a choice (fewer: the firmware default)
 MIN_WALKS = 6
 
 
+def _variants(param_sets, table, keys) -> dict[str, list[str]]:
+    if any(kv.split("=", 1)[0].strip() in keys for kv in param_sets or []):
+        return {"given": []}
+    return dict(table)
+
+
 def matcher_variants(param_sets) -> dict[str, list[str]]:
     """The candidates, or only the user's own choice when ``--set`` gives one of their keys."""
-    if any(kv.split("=", 1)[0].strip() in _MATCHER_KEYS for kv in param_sets or []):
-        return {"given": []}
-    return dict(MATCHER_VARIANTS)
+    return _variants(param_sets, MATCHER_VARIANTS, _MATCHER_KEYS)
+
+
+def adaptive_variants(param_sets) -> dict[str, list[str]]:
+    """The adaptive scheme's candidates, or the user's own ``fusion.acc_wifi_scale``."""
+    return _variants(param_sets, ADAPTIVE_VARIANTS, _ADAPTIVE_KEYS)
 
 
 def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
@@ -68,27 +88,48 @@ def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
     return np.hypot(fix["x_m"][first] - x, fix["y_m"][first] - y)
 
 
+def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
+    """2-D error [m] at each waypoint of the latest POSE at or before it (causal, as realbench scores;
+    the log holds one scheme); waypoints before the first pose are left out."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LogTruncatedWarning)
+        pose = read_logs([fw_log], decode=("POSE",)).table("POSE")
+    wp_t_us = np.asarray(wp_t_us, np.int64)
+    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
+    if pose is None or not len(pose):
+        return np.zeros(0)
+    pose = pose.rows(np.isfinite(pose["sigma_m"]) & (pose["sigma_m"] < 1e6))  # initialised only
+    k = np.searchsorted(pose["t_us"], wp_t_us, side="right") - 1
+    ok = k >= 0
+    return np.hypot(pose["x_m"][k[ok]] - wp[ok, 0], pose["y_m"][k[ok]] - wp[ok, 1])
+
+
 def _replay(job: dict) -> dict:
     cmd = [job["stridefixd"], "--input", f"lcmlog:{job['import_log']}", "--site", job["site"],
-           "--fusion", "wifi_only", "--log", job["log"], "-q"]
+           "--fusion", STAGES[job["stage"]], "--log", job["log"], "-q"]
     cmd += [a for kv in job["sets"] for a in ("--set", kv)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
-    err = fix_errors_m(job["log"], job["wp_t_us"], job["wp_xy_m"])
+    score = fix_errors_m if job["stage"] == "matcher" else pose_errors_m
+    err = score(job["log"], job["wp_t_us"], job["wp_xy_m"])
     Path(job["log"]).unlink(missing_ok=True)  # only the numbers are kept
     return {**job, "errors": err, "failure": None}
 
 
 def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list[str],
            candidates: dict[str, list[str]], jobs: int = 2, n_blocks: int = DEFAULT_BLOCKS,
-           progress=None, replay=None) -> tuple[list[str], dict]:
+           progress=None, replay=None, stage: str = "matcher",
+           block_sets: dict[int, list[str]] | None = None) -> tuple[list[str], dict]:
     """Choose a candidate for every walk of ``sub`` (the prepared walks of one group).
 
     ``build_site(stats_removed, others, name, path)`` writes to ``path`` the site whose radio map is
     the group's total minus ``stats_removed`` (the summed ``stats`` of the excluded walks), learned
-    from the walks ``others``. ``replay(task) -> task + {"errors", "failure"}`` runs one walk (default:
-    stridefixd; in this process when ``jobs`` ≤ 1). Returns (the candidate per walk, a report).
+    from the walks ``others`` (map rotation included), and returns the stridefixd settings learned
+    from them too (heading variant, stride K) for the replays with that site. ``replay(task) -> task + {"errors", "failure"}`` runs one walk (default:
+    stridefixd; in this process when ``jobs`` ≤ 1). ``stage`` says what is replayed and scored
+    (:data:`STAGES`: Wi-Fi fix errors, or the adaptive POSE at the waypoints); ``block_sets[a]`` are
+    settings already chosen for block a (its matcher). Returns (the candidate per walk, a report).
     """
     names = list(candidates)
     n_blocks = min(n_blocks, len(sub))
@@ -108,12 +149,13 @@ def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list
             removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
             others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
             site_path = work_dir / f"site_{a}_{b}.sfsite"
-            build_site(removed, others, f"select {a}/{b}", site_path)
+            site_sets = build_site(removed, others, f"select {a}/{b}", site_path) or []
             for i in (i for i in range(len(sub)) if block[i] == b):
                 for name in names:
-                    tasks.append({"a": a, "name": name, "walk": sub[i]["walk"],
+                    sets = base_sets + site_sets + (block_sets or {}).get(a, []) + candidates[name]
+                    tasks.append({"a": a, "name": name, "walk": sub[i]["walk"], "stage": stage,
                                   "stridefixd": str(stridefixd), "import_log": sub[i]["import_log"],
-                                  "site": str(site_path), "sets": base_sets + candidates[name],
+                                  "site": str(site_path), "sets": sets,
                                   "log": str(work_dir / f"{a}_{b}_{i}_{names.index(name)}.lcmlog"),
                                   "wp_t_us": sub[i]["waypoint_t_us"],
                                   "wp_xy_m": sub[i]["waypoint_xy_m"]})
@@ -128,8 +170,9 @@ def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list
                 pooled[r["a"]][r["name"]].append(r["errors"])
             if progress:
                 progress()
-    report = {"chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, mean Wi-Fi "
-                           "fix error)", "blocks": {}, "failures": failures[:10]}
+    what = "mean Wi-Fi fix error" if stage == "matcher" else f"mean {STAGES[stage]} error at waypoints"
+    report = {"chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, {what})",
+              "blocks": {}, "failures": failures[:10], "block_of_walk": block}
     choice_of_block = {}
     for a in range(n_blocks):
         means = {}
@@ -139,6 +182,7 @@ def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list
         finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
         choice_of_block[a] = min(finite, key=finite.get) if finite else names[0]
         report["blocks"][str(a)] = {"candidates": means, "chosen": choice_of_block[a]}
+    report["choice_of_block"] = choice_of_block
     return [choice_of_block[block[i]] for i in range(len(sub))], report
 
 

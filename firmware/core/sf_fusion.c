@@ -316,7 +316,7 @@ double sf_fusion_accuracy_factor(const sf_params_t *const p, const sf_fix_t *con
                               p->fusion_acc_wifi_ap4};
         const double vs[4] = {p->fusion_acc_wifi_val1, p->fusion_acc_wifi_val2, p->fusion_acc_wifi_val3,
                               p->fusion_acc_wifi_val4};
-        return interp4(xs, vs, (double)fix->n_ap_used);
+        return p->fusion_acc_wifi_scale * interp4(xs, vs, (double)fix->n_ap_used);
     }
     case sf_fix_gnss: {
         const double xs[4] = {p->fusion_acc_gnss_m1, p->fusion_acc_gnss_m2, p->fusion_acc_gnss_m3,

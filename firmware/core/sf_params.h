@@ -149,6 +149,7 @@
     X(fusion, acc_wifi_val2,       double,  0.25,    0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 2 (placeholder)") \
     X(fusion, acc_wifi_val3,       double,  0.45,    0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 3 (placeholder)") \
     X(fusion, acc_wifi_val4,       double,  0.6,     0.0,     1.0,     "",      "adaptive: Wi-Fi accuracy factor at knot 4 (placeholder)") \
+    X(fusion, acc_wifi_scale,      double,  1.0,     0.0,     1.0,     "",      "adaptive: the Wi-Fi accuracy factors above times this (realbench learns it per fold: with ~100 APs per scan the AP count says little)") \
     X(fusion, acc_gnss_m1,         double,  6.0,     0.0,     1e4,     "m",     "adaptive: GNSS accuracy-factor knot 1, reported accuracy (knots increasing; flat outside)") \
     X(fusion, acc_gnss_m2,         double,  12.0,    0.0,     1e4,     "m",     "adaptive: GNSS knot 2, reported accuracy") \
     X(fusion, acc_gnss_m3,         double,  21.0,    0.0,     1e4,     "m",     "adaptive: GNSS knot 3, reported accuracy") \

@@ -123,12 +123,17 @@ static void test_alpha_law_tables(void **state)
     for (size_t i = 0; i < sizeof wifi_cases / sizeof wifi_cases[0]; i++) {
         const sf_fix_t fx = wifi(1.0, 0.0, 0.0, 3.0, wifi_cases[i].n_ap);
         near(sf_fusion_accuracy_factor(&p, &fx), wifi_cases[i].factor);
+        p.fusion_acc_wifi_scale = 0.5; /* the learnt scale multiplies the Wi-Fi table only */
+        near(sf_fusion_accuracy_factor(&p, &fx), 0.5 * wifi_cases[i].factor);
+        p.fusion_acc_wifi_scale = 1.0;
     }
     const double gnss_cases[][2] = {{0.5, 0.8}, {6.0, 0.8}, {9.0, 0.7}, {12.0, 0.6}, {15.0, 0.5},
                                     {21.0, 0.3}, {25.5, 0.15}, {30.0, 0.0}, {500.0, 0.0}};
     for (size_t i = 0; i < sizeof gnss_cases / sizeof gnss_cases[0]; i++) {
         const sf_fix_t fx = fix_at(1.0, sf_fix_gnss, 0.0, 0.0, 0, gnss_cases[i][0], 0);
+        p.fusion_acc_wifi_scale = 0.5;
         near(sf_fusion_accuracy_factor(&p, &fx), gnss_cases[i][1]);
+        p.fusion_acc_wifi_scale = 1.0;
     }
     const sf_fix_t lm = fix_at(1.0, sf_fix_landmark, 0.0, 0.0, 0, 0.2, 0);
     assert_true(sf_fusion_accuracy_factor(&p, &lm) == 1.0);

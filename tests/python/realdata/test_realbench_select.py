@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from stridefix import fix_t
+from stridefix import fix_t, pose_t
 from stridefix_analyzer import realbench_select as rs
 from stridefix_analyzer.sitefile import read_site
 
@@ -37,11 +37,28 @@ def test_fix_errors_against_interpolated_truth(tmp_path):
     assert_allclose(err, [3.0, 4.0])
 
 
+def test_pose_errors_are_causal_at_the_waypoints(tmp_path):
+    # poses: uninitialised at 0.5 s, (1,0) at 1 s, (4,4) at 3 s. Waypoints at 0.6 s (no pose yet),
+    # 2 s (latest pose (1,0) against (1,2): 2 m) and 3 s ((4,4) against (1,0): 5 m).
+    path = tmp_path / "fw.lcmlog"
+    log = lcm.EventLog(str(path), "w", overwrite=True)
+    for t, x, y, sigma in ((500_000, 0.0, 0.0, 1e6), (1_000_000, 1.0, 0.0, 2.0),
+                           (3_000_000, 4.0, 4.0, 2.0)):
+        m = pose_t()
+        m.t_us, m.x_m, m.y_m, m.sigma_m, m.scheme = t, x, y, sigma, pose_t.SCHEME_ADAPTIVE
+        log.write_event(t, "POSE", m.encode())
+    log.close()
+    err = rs.pose_errors_m(path, [600_000, 2_000_000, 3_000_000], [[9, 9], [1.0, 2.0], [1.0, 0.0]])
+    assert_allclose(err, [2.0, 5.0])
+
+
 def test_a_user_setting_replaces_the_candidates():
     assert rs.matcher_variants([]) == rs.MATCHER_VARIANTS
     assert rs.matcher_variants(["fingerprint.average_scans=3"]) == {"given": []}
     assert rs.matcher_variants(["fingerprint.powed_beta=3"]) == {"given": []}
     assert rs.matcher_variants(["fusion.gate_sigma=4"]) == rs.MATCHER_VARIANTS
+    assert rs.adaptive_variants(["fusion.acc_wifi_scale=0.3"]) == {"given": []}
+    assert rs.adaptive_variants([]) == rs.ADAPTIVE_VARIANTS
 
 
 def test_too_few_walks_keep_the_firmware_default():
@@ -119,8 +136,14 @@ def test_each_block_takes_the_candidate_with_the_lowest_pooled_error(realbench_e
             assert v["fixes"] > 20 and 0.5 < v["mean_m"] < 50.0  # real fixes, plausible errors
         assert b["chosen"] == min(c, key=lambda n: c[n]["mean_m"])
     # walk i (sorted by name) is in block i mod 4 and replays with that block's choice
+    ad = g["adaptive_selection"]
+    for b in ad["blocks"].values():
+        c = b["candidates"]
+        assert set(c) == set(rs.ADAPTIVE_VARIANTS)
+        assert b["chosen"] == min(c, key=lambda n: c[n]["mean_m"])
     for i, row in enumerate(g["walk_rows"]):
         assert row["fold"]["matcher_variant"] == sel["blocks"][str(i % 4)]["chosen"]
+        assert row["fold"]["adaptive_variant"] == ad["blocks"][str(i % 4)]["chosen"]
 
 
 def test_selection_maps_are_smaller_than_fold_maps(realbench_eight):
