@@ -444,3 +444,11 @@ def read_logs(paths: Iterable[str | os.PathLike], decode: Iterable[str] | None =
     for path in paths:
         _read_file(path, collector)
     return collector.finish()
+
+
+def read_table(path: str | os.PathLike, channel: str) -> Table | None:
+    """One channel of one log (``None`` when it has none), a truncated tail read silently: the
+    stridefixd logs the benchmarks read back may end mid-record when a run is cut short."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LogTruncatedWarning)
+        return read_logs([path], decode=(channel,)).table(channel)

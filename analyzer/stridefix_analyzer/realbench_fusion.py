@@ -48,7 +48,7 @@ import numpy as np
 
 from . import realbench as rb
 from . import realbench_select as rs
-from .logread import LogReadError, LogTruncatedWarning, read_logs
+from .logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 from .radiomap import WalkStats
 
 FORMATS = ("msindoor", "gsd")
@@ -73,7 +73,6 @@ _WIDE_MAG_GATE = ["attitude.mag_field_tol_ut=16", "attitude.mag_dip_tol_deg=16"]
 HEADING_VARIANTS = {"learned": [], "fixed": ["heading.learn_offset=0"],
                     "learned, wide mag gate": _WIDE_MAG_GATE,
                     "fixed, wide mag gate": ["heading.learn_offset=0"] + _WIDE_MAG_GATE}
-_HEADING_KEYS = {kv.split("=", 1)[0] for v in HEADING_VARIANTS.values() for kv in v}
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
 #: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
 DEFAULT_MIN_COUNT = 1
@@ -207,9 +206,7 @@ def learn_rotation_deg(stats: list[dict], exclude: int | None = None) -> float:
 def heading_variants(param_sets) -> dict[str, list[str]]:
     """The heading variants to try: :data:`HEADING_VARIANTS`, or only the user's own choice when
     any of their keys is given with ``--set``."""
-    if any(kv.split("=", 1)[0].strip() in _HEADING_KEYS for kv in param_sets or []):
-        return {"given": []}
-    return dict(HEADING_VARIANTS)
+    return rs.variants_unless_given(param_sets, HEADING_VARIANTS)
 
 
 def choose_heading_variant(per_walk: list[dict], exclude: int | None = None) -> tuple[str, dict]:
@@ -226,6 +223,19 @@ def choose_heading_variant(per_walk: list[dict], exclude: int | None = None) -> 
     finite = {k: v for k, v in score.items() if math.isfinite(v)}
     best = max(finite, key=finite.get) if finite else next(iter(score))
     return best, score
+
+
+def learn_heading(per_walk: list[dict], exclude: int | None = None) -> tuple[str, dict, float]:
+    """:func:`choose_heading_variant` and the map rotation [deg] of that variant (NaN without
+    straight segments), both from the walks but ``exclude``."""
+    variant, score = choose_heading_variant(per_walk, exclude)
+    return variant, score, learn_rotation_deg([r[variant] for r in per_walk], exclude)
+
+
+def stride_k(seg: dict, mask) -> float:
+    """Weinberg K of the segments in ``mask``: Σ true distance / Σ Weinberg sum (NaN when empty)."""
+    w = seg["weinberg"][mask].sum()
+    return float(seg["true_m"][mask].sum() / w) if w > 0 else math.nan
 
 
 def pressure_to_height_m(pressure_pa):
@@ -338,9 +348,7 @@ def prepare(trace, fmt: str, work_dir, cache_dir, stridefixd, max_wifi_age_s: fl
             walk["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
             return walk
         if name != next(iter(variants)):
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", LogTruncatedWarning)
-                st = read_logs([fw_log], decode=("STEP",)).table("STEP")
+            st = read_table(fw_log, "STEP")
             headings[name] = (st["t_us"], st["heading_rad"]) if st is not None else None
     fw_log = fw_dir / f"{trace.stem}.{next(iter(variants))}.lcmlog"
     try:
@@ -406,9 +414,7 @@ def fold_site(total, held, *, name: str, rotation_deg: float, floor_heights_m, l
 
 
 def _first_fix_floor(fw_log: Path) -> int | None:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", LogTruncatedWarning)
-        fix = read_logs([fw_log], decode=("FIX",)).table("FIX")
+    fix = read_table(fw_log, "FIX")
     if fix is None or not len(fix):
         return None
     ok = fix["n_ap_used"] > 0
@@ -635,33 +641,32 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
         total = WalkStats.total([w["stats"] for w in sub])
         totals[g["label"]] = total
         rot_stats = [w["rotation"] for w in sub]
-        info["K_all_walks"] = float(seg["true_m"][used].sum() / seg["weinberg"][used].sum()) \
-            if seg["weinberg"][used].sum() > 0 else math.nan
-        best_all, score_all = choose_heading_variant(rot_stats)
-        info["heading_variant_all_walks"] = best_all
-        info["heading_resultant_all_walks"] = score_all
-        info["rotation_all_walks_deg"] = learn_rotation_deg([r[best_all] for r in rot_stats])
+        info["K_all_walks"] = stride_k(seg, used)
+        (info["heading_variant_all_walks"], info["heading_resultant_all_walks"],
+         info["rotation_all_walks_deg"]) = learn_heading(rot_stats)
         candidates = rs.matcher_variants(param_sets)
         sel_prog = _Progress("choose matcher", rs.n_tasks(len(sub), len(candidates)), stream)
 
+        built_sites: dict[str, list[str]] = {}
+
         def build_site(removed, others, name, path, total=total, sub=sub, seg=seg, used=used,
-                       rot_stats=rot_stats):
-            """A selection site and the settings learned with it, from ``others`` only."""
+                       rot_stats=rot_stats, built=built_sites):
+            """A selection site and the settings learned with it, from ``others`` only. Both
+            selection stages use the same block pairs: each site is written once."""
+            if str(path) in built:
+                return built[str(path)]
             from .sitefile import write_site
             idx = [j for j, w in enumerate(sub) if any(w is o for o in others)]
             heights, _, lowest = fold_floors(others, [])
-            stats = [rot_stats[j] for j in idx]
-            variant, _ = choose_heading_variant(stats)
-            rot = learn_rotation_deg([r[variant] for r in stats])
+            variant, _, rot = learn_heading([rot_stats[j] for j in idx])
             write_site(path, fold_site(total, removed, name=name,
                                        rotation_deg=rot if math.isfinite(rot) else 0.0,
                                        floor_heights_m=heights, lowest_floor=lowest,
                                        min_count=min_count)[0])
-            mine = used & np.isin(seg["walk"], idx)
-            k = seg["true_m"][mine].sum() / seg["weinberg"][mine].sum() \
-                if seg["weinberg"][mine].sum() > 0 else math.nan
-            return heading_variants(param_sets)[variant] + \
+            k = stride_k(seg, used & np.isin(seg["walk"], idx))
+            built[str(path)] = heading_variants(param_sets)[variant] + \
                 ([f"stride.weinberg_k={k:.6f}"] if math.isfinite(k) else [])
+            return built[str(path)]
 
         matcher, info["matcher_selection"] = rs.select(
             sub, build_site, stridefixd=stridefixd, work_dir=g["work"] / "select",
@@ -677,8 +682,7 @@ def run_fusion(fmt: str, dirs, out_json, stridefixd=rb.DEFAULT_STRIDEFIXD, limit
             block_sets={a: candidates[n] for a, n in chosen.items()})
         for j, i in enumerate(ok):
             others = [w for jj, w in enumerate(sub) if jj != j]
-            variant, variant_score = choose_heading_variant(rot_stats, exclude=j)
-            rot = learn_rotation_deg([r[variant] for r in rot_stats], exclude=j)
+            variant, variant_score, rot = learn_heading(rot_stats, exclude=j)
             heights, src, lowest = fold_floors(others, sub[j]["floors"])
             fold_jobs.append({
                 "index": i, "walk": walks[i]["walk"], "group": g["label"],

@@ -27,12 +27,11 @@ from __future__ import annotations
 import concurrent.futures
 import math
 import subprocess
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .logread import LogTruncatedWarning, read_logs
+from .logread import read_table
 
 #: candidates, as stridefixd --set arguments; the first is the firmware default. Scans averaged
 #: (1 or 2) × WkNN representation (dBm, or "powed" with beta 2 or e — Torres-Sospedra 2015's choice)
@@ -41,12 +40,10 @@ _REPRESENTATION = {"dBm": [], "powed 2": ["fingerprint.powed_beta=2"],
                    "powed e": ["fingerprint.powed_beta=2.718281828"]}
 MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items()
                     for r, sr in _REPRESENTATION.items()}
-_MATCHER_KEYS = {kv.split("=", 1)[0] for v in MATCHER_VARIANTS.values() for kv in v}
 #: the adaptive scheme's Wi-Fi accuracy factors (a table on the AP count, AADR 2015) times a scale:
 #: chosen second, with the block's matcher, on the adaptive POSE error at the waypoints
 ADAPTIVE_VARIANTS = {"table x 1": [], "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
                      "table x 0.25": ["fusion.acc_wifi_scale=0.25"]}
-_ADAPTIVE_KEYS = {"fusion.acc_wifi_scale"}
 #: what each stage replays (--fusion) and scores
 STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
 DEFAULT_BLOCKS = 4
@@ -54,28 +51,29 @@ DEFAULT_BLOCKS = 4
 MIN_WALKS = 6
 
 
-def _variants(param_sets, table, keys) -> dict[str, list[str]]:
+def variants_unless_given(param_sets, table: dict[str, list[str]]) -> dict[str, list[str]]:
+    """The candidates of ``table`` ({name: ["key=value", ...]}), or only ``{"given": []}`` when the
+    user's ``--set`` list already sets one of the keys they vary (the user's choice wins)."""
+    keys = {kv.split("=", 1)[0] for sets in table.values() for kv in sets}
     if any(kv.split("=", 1)[0].strip() in keys for kv in param_sets or []):
         return {"given": []}
     return dict(table)
 
 
 def matcher_variants(param_sets) -> dict[str, list[str]]:
-    """The candidates, or only the user's own choice when ``--set`` gives one of their keys."""
-    return _variants(param_sets, MATCHER_VARIANTS, _MATCHER_KEYS)
+    """The matcher candidates, or only the user's own choice when ``--set`` gives one of their keys."""
+    return variants_unless_given(param_sets, MATCHER_VARIANTS)
 
 
 def adaptive_variants(param_sets) -> dict[str, list[str]]:
     """The adaptive scheme's candidates, or the user's own ``fusion.acc_wifi_scale``."""
-    return _variants(param_sets, ADAPTIVE_VARIANTS, _ADAPTIVE_KEYS)
+    return variants_unless_given(param_sets, ADAPTIVE_VARIANTS)
 
 
 def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
     """2-D error [m] of every Wi-Fi fix of a stridefixd log (one per scan) against the truth
     interpolated linearly between waypoints; fixes outside the truth span are left out."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", LogTruncatedWarning)
-        fix = read_logs([fw_log], decode=("FIX",)).table("FIX")
+    fix = read_table(fw_log, "FIX")
     wp_t_us = np.asarray(wp_t_us, np.int64)
     wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
     if fix is None or not len(fix) or len(wp_t_us) < 2:
@@ -91,9 +89,7 @@ def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
 def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
     """2-D error [m] at each waypoint of the latest POSE at or before it (causal, as realbench scores;
     the log holds one scheme); waypoints before the first pose are left out."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", LogTruncatedWarning)
-        pose = read_logs([fw_log], decode=("POSE",)).table("POSE")
+    pose = read_table(fw_log, "POSE")
     wp_t_us = np.asarray(wp_t_us, np.int64)
     wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
     if pose is None or not len(pose):
