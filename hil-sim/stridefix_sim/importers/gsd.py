@@ -46,12 +46,12 @@ import dataclasses
 import math
 import os
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .msindoor import DEFAULT_MAX_WIFI_AGE_S, MalformedLineWarning, _dedupe_sorted, bssid_to_int
+from .lines import LineReader, MalformedLineWarning
+from .msindoor import DEFAULT_MAX_WIFI_AGE_S, _dedupe_sorted, bssid_to_int
 
 __all__ = ["GsdLog", "LogReadError", "LogHeaderError", "MalformedLineWarning", "read_log",
            "write_lcmlog", "import_log", "import_trace", "project", "parse_origin"]
@@ -271,80 +271,59 @@ def read_log(path, origin: tuple[float, float] | None = None,
     LogHeaderError
         The header declares a pressure unit that cannot be converted to Pa.
     """
-    path = os.fspath(path)
-    if not os.path.exists(path):
-        raise LogReadError(path, "no such file")
-    if not os.path.isfile(path):
-        raise LogReadError(path, "not a regular file")
+    reader = LineReader(path, LogReadError, max_line_warnings)
+    path = reader.path
     inertial = {k: [] for k in _INERTIAL}      # (app, sensor, x, y, z)
     pres, gnss, wifi, posi = [], [], [], []
     header_lines: list[tuple[int, str]] = []
     header: dict[str, str] = {}
-    skipped: list[tuple[int, str]] = []
-    ignored: dict[str, int] = {}
-    n_lines = 0
-
-    def bad(line_no: int, reason: str) -> None:
-        skipped.append((line_no, reason))
-        if len(skipped) <= max_line_warnings:
-            warnings.warn(f"{path}:{line_no}: skipped malformed line ({reason})",
-                          MalformedLineWarning, stacklevel=3)
-
-    try:
-        with open(path, "r", encoding="utf-8", errors="replace", newline="") as f:
-            for line_no, line in enumerate(f, 1):
-                n_lines += 1
-                line = line.rstrip("\r\n")
-                if not line.strip():
-                    continue
-                if line.startswith("%"):
-                    header_lines.append((line_no, line))
-                    key, sep, value = line[1:].partition(":")
-                    if sep and key.strip() in ("Manufacturer", "Model", "API Android version",
-                                               "Android version Release"):
-                        header[key.strip()] = value.strip()
-                    continue
-                parts = line.split(";")
-                kind = parts[0]
-                if kind not in _FIELDS:
-                    if _TAG_RE.match(kind) and len(parts) > 1:
-                        ignored[kind] = ignored.get(kind, 0) + 1
-                    else:
-                        bad(line_no, f"unknown record type {kind[:40]!r}")
-                    continue
-                n = _FIELDS[kind]
-                if len(parts) > n and parts[-1] == "":
-                    parts.pop()                 # a trailing ';' (the header writes WIFI and POSI so)
-                if len(parts) != n and not (kind == "WIFI" and len(parts) > n):
-                    bad(line_no, f"{kind} with {len(parts)} fields, expected {n}")
-                    continue
-                try:
-                    if kind in inertial:
-                        inertial[kind].append(_finite(parts[1:6]))
-                    elif kind == "PRES":
-                        pres.append(_finite(parts[1:4]))
-                    elif kind == "GNSS":
-                        app, sensor, lat, lon, alt = _finite(parts[1:6])
-                        acc = _finite(parts[7:8])[0]
-                        if not (-90 <= lat <= 90 and -180 <= lon <= 180):
-                            raise ValueError(f"latitude/longitude {lat}, {lon} out of range")
-                        gnss.append((app, sensor, lat, lon, alt, acc))
-                    elif kind == "WIFI":
-                        app, sensor = _finite(parts[1:3])
-                        wifi.append((app, sensor, bssid_to_int(parts[-3].strip()),
-                                     _finite(parts[-1:])[0], int(parts[-2])))
-                    else:   # POSI
-                        app, lat, lon = _finite([parts[1], parts[3], parts[4]])
-                        if not (-90 <= lat <= 90 and -180 <= lon <= 180):
-                            raise ValueError(f"latitude/longitude {lat}, {lon} out of range")
-                        posi.append((app, lat, lon, int(parts[5]), parts[6].strip()))
-                except ValueError as exc:
-                    bad(line_no, f"{kind}: {exc}")
-    except OSError as exc:
-        raise LogReadError(path, f"cannot read ({exc.strerror or exc})") from exc
-    if len(skipped) > max_line_warnings:
-        warnings.warn(f"{path}: {len(skipped) - max_line_warnings} more malformed line(s) skipped "
-                      f"({len(skipped)} in all)", MalformedLineWarning, stacklevel=2)
+    bad = reader.bad
+    for line_no, line in reader.lines():
+        if line.startswith("%"):
+            header_lines.append((line_no, line))
+            key, sep, value = line[1:].partition(":")
+            if sep and key.strip() in ("Manufacturer", "Model", "API Android version",
+                                       "Android version Release"):
+                header[key.strip()] = value.strip()
+            continue
+        parts = line.split(";")
+        kind = parts[0]
+        if kind not in _FIELDS:
+            if _TAG_RE.match(kind) and len(parts) > 1:
+                reader.ignore(kind)
+            else:
+                bad(line_no, f"unknown record type {kind[:40]!r}")
+            continue
+        n = _FIELDS[kind]
+        if len(parts) > n and parts[-1] == "":
+            parts.pop()                 # a trailing ';' (the header writes WIFI and POSI so)
+        if len(parts) != n and not (kind == "WIFI" and len(parts) > n):
+            bad(line_no, f"{kind} with {len(parts)} fields, expected {n}")
+            continue
+        try:
+            if kind in inertial:
+                inertial[kind].append(_finite(parts[1:6]))
+            elif kind == "PRES":
+                pres.append(_finite(parts[1:4]))
+            elif kind == "GNSS":
+                app, sensor, lat, lon, alt = _finite(parts[1:6])
+                acc = _finite(parts[7:8])[0]
+                if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+                    raise ValueError(f"latitude/longitude {lat}, {lon} out of range")
+                gnss.append((app, sensor, lat, lon, alt, acc))
+            elif kind == "WIFI":
+                app, sensor = _finite(parts[1:3])
+                wifi.append((app, sensor, bssid_to_int(parts[-3].strip()),
+                             _finite(parts[-1:])[0], int(parts[-2])))
+            else:   # POSI
+                app, lat, lon = _finite([parts[1], parts[3], parts[4]])
+                if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+                    raise ValueError(f"latitude/longitude {lat}, {lon} out of range")
+                posi.append((app, lat, lon, int(parts[5]), parts[6].strip()))
+        except ValueError as exc:
+            bad(line_no, f"{kind}: {exc}")
+    reader.finish()
+    skipped, ignored, n_lines = reader.skipped, reader.ignored, reader.n_lines
 
     notes: list[str] = []
     pa_per_unit, unit, _ = _header_units(header_lines, path)

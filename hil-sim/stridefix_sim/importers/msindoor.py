@@ -35,10 +35,11 @@ import dataclasses
 import math
 import os
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
+
+from .lines import LineReader, MalformedLineWarning
 
 #: Bump when the log content for the same input changes (caches compare it).
 IMPORTER_VERSION = 1
@@ -71,8 +72,6 @@ class TraceHeaderError(TraceReadError):
     """The trace's header lacks what the import needs (e.g. an unknown FloorName)."""
 
 
-class MalformedLineWarning(UserWarning):
-    """A line of a trace was skipped; the message names the file and line."""
 
 
 def floor_index(name: str) -> int:
@@ -218,72 +217,51 @@ def read_trace(path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int 
     TraceHeaderError
         No usable FloorName header and ``floor`` not given.
     """
-    path = os.fspath(path)
-    if not os.path.exists(path):
-        raise TraceReadError(path, "no such file")
-    if not os.path.isfile(path):
-        raise TraceReadError(path, "not a regular file")
+    reader = LineReader(path, TraceReadError, max_line_warnings)
+    path = reader.path
     samples = {"accel": [], "gyro": [], "mag": []}
     wifi: dict[int, list] = {}
     waypoints = []
     header: dict[str, str] = {}
-    skipped: list[tuple[int, str]] = []
-    ignored: dict[str, int] = {}
-    n_lines = 0
-
-    def bad(line_no: int, reason: str) -> None:
-        skipped.append((line_no, reason))
-        if len(skipped) <= max_line_warnings:
-            warnings.warn(f"{path}:{line_no}: skipped malformed line ({reason})",
-                          MalformedLineWarning, stacklevel=3)
-
-    try:
-        with open(path, "r", encoding="utf-8", errors="replace", newline="") as f:
-            for line_no, line in enumerate(f, 1):
-                n_lines += 1
-                line = line.rstrip("\r\n")
-                if not line.strip():
-                    continue
-                if line.startswith("#"):
-                    for token in line[1:].split("\t"):
-                        key, sep, value = token.strip().partition(":")
-                        if sep:
-                            header[key] = value
-                    continue
-                parts = line.split("\t")
-                if line.count("\tTYPE_") > 1:
-                    bad(line_no, f"{line.count(chr(9) + 'TYPE_')} records run together")
-                    continue
-                if len(parts) < 2 or not parts[0].isdigit():
-                    bad(line_no, "no unix-ms time in the first field")
-                    continue
-                kind = parts[1]
-                if kind not in _FIELDS:
-                    if kind.startswith("TYPE_"):
-                        ignored[kind] = ignored.get(kind, 0) + 1
-                    else:
-                        bad(line_no, f"unknown record type {kind[:40]!r}")
-                    continue
-                if len(parts) != _FIELDS[kind]:
-                    bad(line_no, f"{kind} with {len(parts)} fields, expected {_FIELDS[kind]}")
-                    continue
-                t_ms = int(parts[0])
-                try:
-                    if kind == "TYPE_WIFI":
-                        entry = (bssid_to_int(parts[3]), _finite(parts[4:5])[0],
-                                 int(parts[5]), int(parts[6]))
-                        wifi.setdefault(t_ms, []).append(entry)
-                    elif kind == "TYPE_WAYPOINT":
-                        waypoints.append((t_ms, *_finite(parts[2:4])))
-                    else:
-                        samples[_SENSOR_TYPES[kind]].append((t_ms, *_finite(parts[2:5])))
-                except ValueError as exc:
-                    bad(line_no, f"{kind}: {exc}")
-    except OSError as exc:
-        raise TraceReadError(path, f"cannot read ({exc.strerror or exc})") from exc
-    if len(skipped) > max_line_warnings:
-        warnings.warn(f"{path}: {len(skipped) - max_line_warnings} more malformed line(s) skipped "
-                      f"({len(skipped)} in all)", MalformedLineWarning, stacklevel=2)
+    bad = reader.bad
+    for line_no, line in reader.lines():
+        if line.startswith("#"):
+            for token in line[1:].split("\t"):
+                key, sep, value = token.strip().partition(":")
+                if sep:
+                    header[key] = value
+            continue
+        parts = line.split("\t")
+        if line.count("\tTYPE_") > 1:
+            bad(line_no, f"{line.count(chr(9) + 'TYPE_')} records run together")
+            continue
+        if len(parts) < 2 or not parts[0].isdigit():
+            bad(line_no, "no unix-ms time in the first field")
+            continue
+        kind = parts[1]
+        if kind not in _FIELDS:
+            if kind.startswith("TYPE_"):
+                reader.ignore(kind)
+            else:
+                bad(line_no, f"unknown record type {kind[:40]!r}")
+            continue
+        if len(parts) != _FIELDS[kind]:
+            bad(line_no, f"{kind} with {len(parts)} fields, expected {_FIELDS[kind]}")
+            continue
+        t_ms = int(parts[0])
+        try:
+            if kind == "TYPE_WIFI":
+                entry = (bssid_to_int(parts[3]), _finite(parts[4:5])[0],
+                         int(parts[5]), int(parts[6]))
+                wifi.setdefault(t_ms, []).append(entry)
+            elif kind == "TYPE_WAYPOINT":
+                waypoints.append((t_ms, *_finite(parts[2:4])))
+            else:
+                samples[_SENSOR_TYPES[kind]].append((t_ms, *_finite(parts[2:5])))
+        except ValueError as exc:
+            bad(line_no, f"{kind}: {exc}")
+    reader.finish()
+    skipped, ignored, n_lines = reader.skipped, reader.ignored, reader.n_lines
 
     floor_name = header.get("FloorName", "")
     if floor is None:
