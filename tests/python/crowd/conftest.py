@@ -1,7 +1,6 @@
 """Fixtures for the crowdsourced-model tests: hand-made scans, synthetic pairs, short SIL walks."""
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -9,19 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-REPO = Path(__file__).resolve().parents[3]
 NAN = np.nan
-
-
-def run_cli(*args: str) -> subprocess.CompletedProcess:
-    """The `stridefix` console script of this venv."""
-    exe = Path(sys.executable).with_name("stridefix")
-    return subprocess.run([str(exe), *args], capture_output=True, text=True)
-
-
-@pytest.fixture(scope="session")
-def cli():
-    return run_cli
 
 
 @pytest.fixture
@@ -47,14 +34,6 @@ def random_scans():
     xy = rng.uniform(0, 50, size=(40, 2))
     floor = (np.arange(40) % 3 == 0).astype(np.int64)
     return R, xy, floor
-
-
-@pytest.fixture(scope="session")
-def stridefixd() -> Path:
-    path = Path(os.environ.get("STRIDEFIXD", REPO / "build" / "firmware" / "stridefixd"))
-    if not path.is_file():
-        pytest.fail(f"stridefixd not built at {path}: run `make build` first")
-    return path
 
 
 @pytest.fixture(scope="session")

@@ -2,9 +2,6 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -62,27 +59,6 @@ def real_trace() -> Path:
         pytest.skip(f"real msindoor data not found at {REAL_TRACE} (needs ../shared/data beside "
                     "the repository)")
     return REAL_TRACE
-
-
-@pytest.fixture(scope="session")
-def stridefixd() -> Path:
-    """The firmware binary built by CMake (make test passes its path in STRIDEFIXD)."""
-    path = Path(os.environ.get("STRIDEFIXD", REPO / "build" / "firmware" / "stridefixd"))
-    if not path.is_file():
-        pytest.fail(f"stridefixd not built at {path}: run `make build` first")
-    return path
-
-
-def run_cli(*args: str, **kwargs) -> subprocess.CompletedProcess:
-    """Runs the `stridefix` console script of this venv."""
-    exe = Path(sys.executable).with_name("stridefix")
-    return subprocess.run([str(exe), *args], capture_output=True, text=True, **kwargs)
-
-
-@pytest.fixture(scope="session")
-def cli():
-    """The `stridefix` console script, as a function of its arguments."""
-    return run_cli
 
 
 @pytest.fixture(scope="session")
