@@ -1,5 +1,5 @@
 /* sf_test_gait.h — synthetic gravity-aligned vertical acceleration of a walker, with a seeded RNG,
- * for test_steps.c and test_activity.c (header-only: static inline functions).
+ * for test_steps.c and test_activity.c (header-only: static inline functions; the RNG is sf_test_rng.h).
  *
  * Waveform of step k (heel strike at t_k, period P_k, amplitude A_k):
  *   - heel strike: a sharp Gaussian spike A_k · exp(−½ ((t − t_k)/σ)²), σ = 40 ms (spikes of the
@@ -17,35 +17,11 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "sf_test_rng.h"
+
 #define GAIT_PI 3.14159265358979323846
 #define GAIT_MAX_STEPS 400
 #define GAIT_SPIKE_S 0.040
-
-/* ---- seeded noise (xorshift64* + Box-Muller), the same on every platform ---- */
-typedef struct {
-    uint64_t s;
-} rng_t;
-
-static inline double rng_uniform01(rng_t *const r)
-{
-    r->s ^= r->s >> 12;
-    r->s ^= r->s << 25;
-    r->s ^= r->s >> 27;
-    return (double)((r->s * 2685821657736338717ULL) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/* uniform in [−1, 1) */
-static inline double rng_pm1(rng_t *const r)
-{
-    return 2.0 * rng_uniform01(r) - 1.0;
-}
-
-static inline double rng_gauss(rng_t *const r)
-{
-    const double u1 = rng_uniform01(r) + 1e-300;
-    const double u2 = rng_uniform01(r);
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * GAIT_PI * u2);
-}
 
 typedef struct {
     const char *name;

@@ -16,28 +16,13 @@
 
 #include "sf_attitude.h"
 #include "sf_params.h"
+#include "sf_test_rng.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
 #define G 9.80665
 
-/* ---- seeded noise (xorshift64* + Box-Muller), the same on every platform ---- */
-static uint64_t g_rng;
-
-static double uniform01(void)
-{
-    g_rng ^= g_rng >> 12;
-    g_rng ^= g_rng << 25;
-    g_rng ^= g_rng >> 27;
-    return (double)((g_rng * 2685821657736338717ULL) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double gauss(void)
-{
-    const double u1 = uniform01() + 1e-300;
-    const double u2 = uniform01();
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * PI * u2);
-}
+static rng_t g_rng; /* seeded per test (sf_test_rng.h) */
 
 /* ---- quaternion helpers (w, x, y, z), body → nav ---- */
 static void qmul(const double a[4], const double b[4], double o[4])
@@ -158,7 +143,7 @@ static void field_nav(const scenario_t *const s, const double t, double m[3])
 
 static double next_interval(const double hz, const double jitter)
 {
-    return (1.0 / hz) * (1.0 + jitter * (2.0 * uniform01() - 1.0));
+    return (1.0 / hz) * (1.0 + jitter * (2.0 * rng_uniform01(&g_rng) - 1.0));
 }
 
 static result_t run(const scenario_t *const s, const uint64_t seed)
@@ -172,7 +157,7 @@ static result_t run(const scenario_t *const s, const uint64_t seed)
     if (s->dip_tol_deg > 0) {
         p.attitude_mag_dip_tol_deg = s->dip_tol_deg;
     }
-    g_rng = seed;
+    g_rng.s = seed;
     result_t r;
     memset(&r, 0, sizeof r);
     sf_attitude_init(&r.att);
@@ -206,8 +191,8 @@ static result_t run(const scenario_t *const s, const uint64_t seed)
                 double f[3], w[3];
                 qrot(q, 1, f_nav, f);
                 for (int i = 0; i < 3; i++) {
-                    f[i] += s->accel_noise * gauss();
-                    w[i] = (in_wrong ? 0.0 : w_body[i]) + s->bias_radps[i] + s->gyro_noise * gauss();
+                    f[i] += s->accel_noise * rng_gauss(&g_rng);
+                    w[i] = (in_wrong ? 0.0 : w_body[i]) + s->bias_radps[i] + s->gyro_noise * rng_gauss(&g_rng);
                 }
                 sf_attitude_update_imu(&r.att, &p, t_us, f, w);
             }
@@ -218,7 +203,7 @@ static result_t run(const scenario_t *const s, const uint64_t seed)
                 field_nav(s, t, m_nav);
                 qrot(q, 1, m_nav, m);
                 for (int i = 0; i < 3; i++) {
-                    m[i] += s->mag_noise * gauss();
+                    m[i] += s->mag_noise * rng_gauss(&g_rng);
                 }
                 sf_attitude_update_mag(&r.att, &p, t_us, m);
             }

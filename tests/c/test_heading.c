@@ -22,6 +22,7 @@
 #include "sf_attitude.h"
 #include "sf_heading.h"
 #include "sf_params.h"
+#include "sf_test_rng.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -34,23 +35,7 @@
 #define SWAY_MPS2 0.6 /* lateral, half the step rate */
 #define NOISE_MPS2 0.15
 
-/* ---- seeded noise (xorshift64* + Box-Muller), the same on every platform ---- */
-static uint64_t g_rng;
-
-static double uniform01(void)
-{
-    g_rng ^= g_rng >> 12;
-    g_rng ^= g_rng << 25;
-    g_rng ^= g_rng >> 27;
-    return (double)((g_rng * 2685821657736338717ULL) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double gauss(void)
-{
-    const double u1 = uniform01() + 1e-300;
-    const double u2 = uniform01();
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * PI * u2);
-}
+static rng_t g_rng; /* seeded per test (sf_test_rng.h) */
 
 static double wrap(const double a)
 {
@@ -89,9 +74,9 @@ static void gait_accel(const gait_t *const g, const double t, const double psi, 
     const double a_up = -Z_M * w * w * cos(ph);
     const double a_f = g->pendulum_sign * B_MPS * w * sin(ph) + HARM_MPS2 * sin(2 * ph + 0.7);
     const double a_l = SWAY_MPS2 * sin(0.5 * ph + 0.3);
-    a[0] = a_f * cos(psi) - a_l * sin(psi) + 0.10 + NOISE_MPS2 * gauss();
-    a[1] = a_f * sin(psi) + a_l * cos(psi) - 0.05 + NOISE_MPS2 * gauss();
-    a[2] = G + a_up + NOISE_MPS2 * gauss();
+    a[0] = a_f * cos(psi) - a_l * sin(psi) + 0.10 + NOISE_MPS2 * rng_gauss(&g_rng);
+    a[1] = a_f * sin(psi) + a_l * cos(psi) - 0.05 + NOISE_MPS2 * rng_gauss(&g_rng);
+    a[2] = G + a_up + NOISE_MPS2 * rng_gauss(&g_rng);
 }
 
 static gait_result_t walk(const gait_t *const g, const uint64_t seed)
@@ -102,7 +87,7 @@ static gait_result_t walk(const gait_t *const g, const uint64_t seed)
     r.p.heading_map_rotation_deg = g->map_rotation_deg;
     r.p.heading_mount_offset_deg = g->mount_offset_deg;
     sf_heading_init(&r.h, &r.p);
-    g_rng = seed;
+    g_rng.s = seed;
     const double lead_s = 0.4; /* the detector fires 0.1 s after the lowest point (φ = π) */
     int steps = 0;
     double t = 0.0;
@@ -110,7 +95,7 @@ static gait_result_t walk(const gait_t *const g, const uint64_t seed)
         const double psi = walk_dir(g, STEP_HZ * t);
         double a[3];
         gait_accel(g, t, psi, a);
-        const double yaw = wrap(psi - g->offset_deg * DEG + 1.0 * DEG * gauss());
+        const double yaw = wrap(psi - g->offset_deg * DEG + 1.0 * DEG * rng_gauss(&g_rng));
         const int64_t t_us = 2000000 + (int64_t)llround(t * 1e6);
         sf_heading_update(&r.h, &r.p, t_us, a, yaw);
         r.last_yaw = yaw;
@@ -119,7 +104,7 @@ static gait_result_t walk(const gait_t *const g, const uint64_t seed)
             sf_heading_on_step(&r.h, &r.p, t_us);
             steps++;
         }
-        t += (1.0 / g->imu_hz) * (1.0 + g->jitter * (2 * uniform01() - 1));
+        t += (1.0 / g->imu_hz) * (1.0 + g->jitter * (2 * rng_uniform01(&g_rng) - 1));
     }
     return r;
 }
@@ -299,7 +284,7 @@ static void test_chain_attitude_to_heading(void **state)
             sf_attitude_init(&att);
             sf_heading_t h;
             sf_heading_init(&h, &p);
-            g_rng = 61;
+            g_rng.s = 61;
             /* body → nav: Rz(device yaw) ⊗ tilt; the tilt axis is body-fixed, so yaw is about nav z */
             double q_tilt[4], q_yaw[4], q[4];
             qaxis(0.3, 1, 0, 35 * DEG, q_tilt);
@@ -316,20 +301,20 @@ static void test_chain_attitude_to_heading(void **state)
                 double a_nav[3], f[3], w[3], m[3];
                 gait_accel(&g, t, g.walk_deg * DEG, a_nav);
                 if (t < 2.0) { /* standing first: the filters settle */
-                    a_nav[0] = NOISE_MPS2 * gauss();
-                    a_nav[1] = NOISE_MPS2 * gauss();
-                    a_nav[2] = G + NOISE_MPS2 * gauss();
+                    a_nav[0] = NOISE_MPS2 * rng_gauss(&g_rng);
+                    a_nav[1] = NOISE_MPS2 * rng_gauss(&g_rng);
+                    a_nav[2] = G + NOISE_MPS2 * rng_gauss(&g_rng);
                 }
                 qrot_t(q, a_nav, f);
                 for (int j = 0; j < 3; j++) {
-                    w[j] = zero[j] + 0.003 * gauss(); /* held steady: walking straight */
+                    w[j] = zero[j] + 0.003 * rng_gauss(&g_rng); /* held steady: walking straight */
                 }
                 const int64_t t_us = 1000000 + (int64_t)k * 10000;
                 sf_attitude_update_imu(&att, &p, t_us, f, w);
                 if (k % 2 == 0) {
                     qrot_t(q, m_nav, m);
                     for (int j = 0; j < 3; j++) {
-                        m[j] += 0.4 * gauss();
+                        m[j] += 0.4 * rng_gauss(&g_rng);
                     }
                     sf_attitude_update_mag(&att, &p, t_us + 2000, m);
                 }

@@ -28,6 +28,7 @@
 #include "sf_estimator.h"
 #include "sf_magcal.h"
 #include "sf_params.h"
+#include "sf_test_rng.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -36,23 +37,7 @@
 #define DIP_RAD (60.0 * DEG)
 #define MAG_HZ 50.0
 
-/* ---- seeded noise (xorshift64* + Box-Muller), the same on every platform ---- */
-static uint64_t g_rng;
-
-static double uniform01(void)
-{
-    g_rng ^= g_rng >> 12;
-    g_rng ^= g_rng << 25;
-    g_rng ^= g_rng >> 27;
-    return (double)((g_rng * 2685821657736338717ULL) >> 11) * (1.0 / 9007199254740992.0);
-}
-
-static double gauss(void)
-{
-    const double u1 = uniform01() + 1e-300;
-    const double u2 = uniform01();
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * PI * u2);
-}
+static rng_t g_rng; /* seeded per test (sf_test_rng.h) */
 
 /* v_body = Rᵀ v_nav, R = Rz(yaw) Ry(pitch) Rx(roll). */
 static void nav_to_body(const double v[3], const double yaw, const double pitch, const double roll, double out[3])
@@ -86,7 +71,7 @@ static void measure(const double yaw, const double pitch, const double roll, con
     field_nav(s, mn);
     nav_to_body(mn, yaw, pitch, roll, m);
     for (int i = 0; i < 3; i++) {
-        m[i] += b[i] + sigma_ut * gauss();
+        m[i] += b[i] + sigma_ut * rng_gauss(&g_rng);
     }
 }
 
@@ -154,7 +139,7 @@ static void print_cal(const char *what, const sf_magcal_t *cal)
 static void test_level_turning_horizontal_recovered_vertical_held(void **state)
 {
     (void)state;
-    g_rng = 0x5EED0001ULL;
+    g_rng.s = 0x5EED0001ULL;
     const sf_params_t p = defaults();
     sf_magcal_t cal;
     sf_magcal_init(&cal, &p);
@@ -187,7 +172,7 @@ static void test_level_turning_horizontal_recovered_vertical_held(void **state)
 static void test_tumbling_all_components(void **state)
 {
     (void)state;
-    g_rng = 0x5EED0002ULL;
+    g_rng.s = 0x5EED0002ULL;
     const sf_params_t p = defaults();
     sf_magcal_t cal;
     sf_magcal_init(&cal, &p);
@@ -212,7 +197,7 @@ static void test_tumbling_all_components(void **state)
 static void test_ridge_shrinks_as_documented(void **state)
 {
     (void)state;
-    g_rng = 0x5EED0003ULL;
+    g_rng.s = 0x5EED0003ULL;
     sf_params_t p = defaults();
     p.magcal_ridge_ut = FIELD_UT * cos(DIP_RAD) / sqrt(2.0);
     sf_magcal_t cal;
@@ -259,7 +244,7 @@ static void test_disturbance_zones_are_gated(void **state)
     const double zone_len_s = 0.2 * LOOP_S;
     sf_params_t p = defaults();
     sf_magcal_t cal;
-    g_rng = 0x5EED0004ULL;
+    g_rng.s = 0x5EED0004ULL;
     const double frac = run_square(&cal, &p, b, 15, zone_len_s);
     print_cal("zones, gated", &cal);
     printf("  disturbed fraction %.3f\n", frac);
@@ -272,7 +257,7 @@ static void test_disturbance_zones_are_gated(void **state)
     assert_true(cal.restarts >= 1); /* the walk starts in the zone: the first fit was inconsistent */
 
     p.magcal_gate_ut = 1e6; /* control: no gating */
-    g_rng = 0x5EED0004ULL;
+    g_rng.s = 0x5EED0004ULL;
     (void)run_square(&cal, &p, b, 15, zone_len_s);
     print_cal("zones, gate off", &cal);
     const double err_off = hypot(cal.offset_ut[0] - b[0], cal.offset_ut[1] - b[1]);
@@ -285,7 +270,7 @@ static void test_disturbance_zones_are_gated(void **state)
 static void test_walking_straight_no_update(void **state)
 {
     (void)state;
-    g_rng = 0x5EED0005ULL;
+    g_rng.s = 0x5EED0005ULL;
     const sf_params_t p = defaults();
     sf_magcal_t cal;
     sf_magcal_init(&cal, &p);
@@ -310,7 +295,7 @@ static void test_walking_straight_no_update(void **state)
 static void test_bound_bad_input_and_disable(void **state)
 {
     (void)state;
-    g_rng = 0x5EED0006ULL;
+    g_rng.s = 0x5EED0006ULL;
     sf_params_t p = defaults();
     p.magcal_max_offset_ut = 2.0;
     sf_magcal_t cal;
@@ -372,7 +357,7 @@ static uint64_t fnv(uint64_t h, const void *data, const size_t n)
  * (2.5 m/s² at 1.8 Hz) and the yaw rate; mag at 50 Hz with offset b and 0.3 µT noise. */
 static est_result_t run_estimator_square(const int enable, const int n_loops)
 {
-    g_rng = 0x5EED0007ULL;
+    g_rng.s = 0x5EED0007ULL;
     sf_params_t p = defaults();
     p.magcal_enable = enable;
     static sf_estimator_t est; /* static: keeps the test's stack small; re-initialised here */
@@ -389,7 +374,7 @@ static est_result_t run_estimator_square(const int enable, const int n_loops)
         const double yaw = square_yaw(t, &leg, &tl);
         const double yaw_rate = leg < 0 ? 0.5 * PI / TURN_S : 0.0;
         sf_imu_sample_t s = {.t_us = (int64_t)llround(t * 1e6)};
-        const double f_nav[3] = {0.0, 0.0, G + 2.5 * sin(w * t) + 0.05 * gauss()};
+        const double f_nav[3] = {0.0, 0.0, G + 2.5 * sin(w * t) + 0.05 * rng_gauss(&g_rng)};
         nav_to_body(f_nav, yaw, 0.0, 0.0, s.accel_mps2);
         s.gyro_radps[2] = yaw_rate;
         if (k % 2 == 0) {
@@ -444,9 +429,9 @@ static void test_determinism(void **state)
     const double b[3] = {3.0, -2.0, 1.5};
     const sf_params_t p = defaults();
     static sf_magcal_t a, c;
-    g_rng = 0x5EED0008ULL;
+    g_rng.s = 0x5EED0008ULL;
     (void)run_square(&a, &p, b, 3, 0.2 * LOOP_S);
-    g_rng = 0x5EED0008ULL;
+    g_rng.s = 0x5EED0008ULL;
     (void)run_square(&c, &p, b, 3, 0.2 * LOOP_S);
     assert_memory_equal(a.ata, c.ata, sizeof a.ata);
     assert_memory_equal(a.aty, c.aty, sizeof a.aty);
