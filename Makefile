@@ -9,7 +9,7 @@ PY := $(VENV)/bin/python
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build test test-c test-python demo bench clean help
+.PHONY: all deps build test test-c test-python demo bench clean help change-indication
 
 all: build
 
@@ -17,6 +17,7 @@ help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end)"
 	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
+	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
 	@echo "make clean  - remove $(BUILD)/ and out/"
@@ -37,6 +38,9 @@ test-c:
 
 test-python:
 	STRIDEFIXD=$(abspath $(STRIDEFIXD)) $(PY) -m pytest -q
+
+change-indication: build
+	STRIDEFIXD=$(abspath $(STRIDEFIXD)) $(PY) tests/change_indication/replay.py --out tests/change_indication
 
 demo: build
 	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
