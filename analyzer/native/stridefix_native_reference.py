@@ -16,6 +16,7 @@ it is not meant to be fast. Also here: a synthetic walk problem (:func:`make_pro
 Built into ``build/analyzer/native/`` beside ``stridefix_native`` (CMake copies it), so one path entry
 imports both. Reference: Kannan (2024), MSc thesis, Tampere University, section 4.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -39,8 +40,10 @@ def thesis_weights(ranges_m, weight_slope=1.0, weight_intercept_m=2.0):
         w = 1.0 / denom
     bad = ~(denom > 0) | ~np.isfinite(w)
     if bad.any():
-        raise ValueError(f"weight law 1/(m*b + c) with m={weight_slope}, c={weight_intercept_m} gives "
-                         f"{int(bad.sum())} non-positive or non-finite weight(s); need c > -m*min(b)")
+        raise ValueError(
+            f"weight law 1/(m*b + c) with m={weight_slope}, c={weight_intercept_m} gives "
+            f"{int(bad.sum())} non-positive or non-finite weight(s); need c > -m*min(b)"
+        )
     return w
 
 
@@ -91,11 +94,26 @@ def _loss(name, scale, n_anchor_rows):
     return loss
 
 
-def solve_coordinates_ref(n_points, anchors_idx, anchors_xy, pairs, ranges_m, weights=None, *,
-                          weight_slope=None, weight_intercept_m=None, init_xy=None, robust_loss="none",
-                          loss_scale=1.0, max_iterations=200, function_tolerance=1e-10,
-                          gradient_tolerance=1e-12, parameter_tolerance=1e-10, use_sparse=None,
-                          lsmr_tol=None):
+def solve_coordinates_ref(
+    n_points,
+    anchors_idx,
+    anchors_xy,
+    pairs,
+    ranges_m,
+    weights=None,
+    *,
+    weight_slope=None,
+    weight_intercept_m=None,
+    init_xy=None,
+    robust_loss="none",
+    loss_scale=1.0,
+    max_iterations=200,
+    function_tolerance=1e-10,
+    gradient_tolerance=1e-12,
+    parameter_tolerance=1e-10,
+    use_sparse=None,
+    lsmr_tol=None,
+):
     """The scipy twin of ``stridefix_native.solve_coordinates`` (same arguments and result keys).
 
     ``use_sparse``: sparse Jacobian with the LSMR trust-region solver (default when n_points > 300), else
@@ -114,8 +132,11 @@ def solve_coordinates_ref(n_points, anchors_idx, anchors_xy, pairs, ranges_m, we
             raise ValueError("pass either weights or weight_slope/weight_intercept_m, not both")
         w = np.asarray(weights, dtype=float).reshape(-1)
     else:
-        w = thesis_weights(b, 1.0 if weight_slope is None else weight_slope,
-                           2.0 if weight_intercept_m is None else weight_intercept_m)
+        w = thesis_weights(
+            b,
+            1.0 if weight_slope is None else weight_slope,
+            2.0 if weight_intercept_m is None else weight_intercept_m,
+        )
     x0 = default_init(n, a_idx, a_xy) if init_xy is None else np.asarray(init_xy, dtype=float).reshape(n, 2)
     k, m = a_idx.size, b.size
     ii, jj = pr[:, 0], pr[:, 1]
@@ -127,8 +148,12 @@ def solve_coordinates_ref(n_points, anchors_idx, anchors_xy, pairs, ranges_m, we
 
     # Jacobian pattern: anchor rows 2a, 2a+1 -> columns 2i, 2i+1; range row 2k+q -> 2I, 2I+1, 2J, 2J+1.
     rows = np.concatenate([np.arange(2 * k), np.repeat(2 * k + np.arange(m), 4)])
-    cols = np.concatenate([(2 * a_idx[:, None] + np.arange(2)).reshape(-1),
-                           np.stack([2 * ii, 2 * ii + 1, 2 * jj, 2 * jj + 1], axis=1).reshape(-1)])
+    cols = np.concatenate(
+        [
+            (2 * a_idx[:, None] + np.arange(2)).reshape(-1),
+            np.stack([2 * ii, 2 * ii + 1, 2 * jj, 2 * jj + 1], axis=1).reshape(-1),
+        ]
+    )
 
     def jac(x):
         p = x.reshape(n, 2)
@@ -144,22 +169,46 @@ def solve_coordinates_ref(n_points, anchors_idx, anchors_xy, pairs, ranges_m, we
     sparse_mode = n > 300 if use_sparse is None else bool(use_sparse)
     loss = _loss(robust_loss, loss_scale, 2 * k)
     f0 = fun(x0.reshape(-1))
-    initial_cost = 0.5 * float(np.sum(f0 ** 2 if loss == "linear" else loss(f0 ** 2)[0]))
+    initial_cost = 0.5 * float(np.sum(f0**2 if loss == "linear" else loss(f0**2)[0]))
     t0 = time.perf_counter()
-    res = least_squares(fun, x0.reshape(-1), jac=jac, method="trf",
-                        tr_solver="lsmr" if sparse_mode else "exact",
-                        tr_options={"atol": lsmr_tol, "btol": lsmr_tol} if sparse_mode and lsmr_tol else {},
-                        loss=loss, f_scale=1.0,
-                        ftol=function_tolerance or None, gtol=gradient_tolerance or None,
-                        xtol=parameter_tolerance or None, max_nfev=max_iterations + 1)
+    res = least_squares(
+        fun,
+        x0.reshape(-1),
+        jac=jac,
+        method="trf",
+        tr_solver="lsmr" if sparse_mode else "exact",
+        tr_options={"atol": lsmr_tol, "btol": lsmr_tol} if sparse_mode and lsmr_tol else {},
+        loss=loss,
+        f_scale=1.0,
+        ftol=function_tolerance or None,
+        gtol=gradient_tolerance or None,
+        xtol=parameter_tolerance or None,
+        max_nfev=max_iterations + 1,
+    )
     time_s = time.perf_counter() - t0
-    return {"xy": res.x.reshape(n, 2), "cost": float(res.cost), "initial_cost": initial_cost,
-            "iterations": int(res.nfev - 1), "converged": bool(res.status > 0), "time_s": time_s,
-            "message": res.message, "weights": w}
+    return {
+        "xy": res.x.reshape(n, 2),
+        "cost": float(res.cost),
+        "initial_cost": initial_cost,
+        "iterations": int(res.nfev - 1),
+        "converged": bool(res.status > 0),
+        "time_s": time_s,
+        "message": res.message,
+        "weights": w,
+    }
 
 
-def make_problem(n=5000, seed=0, anchor_every=4, step_m=0.7, range_sigma_m=0.05, near_gap=3,
-                 n_long_pairs=None, long_span=(4, 30), turn_sigma_rad=0.5):
+def make_problem(
+    n=5000,
+    seed=0,
+    anchor_every=4,
+    step_m=0.7,
+    range_sigma_m=0.05,
+    near_gap=3,
+    n_long_pairs=None,
+    long_span=(4, 30),
+    turn_sigma_rad=0.5,
+):
     """A synthetic walk (the thesis's setting): truth ``xy_gt`` (n, 2) from a heading random walk with
     ``step_m`` steps; anchors every ``anchor_every``-th point (exact, as the thesis simulates them);
     ranges between all points up to ``near_gap`` apart in index (the PDR distances of neighbours), and
@@ -183,8 +232,14 @@ def make_problem(n=5000, seed=0, anchor_every=4, step_m=0.7, range_sigma_m=0.05,
     pairs = np.concatenate(pairs).astype(np.int64)
     true_b = np.hypot(*(xy_gt[pairs[:, 0]] - xy_gt[pairs[:, 1]]).T)
     ranges_m = np.abs(true_b + range_sigma_m * (1.0 + true_b / 10.0) * rng.standard_normal(true_b.size))
-    return {"n_points": n, "anchors_idx": anchors_idx, "anchors_xy": xy_gt[anchors_idx],
-            "pairs": pairs, "ranges_m": ranges_m, "xy_gt": xy_gt}
+    return {
+        "n_points": n,
+        "anchors_idx": anchors_idx,
+        "anchors_xy": xy_gt[anchors_idx],
+        "pairs": pairs,
+        "ranges_m": ranges_m,
+        "xy_gt": xy_gt,
+    }
 
 
 def benchmark(n=5000, seed=0, tol=1e-6, max_iterations=1000):
@@ -201,8 +256,12 @@ def benchmark(n=5000, seed=0, tol=1e-6, max_iterations=1000):
 
     pb = make_problem(n=n, seed=seed)
     xy_gt = pb.pop("xy_gt")
-    tols = {"function_tolerance": tol, "gradient_tolerance": tol, "parameter_tolerance": tol,
-            "max_iterations": max_iterations}
+    tols = {
+        "function_tolerance": tol,
+        "gradient_tolerance": tol,
+        "parameter_tolerance": tol,
+        "max_iterations": max_iterations,
+    }
     t0 = time.perf_counter()
     ceres = stridefix_native.solve_coordinates(**pb, **tols)
     t_ceres = time.perf_counter() - t0
@@ -213,20 +272,33 @@ def benchmark(n=5000, seed=0, tol=1e-6, max_iterations=1000):
     def rmse(xy):
         return float(np.sqrt(np.mean(np.sum((xy - xy_gt) ** 2, axis=1))))
 
-    return {"n_points": n, "seed": seed, "n_anchors": int(pb["anchors_idx"].size),
-            "n_pairs": int(pb["ranges_m"].size), "ceres_s": t_ceres, "scipy_s": t_scipy,
-            "speedup": t_scipy / t_ceres, "ceres_iterations": ceres["iterations"],
-            "scipy_iterations": ref["iterations"], "ceres_converged": ceres["converged"],
-            "scipy_converged": ref["converged"], "initial_cost": ceres["initial_cost"],
-            "ceres_cost": ceres["cost"], "scipy_cost": ref["cost"],
-            "max_diff_m": float(np.max(np.abs(ceres["xy"] - ref["xy"]))),
-            "ceres_rmse_m": rmse(ceres["xy"]), "scipy_rmse_m": rmse(ref["xy"]),
-            "init_rmse_m": rmse(default_init(n, pb["anchors_idx"], pb["anchors_xy"]))}
+    return {
+        "n_points": n,
+        "seed": seed,
+        "n_anchors": int(pb["anchors_idx"].size),
+        "n_pairs": int(pb["ranges_m"].size),
+        "ceres_s": t_ceres,
+        "scipy_s": t_scipy,
+        "speedup": t_scipy / t_ceres,
+        "ceres_iterations": ceres["iterations"],
+        "scipy_iterations": ref["iterations"],
+        "ceres_converged": ceres["converged"],
+        "scipy_converged": ref["converged"],
+        "initial_cost": ceres["initial_cost"],
+        "ceres_cost": ceres["cost"],
+        "scipy_cost": ref["cost"],
+        "max_diff_m": float(np.max(np.abs(ceres["xy"] - ref["xy"]))),
+        "ceres_rmse_m": rmse(ceres["xy"]),
+        "scipy_rmse_m": rmse(ref["xy"]),
+        "init_rmse_m": rmse(default_init(n, pb["anchors_idx"], pb["anchors_xy"])),
+    }
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m stridefix_native_reference",
-                                 description="Time the Ceres coordinate solver against scipy least_squares.")
+    ap = argparse.ArgumentParser(
+        prog="python -m stridefix_native_reference",
+        description="Time the Ceres coordinate solver against scipy least_squares.",
+    )
     ap.add_argument("--n", type=int, default=5000, help="points in the synthetic walk (default 5000)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--tol", type=float, default=1e-6, help="function/gradient/parameter tolerance")
@@ -238,6 +310,7 @@ def main(argv=None):
     print(text)
     if args.out:
         import pathlib
+
         path = pathlib.Path(args.out)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text + "\n")

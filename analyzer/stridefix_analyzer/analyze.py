@@ -12,6 +12,7 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
 Exit status: 0 success; 1 nothing could be scored (every truth sample precedes the first POSE);
 2 missing or unreadable input, or no TRUTH / no POSE in the logs.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -37,30 +38,54 @@ _DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG")
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Declare the ``analyze`` sub-command and its options."""
     p = subparsers.add_parser(
-        "analyze", help="score POSE against TRUTH in LCM logs; write metrics.json and analysis.npz",
+        "analyze",
+        help="score POSE against TRUTH in LCM logs; write metrics.json and analysis.npz",
         description="Read one or more LCM event logs (e.g. the firmware's log and the simulator's "
-                    "truth log), score every POSE scheme against TRUTH with the causal protocol of "
-                    "DESIGN.md, and write DIR/metrics.json and DIR/analysis.npz.")
-    p.add_argument("logs", nargs="+", metavar="LOG",
-                   help="LCM event log(s); events of all logs are merged")
-    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
-                   help=f"output directory, created if needed (default: {DEFAULT_OUT})")
-    p.add_argument("--scheme", default=None, metavar="NAME",
-                   help="pose scheme reported at the top level when POSE holds several "
-                        "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
-                        "default: the one with most POSE messages)")
-    p.add_argument("--truth-source", default=None, choices=["simulation", "waypoint"],
-                   help="score only TRUTH of this source, e.g. waypoint = the reference points of a "
-                        "walk (default: all TRUTH)")
-    p.add_argument("--label", default=None, metavar="TEXT",
-                   help="what this run is (e.g. 'PDR only, truth-initialised start'); kept in "
-                        "metrics.json and shown as the report's title")
-    p.add_argument("--tum", default=None, metavar="DIR",
-                   help="also write TUM trajectories into DIR: truth.tum and <scheme>.tum with the "
-                        "POSE matched causally to each scored truth time (for evo)")
-    p.add_argument("--all-channels", action="store_true",
-                   help=f"decode every known channel ({', '.join(KNOWN_CHANNELS)}) to check their "
-                        "payloads, not only those the analysis needs (slower on long logs)")
+        "truth log), score every POSE scheme against TRUTH with the causal protocol of "
+        "DESIGN.md, and write DIR/metrics.json and DIR/analysis.npz.",
+    )
+    p.add_argument("logs", nargs="+", metavar="LOG", help="LCM event log(s); events of all logs are merged")
+    p.add_argument(
+        "--out",
+        default=DEFAULT_OUT,
+        metavar="DIR",
+        help=f"output directory, created if needed (default: {DEFAULT_OUT})",
+    )
+    p.add_argument(
+        "--scheme",
+        default=None,
+        metavar="NAME",
+        help="pose scheme reported at the top level when POSE holds several "
+        "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
+        "default: the one with most POSE messages)",
+    )
+    p.add_argument(
+        "--truth-source",
+        default=None,
+        choices=["simulation", "waypoint"],
+        help="score only TRUTH of this source, e.g. waypoint = the reference points of a "
+        "walk (default: all TRUTH)",
+    )
+    p.add_argument(
+        "--label",
+        default=None,
+        metavar="TEXT",
+        help="what this run is (e.g. 'PDR only, truth-initialised start'); kept in "
+        "metrics.json and shown as the report's title",
+    )
+    p.add_argument(
+        "--tum",
+        default=None,
+        metavar="DIR",
+        help="also write TUM trajectories into DIR: truth.tum and <scheme>.tum with the "
+        "POSE matched causally to each scored truth time (for evo)",
+    )
+    p.add_argument(
+        "--all-channels",
+        action="store_true",
+        help=f"decode every known channel ({', '.join(KNOWN_CHANNELS)}) to check their "
+        "payloads, not only those the analysis needs (slower on long logs)",
+    )
     return p
 
 
@@ -83,12 +108,14 @@ def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> 
     """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
     doc = {"label": label, "inputs": data.inputs}
     doc.update(metrics.summary())
-    doc.update(messages=dict(sorted(data.messages.items())),
-               unknown_channels=data.unknown_channels,
-               decode_errors=data.decode_errors,
-               health=data.health,
-               config={**data.versions, "params": data.config},
-               warnings=data.warnings)
+    doc.update(
+        messages=dict(sorted(data.messages.items())),
+        unknown_channels=data.unknown_channels,
+        decode_errors=data.decode_errors,
+        health=data.health,
+        config={**data.versions, "params": data.config},
+        warnings=data.warnings,
+    )
     return _json_ready(doc)
 
 
@@ -115,30 +142,43 @@ def _fmt(value, digits: int = 2) -> str:
 def format_summary(summary: dict) -> str:
     """A compact plain-text table of the per-scheme scores, for the terminal."""
     cols = ["n", "mean", "median", "p75", "p90", "p95", "max", "rmse"]
-    lines = [f"{'scheme':<11}" + "".join(f"{c:>8}" for c in cols)
-             + f"{'floor%':>8}{'final':>8}{'final%':>8}{'hdgRMS':>8}{'steps':>8}"]
+    lines = [
+        f"{'scheme':<11}"
+        + "".join(f"{c:>8}" for c in cols)
+        + f"{'floor%':>8}{'final':>8}{'final%':>8}{'hdgRMS':>8}{'steps':>8}"
+    ]
     for name, s in summary["per_scheme"].items():
         e = s["position_error_m"]
         mark = "*" if name == summary["primary_scheme"] else " "
         floor = s["floor_hit_rate"]
-        lines.append(f"{mark}{name:<10}" + "".join(f"{_fmt(e[c]):>8}" for c in cols)
-                     + f"{_fmt(None if floor is None else 100 * floor, 1):>8}"
-                     + f"{_fmt(s['final_error_m']):>8}"
-                     + f"{_fmt(s['final_error_pct_of_distance']):>8}"
-                     + f"{_fmt(s['heading_error']['rms_deg'], 1):>8}"
-                     + f"{_fmt(s['steps']['error']):>8}")
+        lines.append(
+            f"{mark}{name:<10}"
+            + "".join(f"{_fmt(e[c]):>8}" for c in cols)
+            + f"{_fmt(None if floor is None else 100 * floor, 1):>8}"
+            + f"{_fmt(s['final_error_m']):>8}"
+            + f"{_fmt(s['final_error_pct_of_distance']):>8}"
+            + f"{_fmt(s['heading_error']['rms_deg'], 1):>8}"
+            + f"{_fmt(s['steps']['error']):>8}"
+        )
     st = summary["steps"]
-    lines.append(f"(errors in m; final% of distance walked; hdgRMS in deg; * primary scheme; "
-                 f"steps = detected - truth)  "
-                 f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
-                 f"walked {summary['distance_walked_m']:.1f} m, "
-                 f"steps detected {st['detected']} / truth {_fmt(st['truth'])}")
+    lines.append(
+        f"(errors in m; final% of distance walked; hdgRMS in deg; * primary scheme; "
+        f"steps = detected - truth)  "
+        f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
+        f"walked {summary['distance_walked_m']:.1f} m, "
+        f"steps detected {st['detected']} / truth {_fmt(st['truth'])}"
+    )
     return "\n".join(lines)
 
 
-def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None = None,
-                all_channels: bool = False, label: str | None = None,
-                truth_source: str | None = None) -> tuple[dict, Metrics]:
+def run_analyze(
+    logs: list[str],
+    out_dir: str = DEFAULT_OUT,
+    scheme: str | None = None,
+    all_channels: bool = False,
+    label: str | None = None,
+    truth_source: str | None = None,
+) -> tuple[dict, Metrics]:
     """Read ``logs``, score them and write the outputs; return (summary, metrics).
 
     Raises
@@ -149,7 +189,7 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
         No TRUTH or no POSE, or the requested scheme is absent.
     """
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", LogTruncatedWarning)   # kept in data.warnings instead
+        warnings.simplefilter("ignore", LogTruncatedWarning)  # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
     metrics = run_metrics(data, scheme=code, truth_source=truth_source)
@@ -161,8 +201,9 @@ def run_analyze(logs: list[str], out_dir: str = DEFAULT_OUT, scheme: str | None 
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
-        summary, metrics = run_analyze(args.logs, args.out, args.scheme, args.all_channels,
-                                       args.label, args.truth_source)
+        summary, metrics = run_analyze(
+            args.logs, args.out, args.scheme, args.all_channels, args.label, args.truth_source
+        )
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return 2
@@ -172,10 +213,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
         from .tum import write_tum
+
         paths = write_tum(metrics, args.tum)
         print(f"wrote {len(paths)} TUM trajectories into {args.tum}")
     if summary["position_error_m"]["n"] == 0:
-        print("stridefix analyze: error: no truth sample could be scored (all precede the first "
-              "POSE of the primary scheme)", file=sys.stderr)
+        print(
+            "stridefix analyze: error: no truth sample could be scored (all precede the first "
+            "POSE of the primary scheme)",
+            file=sys.stderr,
+        )
         return 1
     return 0

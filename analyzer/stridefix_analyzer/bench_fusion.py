@@ -15,6 +15,7 @@ mean ≤ 2.0 m, p95 ≤ 4.5 m).
 Every scheme starts at its first fix (no truth initialisation). The survey, the map and the scored
 walks use different seeds: the map is never built from the walk it scores.
 """
+
 from __future__ import annotations
 
 import json
@@ -25,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from stridefix_analyzer.analyze import run_analyze
-from stridefix_analyzer.bench import BenchError, _run, _stridefix
+from stridefix_analyzer.bench import _run, _stridefix
 from stridefix_analyzer.metrics import SCHEME_NAMES
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
@@ -33,14 +34,24 @@ SCHEME_ORDER = ["wifi_only", "overwrite", "static", "adaptive", "kalman", "pdr_o
 SURVEY_SEED = 1000  # the survey is its own recording, never one of the scored walks
 
 
-def simulate_and_log(scenario: str, seed: int, stridefixd: Path, out: Path, site: Path | None,
-                     sets: list[str] = ()) -> dict:
+def simulate_and_log(
+    scenario: str, seed: int, stridefixd: Path, out: Path, site: Path | None, sets: list[str] = ()
+) -> dict:
     """sim → candump → stridefixd (with the site, if any) → out/stridefixd.lcmlog; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
-    _run([_stridefix(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)],
-         f"sim {scenario} seed {seed}")
+    _run(
+        [_stridefix(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)],
+        f"sim {scenario} seed {seed}",
+    )
     summary = json.loads((out / "sim_summary.json").read_text())
-    cmd = [str(stridefixd), "--input", str(out / "board.candump"), "--log", str(out / "stridefixd.lcmlog"), "-q"]
+    cmd = [
+        str(stridefixd),
+        "--input",
+        str(out / "board.candump"),
+        "--log",
+        str(out / "stridefixd.lcmlog"),
+        "-q",
+    ]
     if site is not None:
         cmd += ["--site", str(site)]
     else:  # a survey replay: only the WIFI scans matter; the start pose is irrelevant
@@ -55,9 +66,21 @@ def build_site(survey_scenario: str, stridefixd: Path, out: Path) -> Path:
     """Survey → firmware log → radio map → site file."""
     summary = simulate_and_log(survey_scenario, SURVEY_SEED, stridefixd, out, None)
     site = out / "site.sfsite"
-    cmd = [_stridefix(), "radiomap", "build", str(out / "stridefixd.lcmlog"), str(out / "truth.lcmlog"),
-           "--mode", "survey", "--out", str(site), "--name", survey_scenario,
-           "--map-rotation-deg", str(summary.get("map_rotation_deg", 0.0))]
+    cmd = [
+        _stridefix(),
+        "radiomap",
+        "build",
+        str(out / "stridefixd.lcmlog"),
+        str(out / "truth.lcmlog"),
+        "--mode",
+        "survey",
+        "--out",
+        str(site),
+        "--name",
+        survey_scenario,
+        "--map-rotation-deg",
+        str(summary.get("map_rotation_deg", 0.0)),
+    ]
     if "floor_height_m" in summary:
         cmd += ["--floor-height-m", str(summary["floor_height_m"])]
     _run(cmd, f"radiomap build {survey_scenario}")
@@ -66,8 +89,12 @@ def build_site(survey_scenario: str, stridefixd: Path, out: Path) -> Path:
 
 def score(out: Path, truth_source: str | None, label: str) -> dict[str, np.ndarray]:
     """Per-scheme arrays of the scored errors [m] of one walk."""
-    run_analyze([str(out / "stridefixd.lcmlog"), str(out / "truth.lcmlog")], str(out), label=label,
-                truth_source=truth_source)
+    run_analyze(
+        [str(out / "stridefixd.lcmlog"), str(out / "truth.lcmlog")],
+        str(out),
+        label=label,
+        truth_source=truth_source,
+    )
     series = np.load(out / "analysis.npz")
     errors = {}
     for code in series["scheme_codes"]:
@@ -82,8 +109,13 @@ def pooled_table(pooled: dict[str, list[np.ndarray]]) -> dict[str, dict]:
         if name not in pooled:
             continue
         e = np.concatenate(pooled[name])
-        table[name] = {"n": int(e.size), "mean_m": float(np.mean(e)), "p75_m": float(np.percentile(e, 75)),
-                       "p95_m": float(np.percentile(e, 95)), "max_m": float(np.max(e))}
+        table[name] = {
+            "n": int(e.size),
+            "mean_m": float(np.mean(e)),
+            "p75_m": float(np.percentile(e, 75)),
+            "p95_m": float(np.percentile(e, 95)),
+            "max_m": float(np.max(e)),
+        }
     return table
 
 
@@ -93,7 +125,9 @@ def format_table(table: dict[str, dict], paper: bool) -> str:
         head += f"{'paper mean':>12}{'paper p75':>11}"
     lines = [head]
     for name, r in table.items():
-        line = f"{name:<11}{r['n']:>6}{r['mean_m']:>9.2f}{r['p75_m']:>8.2f}{r['p95_m']:>8.2f}{r['max_m']:>8.2f}"
+        line = (
+            f"{name:<11}{r['n']:>6}{r['mean_m']:>9.2f}{r['p75_m']:>8.2f}{r['p95_m']:>8.2f}{r['max_m']:>8.2f}"
+        )
         if paper:
             pm = PAPER.get(name)
             line += f"{pm[0]:>12.2f}{pm[1]:>11.2f}" if pm else f"{'-':>12}{'-':>11}"
@@ -114,20 +148,35 @@ def run_aadr2015(seeds: list[int], paces: list[str], stridefixd: Path, out: Path
         walk = out / f"{scenario}-s{seed}"
         simulate_and_log(scenario, seed, stridefixd, walk, site, sets)
         errors = score(walk, "waypoint", f"{scenario} seed {seed}, error at the reference points")
-        runs.append({"scenario": scenario, "seed": seed,
-                     "mean_m": {k: float(np.mean(v)) for k, v in errors.items() if v.size}})
+        runs.append(
+            {
+                "scenario": scenario,
+                "seed": seed,
+                "mean_m": {k: float(np.mean(v)) for k, v in errors.items() if v.size},
+            }
+        )
         for k, v in errors.items():
             pooled.setdefault(k, []).append(v)
     table = pooled_table(pooled)
     wifi, adaptive, kalman = (table.get(k, {}).get("mean_m") for k in ("wifi_only", "adaptive", "kalman"))
     reduction = None if not (wifi and adaptive) else 100.0 * (wifi - adaptive) / wifi
-    doc = {"bench": "aadr2015", "seeds": seeds, "paces": paces, "sets": list(sets), "site": str(site),
-           "table": table, "paper": PAPER, "runs": runs,
-           "adaptive_reduction_pct": reduction,
-           "targets": {"adaptive_reduction_pct_min": 43.0, "kalman_at_least_as_good_as_adaptive": True},
-           "targets_met": {"adaptive_reduction": reduction is not None and reduction >= 43.0,
-                           "kalman_vs_adaptive": kalman is not None and adaptive is not None and kalman <= adaptive},
-           "run_s": time.perf_counter() - t0}
+    doc = {
+        "bench": "aadr2015",
+        "seeds": seeds,
+        "paces": paces,
+        "sets": list(sets),
+        "site": str(site),
+        "table": table,
+        "paper": PAPER,
+        "runs": runs,
+        "adaptive_reduction_pct": reduction,
+        "targets": {"adaptive_reduction_pct_min": 43.0, "kalman_at_least_as_good_as_adaptive": True},
+        "targets_met": {
+            "adaptive_reduction": reduction is not None and reduction >= 43.0,
+            "kalman_vs_adaptive": kalman is not None and adaptive is not None and kalman <= adaptive,
+        },
+        "run_s": time.perf_counter() - t0,
+    }
     (out / "aadr2015.json").write_text(json.dumps(doc, indent=2) + "\n")
     return doc
 
@@ -148,9 +197,16 @@ def run_office(seeds: list[int], stridefixd: Path, out: Path, sets: list[str]) -
             pooled.setdefault(k, []).append(v)
     table = pooled_table(pooled)
     k = table.get("kalman", {})
-    doc = {"bench": "office_wifi", "seeds": seeds, "sets": list(sets), "site": str(site), "table": table,
-           "runs": runs, "targets": {"kalman_mean_m_max": 2.0, "kalman_p95_m_max": 4.5},
-           "targets_met": {"kalman_mean": k.get("mean_m", 1e9) <= 2.0, "kalman_p95": k.get("p95_m", 1e9) <= 4.5},
-           "run_s": time.perf_counter() - t0}
+    doc = {
+        "bench": "office_wifi",
+        "seeds": seeds,
+        "sets": list(sets),
+        "site": str(site),
+        "table": table,
+        "runs": runs,
+        "targets": {"kalman_mean_m_max": 2.0, "kalman_p95_m_max": 4.5},
+        "targets_met": {"kalman_mean": k.get("mean_m", 1e9) <= 2.0, "kalman_p95": k.get("p95_m", 1e9) <= 4.5},
+        "run_s": time.perf_counter() - t0,
+    }
     (out / "office_wifi.json").write_text(json.dumps(doc, indent=2) + "\n")
     return doc

@@ -4,6 +4,7 @@ Each sub-command lives in the module that does the work and contributes two func
 ``add_parser(subparsers)`` (declares its arguments and help) and ``run(args) -> int`` (the exit status).
 Exit status: 0 success, 1 the work failed, 2 bad usage or unreadable input.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -46,13 +47,14 @@ def _unavailable(name: str, exc: ImportError):
     def run(_args) -> int:
         print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
         return 1
+
     return run
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
-        from .realbench import with_default_bench   # `realbench --format ...` = `realbench fusion ...`
+        from .realbench import with_default_bench  # `realbench --format ...` = `realbench fusion ...`
     except ImportError:
         pass
     else:

@@ -17,6 +17,7 @@ on all its traces and reported.
 Stride scale: Σ‖truth_{k+1} − truth_k‖ / Σ‖DR_{k+1} − DR_k‖ over consecutive truth points of the
 fitting walks (the firmware's default Weinberg K is not the crowd's).
 """
+
 from __future__ import annotations
 
 import concurrent.futures
@@ -37,30 +38,48 @@ DEFAULT_OUT = os.path.join("out", "crowd", "experiment")
 
 # (key, label, thesis mean, thesis std, solve options)
 ROWS = [
-    ("pdr", "PDR only, no weights/filtering", 10.0143, 5.097,
-     dict(ranges="pdr", pdr_span=0, weights=None, tau=None)),
-    ("pdr_w", "PDR only, weights", 3.1467, 2.602,
-     dict(ranges="pdr", pdr_span=0, tau=None)),
-    ("pdr_wf", "PDR only, weights + filtering |i-j|<=2", 2.1653, 2.564,
-     dict(ranges="pdr", pdr_span=2, tau=None)),
-    ("wifi", "Wi-Fi only, no weights/filtering", 7.5489, 4.2453,
-     dict(ranges="wifi", weights=None, tau=None)),
+    (
+        "pdr",
+        "PDR only, no weights/filtering",
+        10.0143,
+        5.097,
+        dict(ranges="pdr", pdr_span=0, weights=None, tau=None),
+    ),
+    ("pdr_w", "PDR only, weights", 3.1467, 2.602, dict(ranges="pdr", pdr_span=0, tau=None)),
+    (
+        "pdr_wf",
+        "PDR only, weights + filtering |i-j|<=2",
+        2.1653,
+        2.564,
+        dict(ranges="pdr", pdr_span=2, tau=None),
+    ),
+    ("wifi", "Wi-Fi only, no weights/filtering", 7.5489, 4.2453, dict(ranges="wifi", weights=None, tau=None)),
     ("wifi_w", "Wi-Fi only, weights", 4.1095, 3.8607, dict(ranges="wifi", tau=None)),
     ("wifi_wf", "Wi-Fi only, weights + filtering", 3.7228, 3.5579, dict(ranges="wifi")),
-    ("hybrid", "PDR + Wi-Fi (filtered PDR), no weights", 2.1124, 2.3614,
-     dict(ranges="hybrid", pdr_span=0, weights=None)),
-    ("hybrid_w", "PDR + Wi-Fi (filtered PDR), weights", 1.9189, 2.335,
-     dict(ranges="hybrid", pdr_span=0)),
-    ("both_w", "ours: PDR consecutive + filtered Wi-Fi rows, weights", None, None,
-     dict(ranges="both", pdr_span=1)),
+    (
+        "hybrid",
+        "PDR + Wi-Fi (filtered PDR), no weights",
+        2.1124,
+        2.3614,
+        dict(ranges="hybrid", pdr_span=0, weights=None),
+    ),
+    ("hybrid_w", "PDR + Wi-Fi (filtered PDR), weights", 1.9189, 2.335, dict(ranges="hybrid", pdr_span=0)),
+    (
+        "both_w",
+        "ours: PDR consecutive + filtered Wi-Fi rows, weights",
+        None,
+        None,
+        dict(ranges="both", pdr_span=1),
+    ),
 ]
 
 
 def _run(cmd: list[str], what: str) -> None:
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
-        raise CrowdInputError(f"{what} failed (exit {proc.returncode}): {' '.join(cmd)}\n"
-                              f"{proc.stderr[-1500:]}")
+        raise CrowdInputError(
+            f"{what} failed (exit {proc.returncode}): {' '.join(cmd)}\n{proc.stderr[-1500:]}"
+        )
 
 
 def _stridefix() -> str:
@@ -81,8 +100,9 @@ def stride_scale(walks) -> float:
     return num / den if den > 0 else 1.0
 
 
-def run_table(walks, model, anchors: str, solver: str, band: str, scale: float,
-              progress=print) -> tuple[list[dict], dict]:
+def run_table(
+    walks, model, anchors: str, solver: str, band: str, scale: float, progress=print
+) -> tuple[list[dict], dict]:
     """Every row of :data:`ROWS` on ``walks``; returns (rows, positions of each row)."""
     from .crowd import solve_walks
     from .crowd_solve import error_stats
@@ -94,44 +114,75 @@ def run_table(walks, model, anchors: str, solver: str, band: str, scale: float,
         opts.setdefault("tau", 0.45)
         opts.setdefault("pdr_span", 1)
         t0 = time.perf_counter()
-        xy, points, prob, res = solve_walks(walks, model, anchors=anchors, solver=solver,
-                                            band=band, step_scale=scale, **opts)
+        xy, points, prob, res = solve_walks(
+            walks, model, anchors=anchors, solver=solver, band=band, step_scale=scale, **opts
+        )
         e = res["error"]
-        out.append({"key": key, "label": label, "thesis_mean_m": tm, "thesis_std_m": ts,
-                    "mean_m": e.get("mean_m"), "std_m": e.get("std_m"),
-                    "median_m": e.get("median_m"), "p90_m": e.get("p90_m"), "n": e.get("n"),
-                    "mean_all_m": e.get("mean_all_m"), "rows": res["rows"],
-                    "solver": res["solver"]["solver"], "run_s": time.perf_counter() - t0,
-                    "problem": res["problem"]})
+        out.append(
+            {
+                "key": key,
+                "label": label,
+                "thesis_mean_m": tm,
+                "thesis_std_m": ts,
+                "mean_m": e.get("mean_m"),
+                "std_m": e.get("std_m"),
+                "median_m": e.get("median_m"),
+                "p90_m": e.get("p90_m"),
+                "n": e.get("n"),
+                "mean_all_m": e.get("mean_all_m"),
+                "rows": res["rows"],
+                "solver": res["solver"]["solver"],
+                "run_s": time.perf_counter() - t0,
+                "problem": res["problem"],
+            }
+        )
         positions[key] = (xy, points, prob)
-        progress(f"  {label:<55} mean {e.get('mean_m', float('nan')):6.2f} m  "
-                 f"({out[-1]['run_s']:.1f} s)")
+        progress(f"  {label:<55} mean {e.get('mean_m', float('nan')):6.2f} m  ({out[-1]['run_s']:.1f} s)")
     # reference: the initial guess alone (anchors interpolated linearly in time, no range rows)
     xy, points, prob = positions[ROWS[0][0]]
     e = error_stats(prob.x0, points, prob)
-    out.append({"key": "anchors_interp", "label": "reference: anchors only, linear in time",
-                "thesis_mean_m": None, "thesis_std_m": None, "mean_m": e.get("mean_m"),
-                "std_m": e.get("std_m"), "median_m": e.get("median_m"), "p90_m": e.get("p90_m"),
-                "n": e.get("n"), "mean_all_m": e.get("mean_all_m"),
-                "rows": {"anchors": int(len(prob.anchor_index)), "pdr": 0, "wifi": 0},
-                "solver": "-", "run_s": 0.0, "problem": {}})
+    out.append(
+        {
+            "key": "anchors_interp",
+            "label": "reference: anchors only, linear in time",
+            "thesis_mean_m": None,
+            "thesis_std_m": None,
+            "mean_m": e.get("mean_m"),
+            "std_m": e.get("std_m"),
+            "median_m": e.get("median_m"),
+            "p90_m": e.get("p90_m"),
+            "n": e.get("n"),
+            "mean_all_m": e.get("mean_all_m"),
+            "rows": {"anchors": int(len(prob.anchor_index)), "pdr": 0, "wifi": 0},
+            "solver": "-",
+            "run_s": 0.0,
+            "problem": {},
+        }
+    )
     return out, positions
 
 
 def format_table(rows: list[dict]) -> str:
-    head = (f"{'method':<55}{'mean m':>8}{'std m':>8}{'p90 m':>8}{'n':>6}{'rows':>9}"
-            f"{'thesis mean':>13}{'thesis std':>11}")
+    head = (
+        f"{'method':<55}{'mean m':>8}{'std m':>8}{'p90 m':>8}{'n':>6}{'rows':>9}"
+        f"{'thesis mean':>13}{'thesis std':>11}"
+    )
     lines = [head]
     for r in rows:
+
         def f(v, w=8):
             return f"{v:>{w}.2f}" if v is not None else f"{'-':>{w}}"
+
         nrows = r["rows"]["pdr"] + r["rows"]["wifi"]
-        lines.append(f"{r['label']:<55}{f(r['mean_m'])}{f(r['std_m'])}{f(r['p90_m'])}"
-                     f"{r['n'] or 0:>6}{nrows:>9}{f(r['thesis_mean_m'], 13)}{f(r['thesis_std_m'], 11)}")
+        lines.append(
+            f"{r['label']:<55}{f(r['mean_m'])}{f(r['std_m'])}{f(r['p90_m'])}"
+            f"{r['n'] or 0:>6}{nrows:>9}{f(r['thesis_mean_m'], 13)}{f(r['thesis_std_m'], 11)}"
+        )
     return "\n".join(lines)
 
 
 # --- SIL ---------------------------------------------------------------------------------------------
+
 
 def _sil_walk(scenario: str, seed: int, stridefixd: Path, out: Path, duration_s: float | None) -> dict:
     out.mkdir(parents=True, exist_ok=True)
@@ -140,12 +191,27 @@ def _sil_walk(scenario: str, seed: int, stridefixd: Path, out: Path, duration_s:
         sim += ["--duration-s", str(duration_s)]
     _run(sim, f"sim {scenario} seed {seed}")
     summary = json.loads((out / "sim_summary.json").read_text())
-    _run([str(stridefixd), "--input", str(out / "board.candump"), "--log",
-          str(out / "stridefixd.lcmlog"), "-q", "--config", str(out / "init_truth.ini"), "--set",
-          f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}"],
-         f"stridefixd seed {seed}")
-    return {"seed": seed, "dir": out, "summary": summary,
-            "spec": f"{out / 'stridefixd.lcmlog'},{out / 'truth.lcmlog'}"}
+    _run(
+        [
+            str(stridefixd),
+            "--input",
+            str(out / "board.candump"),
+            "--log",
+            str(out / "stridefixd.lcmlog"),
+            "-q",
+            "--config",
+            str(out / "init_truth.ini"),
+            "--set",
+            f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}",
+        ],
+        f"stridefixd seed {seed}",
+    )
+    return {
+        "seed": seed,
+        "dir": out,
+        "summary": summary,
+        "spec": f"{out / 'stridefixd.lcmlog'},{out / 'truth.lcmlog'}",
+    }
 
 
 def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
@@ -153,10 +219,27 @@ def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
 
     out.mkdir(parents=True, exist_ok=True)
     log = out / "stridefixd.lcmlog"
-    _run([str(stridefixd), "--input", str(walk["dir"] / "board.candump"), "--log", str(log), "-q",
-          "--site", str(site), "--fusion", "wifi_only"], f"stridefixd --site {site}")
-    summary, _ = run_analyze([str(log), str(walk["dir"] / "truth.lcmlog")], str(out),
-                             scheme="wifi_only", label=f"seed {walk['seed']} wifi_only, {site.name}")
+    _run(
+        [
+            str(stridefixd),
+            "--input",
+            str(walk["dir"] / "board.candump"),
+            "--log",
+            str(log),
+            "-q",
+            "--site",
+            str(site),
+            "--fusion",
+            "wifi_only",
+        ],
+        f"stridefixd --site {site}",
+    )
+    summary, _ = run_analyze(
+        [str(log), str(walk["dir"] / "truth.lcmlog")],
+        str(out),
+        scheme="wifi_only",
+        label=f"seed {walk['seed']} wifi_only, {site.name}",
+    )
     pe = summary.get("position_error_m") or summary.get("metrics", {}).get("position_error_m", {})
     return {"mean_m": pe.get("mean"), "p90_m": pe.get("p90"), "n": pe.get("n")}
 
@@ -170,19 +253,23 @@ def run_sil(args, progress) -> dict:
     seeds = [int(s) for s in args.seeds.split(",") if s]
     fit_seeds = [int(s) for s in args.fit_seeds.split(",") if s]
     heldout = [int(s) for s in args.heldout_seeds.split(",") if s]
-    jobs = [(s, "fit") for s in fit_seeds] + [(s, "walk") for s in seeds] + \
-        [(s, "heldout") for s in heldout]
-    progress(f"crowd experiment --sil: simulating {len(jobs)} walkers ({args.scenario}) and "
-             f"replaying them through stridefixd")
+    jobs = [(s, "fit") for s in fit_seeds] + [(s, "walk") for s in seeds] + [(s, "heldout") for s in heldout]
+    progress(
+        f"crowd experiment --sil: simulating {len(jobs)} walkers ({args.scenario}) and "
+        f"replaying them through stridefixd"
+    )
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futs = {(s, kind): pool.submit(_sil_walk, args.scenario, s, stridefixd,
-                                       out / f"{kind}-s{s}", args.duration_s) for s, kind in jobs}
+        futs = {
+            (s, kind): pool.submit(
+                _sil_walk, args.scenario, s, stridefixd, out / f"{kind}-s{s}", args.duration_s
+            )
+            for s, kind in jobs
+        }
         runs = {k: f.result() for k, f in futs.items()}
     sim_s = time.perf_counter() - t0
     fit_w = load_walks([runs[(s, "fit")]["spec"] for s in fit_seeds])
     walks = load_walks([runs[(s, "walk")]["spec"] for s in seeds])
-    model, _ = fit_walks(fit_w, mode=args.dissimilarity, band=args.band,
-                         min_common=args.min_common_aps)
+    model, _ = fit_walks(fit_w, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps)
     scale = stride_scale(fit_w)
     progress("model (fit walkers " + ",".join(map(str, fit_seeds)) + "): " + format_model(model))
     progress(f"stride scale {scale:.4f}; table on {len(walks)} walkers, anchors every:4")
@@ -191,21 +278,34 @@ def run_sil(args, progress) -> dict:
     best = min((r for r in rows if r["key"] in ("hybrid_w", "both_w")), key=lambda r: r["mean_m"])
     xy, points, _ = positions[best["key"]]
     rot = runs[(seeds[0], "walk")]["summary"].get("map_rotation_deg", 0.0)
-    sites = build_crowd_sites(walks, xy, points, str(out / "crowd.sfsite"),
-                              str(out / "truth.sfsite"), map_rotation_deg=rot)
+    sites = build_crowd_sites(
+        walks, xy, points, str(out / "crowd.sfsite"), str(out / "truth.sfsite"), map_rotation_deg=rot
+    )
     fixes = []
     for kind, ss in (("walk", seeds), ("heldout", heldout)):
         for s in ss:
             row = {"seed": s, "kind": kind}
             for label in ("truth", "crowd"):
-                row[label] = _replay_score(runs[(s, kind)], Path(sites[label]["path"]), stridefixd,
-                                           out / "replay" / f"{kind}-s{s}-{label}")
+                row[label] = _replay_score(
+                    runs[(s, kind)],
+                    Path(sites[label]["path"]),
+                    stridefixd,
+                    out / "replay" / f"{kind}-s{s}-{label}",
+                )
             fixes.append(row)
-    doc = {"experiment": "sil", "scenario": args.scenario, "seeds": seeds, "fit_seeds": fit_seeds,
-           "heldout_seeds": heldout, "model": model.to_json(), "stride_scale": scale,
-           "rows": rows, "radiomap": {"positions_from": best["key"], "sites": sites,
-                                      "wifi_only": fixes},
-           "sim_s": sim_s, "run_s": time.perf_counter() - t0}
+    doc = {
+        "experiment": "sil",
+        "scenario": args.scenario,
+        "seeds": seeds,
+        "fit_seeds": fit_seeds,
+        "heldout_seeds": heldout,
+        "model": model.to_json(),
+        "stride_scale": scale,
+        "rows": rows,
+        "radiomap": {"positions_from": best["key"], "sites": sites, "wifi_only": fixes},
+        "sim_s": sim_s,
+        "run_s": time.perf_counter() - t0,
+    }
     return doc
 
 
@@ -219,17 +319,20 @@ def format_fixes(fixes: list[dict]) -> str:
 
 # --- msindoor ----------------------------------------------------------------------------------------
 
+
 def _ms_walk(trace: Path, cache: Path, stridefixd: Path) -> dict:
-    from stridefix_sim.importers import msindoor
     import warnings
+
+    from stridefix_sim.importers import msindoor
 
     log, fw = cache / f"{trace.stem}.lcmlog", cache / f"{trace.stem}.fw.lcmlog"
     if not (log.is_file() and fw.is_file() and log.stat().st_mtime >= trace.stat().st_mtime):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             msindoor.import_trace(trace, log)
-        _run([str(stridefixd), "--input", f"lcmlog:{log}", "--log", str(fw), "-q"],
-             f"stridefixd {trace.name}")
+        _run(
+            [str(stridefixd), "--input", f"lcmlog:{log}", "--log", str(fw), "-q"], f"stridefixd {trace.name}"
+        )
     return {"trace": trace.name, "spec": f"{fw},{log}"}
 
 
@@ -261,56 +364,83 @@ def run_msindoor(args, progress) -> dict:
         progress(f"crowd experiment --msindoor {label}: importing and replaying {len(traces)} traces")
         t1 = time.perf_counter()
         with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces),
-                                     [stridefixd] * len(traces)))
+            prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces), [stridefixd] * len(traces)))
         prep_s = time.perf_counter() - t1
         all_walks = load_walks([p["spec"] for p in prepared])
         for w, p in zip(all_walks, prepared):
             w.name = p["trace"]
-        scored = _usable(all_walks[:args.limit]) if args.limit else _usable(all_walks)
-        fitting = all_walks[args.limit:] if args.limit and args.limit < len(all_walks) else all_walks
-        model_all, _ = fit_walks(all_walks, mode=args.dissimilarity, band=args.band,
-                                 min_common=args.min_common_aps)
-        model, _ = fit_walks(fitting, mode=args.dissimilarity, band=args.band,
-                             min_common=args.min_common_aps)
+        scored = _usable(all_walks[: args.limit]) if args.limit else _usable(all_walks)
+        fitting = all_walks[args.limit :] if args.limit and args.limit < len(all_walks) else all_walks
+        model_all, _ = fit_walks(
+            all_walks, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps
+        )
+        model, _ = fit_walks(fitting, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps)
         scale = stride_scale(_usable(fitting, 2))
         progress(f"{label} model on all {len(all_walks)} traces: " + format_model(model_all))
-        progress(f"{label} model on the {len(fitting)} non-scored traces: X = "
-                 f"{[round(v, 4) for v in model.params]}; stride scale {scale:.3f}; "
-                 f"table on {len(scored)} walks")
-        rows, _ = run_table(scored, model, "every-other-waypoint", args.solver, args.band, scale,
-                            progress)
-        docs.append({"floor": label, "traces": len(traces), "scored_walks": [w.name for w in scored],
-                     "fit_traces": len(fitting), "model_all_traces": model_all.to_json(),
-                     "model_used": model.to_json(), "stride_scale": scale, "rows": rows,
-                     "prepare_s": prep_s})
+        progress(
+            f"{label} model on the {len(fitting)} non-scored traces: X = "
+            f"{[round(v, 4) for v in model.params]}; stride scale {scale:.3f}; "
+            f"table on {len(scored)} walks"
+        )
+        rows, _ = run_table(scored, model, "every-other-waypoint", args.solver, args.band, scale, progress)
+        docs.append(
+            {
+                "floor": label,
+                "traces": len(traces),
+                "scored_walks": [w.name for w in scored],
+                "fit_traces": len(fitting),
+                "model_all_traces": model_all.to_json(),
+                "model_used": model.to_json(),
+                "stride_scale": scale,
+                "rows": rows,
+                "prepare_s": prep_s,
+            }
+        )
     return {"experiment": "msindoor", "floors": docs, "run_s": time.perf_counter() - t0}
 
 
 # --- command line ------------------------------------------------------------------------------------
 
+
 def add_arguments(p) -> None:
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--sil", action="store_true", help="SIL: several simulated walkers")
     g.add_argument("--msindoor", metavar="DIR", help="msindoor floor folder (or the root)")
-    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
-                   help=f"outputs and caches (default {DEFAULT_OUT})")
-    p.add_argument("--stridefixd", default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
-                   help="firmware binary (default $STRIDEFIXD or build/firmware/stridefixd)")
+    p.add_argument(
+        "--out", default=DEFAULT_OUT, metavar="DIR", help=f"outputs and caches (default {DEFAULT_OUT})"
+    )
+    p.add_argument(
+        "--stridefixd",
+        default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
+        help="firmware binary (default $STRIDEFIXD or build/firmware/stridefixd)",
+    )
     p.add_argument("--scenario", default="pace_normal", help="SIL scenario (default pace_normal)")
     p.add_argument("--seeds", default="1,2,3,4,5,6", help="SIL scored walkers (default 1..6)")
     p.add_argument("--fit-seeds", default="101,102", help="SIL model-fitting walkers")
     p.add_argument("--heldout-seeds", default="201", help="SIL walkers only replayed on the maps")
     p.add_argument("--duration-s", type=float, default=None, help="SIL: cut each walk (s)")
-    p.add_argument("--limit", type=int, default=20,
-                   help="msindoor: score the first N traces per floor, fit on the rest (default 20;"
-                        " 0 = score all, fit on all)")
-    p.add_argument("--band", choices=("2.4", "all"), default="2.4",
-                   help="APs used (default 2.4 GHz only, the thesis)")
-    p.add_argument("--dissimilarity", choices=("common_sum", "common_scaled"),
-                   default="common_sum", help="dissimilarity (default common_sum, the thesis)")
-    p.add_argument("--min-common-aps", type=int, default=1,
-                   help="exclude pairs sharing fewer APs (default 1, the thesis)")
+    p.add_argument(
+        "--limit",
+        type=int,
+        default=20,
+        help="msindoor: score the first N traces per floor, fit on the rest (default 20;"
+        " 0 = score all, fit on all)",
+    )
+    p.add_argument(
+        "--band", choices=("2.4", "all"), default="2.4", help="APs used (default 2.4 GHz only, the thesis)"
+    )
+    p.add_argument(
+        "--dissimilarity",
+        choices=("common_sum", "common_scaled"),
+        default="common_sum",
+        help="dissimilarity (default common_sum, the thesis)",
+    )
+    p.add_argument(
+        "--min-common-aps",
+        type=int,
+        default=1,
+        help="exclude pairs sharing fewer APs (default 1, the thesis)",
+    )
     p.add_argument("--solver", choices=("auto", "native", "scipy"), default="auto")
     p.add_argument("--jobs", type=int, default=2, help="parallel sim/replay jobs (default 2)")
 
@@ -323,29 +453,40 @@ def run_experiment(args) -> int:
     if args.sil:
         doc = run_sil(args, progress)
         m = doc["model"]
-        print(f"SIL model ({m['mode']}, band {args.band}; fitted on walkers {args.fit_seeds}): "
-              f"X1 {m['floor_m']:.3f} m, X2 {m['intercept_m']:.3f} m, X3 {m['slope_m_per_db']:.4f} "
-              f"m/dB, RMSE {m['rmse_m']:.2f} m, R² {m['r2']:.3f}, {m['n_pairs']} pairs; stride "
-              f"scale {doc['stride_scale']:.3f}")
-        print(f"SIL: {len(doc['seeds'])} walkers of {doc['scenario']}, anchors every 4th scan "
-              f"point, error at the other scan points; solver {doc['rows'][0]['solver']}")
+        print(
+            f"SIL model ({m['mode']}, band {args.band}; fitted on walkers {args.fit_seeds}): "
+            f"X1 {m['floor_m']:.3f} m, X2 {m['intercept_m']:.3f} m, X3 {m['slope_m_per_db']:.4f} "
+            f"m/dB, RMSE {m['rmse_m']:.2f} m, R² {m['r2']:.3f}, {m['n_pairs']} pairs; stride "
+            f"scale {doc['stride_scale']:.3f}"
+        )
+        print(
+            f"SIL: {len(doc['seeds'])} walkers of {doc['scenario']}, anchors every 4th scan "
+            f"point, error at the other scan points; solver {doc['rows'][0]['solver']}"
+        )
         print(format_table(doc["rows"]))
-        print(f"radio map from crowd positions ({doc['radiomap']['positions_from']}) vs truth, "
-              f"wifi_only fixes replayed through stridefixd:")
+        print(
+            f"radio map from crowd positions ({doc['radiomap']['positions_from']}) vs truth, "
+            f"wifi_only fixes replayed through stridefixd:"
+        )
         print(format_fixes(doc["radiomap"]["wifi_only"]))
         path = Path(args.out) / "sil.json"
     else:
         doc = run_msindoor(args, progress)
         for f in doc["floors"]:
             m = f["model_all_traces"]
-            print(f"{f['floor']}: model on all {f['traces']} traces X1 {m['floor_m']:.3f} m, "
-                  f"X2 {m['intercept_m']:.3f} m, X3 {m['slope_m_per_db']:.4f} m/dB, RMSE "
-                  f"{m['rmse_m']:.2f} m, R² {m['r2']:.3f}, {m['n_pairs']} pairs")
-            print(f"{f['floor']}: {len(f['scored_walks'])} walks, anchors every other waypoint, "
-                  f"error at the held-out waypoints; solver {f['rows'][0]['solver']}")
+            print(
+                f"{f['floor']}: model on all {f['traces']} traces X1 {m['floor_m']:.3f} m, "
+                f"X2 {m['intercept_m']:.3f} m, X3 {m['slope_m_per_db']:.4f} m/dB, RMSE "
+                f"{m['rmse_m']:.2f} m, R² {m['r2']:.3f}, {m['n_pairs']} pairs"
+            )
+            print(
+                f"{f['floor']}: {len(f['scored_walks'])} walks, anchors every other waypoint, "
+                f"error at the held-out waypoints; solver {f['rows'][0]['solver']}"
+            )
             print(format_table(f["rows"]))
         path = Path(args.out) / "msindoor.json"
-    path.write_text(json.dumps(doc, indent=2, default=lambda o: str(o) if isinstance(o, Path)
-                               else float(o)) + "\n")
+    path.write_text(
+        json.dumps(doc, indent=2, default=lambda o: str(o) if isinstance(o, Path) else float(o)) + "\n"
+    )
     print(f"wrote {path} ({doc['run_s']:.0f} s)")
     return 0

@@ -28,6 +28,7 @@ counts. That is the pair-level least-squares problem with each pair's dissimilar
 bin's mean dissimilarity; the sums of distance are exact, so the residual SSE, RMSE and R² are exact
 up to that replacement.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -48,9 +49,14 @@ _TINY_M = 1e-9
 
 # --- fingerprint matrix -----------------------------------------------------------------------------
 
-def fingerprint_matrix(scan_index: np.ndarray, bssid: np.ndarray, rssi_dbm: np.ndarray,
-                       n_scans: int, bssids: np.ndarray | None = None
-                       ) -> tuple[np.ndarray, np.ndarray]:
+
+def fingerprint_matrix(
+    scan_index: np.ndarray,
+    bssid: np.ndarray,
+    rssi_dbm: np.ndarray,
+    n_scans: int,
+    bssids: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Scans × APs RSS matrix from per-AP rows.
 
     Parameters
@@ -105,8 +111,7 @@ class _Prepared:
         return self.M.shape[0]
 
 
-def _block(pa: _Prepared, ia: slice, pb: _Prepared, ib: slice, mode: str,
-           min_common: int = 1) -> np.ndarray:
+def _block(pa: _Prepared, ia: slice, pb: _Prepared, ib: slice, mode: str, min_common: int = 1) -> np.ndarray:
     """Dissimilarity of rows ``ia`` of ``pa`` against rows ``ib`` of ``pb``; NaN = fewer than
     ``min_common`` common APs."""
     s = pa.left[ia] @ pb.right[ib].T
@@ -126,8 +131,7 @@ def _check_mode(mode: str) -> None:
         raise ValueError(f"dissimilarity mode {mode!r} not one of {MODES}")
 
 
-def dissimilarity(Ra: np.ndarray, Rb: np.ndarray | None = None, mode: str = DEFAULT_MODE
-                  ) -> np.ndarray:
+def dissimilarity(Ra: np.ndarray, Rb: np.ndarray | None = None, mode: str = DEFAULT_MODE) -> np.ndarray:
     """Pairwise dissimilarity [dB] between the scans of ``Ra`` (n_a × m) and ``Rb`` (n_b × m).
 
     ``Rb`` defaults to ``Ra``. Returns (n_a, n_b) float64; NaN where the two scans share no AP.
@@ -141,8 +145,9 @@ def dissimilarity(Ra: np.ndarray, Rb: np.ndarray | None = None, mode: str = DEFA
     return _block(pa, slice(None), pb, slice(None), mode)
 
 
-def iter_pair_blocks(R: np.ndarray, mode: str = DEFAULT_MODE, block: int = DEFAULT_BLOCK,
-                     dtype=np.float64, min_common: int = 1):
+def iter_pair_blocks(
+    R: np.ndarray, mode: str = DEFAULT_MODE, block: int = DEFAULT_BLOCK, dtype=np.float64, min_common: int = 1
+):
     """Unordered pairs i > j of the scans of ``R``, in blocks.
 
     Yields
@@ -166,6 +171,7 @@ def iter_pair_blocks(R: np.ndarray, mode: str = DEFAULT_MODE, block: int = DEFAU
 
 # --- streaming binning ------------------------------------------------------------------------------
 
+
 @dataclasses.dataclass
 class PairBins:
     """Per dissimilarity bin k (edges k·width … (k+1)·width [dB]): pair count and sums.
@@ -174,6 +180,7 @@ class PairBins:
     ``sum_d2`` Σ distance² [m²]; ``min_d`` smallest distance of a used pair [m]; ``n_no_common``
     pairs excluded for having no common AP; ``n_pairs`` pairs used.
     """
+
     width: float = DEFAULT_BIN_WIDTH_DB
     count: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0, np.int64))
     sum_x: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
@@ -196,8 +203,9 @@ class PairBins:
         if n > len(self.count):
             pad = n - len(self.count)
             self.count = np.concatenate([self.count, np.zeros(pad, np.int64)])
-            self.sum_x, self.sum_d, self.sum_d2 = (np.concatenate([a, np.zeros(pad)])
-                                                   for a in (self.sum_x, self.sum_d, self.sum_d2))
+            self.sum_x, self.sum_d, self.sum_d2 = (
+                np.concatenate([a, np.zeros(pad)]) for a in (self.sum_x, self.sum_d, self.sum_d2)
+            )
         m = len(self.count)
         self.count += np.bincount(k, minlength=m)
         self.sum_x += np.bincount(k, weights=x, minlength=m)
@@ -221,18 +229,26 @@ class PairBins:
         """The same sums on bins ``factor`` times wider (exact: sums add)."""
         k = np.arange(len(self.count)) // int(factor)
         m = int(k.max()) + 1 if len(k) else 0
-        out = PairBins(width=self.width * factor, min_d=self.min_d, n_no_common=self.n_no_common,
-                       n_pairs=self.n_pairs)
+        out = PairBins(
+            width=self.width * factor, min_d=self.min_d, n_no_common=self.n_no_common, n_pairs=self.n_pairs
+        )
         out.count = np.bincount(k, weights=self.count, minlength=m).astype(np.int64)
-        out.sum_x, out.sum_d, out.sum_d2 = (np.bincount(k, weights=a, minlength=m)
-                                            for a in (self.sum_x, self.sum_d, self.sum_d2))
+        out.sum_x, out.sum_d, out.sum_d2 = (
+            np.bincount(k, weights=a, minlength=m) for a in (self.sum_x, self.sum_d, self.sum_d2)
+        )
         return out
 
 
-def bin_pairs(R: np.ndarray, xy_m: np.ndarray, group: np.ndarray | None = None,
-              mode: str = DEFAULT_MODE, width_db: float = DEFAULT_BIN_WIDTH_DB,
-              block: int = DEFAULT_BLOCK, bins: PairBins | None = None,
-              min_common: int = 1) -> PairBins:
+def bin_pairs(
+    R: np.ndarray,
+    xy_m: np.ndarray,
+    group: np.ndarray | None = None,
+    mode: str = DEFAULT_MODE,
+    width_db: float = DEFAULT_BIN_WIDTH_DB,
+    block: int = DEFAULT_BLOCK,
+    bins: PairBins | None = None,
+    min_common: int = 1,
+) -> PairBins:
     """Stream every unordered scan pair (i > j) of the same ``group`` (floor) into :class:`PairBins`.
 
     Parameters
@@ -256,9 +272,9 @@ def bin_pairs(R: np.ndarray, xy_m: np.ndarray, group: np.ndarray | None = None,
             bi, bj = D.shape
             tri = np.tri(bi, bj, -1, dtype=bool) if i0 == j0 else np.ones((bi, bj), bool)
             bins.n_no_common += int(np.sum(tri & ~keep))
-            d2 = np.subtract.outer(P[i0:i0 + bi, 0], P[j0:j0 + bj, 0])
+            d2 = np.subtract.outer(P[i0 : i0 + bi, 0], P[j0 : j0 + bj, 0])
             d2 *= d2
-            dy = np.subtract.outer(P[i0:i0 + bi, 1], P[j0:j0 + bj, 1])
+            dy = np.subtract.outer(P[i0 : i0 + bi, 1], P[j0 : j0 + bj, 1])
             dy *= dy
             d2 += dy
             if i0 != j0 and keep.all():
@@ -271,6 +287,7 @@ def bin_pairs(R: np.ndarray, xy_m: np.ndarray, group: np.ndarray | None = None,
 
 # --- the distance model -----------------------------------------------------------------------------
 
+
 def model_distance(x, params) -> np.ndarray:
     """g(d) = max(X1, X2 + X3·d) [m] for dissimilarity ``x`` [dB] (NaN stays NaN)."""
     X1, X2, X3 = (float(v) for v in params)
@@ -281,6 +298,7 @@ def model_distance(x, params) -> np.ndarray:
 @dataclasses.dataclass
 class DistanceModel:
     """Fitted g(d) = max(X1, X2 + X3·d): ``floor_m`` X1, ``intercept_m`` X2, ``slope_m_per_db`` X3."""
+
     floor_m: float
     intercept_m: float
     slope_m_per_db: float
@@ -318,8 +336,9 @@ class DistanceModel:
         return cls(**kw)
 
 
-def fit_distance_model(x, d, weight=None, min_distance_m: float | None = None,
-                       mode: str = DEFAULT_MODE, sse_extra=None) -> DistanceModel:
+def fit_distance_model(
+    x, d, weight=None, min_distance_m: float | None = None, mode: str = DEFAULT_MODE, sse_extra=None
+) -> DistanceModel:
     """Bounded least-squares fit of g to dissimilarities ``x`` [dB] and distances ``d`` [m].
 
     Minimises Σ w_k (d_k − g(x_k))² with X1 ∈ [0, min_distance_m], X2 ≤ 0, X3 ≥ 0, from the
@@ -354,8 +373,14 @@ def fit_distance_model(x, d, weight=None, min_distance_m: float | None = None,
     def resid(X):
         return sw * (d - np.maximum(X[0], X[1] + X[2] * x))
 
-    res = least_squares(resid, x0, bounds=([0.0, -np.inf, 0.0], [ub1, 0.0, np.inf]),
-                        method="trf", x_scale="jac", max_nfev=2000)
+    res = least_squares(
+        resid,
+        x0,
+        bounds=([0.0, -np.inf, 0.0], [ub1, 0.0, np.inf]),
+        method="trf",
+        x_scale="jac",
+        max_nfev=2000,
+    )
     X = res.x
     if sse_extra is not None:
         sse, sst, n = sse_extra(X)
@@ -364,11 +389,18 @@ def fit_distance_model(x, d, weight=None, min_distance_m: float | None = None,
         sse = float((w * r * r).sum())
         sst = float((w * (d - md) ** 2).sum())
         n = float(W)
-    return DistanceModel(floor_m=float(X[0]), intercept_m=float(X[1]), slope_m_per_db=float(X[2]),
-                         mode=mode, rmse_m=math.sqrt(sse / n), r2=1.0 - sse / sst if sst > 0 else
-                         math.nan, n_pairs=int(round(n)), min_distance_m=ub1,
-                         ols_start=(float(a), float(b)),
-                         method="bounded least squares on pairs")
+    return DistanceModel(
+        floor_m=float(X[0]),
+        intercept_m=float(X[1]),
+        slope_m_per_db=float(X[2]),
+        mode=mode,
+        rmse_m=math.sqrt(sse / n),
+        r2=1.0 - sse / sst if sst > 0 else math.nan,
+        n_pairs=int(round(n)),
+        min_distance_m=ub1,
+        ols_start=(float(a), float(b)),
+        method="bounded least squares on pairs",
+    )
 
 
 def fit_binned(bins: PairBins, mode: str = DEFAULT_MODE) -> DistanceModel:
@@ -388,14 +420,17 @@ def fit_binned(bins: PairBins, mode: str = DEFAULT_MODE) -> DistanceModel:
         return max(sse, 0.0), sst, N
 
     m = fit_distance_model(mx, md, n, bins.min_d, mode, sse_extra=stats)
-    m.method = (f"exact streaming binning: {bins.n_pairs} pairs in {int(u.sum())} dissimilarity "
-                f"bins of {bins.width:g} dB (count, Σ distance, Σ distance² per bin); weighted "
-                f"bounded least squares on the bin means")
+    m.method = (
+        f"exact streaming binning: {bins.n_pairs} pairs in {int(u.sum())} dissimilarity "
+        f"bins of {bins.width:g} dB (count, Σ distance, Σ distance² per bin); weighted "
+        f"bounded least squares on the bin means"
+    )
     m.extra = {"n_pairs_no_common_ap": int(bins.n_no_common), "bin_width_db": bins.width}
     return m
 
 
 # --- reliability filter -----------------------------------------------------------------------------
+
 
 def reliability_mask(model_dist_m: np.ndarray, tau: float = DEFAULT_TAU) -> tuple[np.ndarray, float]:
     """Pairs kept by the filter: g(d) ≤ τ · max g (NaN never kept). Returns (mask, threshold [m])."""

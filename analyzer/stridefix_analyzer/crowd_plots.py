@@ -1,4 +1,5 @@
 """Plots of the crowdsourced model (kept apart from the numbers): fit and solved positions."""
+
 from __future__ import annotations
 
 import os
@@ -10,28 +11,37 @@ from .crowd_model import DistanceModel, PairBins
 
 def _plt():
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     return plt
 
 
-def plot_fit(bins: PairBins, model: DistanceModel, png_path: str, title: str = "",
-             display_width_db: float = 2.0) -> None:
+def plot_fit(
+    bins: PairBins, model: DistanceModel, png_path: str, title: str = "", display_width_db: float = 2.0
+) -> None:
     """Binned true distance vs dissimilarity (mean ± 1 std per display bin, pair counts shaded)
     with the fitted g(d)."""
     plt = _plt()
     factor = max(1, int(round(display_width_db / bins.width)))
     b = bins.coarsen(factor)
     mx, md, sd, n = b.means()
-    fig, (ax, axn) = plt.subplots(2, 1, figsize=(7, 6), sharex=True,
-                                  gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True)
+    fig, (ax, axn) = plt.subplots(
+        2, 1, figsize=(7, 6), sharex=True, gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True
+    )
     ax.fill_between(mx, md - sd, md + sd, color="tab:blue", alpha=0.2, label="±1 std (per bin)")
     ax.plot(mx, md, "o", ms=3, color="tab:blue", label=f"mean distance per {b.width:g} dB bin")
     xs = np.linspace(0, float(mx.max()) if len(mx) else 1.0, 300)
     X = model.params
-    ax.plot(xs, model(xs), "r-", lw=2,
-            label=f"g(d) = max({X[0]:.2f}, {X[1]:.2f} + {X[2]:.3f}·d)  RMSE {model.rmse_m:.2f} m, "
-                  f"R² {model.r2:.2f}")
+    ax.plot(
+        xs,
+        model(xs),
+        "r-",
+        lw=2,
+        label=f"g(d) = max({X[0]:.2f}, {X[1]:.2f} + {X[2]:.3f}·d)  RMSE {model.rmse_m:.2f} m, "
+        f"R² {model.r2:.2f}",
+    )
     ax.set_ylabel("true distance [m]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
@@ -45,8 +55,14 @@ def plot_fit(bins: PairBins, model: DistanceModel, png_path: str, title: str = "
     plt.close(fig)
 
 
-def plot_solution(xy: np.ndarray, truth_xy: np.ndarray, is_truth: np.ndarray,
-                  anchor_index: np.ndarray, png_path: str, title: str = "") -> None:
+def plot_solution(
+    xy: np.ndarray,
+    truth_xy: np.ndarray,
+    is_truth: np.ndarray,
+    anchor_index: np.ndarray,
+    png_path: str,
+    title: str = "",
+) -> None:
     """Truth (red o) vs estimate (blue *) with a black line per pair, as in the thesis; anchors ■."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)

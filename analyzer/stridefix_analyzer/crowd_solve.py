@@ -30,6 +30,7 @@ interpolated linearly in time (held before the first / after the last).
 Error: ‖p̂ − truth‖ at the non-anchor truth points: mean, std (ddof 1, the thesis's MATLAB std),
 median, p90, RMSE; the thesis also averaged over the anchors (reported as ``mean_all_m``).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -41,13 +42,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import least_squares
 
-from .crowd_model import DEFAULT_TAU, DistanceModel, _Prepared, _block
+from .crowd_model import DEFAULT_TAU, DistanceModel, _block, _Prepared
 from .crowd_walks import DEFAULT_BORROW_S, CrowdInputError, ScanSet, Walk
 
 RANGES = ("pdr", "wifi", "both", "hybrid")
 DEFAULT_WEIGHTS = (1.0, 2.0)
 SOLVERS = ("auto", "native", "scipy")
-DEFAULT_MAX_NFEV = 8000     # thesis: lsqnonlin MaxFunctionEvaluations
+DEFAULT_MAX_NFEV = 8000  # thesis: lsqnonlin MaxFunctionEvaluations
 
 
 def parse_anchors(spec: str) -> int:
@@ -63,6 +64,7 @@ def parse_anchors(spec: str) -> int:
 @dataclasses.dataclass
 class Points:
     """The unknown points of a set of walks, (n,) each; ``fp`` row of the scan set or −1."""
+
     walk: np.ndarray
     t_us: np.ndarray
     is_scan: np.ndarray
@@ -86,8 +88,11 @@ def make_points(walks: list[Walk], scans: ScanSet, borrow_s: float = DEFAULT_BOR
             wt = w.truth_t_us
             near = np.full(len(wt), -1, np.int64)
             if len(st):
-                j = np.clip(np.searchsorted(st, wt), 1, len(st)) if len(st) > 1 else \
-                    np.zeros(len(wt), np.int64)
+                j = (
+                    np.clip(np.searchsorted(st, wt), 1, len(st))
+                    if len(st) > 1
+                    else np.zeros(len(wt), np.int64)
+                )
                 cand = np.stack([np.clip(j - 1, 0, len(st) - 1), np.clip(j, 0, len(st) - 1)])
                 dt = np.abs(st[cand] - wt[None, :])
                 best = cand[np.argmin(dt, axis=0), np.arange(len(wt))]
@@ -109,6 +114,7 @@ def make_points(walks: list[Walk], scans: ScanSet, borrow_s: float = DEFAULT_BOR
 @dataclasses.dataclass
 class Problem:
     """Anchors, ranges and the initial guess; arrays as in the native call (module docstring)."""
+
     n: int
     anchor_index: np.ndarray
     anchor_xy: np.ndarray
@@ -116,13 +122,14 @@ class Problem:
     pair_j: np.ndarray
     range_m: np.ndarray
     weight: np.ndarray
-    row_kind: np.ndarray         # 0 PDR, 1 Wi-Fi
-    x0: np.ndarray               # (n, 2)
+    row_kind: np.ndarray  # 0 PDR, 1 Wi-Fi
+    x0: np.ndarray  # (n, 2)
     info: dict
 
 
-def _wifi_pairs(points: Points, scans: ScanSet, model: DistanceModel, tau, block: int = 2048,
-                collect: bool = True):
+def _wifi_pairs(
+    points: Points, scans: ScanSet, model: DistanceModel, tau, block: int = 2048, collect: bool = True
+):
     """Candidate Wi-Fi pairs (i > j, both with a fingerprint, same floor, a common AP):
     returns (i, j, g) of those passing the filter, the threshold [m], candidates, no-common count."""
     idx = np.flatnonzero(points.fp >= 0)
@@ -132,14 +139,14 @@ def _wifi_pairs(points: Points, scans: ScanSet, model: DistanceModel, tau, block
     n = len(idx)
     # g is non-decreasing in d: max g = g(max d), so the threshold needs one pass for max d
     chunks, dmax, n_cand, n_nocommon = [], -np.inf, 0, 0
-    for pass_ in ((0, 1) if collect else (0,)):
+    thr = math.nan  # set at the end of pass 0, used by pass 1
+    for pass_ in (0, 1) if collect else (0,):
         for i0 in range(0, n, block):
             ia = slice(i0, min(n, i0 + block))
             for j0 in range(0, i0 + 1, block):
                 ib = slice(j0, min(n, j0 + block))
                 D = _block(p, ia, p, ib, model.mode, model.min_common_aps)
-                tri = np.tri(D.shape[0], D.shape[1], -1, dtype=bool) if i0 == j0 else \
-                    np.ones(D.shape, bool)
+                tri = np.tri(D.shape[0], D.shape[1], -1, dtype=bool) if i0 == j0 else np.ones(D.shape, bool)
                 same = fl[ia][:, None] == fl[ib][None, :]
                 cand = tri & same
                 ok = cand & np.isfinite(D)
@@ -155,8 +162,9 @@ def _wifi_pairs(points: Points, scans: ScanSet, model: DistanceModel, tau, block
                 ii, jj = np.nonzero(ok)
                 chunks.append((idx[ii + i0], idx[jj + j0], model(D[ii, jj])))
         if pass_ == 0:
-            thr = math.nan if not np.isfinite(dmax) else \
-                (tau if tau is not None else 1.0) * float(model(dmax))
+            thr = (
+                math.nan if not np.isfinite(dmax) else (tau if tau is not None else 1.0) * float(model(dmax))
+            )
     if chunks:
         i, j, g = (np.concatenate(c) for c in zip(*chunks))
     else:
@@ -164,10 +172,19 @@ def _wifi_pairs(points: Points, scans: ScanSet, model: DistanceModel, tau, block
     return i, j, g, thr, n_cand, n_nocommon
 
 
-def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: DistanceModel | None,
-                  ranges: str = "both", anchors: str = "every:4", pdr_span: int = 1,
-                  pdr_metric: str = "chord", weights: tuple | None = DEFAULT_WEIGHTS,
-                  tau: float | None = DEFAULT_TAU) -> Problem:
+def build_problem(
+    walks: list[Walk],
+    scans: ScanSet,
+    points: Points,
+    *,
+    model: DistanceModel | None,
+    ranges: str = "both",
+    anchors: str = "every:4",
+    pdr_span: int = 1,
+    pdr_metric: str = "chord",
+    weights: tuple | None = DEFAULT_WEIGHTS,
+    tau: float | None = DEFAULT_TAU,
+) -> Problem:
     """Rows of the problem (module docstring). ``weights`` = (m, c) or None; ``tau`` None = no filter."""
     if ranges not in RANGES:
         raise CrowdInputError(f"ranges {ranges!r} not one of {RANGES}")
@@ -177,9 +194,15 @@ def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: D
         raise CrowdInputError(f"pdr metric {pdr_metric!r} not chord or path")
     K = parse_anchors(anchors)
     n = len(points.t_us)
-    info: dict = {"points": n, "ranges": ranges, "anchors": anchors, "pdr_span": pdr_span,
-                  "pdr_metric": pdr_metric, "weights": list(weights) if weights else None,
-                  "tau": tau}
+    info: dict = {
+        "points": n,
+        "ranges": ranges,
+        "anchors": anchors,
+        "pdr_span": pdr_span,
+        "pdr_metric": pdr_metric,
+        "weights": list(weights) if weights else None,
+        "tau": tau,
+    }
     # anchors: every K-th truth point of each walk
     is_anchor = np.zeros(n, bool)
     for k in range(len(walks)):
@@ -191,8 +214,10 @@ def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: D
     if ranges != "wifi":
         for k, w in enumerate(walks):
             if len(w.step_t_us) == 0:
-                raise CrowdInputError(f"{w.name}: no STEP messages (PDR ranges need the firmware "
-                                      f"log of the walk: give 'firmware.lcmlog,truth.lcmlog')")
+                raise CrowdInputError(
+                    f"{w.name}: no STEP messages (PDR ranges need the firmware "
+                    f"log of the walk: give 'firmware.lcmlog,truth.lcmlog')"
+                )
             ids = np.flatnonzero(points.walk == k)
             m = len(ids)
             span = m - 1 if pdr_span <= 0 else min(pdr_span, m - 1)
@@ -209,10 +234,8 @@ def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: D
     bw = np.zeros(0)
     if ranges != "pdr":
         use_tau = tau if ranges in ("wifi", "both") else None
-        wi, wj, bw, thr, n_cand, n_nc = _wifi_pairs(points, scans, model, use_tau,
-                                                      collect=ranges != "hybrid")
-        info.update(wifi_candidate_pairs=n_cand, wifi_pairs_no_common_ap=n_nc,
-                    wifi_threshold_m=thr)
+        wi, wj, bw, thr, n_cand, n_nc = _wifi_pairs(points, scans, model, use_tau, collect=ranges != "hybrid")
+        info.update(wifi_candidate_pairs=n_cand, wifi_pairs_no_common_ap=n_nc, wifi_threshold_m=thr)
         if ranges == "hybrid":
             keep = np.ones(len(pi), bool)
             if tau is not None:
@@ -221,8 +244,7 @@ def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: D
                 fpi, fpj = points.fp[pi], points.fp[pj]
                 has = (fpi >= 0) & (fpj >= 0)
                 if has.any():
-                    D = _block_pairs(scans, fpi[has], fpj[has], model.mode,
-                                     model.min_common_aps)
+                    D = _block_pairs(scans, fpi[has], fpj[has], model.mode, model.min_common_aps)
                     with np.errstate(invalid="ignore"):
                         keep[np.flatnonzero(has)] = np.isfinite(D) & (model(D) <= thr_h)
             pi, pj, b_pdr = pi[keep], pj[keep], b_pdr[keep]
@@ -236,17 +258,27 @@ def build_problem(walks: list[Walk], scans: ScanSet, points: Points, *, model: D
     kind = np.concatenate([np.zeros(len(pi), np.int8), np.ones(len(wi), np.int8)])
     w = 1.0 / (weights[0] * b + weights[1]) if weights else np.ones(len(b))
     if weights and np.any(~np.isfinite(w) | (w <= 0)):
-        raise CrowdInputError(f"weights 1/(m·b + c) with m, c = {weights} are not positive for "
-                              f"every range (need c > −m·min b)")
+        raise CrowdInputError(
+            f"weights 1/(m·b + c) with m, c = {weights} are not positive for every range (need c > −m·min b)"
+        )
     x0 = _initial_guess(points, is_anchor)
     info["anchors_n"] = int(len(a_idx))
     info["unconstrained_points"] = int(n - len(np.unique(np.concatenate([i, j, a_idx]))))
-    return Problem(n=n, anchor_index=a_idx, anchor_xy=points.truth_xy_m[a_idx], pair_i=i, pair_j=j,
-                   range_m=b, weight=w, row_kind=kind, x0=x0, info=info)
+    return Problem(
+        n=n,
+        anchor_index=a_idx,
+        anchor_xy=points.truth_xy_m[a_idx],
+        pair_i=i,
+        pair_j=j,
+        range_m=b,
+        weight=w,
+        row_kind=kind,
+        x0=x0,
+        info=info,
+    )
 
 
-def _block_pairs(scans: ScanSet, a: np.ndarray, b: np.ndarray, mode: str,
-                 min_common: int = 1) -> np.ndarray:
+def _block_pairs(scans: ScanSet, a: np.ndarray, b: np.ndarray, mode: str, min_common: int = 1) -> np.ndarray:
     """Dissimilarity of scan a[k] vs scan b[k] for each k (row-wise, O(k·m))."""
     out = np.empty(len(a))
     for s in range(0, len(a), 4096):
@@ -281,6 +313,7 @@ def _initial_guess(points: Points, is_anchor: np.ndarray) -> np.ndarray:
 
 # --- solvers ----------------------------------------------------------------------------------------
 
+
 def solve_scipy(prob: Problem, max_nfev: int = DEFAULT_MAX_NFEV) -> tuple[np.ndarray, dict]:
     """Scipy reference: least_squares (trf, LSMR) on the stacked weighted residuals."""
     n, a, i, j = prob.n, prob.anchor_index, prob.pair_i, prob.pair_j
@@ -304,17 +337,19 @@ def solve_scipy(prob: Problem, max_nfev: int = DEFAULT_MAX_NFEV) -> tuple[np.nda
         dxy = p[i] - p[j]
         dist = np.maximum(np.hypot(dxy[:, 0], dxy[:, 1]), 1e-9)
         u = dxy / dist[:, None] * w[:, None]
-        vals = np.concatenate([np.ones(2 * na),
-                               np.stack([-u[:, 0], -u[:, 1], u[:, 0], u[:, 1]], 1).ravel()])
+        vals = np.concatenate([np.ones(2 * na), np.stack([-u[:, 0], -u[:, 1], u[:, 0], u[:, 1]], 1).ravel()])
         return sp.csr_matrix((vals, (rows, cols)), shape=(2 * na + k, 2 * n))
 
     t0 = time.perf_counter()
-    res = least_squares(fun, prob.x0.ravel(), jac=jac, method="trf", tr_solver="lsmr",
-                        max_nfev=max_nfev)
+    res = least_squares(fun, prob.x0.ravel(), jac=jac, method="trf", tr_solver="lsmr", max_nfev=max_nfev)
     name = "scipy least_squares (trf, lsmr)"
-    return res.x.reshape(n, 2), {"solver": name, "nfev": int(res.nfev),
-                                 "cost": float(res.cost), "status": int(res.status),
-                                 "solve_s": time.perf_counter() - t0}
+    return res.x.reshape(n, 2), {
+        "solver": name,
+        "nfev": int(res.nfev),
+        "cost": float(res.cost),
+        "status": int(res.status),
+        "solve_s": time.perf_counter() - t0,
+    }
 
 
 def solve_native(prob: Problem, max_iterations: int = 1000) -> tuple[np.ndarray, dict]:
@@ -323,16 +358,24 @@ def solve_native(prob: Problem, max_iterations: int = 1000) -> tuple[np.ndarray,
 
     t0 = time.perf_counter()
     out = stridefix_native.solve_coordinates(
-        int(prob.n), prob.anchor_index.astype(np.int64),
+        int(prob.n),
+        prob.anchor_index.astype(np.int64),
         np.ascontiguousarray(prob.anchor_xy, float),
         np.ascontiguousarray(np.column_stack([prob.pair_i, prob.pair_j]).astype(np.int64)),
-        prob.range_m.astype(float), prob.weight.astype(float),
-        init_xy=np.ascontiguousarray(prob.x0, float), max_iterations=int(max_iterations))
+        prob.range_m.astype(float),
+        prob.weight.astype(float),
+        init_xy=np.ascontiguousarray(prob.x0, float),
+        max_iterations=int(max_iterations),
+    )
     xy = np.asarray(out["xy"], float).reshape(prob.n, 2)
-    return xy, {"solver": "stridefix_native.solve_coordinates (Ceres)",
-                "solve_s": time.perf_counter() - t0, "iterations": out.get("iterations"),
-                "converged": out.get("converged"), "cost": out.get("cost"),
-                "message": out.get("message")}
+    return xy, {
+        "solver": "stridefix_native.solve_coordinates (Ceres)",
+        "solve_s": time.perf_counter() - t0,
+        "iterations": out.get("iterations"),
+        "converged": out.get("converged"),
+        "cost": out.get("cost"),
+        "message": out.get("message"),
+    }
 
 
 def solve(prob: Problem, solver: str = "auto") -> tuple[np.ndarray, dict]:
@@ -346,7 +389,7 @@ def solve(prob: Problem, solver: str = "auto") -> tuple[np.ndarray, dict]:
             if not np.all(np.isfinite(xy)):
                 raise ValueError("non-finite positions")
             return xy, info
-        except Exception as exc:   # noqa: BLE001 - any native failure falls back (reported)
+        except Exception as exc:  # noqa: BLE001 - any native failure falls back (reported)
             if solver == "native":
                 raise CrowdInputError(f"native solver unavailable or failed: {exc!r}") from exc
             note = f"native solver not used ({type(exc).__name__}: {str(exc)[:200]})"
@@ -365,8 +408,14 @@ def error_stats(xy: np.ndarray, points: Points, prob: Problem) -> dict:
     e = np.hypot(*(xy[truth & ~is_anchor] - points.truth_xy_m[truth & ~is_anchor]).T)
     if e.size == 0:
         return {"n": 0}
-    return {"n": int(e.size), "mean_m": float(e.mean()),
-            "std_m": float(e.std(ddof=1)) if e.size > 1 else 0.0,
-            "median_m": float(np.median(e)), "p90_m": float(np.percentile(e, 90)),
-            "rmse_m": float(np.sqrt(np.mean(e * e))), "max_m": float(e.max()),
-            "mean_all_m": float(e_all.mean()), "n_all": int(e_all.size)}
+    return {
+        "n": int(e.size),
+        "mean_m": float(e.mean()),
+        "std_m": float(e.std(ddof=1)) if e.size > 1 else 0.0,
+        "median_m": float(np.median(e)),
+        "p90_m": float(np.percentile(e, 90)),
+        "rmse_m": float(np.sqrt(np.mean(e * e))),
+        "max_m": float(e.max()),
+        "mean_all_m": float(e_all.mean()),
+        "n_all": int(e_all.size),
+    }

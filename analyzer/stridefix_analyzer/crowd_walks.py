@@ -17,6 +17,7 @@ walk is the chord ‖DR(t_j) − DR(t_i)‖ (``chord``, default: invariant to th
 heading change within the span matters) or S(t_j) − S(t_i) (``path``: Σ step lengths between the two
 times; equal to the chord on a straight stretch).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -42,6 +43,7 @@ class CrowdInputError(Exception):
 @dataclasses.dataclass
 class Walk:
     """One recording: scans (n,), their AP rows (a,), truth (k,), steps (s,)."""
+
     name: str
     scan_t_us: np.ndarray
     ap_scan: np.ndarray
@@ -135,14 +137,22 @@ def _make_walk(files: list[str], datas: list) -> Walk:
         st = st[o]
     else:
         st, sl, sh = np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
-    return Walk(name=name, scan_t_us=w["t_us"].astype(np.int64),
-                ap_scan=ap["scan_row"].astype(np.int64), ap_bssid=ap["bssid"].astype(np.int64),
-                ap_rssi_dbm=ap["rssi_dbm"].astype(float), ap_freq_mhz=ap["freq_mhz"].astype(np.int64),
-                truth_t_us=t_us[sel][order].astype(np.int64),
-                truth_xy_m=np.column_stack([x[sel][order], y[sel][order]]),
-                truth_floor=fl[sel][order].astype(np.int64), dense_truth=dense,
-                step_t_us=st.astype(np.int64), step_length_m=sl.astype(float),
-                step_heading_rad=sh.astype(float), scan_complete=w["complete"].astype(bool))
+    return Walk(
+        name=name,
+        scan_t_us=w["t_us"].astype(np.int64),
+        ap_scan=ap["scan_row"].astype(np.int64),
+        ap_bssid=ap["bssid"].astype(np.int64),
+        ap_rssi_dbm=ap["rssi_dbm"].astype(float),
+        ap_freq_mhz=ap["freq_mhz"].astype(np.int64),
+        truth_t_us=t_us[sel][order].astype(np.int64),
+        truth_xy_m=np.column_stack([x[sel][order], y[sel][order]]),
+        truth_floor=fl[sel][order].astype(np.int64),
+        dense_truth=dense,
+        step_t_us=st.astype(np.int64),
+        step_length_m=sl.astype(float),
+        step_heading_rad=sh.astype(float),
+        scan_complete=w["complete"].astype(bool),
+    )
 
 
 def load_walks(args: list[str]) -> list[Walk]:
@@ -166,13 +176,14 @@ def load_walks(args: list[str]) -> list[Walk]:
 @dataclasses.dataclass
 class ScanSet:
     """The scans of several walks pooled: fingerprint matrix and truth per scan."""
-    R: np.ndarray            # (n, m) RSS [dBm], NaN = not heard
-    bssids: np.ndarray       # (m,)
-    walk: np.ndarray         # (n,) walk index
-    t_us: np.ndarray         # (n,)
-    xy_m: np.ndarray         # (n, 2) truth at scan time (NaN unknown)
-    floor: np.ndarray        # (n,) truth floor (−9999 unknown)
-    usable: np.ndarray       # (n,) complete scan with at least one AP of the band
+
+    R: np.ndarray  # (n, m) RSS [dBm], NaN = not heard
+    bssids: np.ndarray  # (m,)
+    walk: np.ndarray  # (n,) walk index
+    t_us: np.ndarray  # (n,)
+    xy_m: np.ndarray  # (n, 2) truth at scan time (NaN unknown)
+    floor: np.ndarray  # (n,) truth floor (−9999 unknown)
+    usable: np.ndarray  # (n,) complete scan with at least one AP of the band
 
 
 def pool_scans(walks: list[Walk], band: str = DEFAULT_BAND) -> ScanSet:
@@ -194,5 +205,6 @@ def pool_scans(walks: list[Walk], band: str = DEFAULT_BAND) -> ScanSet:
     cat = np.concatenate
     R, bssids = fingerprint_matrix(cat(rows), cat(bss), cat(rss), base)
     usable = cat(comp) & np.isfinite(R).any(axis=1)
-    return ScanSet(R=R, bssids=bssids, walk=cat(walk_id), t_us=cat(t), xy_m=cat(xy),
-                   floor=cat(fl), usable=usable)
+    return ScanSet(
+        R=R, bssids=bssids, walk=cat(walk_id), t_us=cat(t), xy_m=cat(xy), floor=cat(fl), usable=usable
+    )

@@ -29,6 +29,7 @@ Errors: a missing or unreadable file raises :class:`LogReadError` naming it. Bad
 error: unknown channels and messages that fail to decode are counted (by channel), and a log cut
 short reads up to its last whole record, with a warning in ``LogData.warnings``.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -38,7 +39,6 @@ from typing import Callable, Iterable, Mapping
 
 import lcm
 import numpy as np
-
 import stridefix
 
 
@@ -149,6 +149,7 @@ class LogData:
 
 # --- per-type row flatteners: message -> tuple of column values --------------------------------
 
+
 def _xyz(prefix: str, unit: str) -> list[str]:
     return [f"{prefix}_{axis}_{unit}" for axis in "xyz"]
 
@@ -157,47 +158,111 @@ _HEALTH_FIELDS = list(stridefix.health_t.__slots__)
 
 # channel -> (type, column names, row function)
 _CHANNELS: dict[str, tuple[type, list[str], Callable]] = {
-    "IMU": (stridefix.imu_t,
-            ["t_us", "seq", *_xyz("accel", "mps2"), *_xyz("gyro", "radps")],
-            lambda m: (m.t_us, m.seq, *m.accel_mps2, *m.gyro_radps)),
-    "MAG": (stridefix.mag_t, ["t_us", "seq", *_xyz("field", "ut")],
-            lambda m: (m.t_us, m.seq, *m.field_ut)),
-    "BARO": (stridefix.baro_t, ["t_us", "seq", "pressure_pa", "temperature_degc"],
-             lambda m: (m.t_us, m.seq, m.pressure_pa, m.temperature_degc)),
-    "WIFI": (stridefix.wifi_scan_t, ["t_us", "scan_id", "complete", "n_ap"],
-             lambda m: (m.t_us, m.scan_id, bool(m.complete), m.n_ap)),
-    "GNSS": (stridefix.gnss_t, ["t_us", "lat_deg", "lon_deg", "alt_m", "accuracy_m"],
-             lambda m: (m.t_us, m.lat_deg, m.lon_deg, m.alt_m, m.accuracy_m)),
-    "STEP": (stridefix.step_t, ["t_us", "index", "length_m", "accel_range_mps2", "period_s",
-                                "heading_rad", "activity", "floor"],
-             lambda m: (m.t_us, m.index, m.length_m, m.accel_range_mps2, m.period_s,
-                        m.heading_rad, m.activity, m.floor)),
-    "FIX": (stridefix.fix_t,
-            ["t_us", "method", "x_m", "y_m", "floor", "accuracy_m", "n_ap_used", "innovation_x_m",
-             "innovation_y_m", "innovation_var_m2", "test_ratio", "alpha", "accepted", "reason",
-             "reason_text"],
-            lambda m: (m.t_us, m.method, m.x_m, m.y_m, m.floor, m.accuracy_m, m.n_ap_used,
-                       m.innovation_m[0], m.innovation_m[1], m.innovation_var_m2, m.test_ratio,
-                       m.alpha, bool(m.accepted), m.reason, m.reason_text)),
-    "POSE": (stridefix.pose_t,
-             ["t_us", "x_m", "y_m", "floor", "heading_rad", "sigma_m", "step_count", "scheme"],
-             lambda m: (m.t_us, m.x_m, m.y_m, m.floor, m.heading_rad, m.sigma_m, m.step_count,
-                        m.scheme)),
-    "TRUTH": (stridefix.truth_t,
-              ["t_us", "x_m", "y_m", "floor", "heading_rad", "step_count", "source"],
-              lambda m: (m.t_us, m.x_m, m.y_m, m.floor, m.heading_rad, m.step_count, m.source)),
-    "HEALTH": (stridefix.health_t, _HEALTH_FIELDS,
-               lambda m: tuple(getattr(m, f) for f in _HEALTH_FIELDS)),
-    "CONFIG": (stridefix.config_t, [], None),   # not a table: see _Collector.add_config
+    "IMU": (
+        stridefix.imu_t,
+        ["t_us", "seq", *_xyz("accel", "mps2"), *_xyz("gyro", "radps")],
+        lambda m: (m.t_us, m.seq, *m.accel_mps2, *m.gyro_radps),
+    ),
+    "MAG": (stridefix.mag_t, ["t_us", "seq", *_xyz("field", "ut")], lambda m: (m.t_us, m.seq, *m.field_ut)),
+    "BARO": (
+        stridefix.baro_t,
+        ["t_us", "seq", "pressure_pa", "temperature_degc"],
+        lambda m: (m.t_us, m.seq, m.pressure_pa, m.temperature_degc),
+    ),
+    "WIFI": (
+        stridefix.wifi_scan_t,
+        ["t_us", "scan_id", "complete", "n_ap"],
+        lambda m: (m.t_us, m.scan_id, bool(m.complete), m.n_ap),
+    ),
+    "GNSS": (
+        stridefix.gnss_t,
+        ["t_us", "lat_deg", "lon_deg", "alt_m", "accuracy_m"],
+        lambda m: (m.t_us, m.lat_deg, m.lon_deg, m.alt_m, m.accuracy_m),
+    ),
+    "STEP": (
+        stridefix.step_t,
+        ["t_us", "index", "length_m", "accel_range_mps2", "period_s", "heading_rad", "activity", "floor"],
+        lambda m: (
+            m.t_us,
+            m.index,
+            m.length_m,
+            m.accel_range_mps2,
+            m.period_s,
+            m.heading_rad,
+            m.activity,
+            m.floor,
+        ),
+    ),
+    "FIX": (
+        stridefix.fix_t,
+        [
+            "t_us",
+            "method",
+            "x_m",
+            "y_m",
+            "floor",
+            "accuracy_m",
+            "n_ap_used",
+            "innovation_x_m",
+            "innovation_y_m",
+            "innovation_var_m2",
+            "test_ratio",
+            "alpha",
+            "accepted",
+            "reason",
+            "reason_text",
+        ],
+        lambda m: (
+            m.t_us,
+            m.method,
+            m.x_m,
+            m.y_m,
+            m.floor,
+            m.accuracy_m,
+            m.n_ap_used,
+            m.innovation_m[0],
+            m.innovation_m[1],
+            m.innovation_var_m2,
+            m.test_ratio,
+            m.alpha,
+            bool(m.accepted),
+            m.reason,
+            m.reason_text,
+        ),
+    ),
+    "POSE": (
+        stridefix.pose_t,
+        ["t_us", "x_m", "y_m", "floor", "heading_rad", "sigma_m", "step_count", "scheme"],
+        lambda m: (m.t_us, m.x_m, m.y_m, m.floor, m.heading_rad, m.sigma_m, m.step_count, m.scheme),
+    ),
+    "TRUTH": (
+        stridefix.truth_t,
+        ["t_us", "x_m", "y_m", "floor", "heading_rad", "step_count", "source"],
+        lambda m: (m.t_us, m.x_m, m.y_m, m.floor, m.heading_rad, m.step_count, m.source),
+    ),
+    "HEALTH": (stridefix.health_t, _HEALTH_FIELDS, lambda m: tuple(getattr(m, f) for f in _HEALTH_FIELDS)),
+    "CONFIG": (stridefix.config_t, [], None),  # not a table: see _Collector.add_config
 }
 
 #: The channels :func:`read_logs` knows how to decode.
 KNOWN_CHANNELS = tuple(_CHANNELS)
 
 # numpy dtype per column (anything not listed is float64)
-_INT_COLUMNS = {"t_us", "seq", "scan_id", "n_ap", "index", "activity", "method", "floor",
-                "n_ap_used", "reason", "step_count", "scheme", "source"} | {
-    f for f in _HEALTH_FIELDS if not f.startswith("loop_")}
+_INT_COLUMNS = {
+    "t_us",
+    "seq",
+    "scan_id",
+    "n_ap",
+    "index",
+    "activity",
+    "method",
+    "floor",
+    "n_ap_used",
+    "reason",
+    "step_count",
+    "scheme",
+    "source",
+} | {f for f in _HEALTH_FIELDS if not f.startswith("loop_")}
 _BOOL_COLUMNS = {"complete", "accepted"}
 _STR_COLUMNS = {"reason_text"}
 
@@ -218,7 +283,7 @@ class _Collector:
     def __init__(self, decode: set[str]):
         self.decode = decode
         self.rows: dict[str, list[tuple]] = {ch: [] for ch in _CHANNELS}
-        self.wifi_aps: list[tuple] = []      # (scan row, bssid, rssi_dbm, freq_mhz)
+        self.wifi_aps: list[tuple] = []  # (scan row, bssid, rssi_dbm, freq_mhz)
         self.data = LogData()
 
     def add_event(self, channel: str, payload: bytes, path: str) -> None:
@@ -236,21 +301,24 @@ class _Collector:
                 self.add_config(msg, path)
                 return
             values = row(msg)
-        except Exception:   # noqa: BLE001 - any decode failure is bad data, counted not fatal
+        except Exception:  # noqa: BLE001 - any decode failure is bad data, counted not fatal
             d.decode_errors[channel] = d.decode_errors.get(channel, 0) + 1
             return
         if channel == "WIFI":
             scan_row = len(self.rows["WIFI"])
             self.wifi_aps.extend(
-                (scan_row, b, r, f) for b, r, f in zip(msg.bssid, msg.rssi_dbm, msg.freq_mhz))
+                (scan_row, b, r, f) for b, r, f in zip(msg.bssid, msg.rssi_dbm, msg.freq_mhz)
+            )
         self.rows[channel].append(values)
 
     def add_config(self, msg, path: str) -> None:
         d = self.data
         for key, value in zip(msg.key, msg.value):
             if key in d.config and d.config[key] != value:
-                d.warnings.append(f"{path}: CONFIG key {key!r} = {value!r} replaces "
-                                  f"{d.config[key]!r} from an earlier CONFIG message")
+                d.warnings.append(
+                    f"{path}: CONFIG key {key!r} = {value!r} replaces "
+                    f"{d.config[key]!r} from an earlier CONFIG message"
+                )
             d.config[key] = value
         d.versions.update(version=msg.version, dbc_sha256=msg.dbc_sha256)
 
@@ -269,11 +337,14 @@ class _Collector:
                 new_row = np.empty(len(order), dtype=np.int64)
                 new_row[order] = np.arange(len(order))
                 aps = list(zip(*self.wifi_aps)) if self.wifi_aps else [[], [], [], []]
-                d.tables["WIFI_AP"] = Table({
-                    "scan_row": new_row[np.asarray(aps[0], dtype=np.int64)],
-                    "bssid": np.asarray(aps[1], dtype=np.int64),
-                    "rssi_dbm": np.asarray(aps[2], dtype=np.float64),
-                    "freq_mhz": np.asarray(aps[3], dtype=np.int64)})
+                d.tables["WIFI_AP"] = Table(
+                    {
+                        "scan_row": new_row[np.asarray(aps[0], dtype=np.int64)],
+                        "bssid": np.asarray(aps[1], dtype=np.int64),
+                        "rssi_dbm": np.asarray(aps[2], dtype=np.float64),
+                        "freq_mhz": np.asarray(aps[3], dtype=np.int64),
+                    }
+                )
             elif channel == "HEALTH":
                 # counters never decrease: the latest report by host clock is the final state
                 table = table.rows(np.argsort(table["host_t_us"], kind="stable"))
@@ -283,14 +354,15 @@ class _Collector:
                 table = table.sorted_by("t_us")
             d.tables[channel] = table
         for channel, n in sorted(d.decode_errors.items()):
-            d.warnings.append(f"{n} message(s) on channel {channel} failed to decode "
-                              f"(wrong type or corrupt payload)")
+            d.warnings.append(
+                f"{n} message(s) on channel {channel} failed to decode (wrong type or corrupt payload)"
+            )
         return d
 
 
-_SYNC_WORD = bytes.fromhex("EDA1DA01")   # first 4 bytes of every LCM log record (big-endian)
-_RECORD_OVERHEAD = 4 + 8 + 8 + 4 + 4   # sync word, event number, timestamp, channel and data lengths
-_MAX_CHANNEL_BYTES = 255               # sanity bound when salvaging (LCM itself allows 63)
+_SYNC_WORD = bytes.fromhex("EDA1DA01")  # first 4 bytes of every LCM log record (big-endian)
+_RECORD_OVERHEAD = 4 + 8 + 8 + 4 + 4  # sync word, event number, timestamp, channel and data lengths
+_MAX_CHANNEL_BYTES = 255  # sanity bound when salvaging (LCM itself allows 63)
 _CHUNK = 1 << 20
 
 
@@ -352,7 +424,7 @@ def _read_file(path: str, collector: _Collector) -> None:
         raise LogReadError(path, f"cannot open as an LCM event log ({exc})") from exc
     size = os.path.getsize(path)
     events = skipped = salvaged = 0
-    end_of_last = 0   # byte offset just past the last whole record read
+    end_of_last = 0  # byte offset just past the last whole record read
     try:
         while True:
             event = log.read_next_event()
@@ -378,7 +450,7 @@ def _read_file(path: str, collector: _Collector) -> None:
                 record = _parse_record(raw, at, size)
                 scan = at + 1
             if record is None:
-                break           # only a partial record or junk up to the end: truncated
+                break  # only a partial record or junk up to the end: truncated
             channel, payload, end = record
             skipped += at - end_of_last
             end_of_last = end
@@ -390,8 +462,14 @@ def _read_file(path: str, collector: _Collector) -> None:
         log.close()
         raw.close()
     trailing = size - end_of_last
-    info = {"path": path, "bytes": size, "events": events, "truncated_bytes": trailing,
-            "skipped_bytes": skipped, "salvaged_events": salvaged}
+    info = {
+        "path": path,
+        "bytes": size,
+        "events": events,
+        "truncated_bytes": trailing,
+        "skipped_bytes": skipped,
+        "salvaged_events": salvaged,
+    }
     collector.data.inputs.append(info)
     if events == 0 and size > 0:
         with open(path, "rb") as f:
@@ -400,8 +478,10 @@ def _read_file(path: str, collector: _Collector) -> None:
             raise LogReadError(path, f"not an LCM event log (no LCM sync word; {size} bytes)")
     notes = []
     if trailing:
-        notes.append(f"ends with {trailing} byte(s) that are not a whole record (truncated?); "
-                     f"read the {events} whole record(s) before them")
+        notes.append(
+            f"ends with {trailing} byte(s) that are not a whole record (truncated?); "
+            f"read the {events} whole record(s) before them"
+        )
     if skipped:
         notes.append(f"{skipped} byte(s) between records were unreadable and skipped")
     for note in notes:
@@ -438,8 +518,10 @@ def read_logs(paths: Iterable[str | os.PathLike], decode: Iterable[str] | None =
     wanted = set(KNOWN_CHANNELS if decode is None else decode)
     unknown = wanted - set(KNOWN_CHANNELS)
     if unknown:
-        raise ValueError(f"read_logs: cannot decode channel(s) {sorted(unknown)}; "
-                         f"known channels are {list(KNOWN_CHANNELS)}")
+        raise ValueError(
+            f"read_logs: cannot decode channel(s) {sorted(unknown)}; "
+            f"known channels are {list(KNOWN_CHANNELS)}"
+        )
     collector = _Collector(wanted)
     for path in paths:
         _read_file(path, collector)

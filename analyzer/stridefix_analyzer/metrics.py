@@ -13,13 +13,14 @@ top level of the summary (see :func:`choose_primary`).
 
 No plotting here: :mod:`stridefix_analyzer.plots` draws what this module computes.
 """
+
 from __future__ import annotations
 
 import dataclasses
 
 import numpy as np
-
 import stridefix
+
 from .logread import LogData, Table
 
 #: pose_t.scheme code → name used in reports and JSON keys
@@ -53,15 +54,15 @@ def scheme_code(name: str) -> int:
         if name.lower() == known:
             return code
     if name.lower().startswith("scheme_"):
-        name = name[len("scheme_"):]
+        name = name[len("scheme_") :]
     try:
         return int(name)
     except ValueError:
-        raise MetricsInputError(f"unknown scheme {name!r}; known: {list(SCHEME_NAMES.values())}") \
-            from None
+        raise MetricsInputError(f"unknown scheme {name!r}; known: {list(SCHEME_NAMES.values())}") from None
 
 
 # --- the causal match ----------------------------------------------------------------------------
+
 
 def match_causal(pose: Table, truth: Table) -> Table:
     """Pair every truth sample with the latest pose at or before its time.
@@ -92,18 +93,23 @@ def match_causal(pose: Table, truth: Table) -> Table:
         return np.where(scored, values[safe], fill)
 
     px, py = take(pose["x_m"], np.nan), take(pose["y_m"], np.nan)
-    return Table({
-        "t_us": t,
-        "truth_x_m": truth["x_m"], "truth_y_m": truth["y_m"], "truth_floor": truth["floor"],
-        "scored": scored,
-        "pose_row": np.where(scored, row, -1),
-        "pose_t_us": take(pose["t_us"], np.int64(-1)),
-        "pose_x_m": px, "pose_y_m": py,
-        "pose_floor": take(pose["floor"], np.int64(-1)),
-        "pose_sigma_m": take(pose["sigma_m"], np.nan),
-        "error_m": np.hypot(px - truth["x_m"], py - truth["y_m"]),
-        "heading_error_rad": wrap_pi(take(pose["heading_rad"], np.nan) - truth["heading_rad"]),
-    })
+    return Table(
+        {
+            "t_us": t,
+            "truth_x_m": truth["x_m"],
+            "truth_y_m": truth["y_m"],
+            "truth_floor": truth["floor"],
+            "scored": scored,
+            "pose_row": np.where(scored, row, -1),
+            "pose_t_us": take(pose["t_us"], np.int64(-1)),
+            "pose_x_m": px,
+            "pose_y_m": py,
+            "pose_floor": take(pose["floor"], np.int64(-1)),
+            "pose_sigma_m": take(pose["sigma_m"], np.nan),
+            "error_m": np.hypot(px - truth["x_m"], py - truth["y_m"]),
+            "heading_error_rad": wrap_pi(take(pose["heading_rad"], np.nan) - truth["heading_rad"]),
+        }
+    )
 
 
 def wrap_pi(angle_rad: np.ndarray) -> np.ndarray:
@@ -118,11 +124,15 @@ def heading_stats(heading_error_rad: np.ndarray) -> dict:
     e = e[np.isfinite(e)]
     if e.size == 0:
         return {"n": 0, "rms_deg": float("nan"), "mean_abs_deg": float("nan")}
-    return {"n": int(e.size), "rms_deg": float(np.sqrt(np.mean(e ** 2))),
-            "mean_abs_deg": float(np.mean(np.abs(e)))}
+    return {
+        "n": int(e.size),
+        "rms_deg": float(np.sqrt(np.mean(e**2))),
+        "mean_abs_deg": float(np.mean(np.abs(e))),
+    }
 
 
 # --- statistics ----------------------------------------------------------------------------------
+
 
 def error_stats(error_m: np.ndarray) -> dict:
     """Summary statistics of position errors.
@@ -142,13 +152,18 @@ def error_stats(error_m: np.ndarray) -> dict:
     finite = error_m[np.isfinite(error_m)]
     stats = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
     if finite.size == 0:
-        stats.update(dict.fromkeys(["mean", "median", "p75", "p90", "p95", "max", "rmse"],
-                                   float("nan")))
+        stats.update(dict.fromkeys(["mean", "median", "p75", "p90", "p95", "max", "rmse"], float("nan")))
         return stats
     p50, p75, p90, p95 = np.percentile(finite, PERCENTILES)
-    stats.update(mean=float(finite.mean()), median=float(p50), p75=float(p75), p90=float(p90),
-                 p95=float(p95), max=float(finite.max()),
-                 rmse=float(np.sqrt(np.mean(finite ** 2))))
+    stats.update(
+        mean=float(finite.mean()),
+        median=float(p50),
+        p75=float(p75),
+        p90=float(p90),
+        p95=float(p95),
+        max=float(finite.max()),
+        rmse=float(np.sqrt(np.mean(finite**2))),
+    )
     return stats
 
 
@@ -182,16 +197,21 @@ def step_metrics(pose: Table, truth: Table, n_step_messages: int) -> dict:
     """
     detected = int(pose["step_count"][-1]) if len(pose) else int(n_step_messages)
     known = truth["step_count"][truth["step_count"] >= 0] if len(truth) else np.array([])
-    out = {"detected": detected, "step_messages": int(n_step_messages),
-           "truth": None, "error": None, "error_pct": None}
+    out = {
+        "detected": detected,
+        "step_messages": int(n_step_messages),
+        "truth": None,
+        "error": None,
+        "error_pct": None,
+    }
     if known.size:
         t = int(known[-1])
-        out.update(truth=t, error=detected - t,
-                   error_pct=(100.0 * (detected - t) / t) if t > 0 else None)
+        out.update(truth=t, error=detected - t, error_pct=(100.0 * (detected - t) / t) if t > 0 else None)
     return out
 
 
 # --- one scheme, and the whole log ---------------------------------------------------------------
+
 
 @dataclasses.dataclass
 class SchemeScore:
@@ -218,14 +238,16 @@ class SchemeScore:
     pose: Table
 
 
-def score_scheme(pose: Table, truth: Table, n_step_messages: int, distance_m: float,
-                 code: int) -> SchemeScore:
+def score_scheme(
+    pose: Table, truth: Table, n_step_messages: int, distance_m: float, code: int
+) -> SchemeScore:
     """Score one scheme's POSE rows (sorted by time) against the TRUTH rows (sorted by time)."""
     m = match_causal(pose, truth)
     scored = m["scored"]
     err = m["error_m"][scored]
-    floor_hit = (float(np.mean(m["pose_floor"][scored] == m["truth_floor"][scored]))
-                 if scored.any() else float("nan"))
+    floor_hit = (
+        float(np.mean(m["pose_floor"][scored] == m["truth_floor"][scored])) if scored.any() else float("nan")
+    )
     sig = m["pose_sigma_m"][scored]
     ok = np.isfinite(err) & np.isfinite(sig) & (sig > 0)
     within = float(np.mean(err[ok] <= sig[ok])) if ok.any() else float("nan")
@@ -255,7 +277,8 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
         if requested not in codes:
             raise MetricsInputError(
                 f"scheme {scheme_name(requested)} not in the POSE stream; present: "
-                f"{[scheme_name(c) for c in codes]}")
+                f"{[scheme_name(c) for c in codes]}"
+            )
         return int(requested)
 
     def rank(i: int):
@@ -318,10 +341,15 @@ class Metrics:
         """
         p = self.schemes[self.primary].match
         out = {
-            "truth_t_us": self.truth["t_us"], "truth_x_m": self.truth["x_m"],
-            "truth_y_m": self.truth["y_m"], "truth_floor": self.truth["floor"],
-            "scored": p["scored"], "match_x_m": p["pose_x_m"], "match_y_m": p["pose_y_m"],
-            "match_floor": p["pose_floor"], "error_m": p["error_m"],
+            "truth_t_us": self.truth["t_us"],
+            "truth_x_m": self.truth["x_m"],
+            "truth_y_m": self.truth["y_m"],
+            "truth_floor": self.truth["floor"],
+            "scored": p["scored"],
+            "match_x_m": p["pose_x_m"],
+            "match_y_m": p["pose_y_m"],
+            "match_floor": p["pose_floor"],
+            "error_m": p["error_m"],
             "scheme_codes": np.array(sorted(self.schemes), dtype=np.int64),
             "primary_scheme": np.int64(self.primary),
         }
@@ -356,8 +384,10 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     """
     missing = [ch for ch in ("TRUTH", "POSE") if data.table(ch) is None or not len(data.table(ch))]
     if missing:
-        raise MetricsInputError(f"no {' and no '.join(missing)} messages in "
-                                f"{', '.join(i['path'] for i in data.inputs) or 'the input'}")
+        raise MetricsInputError(
+            f"no {' and no '.join(missing)} messages in "
+            f"{', '.join(i['path'] for i in data.inputs) or 'the input'}"
+        )
     truth, pose = data.table("TRUTH"), data.table("POSE")
     if truth_source is not None:
         if truth_source not in TRUTH_SOURCES:
@@ -371,6 +401,6 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     primary = choose_primary(pose, scheme)
     schemes = {}
     for code in np.unique(pose["scheme"]):
-        rows = pose.rows(pose["scheme"] == code)   # stays sorted by time
+        rows = pose.rows(pose["scheme"] == code)  # stays sorted by time
         schemes[int(code)] = score_scheme(rows, truth, n_steps, distance, int(code))
     return Metrics(primary=primary, schemes=schemes, truth=truth, distance_walked_m=distance)

@@ -4,6 +4,7 @@ Every function takes the arrays of ``analysis.npz`` (see
 :meth:`stridefix_analyzer.metrics.Metrics.series`) and returns a matplotlib Figure;
 :func:`to_png` renders one to PNG bytes and closes it.
 """
+
 from __future__ import annotations
 
 import io
@@ -60,10 +61,10 @@ def plot_trajectory(series: dict):
         if len(px):
             ax.plot(px[-1], py[-1], marker="s", color=color, markersize=6, linestyle="none")
     if len(tx):
-        ax.plot(tx[0], ty[0], marker="o", color="green", markersize=10, linestyle="none",
-                label="start (truth)")
-        ax.plot(tx[-1], ty[-1], marker="X", color="red", markersize=10, linestyle="none",
-                label="end (truth)")
+        ax.plot(
+            tx[0], ty[0], marker="o", color="green", markersize=10, linestyle="none", label="start (truth)"
+        )
+        ax.plot(tx[-1], ty[-1], marker="X", color="red", markersize=10, linestyle="none", label="end (truth)")
     ax.plot([], [], marker="s", color="grey", linestyle="none", label="end (pose)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x [m]")
@@ -87,8 +88,13 @@ def plot_error_time(series: dict):
     t_s = (series["truth_t_us"] - _t0_us(series)) / 1e6
     primary = int(series["primary_scheme"])
     for code, color in _colors(_scheme_codes(series)).items():
-        ax.plot(t_s, series[f"s{code}_error_m"], color=color,
-                linewidth=1.6 if code == primary else 0.9, label=scheme_name(code))
+        ax.plot(
+            t_s,
+            series[f"s{code}_error_m"],
+            color=color,
+            linewidth=1.6 if code == primary else 0.9,
+            label=scheme_name(code),
+        )
     ax.set_xlabel("time since first truth sample [s]")
     ax.set_ylabel("horizontal error [m]")
     ax.set_title("Position error over time (latest POSE at or before each truth time)")
@@ -114,15 +120,27 @@ def plot_error_cdf(series: dict):
         if not e.size:
             continue
         frac = np.arange(1, e.size + 1) / e.size
-        ax.step(e, frac, where="post", color=color, linewidth=1.8 if code == primary else 1.0,
-                label=scheme_name(code))
+        ax.step(
+            e,
+            frac,
+            where="post",
+            color=color,
+            linewidth=1.8 if code == primary else 1.0,
+            label=scheme_name(code),
+        )
         if code == primary:
             for pct, label, style in _PERCENTILE_LINES:
                 v = float(np.percentile(e, pct))
                 ax.axvline(v, color=color, linestyle=style, linewidth=0.9)
-                ax.annotate(f"{label} {v:.2f} m", xy=(v, pct / 100), xytext=(6, -4),
-                            textcoords="offset points", fontsize="small", color=color,
-                            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+                ax.annotate(
+                    f"{label} {v:.2f} m",
+                    xy=(v, pct / 100),
+                    xytext=(6, -4),
+                    textcoords="offset points",
+                    fontsize="small",
+                    color=color,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8),
+                )
     ax.set_xlabel("horizontal error [m]")
     ax.set_ylabel("fraction of truth samples")
     ax.set_title(f"Error CDF (marks: {scheme_name(primary)})")
@@ -135,6 +153,8 @@ def plot_error_cdf(series: dict):
 
 def render_all(series: dict) -> dict[str, bytes]:
     """All report figures as PNG bytes: ``trajectory``, ``error_time``, ``error_cdf``."""
-    return {"trajectory": to_png(plot_trajectory(series)),
-            "error_time": to_png(plot_error_time(series)),
-            "error_cdf": to_png(plot_error_cdf(series))}
+    return {
+        "trajectory": to_png(plot_trajectory(series)),
+        "error_time": to_png(plot_error_time(series)),
+        "error_cdf": to_png(plot_error_cdf(series)),
+    }

@@ -29,6 +29,7 @@ stridefixd).
 Straight-line truth between waypoints underestimates the distance of a segment that bends, so the
 errors include the surveyor's path shape; K absorbs the floor-wide average of that bias.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -73,6 +74,7 @@ class RealbenchError(RuntimeError):
 
 # --- inputs ----------------------------------------------------------------------------------------
 
+
 def find_traces(floor_dir) -> tuple[str, list[Path]]:
     """The floor's label (``site1/F2``) and its trace files, sorted.
 
@@ -95,8 +97,14 @@ def find_traces(floor_dir) -> tuple[str, list[Path]]:
     return f"{floor.parent.name}/{floor.name}", traces
 
 
-def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport: bool,
-                   importer=None, import_kwargs: dict | None = None) -> dict:
+def _cached_import(
+    trace: Path,
+    cache_dir: Path,
+    max_wifi_age_s: float,
+    reimport: bool,
+    importer=None,
+    import_kwargs: dict | None = None,
+) -> dict:
     """Import ``trace`` into ``cache_dir/<stem>.lcmlog`` unless an up-to-date copy is there.
 
     ``importer``: the importer module (default ``stridefix_sim.importers.msindoor``); it provides
@@ -111,9 +119,13 @@ def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport
     log = cache_dir / f"{trace.stem}.lcmlog"
     meta = cache_dir / f"{trace.stem}.import.json"
     st = trace.stat()
-    key = {"trace": str(trace.resolve()), "size": st.st_size, "mtime_ns": st.st_mtime_ns,
-           "importer_version": getattr(importer, "IMPORTER_VERSION", None),
-           "max_wifi_age_s": max_wifi_age_s}
+    key = {
+        "trace": str(trace.resolve()),
+        "size": st.st_size,
+        "mtime_ns": st.st_mtime_ns,
+        "importer_version": getattr(importer, "IMPORTER_VERSION", None),
+        "max_wifi_age_s": max_wifi_age_s,
+    }
     if importer.__name__.rsplit(".", 1)[-1] != "msindoor":
         key["importer"] = importer.__name__
     if import_kwargs:
@@ -139,8 +151,7 @@ def _cached_import(trace: Path, cache_dir: Path, max_wifi_age_s: float, reimport
     return summary
 
 
-def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0,
-                 reimport: bool = False) -> dict:
+def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0, reimport: bool = False) -> dict:
     """Import one trace (cached), replay it through ``stridefixd``, read STEP and TRUTH.
 
     Returns
@@ -169,8 +180,7 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0,
     cmd = [str(stridefixd), "--input", f"lcmlog:{summary['out']}", "--log", str(fw_log), "-q"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
-        walk["error"] = (f"stridefixd exit {proc.returncode}: {' '.join(cmd)}: "
-                         f"{proc.stderr.strip()[-500:]}")
+        walk["error"] = f"stridefixd exit {proc.returncode}: {' '.join(cmd)}: {proc.stderr.strip()[-500:]}"
         return walk
     try:
         with warnings.catch_warnings():
@@ -183,8 +193,9 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0,
     truth = data.table("TRUTH")
     steps = data.table("STEP")
     walk["waypoint_t_us"] = truth["t_us"] if truth is not None else np.zeros(0, np.int64)
-    walk["waypoint_xy_m"] = (np.column_stack([truth["x_m"], truth["y_m"]]) if truth is not None
-                             else np.zeros((0, 2)))
+    walk["waypoint_xy_m"] = (
+        np.column_stack([truth["x_m"], truth["y_m"]]) if truth is not None else np.zeros((0, 2))
+    )
     empty = np.zeros(0)
     walk["step_t_us"] = steps["t_us"] if steps is not None else np.zeros(0, np.int64)
     walk["step_range_mps2"] = steps["accel_range_mps2"] if steps is not None else empty
@@ -194,6 +205,7 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0,
 
 
 # --- segments, calibration, scores -----------------------------------------------------------------
+
 
 def build_segments(walks: list[dict], min_segment_m: float = DEFAULT_MIN_SEGMENT_M) -> Table:
     """One row per pair of consecutive waypoints of every walk.
@@ -213,8 +225,7 @@ def build_segments(walks: list[dict], min_segment_m: float = DEFAULT_MIN_SEGMENT
         if walk.get("error") or "waypoint_t_us" not in walk:
             n_wp = walk["import"]["waypoints"] if walk.get("import") else 0
             for k in range(max(n_wp - 1, 0)):
-                rows.append((w, k, 0, 0, math.nan, math.nan, 0, math.nan, math.nan, 0, False,
-                             "walk failed"))
+                rows.append((w, k, 0, 0, math.nan, math.nan, 0, math.nan, math.nan, 0, False, "walk failed"))
             continue
         t_wp, xy = walk["waypoint_t_us"], walk["waypoint_xy_m"]
         t_st = walk["step_t_us"]
@@ -238,15 +249,51 @@ def build_segments(walks: list[dict], min_segment_m: float = DEFAULT_MIN_SEGMENT
                 reason = f"shorter than {min_segment_m:g} m"
             else:
                 reason = ""
-            rows.append((w, k, t0, t1, true_m, float(root[i0:i1].sum()), int(i1 - i0),
-                         float(walk["step_length_m"][i0:i1].sum()), speed,
-                         int(bad[i0:i1].sum()),
-                         bool(speed > SUSPECT_SPEED_MPS or speed < SUSPECT_SLOW_MPS), reason))
-    names = ["walk", "k", "t0_us", "t1_us", "true_m", "weinberg", "n_steps", "fw_length_m",
-             "speed_mps", "bad_range", "suspect", "excluded"]
+            rows.append(
+                (
+                    w,
+                    k,
+                    t0,
+                    t1,
+                    true_m,
+                    float(root[i0:i1].sum()),
+                    int(i1 - i0),
+                    float(walk["step_length_m"][i0:i1].sum()),
+                    speed,
+                    int(bad[i0:i1].sum()),
+                    bool(speed > SUSPECT_SPEED_MPS or speed < SUSPECT_SLOW_MPS),
+                    reason,
+                )
+            )
+    names = [
+        "walk",
+        "k",
+        "t0_us",
+        "t1_us",
+        "true_m",
+        "weinberg",
+        "n_steps",
+        "fw_length_m",
+        "speed_mps",
+        "bad_range",
+        "suspect",
+        "excluded",
+    ]
     cols = list(zip(*rows)) if rows else [[] for _ in names]
-    dtypes = [np.int64, np.int64, np.int64, np.int64, float, float, np.int64, float, float,
-              np.int64, bool, object]
+    dtypes = [
+        np.int64,
+        np.int64,
+        np.int64,
+        np.int64,
+        float,
+        float,
+        np.int64,
+        float,
+        float,
+        np.int64,
+        bool,
+        object,
+    ]
     return Table({n: np.asarray(c, dtype=t) for n, c, t in zip(names, cols, dtypes)})
 
 
@@ -306,8 +353,15 @@ def error_stats(err_pct) -> dict:
     if not len(e):
         return {"n": 0, **{k: math.nan for k in ("mean", "median", "p75", "p90", "p95", "max")}}
     p = np.percentile(e, [50, 75, 90, 95])
-    return {"n": int(len(e)), "mean": float(e.mean()), "median": float(p[0]), "p75": float(p[1]),
-            "p90": float(p[2]), "p95": float(p[3]), "max": float(e.max())}
+    return {
+        "n": int(len(e)),
+        "mean": float(e.mean()),
+        "median": float(p[0]),
+        "p75": float(p[1]),
+        "p90": float(p[2]),
+        "p95": float(p[3]),
+        "max": float(e.max()),
+    }
 
 
 def score_segments(seg: Table, n_walks: int) -> tuple[Table, dict]:
@@ -335,34 +389,52 @@ def score_segments(seg: Table, n_walks: int) -> tuple[Table, dict]:
         cols["baseline_err_pct"] = 100 * (cols["baseline_m"] - true) / true
         cols["fw_err_pct"] = np.where(used, 100 * (seg["fw_length_m"] - true) / true, nan)
     all_w = seg["weinberg"][used].sum()
-    fits = {"K": k, "stride_m": stride,
-            "K_all_walks": float(seg["true_m"][used].sum() / all_w) if all_w > 0 else math.nan}
+    fits = {
+        "K": k,
+        "stride_m": stride,
+        "K_all_walks": float(seg["true_m"][used].sum() / all_w) if all_w > 0 else math.nan,
+    }
     return Table(cols), fits
 
 
 # --- the benchmark ---------------------------------------------------------------------------------
+
 
 def _spread(values: np.ndarray) -> dict:
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
     if not len(v):
         return {"n": 0, "mean": math.nan, "std": math.nan, "min": math.nan, "max": math.nan}
-    return {"n": int(len(v)), "mean": float(v.mean()), "std": float(v.std()),
-            "min": float(v.min()), "max": float(v.max())}
+    return {
+        "n": int(len(v)),
+        "mean": float(v.mean()),
+        "std": float(v.std()),
+        "min": float(v.min()),
+        "max": float(v.max()),
+    }
 
 
 def _firmware_version(stridefixd: Path) -> str:
     try:
-        return subprocess.run([str(stridefixd), "-V"], capture_output=True, text=True,
-                              timeout=10).stdout.strip()
+        return subprocess.run(
+            [str(stridefixd), "-V"], capture_output=True, text=True, timeout=10
+        ).stdout.strip()
     except (OSError, subprocess.SubprocessError) as exc:
         return f"unknown ({exc})"
 
 
-def run_pdr_distance(floor_dir, stridefixd=DEFAULT_STRIDEFIXD, out_dir=None, limit=None,
-                     min_segment_m: float = DEFAULT_MIN_SEGMENT_M, max_wifi_age_s: float = 3.0,
-                     jobs: int | None = None, reimport: bool = False, progress=None,
-                     plot: bool = True) -> dict:
+def run_pdr_distance(
+    floor_dir,
+    stridefixd=DEFAULT_STRIDEFIXD,
+    out_dir=None,
+    limit=None,
+    min_segment_m: float = DEFAULT_MIN_SEGMENT_M,
+    max_wifi_age_s: float = 3.0,
+    jobs: int | None = None,
+    reimport: bool = False,
+    progress=None,
+    plot: bool = True,
+) -> dict:
     """Run the PDR distance benchmark on one floor; write JSON (+ PNG) into ``out_dir``.
 
     Returns the JSON document (a dict; non-finite numbers still as NaN).
@@ -375,25 +447,27 @@ def run_pdr_distance(floor_dir, stridefixd=DEFAULT_STRIDEFIXD, out_dir=None, lim
     t_start = time.perf_counter()
     label, traces = find_traces(floor_dir)
     if limit is not None:
-        traces = traces[:max(int(limit), 0)]
+        traces = traces[: max(int(limit), 0)]
     stridefixd = Path(stridefixd)
     if not (stridefixd.is_file() and os.access(stridefixd, os.X_OK)):
-        raise RealbenchError(f"{stridefixd}: stridefixd not found or not executable "
-                             "(build it: cmake --build build)")
+        raise RealbenchError(
+            f"{stridefixd}: stridefixd not found or not executable (build it: cmake --build build)"
+        )
     out_dir = Path(out_dir or os.path.join(DEFAULT_OUT, label.replace("/", "-")))
     out_dir.mkdir(parents=True, exist_ok=True)
     progress = progress or (lambda msg: None)
     jobs = max(1, jobs or os.cpu_count() or 1)
     walks: list[dict | None] = [None] * len(traces)
     with concurrent.futures.ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(prepare_walk, t, out_dir, stridefixd, max_wifi_age_s, reimport): i
-                   for i, t in enumerate(traces)}
+        futures = {
+            pool.submit(prepare_walk, t, out_dir, stridefixd, max_wifi_age_s, reimport): i
+            for i, t in enumerate(traces)
+        }
         for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             i = futures[fut]
             walks[i] = fut.result()
             w = walks[i]
-            state = w["error"] or (f"{len(w['step_t_us'])} steps, "
-                                   f"{len(w['waypoint_t_us'])} waypoints")
+            state = w["error"] or (f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints")
             progress(f"walk {done}/{len(traces)} {w['walk']}: {state}")
 
     seg, fits = score_segments(build_segments(walks, min_segment_m), len(walks))
@@ -409,8 +483,7 @@ def run_pdr_distance(floor_dir, stridefixd=DEFAULT_STRIDEFIXD, out_dir=None, lim
     return doc
 
 
-def summarize(label, floor_dir, walks, seg: Table, fits: dict, min_segment_m, max_wifi_age_s,
-              limit) -> dict:
+def summarize(label, floor_dir, walks, seg: Table, fits: dict, min_segment_m, max_wifi_age_s, limit) -> dict:
     """The JSON document of one run (see the module docstring)."""
     used = seg["excluded"] == ""
     excluded: dict[str, int] = {}
@@ -423,38 +496,61 @@ def summarize(label, floor_dir, walks, seg: Table, fits: dict, min_segment_m, ma
     for i, w in enumerate(walks):
         mine = used & (seg["walk"] == i)
         imp = w.get("import") or {}
-        per_walk.append({
-            "walk": w["walk"], "trace": w["trace"], "error": w["error"],
-            "duration_s": imp.get("duration_s"), "waypoints": imp.get("waypoints"),
-            "steps": int(len(w["step_t_us"])) if "step_t_us" in w else None,
-            "segments_scored": int(mine.sum()),
-            "true_m": float(seg["true_m"][mine].sum()),
-            "K": fits["K"][i], "stride_m": fits["stride_m"][i],
-            "median_abs_err_pct": error_stats(seg["err_pct"][mine])["median"],
-            "skipped_lines": imp.get("skipped_lines"),
-            "warnings": w["warnings"][:10],
-        })
+        per_walk.append(
+            {
+                "walk": w["walk"],
+                "trace": w["trace"],
+                "error": w["error"],
+                "duration_s": imp.get("duration_s"),
+                "waypoints": imp.get("waypoints"),
+                "steps": int(len(w["step_t_us"])) if "step_t_us" in w else None,
+                "segments_scored": int(mine.sum()),
+                "true_m": float(seg["true_m"][mine].sum()),
+                "K": fits["K"][i],
+                "stride_m": fits["stride_m"][i],
+                "median_abs_err_pct": error_stats(seg["err_pct"][mine])["median"],
+                "skipped_lines": imp.get("skipped_lines"),
+                "warnings": w["warnings"][:10],
+            }
+        )
     k_scored = fits["K"][scored_walks] if scored_walks else np.zeros(0)
     steps_in_segments = int(seg["n_steps"][used].sum())
     return {
         "benchmark": "pdr-distance",
         "floor": label,
         "floor_dir": str(floor_dir),
-        "params": {"min_segment_m": min_segment_m, "max_wifi_age_s": max_wifi_age_s,
-                   "limit": limit, "weinberg_exponent": WEINBERG_EXPONENT,
-                   "imu_cover_tolerance_s": IMU_COVER_TOLERANCE_S,
-                   "suspect_speed_mps": [SUSPECT_SLOW_MPS, SUSPECT_SPEED_MPS]},
-        "target": {"median_abs_error_pct_max": TARGET_MEDIAN_ABS_ERROR_PCT,
-                   "met": bool(weinberg["n"] and weinberg["median"] <= TARGET_MEDIAN_ABS_ERROR_PCT)},
-        "walks": {"n": len(walks), "ran": len(ok_walks), "scored": len(scored_walks),
-                  "failed": [{"walk": walks[i]["walk"], "error": walks[i]["error"]}
-                             for i in range(len(walks)) if walks[i]["error"]]},
-        "segments": {"n": len(seg), "scored": int(used.sum()), "excluded": excluded,
-                     "true_m_scored": float(seg["true_m"][used].sum()),
-                     "suspect_speed_scored": int((seg["suspect"] & used).sum()),
-                     "zero_steps_scored": int(((seg["n_steps"] == 0) & used).sum()),
-                     "steps_scored": steps_in_segments,
-                     "bad_range_steps": int(seg["bad_range"][used].sum())},
+        "params": {
+            "min_segment_m": min_segment_m,
+            "max_wifi_age_s": max_wifi_age_s,
+            "limit": limit,
+            "weinberg_exponent": WEINBERG_EXPONENT,
+            "imu_cover_tolerance_s": IMU_COVER_TOLERANCE_S,
+            "suspect_speed_mps": [SUSPECT_SLOW_MPS, SUSPECT_SPEED_MPS],
+        },
+        "target": {
+            "median_abs_error_pct_max": TARGET_MEDIAN_ABS_ERROR_PCT,
+            "met": bool(weinberg["n"] and weinberg["median"] <= TARGET_MEDIAN_ABS_ERROR_PCT),
+        },
+        "walks": {
+            "n": len(walks),
+            "ran": len(ok_walks),
+            "scored": len(scored_walks),
+            "failed": [
+                {"walk": walks[i]["walk"], "error": walks[i]["error"]}
+                for i in range(len(walks))
+                if walks[i]["error"]
+            ],
+        },
+        "segments": {
+            "n": len(seg),
+            "scored": int(used.sum()),
+            "excluded": excluded,
+            "true_m_scored": float(seg["true_m"][used].sum()),
+            "suspect_speed_scored": int((seg["suspect"] & used).sum()),
+            "zero_steps_scored": int(((seg["n_steps"] == 0) & used).sum()),
+            "steps_scored": steps_in_segments,
+            "bad_range_steps": int(seg["bad_range"][used].sum()),
+        },
         "weinberg_lowo": {
             "abs_error_pct": weinberg,
             "abs_error_pct_by_length_m": _by_length(seg, used),
@@ -474,7 +570,8 @@ def summarize(label, floor_dir, walks, seg: Table, fits: dict, min_segment_m, ma
         "per_walk": per_walk,
         "segment_rows": [
             {"walk": walks[int(r["walk"])]["walk"], **{n: r[n] for n in seg.names if n != "walk"}}
-            for r in (_row(seg, i) for i in range(len(seg)))],
+            for r in (_row(seg, i) for i in range(len(seg)))
+        ],
     }
 
 
@@ -496,51 +593,67 @@ def _median(x) -> float:
     return float(np.median(x)) if len(x) else math.nan
 
 
-
-
 def format_table(doc: dict) -> str:
     """A readable plain-text table of one floor's results."""
+
     def f(v, d=2):
         return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
 
     seg, wk = doc["segments"], doc["walks"]
     k = doc["weinberg_lowo"]["K"]
-    lines = [f"PDR distance on {doc['floor']}: {wk['n']} walks ({wk['ran']} ran, {wk['scored']} "
-             f"scored), {seg['n']} segments, {seg['scored']} scored ({seg['true_m_scored']:.0f} m, "
-             f"{seg['steps_scored']} steps)"]
+    lines = [
+        f"PDR distance on {doc['floor']}: {wk['n']} walks ({wk['ran']} ran, {wk['scored']} "
+        f"scored), {seg['n']} segments, {seg['scored']} scored ({seg['true_m_scored']:.0f} m, "
+        f"{seg['steps_scored']} steps)"
+    ]
     if seg["excluded"]:
         lines.append("  excluded: " + ", ".join(f"{n} {r}" for r, n in sorted(seg["excluded"].items())))
     slow, fast = doc["params"]["suspect_speed_mps"]
-    lines.append(f"  flagged (kept): {seg['suspect_speed_scored']} segment(s) with implied speed "
-                 f"outside {slow:g}..{fast:g} m/s, {seg['zero_steps_scored']} with no step")
+    lines.append(
+        f"  flagged (kept): {seg['suspect_speed_scored']} segment(s) with implied speed "
+        f"outside {slow:g}..{fast:g} m/s, {seg['zero_steps_scored']} with no step"
+    )
     cols = ["n", "median", "mean", "p75", "p90", "p95", "max"]
     lines.append(f"  {'abs error %':<34}" + "".join(f"{c:>8}" for c in cols) + f"{'bias%':>8}")
-    for name, key in (("Weinberg, K leave-one-walk-out", "weinberg_lowo"),
-                      ("fixed stride (LOWO median) x steps", "baseline_fixed_stride_lowo"),
-                      ("firmware length_m as configured", "firmware_length_as_configured")):
+    for name, key in (
+        ("Weinberg, K leave-one-walk-out", "weinberg_lowo"),
+        ("fixed stride (LOWO median) x steps", "baseline_fixed_stride_lowo"),
+        ("firmware length_m as configured", "firmware_length_as_configured"),
+    ):
         e = doc[key]["abs_error_pct"]
-        lines.append(f"  {name:<34}" + "".join(
-            f"{(str(e[c]) if c == 'n' else f(e[c], 1)):>8}" for c in cols)
-            + f"{f(doc[key]['signed_error_pct_median'], 1):>8}")
+        lines.append(
+            f"  {name:<34}"
+            + "".join(f"{(str(e[c]) if c == 'n' else f(e[c], 1)):>8}" for c in cols)
+            + f"{f(doc[key]['signed_error_pct_median'], 1):>8}"
+        )
     wl = doc["weinberg_lowo"]
-    lines.append("  Weinberg median abs error % by segment length: " + ", ".join(
-        f"{b} m: {f(e['median'], 1)} (n {e['n']})" for b, e in wl["abs_error_pct_by_length_m"].items())
+    lines.append(
+        "  Weinberg median abs error % by segment length: "
+        + ", ".join(
+            f"{b} m: {f(e['median'], 1)} (n {e['n']})" for b, e in wl["abs_error_pct_by_length_m"].items()
+        )
         + f"; unflagged only: {f(wl['abs_error_pct_unflagged']['median'], 1)} "
-          f"(n {wl['abs_error_pct_unflagged']['n']})")
+        f"(n {wl['abs_error_pct_unflagged']['n']})"
+    )
     st = doc["baseline_fixed_stride_lowo"]["stride_m"]
-    lines.append(f"  K over folds: mean {f(k['mean'], 4)}, std {f(k['std'], 4)}, "
-                 f"range {f(k['min'], 4)}..{f(k['max'], 4)}; all walks {f(k['all_walks'], 4)}"
-                 f"   stride: mean {f(st['mean'], 3)} m ({f(st['min'], 3)}..{f(st['max'], 3)})")
+    lines.append(
+        f"  K over folds: mean {f(k['mean'], 4)}, std {f(k['std'], 4)}, "
+        f"range {f(k['min'], 4)}..{f(k['max'], 4)}; all walks {f(k['all_walks'], 4)}"
+        f"   stride: mean {f(st['mean'], 3)} m ({f(st['min'], 3)}..{f(st['max'], 3)})"
+    )
     t = doc["target"]
     med = doc["weinberg_lowo"]["abs_error_pct"]["median"]
-    lines.append(f"  target: median abs error <= {t['median_abs_error_pct_max']:g} %: "
-                 f"{f(med, 2)} % -> {'MET' if t['met'] else 'NOT MET'}")
+    lines.append(
+        f"  target: median abs error <= {t['median_abs_error_pct_max']:g} %: "
+        f"{f(med, 2)} % -> {'MET' if t['met'] else 'NOT MET'}"
+    )
     for w in wk["failed"]:
         lines.append(f"  failed walk {w['walk']}: {w['error']}")
     return "\n".join(lines)
 
 
 # --- figure (no metrics computed here) -------------------------------------------------------------
+
 
 def plot_pdr_distance(seg: Table, title: str) -> bytes:
     """PNG: PDR vs true segment distance (scatter, 1:1 and ±5 % lines) and the |error| CDFs."""
@@ -559,25 +672,43 @@ def plot_pdr_distance(seg: Table, title: str) -> bytes:
     ax1.plot(x, x, "k-", lw=1, label="1:1")
     ax1.plot(x, 1.05 * x, "k:", lw=0.8, label="±5 %")
     ax1.plot(x, 0.95 * x, "k:", lw=0.8)
-    ax1.set(xlim=(0, top), ylim=(0, top), xlabel="true segment distance [m]",
-            ylabel="PDR distance [m]", title=f"{title}: {int(used.sum())} segments")
+    ax1.set(
+        xlim=(0, top),
+        ylim=(0, top),
+        xlabel="true segment distance [m]",
+        ylabel="PDR distance [m]",
+        title=f"{title}: {int(used.sum())} segments",
+    )
     ax1.set_aspect("equal")
     ax1.legend(loc="upper left", fontsize=8)
-    for col, name, color in (("err_pct", "Weinberg, K LOWO", "C0"),
-                             ("baseline_err_pct", "fixed stride × steps", "0.5"),
-                             ("fw_err_pct", "firmware length_m", "C3")):
+    for col, name, color in (
+        ("err_pct", "Weinberg, K LOWO", "C0"),
+        ("baseline_err_pct", "fixed stride × steps", "0.5"),
+        ("fw_err_pct", "firmware length_m", "C3"),
+    ):
         e = np.sort(np.abs(seg[col][used]))
         e = e[np.isfinite(e)]
         if len(e):
-            ax2.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=color,
-                     label=f"{name} (median {np.median(e):.1f} %)")
+            ax2.step(
+                e,
+                np.arange(1, len(e) + 1) / len(e),
+                where="post",
+                color=color,
+                label=f"{name} (median {np.median(e):.1f} %)",
+            )
     ax2.axvline(TARGET_MEDIAN_ABS_ERROR_PCT, color="k", ls=":", lw=0.8)
     ax2.axhline(0.5, color="k", ls=":", lw=0.8)
-    ax2.set(xlim=(0, 50), ylim=(0, 1), xlabel="|distance error| [%]", ylabel="fraction of segments",
-            title="error CDF")
+    ax2.set(
+        xlim=(0, 50),
+        ylim=(0, 1),
+        xlabel="|distance error| [%]",
+        ylabel="fraction of segments",
+        title="error CDF",
+    )
     ax2.grid(alpha=0.3)
     ax2.legend(loc="lower right", fontsize=8)
     import io
+
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
     plt.close(fig)
@@ -593,8 +724,7 @@ def with_default_bench(argv: list[str]) -> list[str]:
     """``stridefix realbench --format ...`` means ``stridefix realbench fusion --format ...``:
     insert the default benchmark when the word after ``realbench`` names none (and is no help)."""
     argv = list(argv)
-    if argv and argv[0] == "realbench" and (len(argv) == 1 or argv[1] not in
-                                            (*BENCHES, "-h", "--help")):
+    if argv and argv[0] == "realbench" and (len(argv) == 1 or argv[1] not in (*BENCHES, "-h", "--help")):
         argv.insert(1, "fusion")
     return argv
 
@@ -602,34 +732,67 @@ def with_default_bench(argv: list[str]) -> list[str]:
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Declare ``stridefix realbench`` and its benchmarks (``fusion`` is the default)."""
     p = subparsers.add_parser(
-        "realbench", help="benchmarks of stridefixd on real public data (msindoor, gsd)",
+        "realbench",
+        help="benchmarks of stridefixd on real public data (msindoor, gsd)",
         description="Benchmarks of the real firmware on real data sets. Without a benchmark name "
-                    "the fusion benchmark runs: stridefix realbench --format msindoor DIR [DIR...] "
-                    "--out results.json")
+        "the fusion benchmark runs: stridefix realbench --format msindoor DIR [DIR...] "
+        "--out results.json",
+    )
     sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
     from .realbench_fusion import add_fusion_parser
+
     add_fusion_parser(sub)
     d = sub.add_parser(
-        "pdr-distance", help="segment distance from steps + Weinberg length, K leave-one-walk-out",
+        "pdr-distance",
+        help="segment distance from steps + Weinberg length, K leave-one-walk-out",
         description="For every trace of a floor: import, replay through stridefixd, and compare "
-                    "the Weinberg distance (K calibrated leave-one-walk-out) between consecutive "
-                    "waypoints with the true straight-line distance. Writes "
-                    f"DIR/{JSON_FILE} and DIR/{PNG_FILE}.")
-    d.add_argument("--floor", required=True, metavar="DIR",
-                   help="floor folder, e.g. ../shared/data/msindoor/site1/F2[/path_data_files]")
-    d.add_argument("--stridefixd", default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
-                   metavar="PATH", help="firmware binary (default: $STRIDEFIXD or "
-                                        "build/firmware/stridefixd)")
-    d.add_argument("--out", default=None, metavar="DIR",
-                   help=f"output and cache directory (default: {DEFAULT_OUT}/<site>-<floor>)")
-    d.add_argument("--limit", type=int, default=None, metavar="N",
-                   help="only the first N traces (sorted by name)")
-    d.add_argument("--min-segment-m", type=float, default=DEFAULT_MIN_SEGMENT_M, metavar="M",
-                   help=f"exclude shorter segments (default {DEFAULT_MIN_SEGMENT_M:g})")
-    d.add_argument("--max-wifi-age-s", type=float, default=3.0, metavar="S",
-                   help="importer: drop cached Wi-Fi entries older than S (default 3)")
-    d.add_argument("--jobs", "-j", type=int, default=None, metavar="N",
-                   help="walks prepared in parallel (default: CPU count)")
+        "the Weinberg distance (K calibrated leave-one-walk-out) between consecutive "
+        "waypoints with the true straight-line distance. Writes "
+        f"DIR/{JSON_FILE} and DIR/{PNG_FILE}.",
+    )
+    d.add_argument(
+        "--floor",
+        required=True,
+        metavar="DIR",
+        help="floor folder, e.g. ../shared/data/msindoor/site1/F2[/path_data_files]",
+    )
+    d.add_argument(
+        "--stridefixd",
+        default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
+        metavar="PATH",
+        help="firmware binary (default: $STRIDEFIXD or build/firmware/stridefixd)",
+    )
+    d.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help=f"output and cache directory (default: {DEFAULT_OUT}/<site>-<floor>)",
+    )
+    d.add_argument(
+        "--limit", type=int, default=None, metavar="N", help="only the first N traces (sorted by name)"
+    )
+    d.add_argument(
+        "--min-segment-m",
+        type=float,
+        default=DEFAULT_MIN_SEGMENT_M,
+        metavar="M",
+        help=f"exclude shorter segments (default {DEFAULT_MIN_SEGMENT_M:g})",
+    )
+    d.add_argument(
+        "--max-wifi-age-s",
+        type=float,
+        default=3.0,
+        metavar="S",
+        help="importer: drop cached Wi-Fi entries older than S (default 3)",
+    )
+    d.add_argument(
+        "--jobs",
+        "-j",
+        type=int,
+        default=None,
+        metavar="N",
+        help="walks prepared in parallel (default: CPU count)",
+    )
     d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
     d.set_defaults(_bench=_run_pdr_distance_cli)
     return p
@@ -640,15 +803,25 @@ def _run_pdr_distance_cli(args) -> int:
         print(f"realbench: {msg}", file=sys.stderr, flush=True)
 
     try:
-        doc = run_pdr_distance(args.floor, args.stridefixd, args.out, args.limit,
-                               args.min_segment_m, args.max_wifi_age_s, args.jobs, args.reimport,
-                               progress)
+        doc = run_pdr_distance(
+            args.floor,
+            args.stridefixd,
+            args.out,
+            args.limit,
+            args.min_segment_m,
+            args.max_wifi_age_s,
+            args.jobs,
+            args.reimport,
+            progress,
+        )
     except RealbenchError as exc:
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return 2
     print(format_table(doc))
-    print(f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
-          f"({doc['run_s']:.1f} s)")
+    print(
+        f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
+        f"({doc['run_s']:.1f} s)"
+    )
     return 0 if doc["segments"]["scored"] else 1
 
 

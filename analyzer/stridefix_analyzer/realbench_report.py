@@ -7,6 +7,7 @@ walks' trajectories — truth against that walk's best and worst scheme — over
 the bottom-left; gsd: plain axes). No metric is computed here: everything comes from the document of
 :func:`stridefix_analyzer.realbench_fusion.run_fusion` and each walk's ``analysis.npz``.
 """
+
 from __future__ import annotations
 
 import base64
@@ -25,8 +26,14 @@ from .metrics import scheme_code  # noqa: E402
 from .plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
-_COLORS = {"pdr_only": "C7", "wifi_only": "C0", "overwrite": "C1", "static": "C2",
-           "adaptive": "C3", "kalman": "C4"}
+_COLORS = {
+    "pdr_only": "C7",
+    "wifi_only": "C0",
+    "overwrite": "C1",
+    "static": "C2",
+    "adaptive": "C3",
+    "kalman": "C4",
+}
 
 
 def _f(v, d=2) -> str:
@@ -34,8 +41,7 @@ def _f(v, d=2) -> str:
 
 
 def _img(png: bytes, alt: str) -> str:
-    return (f'<img alt="{html.escape(alt)}" src="data:image/png;base64,'
-            f'{base64.b64encode(png).decode()}"/>')
+    return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{base64.b64encode(png).decode()}"/>'
 
 
 def floor_plan(floor_dir) -> tuple[np.ndarray, tuple[float, float, float, float]] | None:
@@ -66,11 +72,21 @@ def plot_cdf(pooled: dict[str, np.ndarray], title: str):
     for name, e in pooled.items():
         e = np.sort(e[np.isfinite(e)])
         if len(e):
-            ax.step(e, np.arange(1, len(e) + 1) / len(e), where="post", color=_COLORS.get(name),
-                    label=f"{name} (mean {e.mean():.1f} m, n {len(e)})")
+            ax.step(
+                e,
+                np.arange(1, len(e) + 1) / len(e),
+                where="post",
+                color=_COLORS.get(name),
+                label=f"{name} (mean {e.mean():.1f} m, n {len(e)})",
+            )
     ax.axvline(15.0, color="k", ls=":", lw=0.8)
-    ax.set(xlabel="position error at ground-truth times [m]", ylabel="fraction of samples",
-           title=title, ylim=(0, 1), xlim=(0, None))
+    ax.set(
+        xlabel="position error at ground-truth times [m]",
+        ylabel="fraction of samples",
+        title=title,
+        ylim=(0, 1),
+        xlim=(0, None),
+    )
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize="small")
     return fig
@@ -130,51 +146,80 @@ def _matched(series) -> dict:
         t = series[f"s{c}_pose_t_us"]
         row = np.searchsorted(t, series["truth_t_us"], side="right") - 1
         safe = np.clip(row, 0, max(len(t) - 1, 0))
-        xy = np.column_stack([series[f"s{c}_pose_x_m"][safe], series[f"s{c}_pose_y_m"][safe]]) \
-            if len(t) else np.full((len(row), 2), np.nan)
+        xy = (
+            np.column_stack([series[f"s{c}_pose_x_m"][safe], series[f"s{c}_pose_y_m"][safe]])
+            if len(t)
+            else np.full((len(row), 2), np.nan)
+        )
         xy[row < 0] = np.nan
         out[f"m{c}_xy"] = xy
     return out
 
 
 def _scheme_table(summary: dict) -> str:
-    head = ["scheme", "n", "mean", "median", "p75", "p90", "p95", "max", "RMSE", "IPIN score",
-            "floor hit %", "walks mean > 15 m"]
+    head = [
+        "scheme",
+        "n",
+        "mean",
+        "median",
+        "p75",
+        "p90",
+        "p95",
+        "max",
+        "RMSE",
+        "IPIN score",
+        "floor hit %",
+        "walks mean > 15 m",
+    ]
     rows = []
     for name, r in summary["schemes"].items():
-        rows.append([name, r["n"], _f(r["mean"]), _f(r["median"]), _f(r["p75"]), _f(r["p90"]),
-                     _f(r["p95"]), _f(r["max"]), _f(r["rmse"]), _f(r["ipin_score"]),
-                     _f(100 * r["floor_hit_rate"], 1),
-                     f"{r['walks_mean_over_15m']}/{r['walks']} "
-                     f"({_f(100 * r['share_walks_mean_over_15m'], 1)} %)"])
+        rows.append(
+            [
+                name,
+                r["n"],
+                _f(r["mean"]),
+                _f(r["median"]),
+                _f(r["p75"]),
+                _f(r["p90"]),
+                _f(r["p95"]),
+                _f(r["max"]),
+                _f(r["rmse"]),
+                _f(r["ipin_score"]),
+                _f(100 * r["floor_hit_rate"], 1),
+                f"{r['walks_mean_over_15m']}/{r['walks']} ({_f(100 * r['share_walks_mean_over_15m'], 1)} %)",
+            ]
+        )
     return _table(head, rows)
 
 
 def _table(head, rows) -> str:
     th = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>"
-                   for r in rows)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
     return f"<table><tr>{th}</tr>{body}</table>"
 
 
 def render(doc: dict) -> str:
-    parts = [f"<h1>StrideFix realbench: fusion schemes, leave one walk out ({doc['format']})</h1>",
-             "<p>Every scheme starts from the fixes; the radio map, map rotation, floor heights and "
-             "stride constant K of each walk come from the other walks of its floor/building only. "
-             "Errors are taken at the walk's ground-truth times against the latest POSE at or "
-             "before them (causal).</p>"]
+    parts = [
+        f"<h1>StrideFix realbench: fusion schemes, leave one walk out ({doc['format']})</h1>",
+        "<p>Every scheme starts from the fixes; the radio map, map rotation, floor heights and "
+        "stride constant K of each walk come from the other walks of its floor/building only. "
+        "Errors are taken at the walk's ground-truth times against the latest POSE at or "
+        "before them (causal).</p>",
+    ]
     for g in doc["groups"]:
         plan = floor_plan(g.get("floor_dir"))
         c = g["constants"]
         parts.append(f"<h2>{html.escape(g['label'])}</h2>")
-        parts.append(f"<p>{g['walks']} walks, {g['ran']} ran. Learned per fold: K "
-                     f"{_f(c['K']['mean'], 3)} ({_f(c['K']['min'], 3)}–{_f(c['K']['max'], 3)}), "
-                     f"rotation {_f(c['rotation_deg']['mean'], 1)}° "
-                     f"({_f(c['rotation_deg']['min'], 1)}–{_f(c['rotation_deg']['max'], 1)}), "
-                     f"radio map {_f(c['n_rp']['mean'], 0)} RPs, {_f(c['n_ap']['mean'], 0)} APs. "
-                     f"adaptive vs wifi_only: "
-                     f"{_f(g['summary']['adaptive_vs_wifi_only_reduction_pct'], 1)} % lower mean."
-                     f"</p>")
+        parts.append(
+            f"<p>{g['walks']} walks, {g['ran']} ran. Learned per fold: K "
+            f"{_f(c['K']['mean'], 3)} ({_f(c['K']['min'], 3)}–{_f(c['K']['max'], 3)}), "
+            f"rotation {_f(c['rotation_deg']['mean'], 1)}° "
+            f"({_f(c['rotation_deg']['min'], 1)}–{_f(c['rotation_deg']['max'], 1)}), "
+            f"radio map {_f(c['n_rp']['mean'], 0)} RPs, {_f(c['n_ap']['mean'], 0)} APs. "
+            f"adaptive vs wifi_only: "
+            f"{_f(g['summary']['adaptive_vs_wifi_only_reduction_pct'], 1)} % lower mean."
+            f"</p>"
+        )
         parts.append(_scheme_table(g["summary"]))
         if "summary_true_start" in g:
             parts.append("<h3>Truth-initialised start (labelled run)</h3>")
@@ -185,16 +230,18 @@ def render(doc: dict) -> str:
             parts.append(_img(to_png(plot_box(pooled, g["label"])), "box plot"))
         # worst walks, ranked by the mean error of the group's best scheme
         sch = g["summary"]["schemes"]
-        finite = {n: s["mean"] for n, s in sch.items()
-                  if s["mean"] is not None and math.isfinite(s["mean"])}
+        finite = {n: s["mean"] for n, s in sch.items() if s["mean"] is not None and math.isfinite(s["mean"])}
         best_overall = min(finite, key=finite.get) if finite else None
         rows = [r for r in g["walk_rows"] if r.get("fixes") and best_overall in r["fixes"]]
         rows.sort(key=lambda r: -(r["fixes"][best_overall]["mean"] or 0))
         if rows:
             parts.append(f"<h3>Worst walks (by {best_overall} mean error)</h3>")
         for r in rows[:WORST_WALKS]:
-            means = {n: s["mean"] for n, s in r["fixes"].items()
-                     if s["mean"] is not None and math.isfinite(s["mean"])}
+            means = {
+                n: s["mean"]
+                for n, s in r["fixes"].items()
+                if s["mean"] is not None and math.isfinite(s["mean"])
+            }
             if not means:
                 continue
             best, worst = min(means, key=means.get), max(means, key=means.get)
@@ -202,23 +249,32 @@ def render(doc: dict) -> str:
             if not npz.is_file():
                 continue
             series = _matched(dict(np.load(npz)))
-            title = (f"{r['walk']}: best {best} {means[best]:.1f} m, worst {worst} "
-                     f"{means[worst]:.1f} m (mean)")
-            parts.append(_img(to_png(plot_walk(series, r["walk"], [best, worst], plan, title)),
-                              r["walk"]))
+            title = f"{r['walk']}: best {best} {means[best]:.1f} m, worst {worst} {means[worst]:.1f} m (mean)"
+            parts.append(_img(to_png(plot_walk(series, r["walk"], [best, worst], plan, title)), r["walk"]))
         head = ["walk", "waypoints", "K", "rotation °", "RPs"] + [f"{n} mean" for n in sch]
         trows = []
         for r in g["walk_rows"]:
             fo = r.get("fold") or {}
-            trows.append([r["walk"], r["waypoints"], _f(fo.get("K"), 3),
-                          _f(fo.get("rotation_deg"), 1), fo.get("n_rp", "-")]
-                         + [_f((r.get("fixes") or {}).get(n, {}).get("mean")) for n in sch])
+            trows.append(
+                [
+                    r["walk"],
+                    r["waypoints"],
+                    _f(fo.get("K"), 3),
+                    _f(fo.get("rotation_deg"), 1),
+                    fo.get("n_rp", "-"),
+                ]
+                + [_f((r.get("fixes") or {}).get(n, {}).get("mean")) for n in sch]
+            )
         parts.append("<h3>Per walk</h3>" + _table(head, trows))
-    style = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
-             "collapse;margin:8px 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
-             "img{max-width:100%}")
-    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>StrideFix realbench fusion"
-            f"</title><style>{style}</style></head><body>{''.join(parts)}</body></html>")
+    style = (
+        "body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
+        "collapse;margin:8px 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
+        "img{max-width:100%}"
+    )
+    return (
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>StrideFix realbench fusion"
+        f"</title><style>{style}</style></head><body>{''.join(parts)}</body></html>"
+    )
 
 
 def write_report(doc: dict, path) -> str:

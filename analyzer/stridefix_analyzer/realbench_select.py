@@ -22,6 +22,7 @@ count, which says little when every scan hears ~100 APs.
 So the held-out walk's data never enter its own choice. Cost: n_blocks·(n_blocks − 1) maps and
 (n_blocks − 1) replays of every walk per candidate.
 """
+
 from __future__ import annotations
 
 import concurrent.futures
@@ -36,14 +37,19 @@ from .logread import read_table
 #: candidates, as stridefixd --set arguments; the first is the firmware default. Scans averaged
 #: (1 or 2) × WkNN representation (dBm, or "powed" with beta 2 or e — Torres-Sospedra 2015's choice)
 _AVERAGE = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
-_REPRESENTATION = {"dBm": [], "powed 2": ["fingerprint.powed_beta=2"],
-                   "powed e": ["fingerprint.powed_beta=2.718281828"]}
-MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items()
-                    for r, sr in _REPRESENTATION.items()}
+_REPRESENTATION = {
+    "dBm": [],
+    "powed 2": ["fingerprint.powed_beta=2"],
+    "powed e": ["fingerprint.powed_beta=2.718281828"],
+}
+MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items() for r, sr in _REPRESENTATION.items()}
 #: the adaptive scheme's Wi-Fi accuracy factors (a table on the AP count, AADR 2015) times a scale:
 #: chosen second, with the block's matcher, on the adaptive POSE error at the waypoints
-ADAPTIVE_VARIANTS = {"table x 1": [], "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
-                     "table x 0.25": ["fusion.acc_wifi_scale=0.25"]}
+ADAPTIVE_VARIANTS = {
+    "table x 1": [],
+    "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
+    "table x 0.25": ["fusion.acc_wifi_scale=0.25"],
+}
 #: what each stage replays (--fusion) and scores
 STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
 DEFAULT_BLOCKS = 4
@@ -101,8 +107,18 @@ def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
 
 
 def _replay(job: dict) -> dict:
-    cmd = [job["stridefixd"], "--input", f"lcmlog:{job['import_log']}", "--site", job["site"],
-           "--fusion", STAGES[job["stage"]], "--log", job["log"], "-q"]
+    cmd = [
+        job["stridefixd"],
+        "--input",
+        f"lcmlog:{job['import_log']}",
+        "--site",
+        job["site"],
+        "--fusion",
+        STAGES[job["stage"]],
+        "--log",
+        job["log"],
+        "-q",
+    ]
     cmd += [a for kv in job["sets"] for a in ("--set", kv)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
@@ -113,10 +129,21 @@ def _replay(job: dict) -> dict:
     return {**job, "errors": err, "failure": None}
 
 
-def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list[str],
-           candidates: dict[str, list[str]], jobs: int = 2, n_blocks: int = DEFAULT_BLOCKS,
-           progress=None, replay=None, stage: str = "matcher",
-           block_sets: dict[int, list[str]] | None = None) -> tuple[list[str], dict]:
+def select(
+    sub: list[dict],
+    build_site,
+    *,
+    stridefixd,
+    work_dir,
+    base_sets: list[str],
+    candidates: dict[str, list[str]],
+    jobs: int = 2,
+    n_blocks: int = DEFAULT_BLOCKS,
+    progress=None,
+    replay=None,
+    stage: str = "matcher",
+    block_sets: dict[int, list[str]] | None = None,
+) -> tuple[list[str], dict]:
     """Choose a candidate for every walk of ``sub`` (the prepared walks of one group).
 
     ``build_site(stats_removed, others, name, path)`` writes to ``path`` the site whose radio map is
@@ -149,16 +176,26 @@ def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list
             for i in (i for i in range(len(sub)) if block[i] == b):
                 for name in names:
                     sets = base_sets + site_sets + (block_sets or {}).get(a, []) + candidates[name]
-                    tasks.append({"a": a, "name": name, "walk": sub[i]["walk"], "stage": stage,
-                                  "stridefixd": str(stridefixd), "import_log": sub[i]["import_log"],
-                                  "site": str(site_path), "sets": sets,
-                                  "log": str(work_dir / f"{a}_{b}_{i}_{names.index(name)}.lcmlog"),
-                                  "wp_t_us": sub[i]["waypoint_t_us"],
-                                  "wp_xy_m": sub[i]["waypoint_xy_m"]})
+                    tasks.append(
+                        {
+                            "a": a,
+                            "name": name,
+                            "walk": sub[i]["walk"],
+                            "stage": stage,
+                            "stridefixd": str(stridefixd),
+                            "import_log": sub[i]["import_log"],
+                            "site": str(site_path),
+                            "sets": sets,
+                            "log": str(work_dir / f"{a}_{b}_{i}_{names.index(name)}.lcmlog"),
+                            "wp_t_us": sub[i]["waypoint_t_us"],
+                            "wp_xy_m": sub[i]["waypoint_xy_m"],
+                        }
+                    )
     pooled = {a: {n: [] for n in names} for a in range(n_blocks)}
     failures = []
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) if jobs > 1 else \
-            _InProcess() as pool:
+    with (
+        concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) if jobs > 1 else _InProcess() as pool
+    ):
         for r in pool.map(replay, tasks, chunksize=4):
             if r["errors"] is None:
                 failures.append(f"{r['walk']} ({r['name']}): {r['failure']}")
@@ -167,8 +204,12 @@ def select(sub: list[dict], build_site, *, stridefixd, work_dir, base_sets: list
             if progress:
                 progress()
     what = "mean Wi-Fi fix error" if stage == "matcher" else f"mean {STAGES[stage]} error at waypoints"
-    report = {"chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, {what})",
-              "blocks": {}, "failures": failures[:10], "block_of_walk": block}
+    report = {
+        "chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, {what})",
+        "blocks": {},
+        "failures": failures[:10],
+        "block_of_walk": block,
+    }
     choice_of_block = {}
     for a in range(n_blocks):
         means = {}

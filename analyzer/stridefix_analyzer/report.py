@@ -6,6 +6,7 @@ Reads ``DIR/metrics.json`` and ``DIR/analysis.npz`` (written by ``stridefix anal
 archived alone. Exit status: 0 written; 2 the directory or one of its two files is missing or
 unreadable.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -67,8 +68,11 @@ def load_analysis(directory: str) -> tuple[dict, dict]:
             series = {k: z[k] for k in z.files}
     except (OSError, ValueError) as exc:
         raise ReportInputError(f"{npz_path}: cannot read as .npz ({exc})") from exc
-    need = [k for k in ("truth_t_us", "truth_x_m", "truth_y_m", "scheme_codes", "primary_scheme")
-            if k not in series]
+    need = [
+        k
+        for k in ("truth_t_us", "truth_x_m", "truth_y_m", "scheme_codes", "primary_scheme")
+        if k not in series
+    ]
     for key in ("per_scheme", "primary_scheme", "position_error_m"):
         if key not in summary:
             need.append(f"{METRICS_FILE}:{key}")
@@ -94,17 +98,20 @@ def _pct(rate) -> str | None:
 
 
 def _kv_table(rows: list[tuple[str, object]], header=("item", "value")) -> str:
-    body = "".join(f"<tr><td class='k'>{html.escape(k)}</td><td>{_cell(v)}</td></tr>"
-                   for k, v in rows)
-    return (f"<table><tr><th class='k'>{html.escape(header[0])}</th>"
-            f"<th>{html.escape(header[1])}</th></tr>{body}</table>")
+    body = "".join(f"<tr><td class='k'>{html.escape(k)}</td><td>{_cell(v)}</td></tr>" for k, v in rows)
+    return (
+        f"<table><tr><th class='k'>{html.escape(header[0])}</th>"
+        f"<th>{html.escape(header[1])}</th></tr>{body}</table>"
+    )
 
 
 def _scheme_table(summary: dict) -> str:
-    head = ("<tr><th class='k'>scheme</th><th>POSE msgs</th>"
-            + "".join(f"<th>{c}{'' if c == 'n' else ' [m]'}</th>" for c in _STAT_COLS)
-            + "<th>unscored</th><th>floor hit</th><th>within 1σ</th><th>final [m]</th>"
-              "<th>final / distance</th></tr>")
+    head = (
+        "<tr><th class='k'>scheme</th><th>POSE msgs</th>"
+        + "".join(f"<th>{c}{'' if c == 'n' else ' [m]'}</th>" for c in _STAT_COLS)
+        + "<th>unscored</th><th>floor hit</th><th>within 1σ</th><th>final [m]</th>"
+        "<th>final / distance</th></tr>"
+    )
     rows = []
     for name, s in summary["per_scheme"].items():
         e = s["position_error_m"]
@@ -114,23 +121,28 @@ def _scheme_table(summary: dict) -> str:
             f"<tr{cls}><td class='k'>{html.escape(name)}</td><td>{_cell(s.get('n_pose'))}</td>"
             + "".join(f"<td>{_cell(e.get(c))}</td>" for c in _STAT_COLS)
             + f"<td>{_cell(s.get('unscored'))}</td><td>{_cell(_pct(s.get('floor_hit_rate')))}</td>"
-              f"<td>{_cell(_pct(s.get('within_1sigma_rate')))}</td>"
-              f"<td>{_cell(s.get('final_error_m'))}</td>"
-              f"<td>{_cell(None if final_pct is None else f'{final_pct:.2f} %')}</td></tr>")
+            f"<td>{_cell(_pct(s.get('within_1sigma_rate')))}</td>"
+            f"<td>{_cell(s.get('final_error_m'))}</td>"
+            f"<td>{_cell(None if final_pct is None else f'{final_pct:.2f} %')}</td></tr>"
+        )
     return f"<table>{head}{''.join(rows)}</table>"
 
 
 def _steps_table(summary: dict) -> str:
-    head = ("<tr><th class='k'>scheme</th><th>detected</th><th>truth</th><th>error</th>"
-            "<th>error %</th><th>STEP msgs</th></tr>")
+    head = (
+        "<tr><th class='k'>scheme</th><th>detected</th><th>truth</th><th>error</th>"
+        "<th>error %</th><th>STEP msgs</th></tr>"
+    )
     rows = []
     for name, s in summary["per_scheme"].items():
         st = s["steps"]
         pct = st.get("error_pct")
-        rows.append(f"<tr><td class='k'>{html.escape(name)}</td><td>{_cell(st.get('detected'))}</td>"
-                    f"<td>{_cell(st.get('truth'))}</td><td>{_cell(st.get('error'))}</td>"
-                    f"<td>{_cell(None if pct is None else f'{pct:+.2f} %')}</td>"
-                    f"<td>{_cell(st.get('step_messages'))}</td></tr>")
+        rows.append(
+            f"<tr><td class='k'>{html.escape(name)}</td><td>{_cell(st.get('detected'))}</td>"
+            f"<td>{_cell(st.get('truth'))}</td><td>{_cell(st.get('error'))}</td>"
+            f"<td>{_cell(None if pct is None else f'{pct:+.2f} %')}</td>"
+            f"<td>{_cell(st.get('step_messages'))}</td></tr>"
+        )
     return f"<table>{head}{''.join(rows)}</table>"
 
 
@@ -148,13 +160,15 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         f"<tr><td class='k'>{html.escape(str(i.get('path')))}</td><td>{_cell(i.get('bytes'))}</td>"
         f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td>"
         f"<td>{_cell(i.get('skipped_bytes'))}</td></tr>"
-        for i in inputs)
+        for i in inputs
+    )
     overview = [
         ("primary scheme", summary["primary_scheme"]),
-        ("truth samples scored / unscored",
-         f"{e.get('n')} / {summary.get('unscored')}"),
-        ("mean / median / p95 error [m]",
-         f"{_cell(e.get('mean'))} / {_cell(e.get('median'))} / {_cell(e.get('p95'))}"),
+        ("truth samples scored / unscored", f"{e.get('n')} / {summary.get('unscored')}"),
+        (
+            "mean / median / p95 error [m]",
+            f"{_cell(e.get('mean'))} / {_cell(e.get('median'))} / {_cell(e.get('p95'))}",
+        ),
         ("distance walked (truth) [m]", summary.get("distance_walked_m")),
         ("final error [m]", summary.get("final_error_m")),
         ("floor hit rate", _pct(summary.get("floor_hit_rate"))),
@@ -164,12 +178,11 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
     config = summary.get("config") or {}
     params = config.get("params") or {}
     version_rows = [(k, v) for k, v in config.items() if k != "params"]
-    warnings_html = "".join(f"<li class='warn'>{html.escape(w)}</li>"
-                            for w in summary.get("warnings", []))
+    warnings_html = "".join(f"<li class='warn'>{html.escape(w)}</li>" for w in summary.get("warnings", []))
     messages = summary.get("messages", {})
-    extra_counts = (
-        [("unknown channel " + k, v) for k, v in summary.get("unknown_channels", {}).items()]
-        + [("decode errors on " + k, v) for k, v in summary.get("decode_errors", {}).items()])
+    extra_counts = [("unknown channel " + k, v) for k, v in summary.get("unknown_channels", {}).items()] + [
+        ("decode errors on " + k, v) for k, v in summary.get("decode_errors", {}).items()
+    ]
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
@@ -178,13 +191,18 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation.</p>",
         _kv_table(overview, ("summary", "")),
         f"<ul>{warnings_html}</ul>" if warnings_html else "",
-        "<h2>Position error by scheme</h2>", _scheme_table(summary),
-        "<div class='figs'>", _img(figs["trajectory"], "trajectory"),
-        _img(figs["error_cdf"], "error CDF"), "</div>",
+        "<h2>Position error by scheme</h2>",
+        _scheme_table(summary),
+        "<div class='figs'>",
+        _img(figs["trajectory"], "trajectory"),
+        _img(figs["error_cdf"], "error CDF"),
+        "</div>",
         _img(figs["error_time"], "error over time"),
-        "<h2>Steps</h2>", _steps_table(summary),
+        "<h2>Steps</h2>",
+        _steps_table(summary),
         "<h2>Logger health (last HEALTH report)</h2>",
-        _kv_table(list(health.items()), ("counter", "value")) if health
+        _kv_table(list(health.items()), ("counter", "value"))
+        if health
         else "<p class='note'>no HEALTH message in the logs</p>",
         "<h2>Messages per channel</h2>",
         _kv_table(list(messages.items()) + extra_counts, ("channel", "events")),
@@ -192,7 +210,8 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         "<table><tr><th class='k'>log</th><th>bytes</th><th>events</th><th>truncated bytes</th>"
         f"<th>skipped bytes</th></tr>{input_rows}</table>",
         "<h2>Configuration</h2>",
-        _kv_table(version_rows + sorted(params.items()), ("key", "value")) if (params or version_rows)
+        _kv_table(version_rows + sorted(params.items()), ("key", "value"))
+        if (params or version_rows)
         else "<p class='note'>no CONFIG message in the logs</p>",
         "</body></html>",
     ]
@@ -213,7 +232,9 @@ def run_report(directory: str, out_file: str | None = None) -> str:
     if parent:
         os.makedirs(parent, exist_ok=True)
     label = summary.get("label")
-    page = render_html(summary, series, f"StrideFix walk report: {label}" if label else "StrideFix walk report")
+    page = render_html(
+        summary, series, f"StrideFix walk report: {label}" if label else "StrideFix walk report"
+    )
     with open(out_file, "w", encoding="utf-8") as f:
         f.write(page)
     return out_file
@@ -222,12 +243,15 @@ def run_report(directory: str, out_file: str | None = None) -> str:
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Declare the ``report`` sub-command and its options."""
     p = subparsers.add_parser(
-        "report", help="render an analyze output directory as a self-contained HTML report",
+        "report",
+        help="render an analyze output directory as a self-contained HTML report",
         description="Read DIR/metrics.json and DIR/analysis.npz (from `stridefix analyze`) and "
-                    "write one HTML file with inline CSS and embedded PNG figures.")
+        "write one HTML file with inline CSS and embedded PNG figures.",
+    )
     p.add_argument("directory", metavar="DIR", help="output directory of `stridefix analyze`")
-    p.add_argument("--out", default=None, metavar="FILE",
-                   help="HTML file to write (default: DIR/report.html)")
+    p.add_argument(
+        "--out", default=None, metavar="FILE", help="HTML file to write (default: DIR/report.html)"
+    )
     return p
 
 

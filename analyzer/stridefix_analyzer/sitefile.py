@@ -25,6 +25,7 @@ order and word their messages alike, so a file rejected by one is rejected by th
 Errors: :class:`SiteFileError` (``path: what``), with ``kind`` one of :data:`ERROR_KINDS`.
 Cost: one read of the file, O(n_ap + n_rp + n_entries) checks.
 """
+
 from __future__ import annotations
 
 import io
@@ -39,7 +40,7 @@ from stridefix import site_t
 MAGIC = b"SFSITE\0\x01"
 FORMAT_VERSION = 1
 HEADER = struct.Struct("<8sIIII")
-HEADER_SIZE = HEADER.size   # 24
+HEADER_SIZE = HEADER.size  # 24
 #: Largest payload either reader accepts [bytes] (the firmware allocates the whole file).
 MAX_PAYLOAD_BYTES = 256 << 20
 BSSID_LIMIT = 1 << 48
@@ -73,6 +74,7 @@ class SiteValidationError(ValueError):
 
 
 # --- field validation ----------------------------------------------------------------------------
+
 
 def _finite(value: float) -> bool:
     return math.isfinite(value)
@@ -117,7 +119,8 @@ def validate_site(site: site_t) -> None:
         if i > 0 and not h > site.floor_height_m[i - 1]:
             raise SiteValidationError(
                 f"floor_height_m[{i}] = {h:g} not above floor_height_m[{i - 1}] = "
-                f"{site.floor_height_m[i - 1]:g} (heights must increase)")
+                f"{site.floor_height_m[i - 1]:g} (heights must increase)"
+            )
 
     n_ap = _check_len(site, "n_ap", "ap_bssid")
     for a, b in enumerate(site.ap_bssid):
@@ -126,7 +129,8 @@ def validate_site(site: site_t) -> None:
         if a > 0 and not b > site.ap_bssid[a - 1]:
             raise SiteValidationError(
                 f"ap {a}: BSSID 0x{b:012x} not above ap {a - 1}'s 0x{site.ap_bssid[a - 1]:012x} "
-                f"(BSSIDs must be strictly ascending)")
+                f"(BSSIDs must be strictly ascending)"
+            )
 
     if not (_finite(site.cell_size_m) and site.cell_size_m >= 0.0):
         raise SiteValidationError(f"cell_size_m = {site.cell_size_m:g}, must be finite and >= 0")
@@ -141,8 +145,9 @@ def validate_site(site: site_t) -> None:
         if s < 1:
             raise SiteValidationError(f"rp {r}: rp_scans = {s}, must be >= 1")
 
-    n_entries = _check_len(site, "n_entries", "entry_ap", "entry_rp", "entry_mean_dbm",
-                           "entry_std_db", "entry_count")
+    n_entries = _check_len(
+        site, "n_entries", "entry_ap", "entry_rp", "entry_mean_dbm", "entry_std_db", "entry_count"
+    )
     for i in range(n_entries):
         a, r = site.entry_ap[i], site.entry_rp[i]
         if not 0 <= a < n_ap:
@@ -152,7 +157,8 @@ def validate_site(site: site_t) -> None:
         if i > 0 and not (a, r) > (site.entry_ap[i - 1], site.entry_rp[i - 1]):
             raise SiteValidationError(
                 f"entry {i}: (ap {a}, rp {r}) not after entry {i - 1}'s (ap {site.entry_ap[i - 1]}, "
-                f"rp {site.entry_rp[i - 1]}) (entries must be sorted by (ap, rp), no duplicates)")
+                f"rp {site.entry_rp[i - 1]}) (entries must be sorted by (ap, rp), no duplicates)"
+            )
         mean, std, count = site.entry_mean_dbm[i], site.entry_std_db[i], site.entry_count[i]
         if not _finite(mean):
             raise SiteValidationError(f"entry {i}: entry_mean_dbm is {mean:g}, must be finite")
@@ -160,18 +166,21 @@ def validate_site(site: site_t) -> None:
             raise SiteValidationError(f"entry {i}: entry_std_db = {std:g}, must be finite and >= 0")
         if not 1 <= count <= site.rp_scans[r]:
             raise SiteValidationError(
-                f"entry {i}: count {count} outside 1..{site.rp_scans[r]} (rp_scans of rp {r})")
+                f"entry {i}: count {count} outside 1..{site.rp_scans[r]} (rp_scans of rp {r})"
+            )
 
 
 # --- file I/O ------------------------------------------------------------------------------------
+
 
 def encode_site_file(site: site_t) -> bytes:
     """Header + payload bytes of ``site`` (validated first; raises SiteValidationError)."""
     validate_site(site)
     payload = site.encode()
     if len(payload) > MAX_PAYLOAD_BYTES:
-        raise SiteValidationError(f"encoded site is {len(payload)} bytes, more than the "
-                                  f"{MAX_PAYLOAD_BYTES} a reader accepts")
+        raise SiteValidationError(
+            f"encoded site is {len(payload)} bytes, more than the {MAX_PAYLOAD_BYTES} a reader accepts"
+        )
     return HEADER.pack(MAGIC, FORMAT_VERSION, len(payload), zlib.crc32(payload), 0) + payload
 
 
@@ -193,7 +202,7 @@ def write_site(path: str | os.PathLike, site: site_t) -> int:
             f.write(data)
         umask = os.umask(0)
         os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)   # mkstemp makes 0600; a site file is an ordinary file
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a site file is an ordinary file
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -212,44 +221,58 @@ def decode_site_file(data: bytes, path: str = "<site>") -> site_t:
     """
     size = len(data)
     if size < HEADER_SIZE:
-        raise SiteFileError(path, "short", f"file has only {size} bytes; a site file starts "
-                                           f"with a {HEADER_SIZE}-byte header")
+        raise SiteFileError(
+            path, "short", f"file has only {size} bytes; a site file starts with a {HEADER_SIZE}-byte header"
+        )
     magic, version, length, crc, reserved = HEADER.unpack_from(data)
     if magic != MAGIC:
-        raise SiteFileError(path, "magic", f"bad magic {magic.hex(' ')}, expected "
-                                           f"{MAGIC.hex(' ')} (not a StrideFix site file)")
+        raise SiteFileError(
+            path,
+            "magic",
+            f"bad magic {magic.hex(' ')}, expected {MAGIC.hex(' ')} (not a StrideFix site file)",
+        )
     if version != FORMAT_VERSION:
-        raise SiteFileError(path, "version", f"format version {version}, this reader supports "
-                                             f"{FORMAT_VERSION}")
+        raise SiteFileError(
+            path, "version", f"format version {version}, this reader supports {FORMAT_VERSION}"
+        )
     if reserved != 0:
-        raise SiteFileError(path, "reserved", f"reserved header field is 0x{reserved:08x}, "
-                                              f"must be 0")
+        raise SiteFileError(path, "reserved", f"reserved header field is 0x{reserved:08x}, must be 0")
     if length != size - HEADER_SIZE:
         what = "truncated" if length > size - HEADER_SIZE else "trailing bytes"
-        raise SiteFileError(path, "length", f"length mismatch ({what}): header says {length} "
-                                            f"payload bytes, file has {size - HEADER_SIZE}")
+        raise SiteFileError(
+            path,
+            "length",
+            f"length mismatch ({what}): header says {length} payload bytes, file has {size - HEADER_SIZE}",
+        )
     if length > MAX_PAYLOAD_BYTES:
-        raise SiteFileError(path, "length", f"payload of {length} bytes exceeds the limit of "
-                                            f"{MAX_PAYLOAD_BYTES}")
+        raise SiteFileError(
+            path, "length", f"payload of {length} bytes exceeds the limit of {MAX_PAYLOAD_BYTES}"
+        )
     payload = data[HEADER_SIZE:]
     actual = zlib.crc32(payload)
     if actual != crc:
-        raise SiteFileError(path, "crc", f"CRC-32 mismatch: header says 0x{crc:08x}, payload "
-                                         f"has 0x{actual:08x}")
+        raise SiteFileError(
+            path, "crc", f"CRC-32 mismatch: header says 0x{crc:08x}, payload has 0x{actual:08x}"
+        )
     expected_hash = site_t._get_packed_fingerprint()
     if payload[:8] != expected_hash:
-        raise SiteFileError(path, "decode", f"payload is not a stridefix.site_t: LCM type hash "
-                                            f"0x{payload[:8].hex()}, expected "
-                                            f"0x{expected_hash.hex()} (written with another "
-                                            f"version of site_t?)")
+        raise SiteFileError(
+            path,
+            "decode",
+            f"payload is not a stridefix.site_t: LCM type hash "
+            f"0x{payload[:8].hex()}, expected "
+            f"0x{expected_hash.hex()} (written with another "
+            f"version of site_t?)",
+        )
     buf = io.BytesIO(payload)
     try:
         site = site_t.decode(buf)
-    except Exception as exc:   # noqa: BLE001 - any decoder failure is a malformed payload
+    except Exception as exc:  # noqa: BLE001 - any decoder failure is a malformed payload
         raise SiteFileError(path, "decode", f"LCM decode of site_t failed: {exc!r}") from exc
     if buf.tell() != length:
-        raise SiteFileError(path, "decode", f"payload has {length - buf.tell()} trailing bytes "
-                                            f"after the site_t")
+        raise SiteFileError(
+            path, "decode", f"payload has {length - buf.tell()} trailing bytes after the site_t"
+        )
     try:
         validate_site(site)
     except SiteValidationError as exc:
@@ -290,7 +313,7 @@ def new_site(**fields) -> site_t:
         if not hasattr(s, name):
             raise AttributeError(f"site_t has no field {name!r}")
         if hasattr(value, "tolist"):
-            value = value.tolist()      # numpy arrays and scalars → Python lists and numbers
+            value = value.tolist()  # numpy arrays and scalars → Python lists and numbers
         elif isinstance(value, tuple):
             value = list(value)
         setattr(s, name, value)

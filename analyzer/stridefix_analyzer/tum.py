@@ -15,6 +15,7 @@ scheme's scored samples when schemes differ in which samples they score. z = 0 (
 orientation = yaw only (``heading_rad``; identity when the heading is unknown). Numbers are written
 with 17 significant digits so reading them back gives the same float64 values.
 """
+
 from __future__ import annotations
 
 import os
@@ -37,10 +38,13 @@ def format_tum(t_us, x_m, y_m, yaw_rad) -> str:
     """TUM lines of the given samples (timestamp = t_us / 1e6 [s])."""
     q = yaw_quaternion(yaw_rad)
     lines = []
-    for t, x, y, qq in zip(np.asarray(t_us, np.int64).tolist(), np.asarray(x_m, float).tolist(),
-                           np.asarray(y_m, float).tolist(), q.tolist()):
-        lines.append(f"{t // 1_000_000}.{t % 1_000_000:06d} {x!r} {y!r} 0.0 "
-                     + " ".join(repr(v) for v in qq))
+    for t, x, y, qq in zip(
+        np.asarray(t_us, np.int64).tolist(),
+        np.asarray(x_m, float).tolist(),
+        np.asarray(y_m, float).tolist(),
+        q.tolist(),
+    ):
+        lines.append(f"{t // 1_000_000}.{t % 1_000_000:06d} {x!r} {y!r} 0.0 " + " ".join(repr(v) for v in qq))
     return "\n".join(lines) + ("\n" if lines else "")
 
 
@@ -63,12 +67,11 @@ def write_tum(metrics: Metrics, out_dir) -> dict[str, str]:
         with open(path, "w", encoding="utf-8") as f:
             f.write(format_tum(m["t_us"][sc], m["pose_x_m"][sc], m["pose_y_m"][sc], pose_heading))
         paths[s.name] = path
-        truth_heading = np.asarray(metrics.truth["heading_rad"], float)[sc]   # NaN → identity
+        truth_heading = np.asarray(metrics.truth["heading_rad"], float)[sc]  # NaN → identity
         if not same or code == metrics.primary:
             name = "truth" if code == metrics.primary else f"truth_{s.name}"
             tpath = os.path.join(out_dir, f"{name}.tum")
             with open(tpath, "w", encoding="utf-8") as f:
-                f.write(format_tum(m["t_us"][sc], m["truth_x_m"][sc], m["truth_y_m"][sc],
-                                   truth_heading))
+                f.write(format_tum(m["t_us"][sc], m["truth_x_m"][sc], m["truth_y_m"][sc], truth_heading))
             paths[name] = tpath
     return paths

@@ -23,6 +23,7 @@ Values are clamped into each signal's DBC range, then encoded per message type a
 ``encode(strict=False)``; a test compares them frame by frame), so an hour of board traffic takes a few
 seconds.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -68,7 +69,7 @@ class _Frames:
     """Events of the run as parallel arrays: board ms, priority, insertion order, message, raw payload."""
 
     def __init__(self):
-        self.parts: list[tuple] = []   # (t_ms, priority, name, payload words, insertion index)
+        self.parts: list[tuple] = []  # (t_ms, priority, name, payload words, insertion index)
         self.n = 0
 
     def add(self, name: str, t_ms, prio: int, payload: np.ndarray, ins: np.ndarray | None = None) -> None:
@@ -120,25 +121,64 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
     ev = _Frames()
 
     t = np.arange(0, duration_ms + 1, 1000, dtype=np.int64)
-    ev.add("BOARD_TIME", t, P_TIME, pack(msgs["BOARD_TIME"], {"time_ms": (start_ms + t) % 2**32, "boot_id": boot_id}))
+    ev.add(
+        "BOARD_TIME",
+        t,
+        P_TIME,
+        pack(msgs["BOARD_TIME"], {"time_ms": (start_ms + t) % 2**32, "boot_id": boot_id}),
+    )
     i = np.arange(n_imu, dtype=np.int64)
     t = i * IMU_PERIOD_MS
     lo = (start_ms + t) % 256
-    base = ev.reserve(2 * n_imu)   # ACCEL and GYRO of a sample alternate
-    ev.add("IMU_ACCEL", t, P_IMU, pack(msgs["IMU_ACCEL"], {
-        "accel_x": acc[:, 0], "accel_y": acc[:, 1], "accel_z": acc[:, 2], "seq": i % 256, "t_lo_ms": lo}),
-        ins=base + 2 * i)
-    ev.add("IMU_GYRO", t, P_IMU, pack(msgs["IMU_GYRO"], {
-        "gyro_x": gyr[:, 0], "gyro_y": gyr[:, 1], "gyro_z": gyr[:, 2], "seq": i % 256, "t_lo_ms": lo}),
-        ins=base + 2 * i + 1)
+    base = ev.reserve(2 * n_imu)  # ACCEL and GYRO of a sample alternate
+    ev.add(
+        "IMU_ACCEL",
+        t,
+        P_IMU,
+        pack(
+            msgs["IMU_ACCEL"],
+            {"accel_x": acc[:, 0], "accel_y": acc[:, 1], "accel_z": acc[:, 2], "seq": i % 256, "t_lo_ms": lo},
+        ),
+        ins=base + 2 * i,
+    )
+    ev.add(
+        "IMU_GYRO",
+        t,
+        P_IMU,
+        pack(
+            msgs["IMU_GYRO"],
+            {"gyro_x": gyr[:, 0], "gyro_y": gyr[:, 1], "gyro_z": gyr[:, 2], "seq": i % 256, "t_lo_ms": lo},
+        ),
+        ins=base + 2 * i + 1,
+    )
     j = np.arange(len(sensors.mag_idx), dtype=np.int64)
     t = sensors.mag_idx.astype(np.int64) * IMU_PERIOD_MS
-    ev.add("MAG", t, P_MAG, pack(msgs["MAG"], {"mag_x": mag[:, 0], "mag_y": mag[:, 1], "mag_z": mag[:, 2],
-                                               "seq": j % 256, "t_lo_ms": (start_ms + t) % 256}))
+    ev.add(
+        "MAG",
+        t,
+        P_MAG,
+        pack(
+            msgs["MAG"],
+            {
+                "mag_x": mag[:, 0],
+                "mag_y": mag[:, 1],
+                "mag_z": mag[:, 2],
+                "seq": j % 256,
+                "t_lo_ms": (start_ms + t) % 256,
+            },
+        ),
+    )
     j = np.arange(len(sensors.baro_idx), dtype=np.int64)
     t = sensors.baro_idx.astype(np.int64) * IMU_PERIOD_MS
-    ev.add("BARO", t, P_BARO, pack(msgs["BARO"], {"pressure": prs, "temperature": tmp, "seq": j % 256,
-                                                  "t_lo_ms": (start_ms + t) % 256}))
+    ev.add(
+        "BARO",
+        t,
+        P_BARO,
+        pack(
+            msgs["BARO"],
+            {"pressure": prs, "temperature": tmp, "seq": j % 256, "t_lo_ms": (start_ms + t) % 256},
+        ),
+    )
     # Wi-Fi: BEGIN, one AP frame per access point, END; in scan order
     wifi = {"WIFI_SCAN_BEGIN": [], "WIFI_AP": [], "WIFI_SCAN_END": []}
     k_ins = 0
@@ -154,20 +194,43 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
         wifi["WIFI_SCAN_END"].append((t_res, k_ins, k % 256, min(255, len(scan.aps)), 0))
         k_ins += 1
     base = ev.reserve(k_ins)
-    names = {"WIFI_SCAN_BEGIN": ("scan_id", "time_ms"), "WIFI_AP": ("bssid", "rssi", "channel"),
-             "WIFI_SCAN_END": ("scan_id", "n_ap")}
+    names = {
+        "WIFI_SCAN_BEGIN": ("scan_id", "time_ms"),
+        "WIFI_AP": ("bssid", "rssi", "channel"),
+        "WIFI_SCAN_END": ("scan_id", "n_ap"),
+    }
     for name, rows in wifi.items():
         if not rows:
             continue
         a = np.asarray(rows, dtype=np.int64)
-        ev.add(name, a[:, 0], P_WIFI, pack(msgs[name], {f: a[:, 2 + c] for c, f in enumerate(names[name])}),
-               ins=base + a[:, 1])
+        ev.add(
+            name,
+            a[:, 0],
+            P_WIFI,
+            pack(msgs[name], {f: a[:, 2 + c] for c, f in enumerate(names[name])}),
+            ins=base + a[:, 1],
+        )
     t = np.arange(500, duration_ms + 1, 1000, dtype=np.int64)
     baro_t = sensors.baro_idx.astype(np.int64) * IMU_PERIOD_MS
     j = np.minimum(np.searchsorted(baro_t, t), len(tmp) - 1)
-    ev.add("BOARD_STATUS", t, P_STATUS, pack(msgs["BOARD_STATUS"], {
-        "tx_overflows": 0, "board_temp": np.round(np.clip(tmp[j], -128, 127)).astype(np.int64),
-        "fw_major": FW_MAJOR, "fw_minor": FW_MINOR, "imu_ok": 1, "mag_ok": 1, "baro_ok": 1, "wifi_ok": 1}))
+    ev.add(
+        "BOARD_STATUS",
+        t,
+        P_STATUS,
+        pack(
+            msgs["BOARD_STATUS"],
+            {
+                "tx_overflows": 0,
+                "board_temp": np.round(np.clip(tmp[j], -128, 127)).astype(np.int64),
+                "fw_major": FW_MAJOR,
+                "fw_minor": FW_MINOR,
+                "imu_ok": 1,
+                "mag_ok": 1,
+                "baro_ok": 1,
+                "wifi_ok": 1,
+            },
+        ),
+    )
     return ev
 
 
@@ -186,8 +249,11 @@ def _candump_lines(host_us: np.ndarray, code: np.ndarray, word: np.ndarray, db) 
         return []
     if any(m.length != 8 for m in msgs) or sec.min() < 10**9 or sec.max() >= 10**10:  # general (slow) path
         data = word.astype("<u8").view(np.uint8).reshape(-1, 8)
-        return [f"({h // 1_000_000}.{h % 1_000_000:06d}) can0 {msgs[c].frame_id:03X}#"
-                f"{bytes(d[:msgs[c].length]).hex().upper()}" for h, c, d in zip(host_us.tolist(), code.tolist(), data)]
+        return [
+            f"({h // 1_000_000}.{h % 1_000_000:06d}) can0 {msgs[c].frame_id:03X}#"
+            f"{bytes(d[: msgs[c].length]).hex().upper()}"
+            for h, c, d in zip(host_us.tolist(), code.tolist(), data)
+        ]
     hexd = np.frombuffer(b"0123456789ABCDEF", dtype=np.uint8)
     ids = np.array([list(f"{m.frame_id:03X}".encode()) for m in msgs], dtype=np.uint8)
     data = word.astype("<u8").view(np.uint8).reshape(-1, 8)
@@ -202,11 +268,17 @@ def _candump_lines(host_us: np.ndarray, code: np.ndarray, word: np.ndarray, db) 
     row[:, 29:45:2] = hexd[data >> 4]
     row[:, 30:46:2] = hexd[data & 15]
     text = row.tobytes().decode("ascii")
-    return [text[i:i + 45] for i in range(0, len(text), 45)]
+    return [text[i : i + 45] for i in range(0, len(text), 45)]
 
 
-def emulate_board(sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict,
-                  rng: np.random.Generator, dbc_path: Path | str = DBC_PATH) -> BoardOutput:
+def emulate_board(
+    sensors: SensorData,
+    scans: list[Scan],
+    n_imu: int,
+    sc: dict,
+    rng: np.random.Generator,
+    dbc_path: Path | str = DBC_PATH,
+) -> BoardOutput:
     db = load_dbc(dbc_path)
     can = sc["can"]
     start_ms = int(can["board_time_start_ms"])
@@ -219,7 +291,7 @@ def emulate_board(sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict,
     name = np.concatenate([np.full(len(p[0]), code[p[2]], dtype=np.int64) for p in ev.parts])
     word = np.concatenate([p[3] for p in ev.parts])
     ins = np.concatenate([p[4] for p in ev.parts])
-    order = np.lexsort((ins, prio, t))   # board ms, then priority, then insertion order
+    order = np.lexsort((ins, prio, t))  # board ms, then priority, then insertion order
     t, name, word = t[order], name[order], word[order]
     n = len(t)
     lost = rng.random(n) < float(can["loss_rate"])

@@ -3,6 +3,7 @@
 Exit status: 0 success, 1 the simulation failed, 2 bad usage or unreadable input (scenario file missing,
 bad TOML, unknown key, value out of range).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -19,19 +20,33 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "sim",
         help="simulate a walk: write the board's candump log, truth LCM log and a summary",
         description="Simulate a walk with the wearable board and write board.candump (candump -L), "
-                    "truth.lcmlog (TRUTH, 10 Hz), sim_summary.json and init_truth.ini into --out.",
+        "truth.lcmlog (TRUTH, 10 Hz), sim_summary.json and init_truth.ini into --out.",
     )
-    p.add_argument("--scenario", metavar="NAME|FILE",
-                   help=f"a built-in scenario ({', '.join(BUILTIN)}) or a scenario TOML file (default: default)")
+    p.add_argument(
+        "--scenario",
+        metavar="NAME|FILE",
+        help=f"a built-in scenario ({', '.join(BUILTIN)}) or a scenario TOML file (default: default)",
+    )
     p.add_argument("--seed", type=int, help="random seed (overrides the scenario)")
     p.add_argument("--out", metavar="DIR", default="out/sim", help="output directory (default: out/sim)")
-    p.add_argument("--stdout", action="store_true", help="stream the candump lines to stdout instead of DIR/board.candump")
-    p.add_argument("--duration-s", type=float, metavar="S", help="simulated duration [s] (0: until the walk ends)")
+    p.add_argument(
+        "--stdout",
+        action="store_true",
+        help="stream the candump lines to stdout instead of DIR/board.candump",
+    )
+    p.add_argument(
+        "--duration-s", type=float, metavar="S", help="simulated duration [s] (0: until the walk ends)"
+    )
     p.add_argument("--loss-rate", type=float, metavar="R", help="CAN frame loss probability 0..1")
-    p.add_argument("--board-time-start-ms", type=int, metavar="MS", help="board time of the first frame [ms], 0..2**32-1")
-    p.add_argument("--survey", action="store_true",
-                   help="survey mode: stand at each calibration point of the world, scan in 4 orientations "
-                        "(scenario [survey] keys), instead of walking the route")
+    p.add_argument(
+        "--board-time-start-ms", type=int, metavar="MS", help="board time of the first frame [ms], 0..2**32-1"
+    )
+    p.add_argument(
+        "--survey",
+        action="store_true",
+        help="survey mode: stand at each calibration point of the world, scan in 4 orientations "
+        "(scenario [survey] keys), instead of walking the route",
+    )
     return p
 
 
@@ -39,13 +54,15 @@ def run(args) -> int:
     t_start = time.perf_counter()
     try:
         scenario = resolve_scenario(args.scenario)
-        scenario = scenario.with_overrides(**{
-            "seed": args.seed,
-            "duration_s": None if args.duration_s is None else float(args.duration_s),
-            "can.loss_rate": None if args.loss_rate is None else float(args.loss_rate),
-            "can.board_time_start_ms": args.board_time_start_ms,
-            "survey.enabled": True if getattr(args, "survey", False) else None,
-        })
+        scenario = scenario.with_overrides(
+            **{
+                "seed": args.seed,
+                "duration_s": None if args.duration_s is None else float(args.duration_s),
+                "can.loss_rate": None if args.loss_rate is None else float(args.loss_rate),
+                "can.board_time_start_ms": args.board_time_start_ms,
+                "survey.enabled": True if getattr(args, "survey", False) else None,
+            }
+        )
     except ScenarioError as e:
         print(f"stridefix sim: error: {e}", file=sys.stderr)
         return 2
@@ -58,13 +75,19 @@ def run(args) -> int:
         return 2
     elapsed = time.perf_counter() - t_start
     where = "stdout" if args.stdout else str(out_dir / "board.candump")
-    print(f"stridefix sim: seed {summary['seed']}, {summary['duration_s']:.1f} s simulated, "
-          f"{summary['steps']} steps, {summary['distance_m']:.1f} m, floors {summary['floors_visited']}, "
-          f"{summary['frames_total']} frames written to {where} ({summary['frames_dropped']} dropped), "
-          f"{summary['imu_samples']} IMU samples, {summary['wifi_scans']} Wi-Fi scans"
-          + (f", {summary['n_points']} calibration points x {summary['scans_per_point']} scans"
-             if "n_points" in summary else "")
-          + (f", {summary['n_reference_points']} reference points" if "n_reference_points" in summary else "")
-          + "; "
-          f"outputs in {out_dir}; {elapsed:.2f} s", file=sys.stderr)
+    print(
+        f"stridefix sim: seed {summary['seed']}, {summary['duration_s']:.1f} s simulated, "
+        f"{summary['steps']} steps, {summary['distance_m']:.1f} m, floors {summary['floors_visited']}, "
+        f"{summary['frames_total']} frames written to {where} ({summary['frames_dropped']} dropped), "
+        f"{summary['imu_samples']} IMU samples, {summary['wifi_scans']} Wi-Fi scans"
+        + (
+            f", {summary['n_points']} calibration points x {summary['scans_per_point']} scans"
+            if "n_points" in summary
+            else ""
+        )
+        + (f", {summary['n_reference_points']} reference points" if "n_reference_points" in summary else "")
+        + "; "
+        f"outputs in {out_dir}; {elapsed:.2f} s",
+        file=sys.stderr,
+    )
     return 0

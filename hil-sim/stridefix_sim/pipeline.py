@@ -13,6 +13,7 @@ and ``init_truth.ini`` (the true start pose for the firmware). On a route with r
 (time interpolated to the µs between walker samples; x, y = the surveyed point), in time order
 with the 10 Hz messages (a SIMULATION message first when both fall on the same µs).
 """
+
 from __future__ import annotations
 
 import json
@@ -60,8 +61,12 @@ class SimResult:
 
     def init_pose(self) -> dict:
         w = self.walk
-        return {"x_m": round(float(w.x_m[0]), 6), "y_m": round(float(w.y_m[0]), 6),
-                "heading_rad": round(_wrap(float(w.heading_rad[0])), 9), "floor": int(w.floor[0])}
+        return {
+            "x_m": round(float(w.x_m[0]), 6),
+            "y_m": round(float(w.y_m[0]), 6),
+            "heading_rad": round(_wrap(float(w.heading_rad[0])), 9),
+            "floor": int(w.floor[0]),
+        }
 
     def activity_s(self) -> dict:
         """Seconds spent in each activity (IMU samples x period, up to the end of the run)."""
@@ -75,15 +80,24 @@ class SimResult:
         for k, (s_ref, x, y) in enumerate(w.route.marks):
             i = int(np.searchsorted(w.s_m, s_ref - 1e-9, side="left"))
             if i >= len(w.s_m):
-                continue            # the run ended before this point
+                continue  # the run ended before this point
             if i == 0:
                 t = float(w.t_s[0])
             else:
                 ds = float(w.s_m[i] - w.s_m[i - 1])
                 f = (s_ref - float(w.s_m[i - 1])) / ds if ds > 0 else 1.0
                 t = float(w.t_s[i - 1] + min(max(f, 0.0), 1.0) * (w.t_s[i] - w.t_s[i - 1]))
-            out.append({"index": k, "x_m": x, "y_m": y, "floor": int(w.floor[i]), "s_m": round(float(s_ref), 6),
-                        "t_s": round(t, 6), "heading_rad": _wrap(float(w.heading_rad[i]))})
+            out.append(
+                {
+                    "index": k,
+                    "x_m": x,
+                    "y_m": y,
+                    "floor": int(w.floor[i]),
+                    "s_m": round(float(s_ref), 6),
+                    "t_s": round(t, 6),
+                    "heading_rad": _wrap(float(w.heading_rad[i])),
+                }
+            )
         return out
 
     def survey_summary(self) -> dict:
@@ -93,11 +107,21 @@ class SimResult:
             "n_points": len(w.stops),
             "scans_per_point": int(sv["orientations"] * sv["scans_per_orientation"]),
             "scans_per_orientation": int(sv["scans_per_orientation"]),
-            "orientations": [round(360.0 * k / sv["orientations"], 6) for k in range(int(sv["orientations"]))],
+            "orientations": [
+                round(360.0 * k / sv["orientations"], 6) for k in range(int(sv["orientations"]))
+            ],
             "spacing_m": sv["spacing_m"],
-            "survey_points": [{"index": st["index"], "x_m": st["x_m"], "y_m": st["y_m"], "floor": st["floor"],
-                               "scans": int(per_point[st["index"]]),
-                               "t_arrive_s": round(st["t_arrive"], 3)} for st in w.stops],
+            "survey_points": [
+                {
+                    "index": st["index"],
+                    "x_m": st["x_m"],
+                    "y_m": st["y_m"],
+                    "floor": st["floor"],
+                    "scans": int(per_point[st["index"]]),
+                    "t_arrive_s": round(st["t_arrive"], 3),
+                }
+                for st in w.stops
+            ],
         }
 
     def summary(self) -> dict:
@@ -108,11 +132,16 @@ class SimResult:
         if self.walk.route.marks:
             refs = self.reference_passes()
             extra["n_reference_points"] = len(refs)
-            extra["reference_points"] = [{k: r[k] for k in ("index", "x_m", "y_m", "floor", "s_m", "t_s")}
-                                         for r in refs]
+            extra["reference_points"] = [
+                {k: r[k] for k in ("index", "x_m", "y_m", "floor", "s_m", "t_s")} for r in refs
+            ]
         if self.world.name != "default":
-            extra["world"] = {"name": self.world.name, "area_m2": self.world.area_m2, "n_aps": len(self.world.aps),
-                              "description": self.world.description}
+            extra["world"] = {
+                "name": self.world.name,
+                "area_m2": self.world.area_m2,
+                "n_aps": len(self.world.aps),
+                "description": self.world.description,
+            }
         return {
             "seed": self.scenario.seed,
             "scenario_source": self.scenario.source,
@@ -130,7 +159,8 @@ class SimResult:
             "dropped_by_name": c["dropped_by_name"],
             "truth_messages": len(self.truth_indices()),
             "board_time_start_ms": self.board_time_start_ms,
-            "board_time_end_ms": (self.board_time_start_ms + (len(self.walk.t_s) - 1) * IMU_PERIOD_MS) % 2**32,
+            "board_time_end_ms": (self.board_time_start_ms + (len(self.walk.t_s) - 1) * IMU_PERIOD_MS)
+            % 2**32,
             "turn_radius_m": round(self.walk.route.radius_m, 6),
             "route": self.walk.route.name,
             "pace": self.walk.person.pace,
@@ -164,8 +194,15 @@ def simulate(scenario: Scenario) -> SimResult:
     sensors = simulate_sensors(sc, world, walk, r_sens)
     scans = simulate_scans(sc, world, walk, r_radio)
     board = emulate_board(sensors, scans, len(walk.t_s), sc, r_can)
-    return SimResult(scenario=scenario, world=world, walk=walk, sensors=sensors, scans=scans,
-                     board=board, duration_s=duration_s)
+    return SimResult(
+        scenario=scenario,
+        world=world,
+        walk=walk,
+        sensors=sensors,
+        scans=scans,
+        board=board,
+        duration_s=duration_s,
+    )
 
 
 def write_truth_log(result: SimResult, path: Path) -> int:
@@ -198,7 +235,7 @@ def write_truth_log(result: SimResult, path: Path) -> int:
         msg.step_count = int(result.steps_until(np.array([ref["t_s"]]))[0])
         msg.source = truth_t.SOURCE_WAYPOINT
         msgs.append(msg)
-    msgs.sort(key=lambda m: (m.t_us, m.source))   # stable: the 10 Hz stream keeps its order
+    msgs.sort(key=lambda m: (m.t_us, m.source))  # stable: the 10 Hz stream keeps its order
     log = lcm.EventLog(str(path), "w", overwrite=True)
     try:
         for msg in msgs:
@@ -210,11 +247,14 @@ def write_truth_log(result: SimResult, path: Path) -> int:
 
 def write_init_ini(result: SimResult, path: Path) -> None:
     p = result.init_pose()
-    path.write_text("[init]\n"
-                    f"x_m = {p['x_m']:.3f}\n"
-                    f"y_m = {p['y_m']:.3f}\n"
-                    f"heading_rad = {p['heading_rad']:.6f}\n"
-                    f"floor = {p['floor']}\n", encoding="utf-8")
+    path.write_text(
+        "[init]\n"
+        f"x_m = {p['x_m']:.3f}\n"
+        f"y_m = {p['y_m']:.3f}\n"
+        f"heading_rad = {p['heading_rad']:.6f}\n"
+        f"floor = {p['floor']}\n",
+        encoding="utf-8",
+    )
 
 
 def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | None = None) -> dict:
@@ -229,6 +269,7 @@ def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | Non
     write_truth_log(result, out_dir / "truth.lcmlog")
     write_init_ini(result, out_dir / "init_truth.ini")
     summary = result.summary()
-    (out_dir / "sim_summary.json").write_text(json.dumps(summary, indent=2, sort_keys=True) + "\n",
-                                              encoding="utf-8")
+    (out_dir / "sim_summary.json").write_text(
+        json.dumps(summary, indent=2, sort_keys=True) + "\n", encoding="utf-8"
+    )
     return summary

@@ -17,6 +17,7 @@ not reported. Scans start every U(min, max) seconds (2–4 s); each returns ever
 channel order, measured at the position where the scan started. In survey mode the scans happen at
 the planned times instead (``Walk.scan_plan``: standing at a calibration point) and nowhere else.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -31,11 +32,13 @@ AP_HEIGHT_M = 2.8
 
 @dataclass
 class Scan:
-    t_ms: int                                   # scan start, ms since the simulation start
-    aps: list[tuple[int, int, int]]             # (bssid, rssi_dbm, channel)
+    t_ms: int  # scan start, ms since the simulation start
+    aps: list[tuple[int, int, int]]  # (bssid, rssi_dbm, channel)
 
 
-def walls_crossed(px: np.ndarray, py: np.ndarray, ax: np.ndarray, ay: np.ndarray, walls: np.ndarray) -> np.ndarray:
+def walls_crossed(
+    px: np.ndarray, py: np.ndarray, ax: np.ndarray, ay: np.ndarray, walls: np.ndarray
+) -> np.ndarray:
     """Count of walls properly crossed by segments (px,py)→(ax,ay); inputs broadcast to shape S, walls (W,4)."""
     px, py, ax, ay = (np.asarray(v, float)[..., None] for v in (px, py, ax, ay))
     x0, y0, x1, y1 = walls[:, 0], walls[:, 1], walls[:, 2], walls[:, 3]
@@ -59,8 +62,9 @@ def walls_loss_db(px, py, ax, ay, walls: np.ndarray, loss_db: np.ndarray) -> np.
     def orient(ox, oy, bx, by, cx, cy):
         return (bx - ox) * (cy - oy) - (by - oy) * (cx - ox)
 
-    hit = ((orient(x0, y0, x1, y1, px, py) * orient(x0, y0, x1, y1, ax, ay) < 0)
-           & (orient(px, py, ax, ay, x0, y0) * orient(px, py, ax, ay, x1, y1) < 0))
+    hit = (orient(x0, y0, x1, y1, px, py) * orient(x0, y0, x1, y1, ax, ay) < 0) & (
+        orient(px, py, ax, ay, x0, y0) * orient(px, py, ax, ay, x1, y1) < 0
+    )
     return (hit * loss_db).sum(axis=-1)
 
 
@@ -81,8 +85,9 @@ def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator)
     r = sc["radio"]
     duration_ms = int(round(walk.t_s[-1] * 1000.0))
     if sc["survey"]["enabled"]:
-        t_ms = np.asarray([p[0] for p in walk.scan_plan if p[0] + r["scan_duration_ms"] <= duration_ms],
-                          dtype=np.int64)
+        t_ms = np.asarray(
+            [p[0] for p in walk.scan_plan if p[0] + r["scan_duration_ms"] <= duration_ms], dtype=np.int64
+        )
     else:
         t_ms = scan_times_ms(duration_ms, rng, r)
     if len(t_ms) == 0:
@@ -101,15 +106,26 @@ def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator)
     f_mhz = np.array([a.freq_mhz for a in aps], dtype=float)
     p0 = tx - (20.0 * np.log10(f_mhz) - 27.55)
     d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + (pz - az) ** 2)
-    args = (np.broadcast_to(px, d.shape), np.broadcast_to(py, d.shape),
-            np.broadcast_to(ax, d.shape), np.broadcast_to(ay, d.shape), world.walls_m)
+    args = (
+        np.broadcast_to(px, d.shape),
+        np.broadcast_to(py, d.shape),
+        np.broadcast_to(ax, d.shape),
+        np.broadcast_to(ay, d.shape),
+        world.walls_m,
+    )
     if world.walls_loss_db is None:
         wall_db = r["wall_loss_db"] * walls_crossed(*args)
     else:
-        wall_db = walls_loss_db(*args, np.where(np.isnan(world.walls_loss_db), r["wall_loss_db"], world.walls_loss_db))
-    rssi = (p0[None, :] - 10.0 * r["path_loss_exponent"] * np.log10(np.maximum(d, 1.0))
-            - wall_db - r["floor_loss_db"] * np.abs(af - pf)
-            + r["shadowing_db"] * rng.standard_normal(d.shape))
+        wall_db = walls_loss_db(
+            *args, np.where(np.isnan(world.walls_loss_db), r["wall_loss_db"], world.walls_loss_db)
+        )
+    rssi = (
+        p0[None, :]
+        - 10.0 * r["path_loss_exponent"] * np.log10(np.maximum(d, 1.0))
+        - wall_db
+        - r["floor_loss_db"] * np.abs(af - pf)
+        + r["shadowing_db"] * rng.standard_normal(d.shape)
+    )
     if r["body_loss_db"] > 0:
         facing = walk.heading_rad[idx][:, None]
         rssi = rssi - r["body_loss_db"] * 0.5 * (1.0 - np.cos(np.arctan2(ay - py, ax - px) - facing))
@@ -117,6 +133,8 @@ def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator)
     order = sorted(range(len(aps)), key=lambda j: (aps[j].channel, aps[j].bssid))
     scans = []
     for i, t in enumerate(t_ms):
-        heard = [(aps[j].bssid, int(rssi[i, j]), aps[j].channel) for j in order if rssi[i, j] >= r["floor_dbm"]]
+        heard = [
+            (aps[j].bssid, int(rssi[i, j]), aps[j].channel) for j in order if rssi[i, j] >= r["floor_dbm"]
+        ]
         scans.append(Scan(t_ms=int(t), aps=heard))
     return scans

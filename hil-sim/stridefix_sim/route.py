@@ -23,6 +23,7 @@ Routes built here (from the world's geometry):
   at every point (the walker stands there, turns through the orientations and scans: ``walker.py``);
   between floors the surveyor walks into the elevator cab and rides (a ``LegBreak("elevator")``).
 """
+
 from __future__ import annotations
 
 import math
@@ -32,8 +33,8 @@ import numpy as np
 
 from .world import World
 
-SLOPE_BLEND_M = 0.3     # height profile: slope changes are blended over this distance
-HEIGHT_GRID_M = 0.01    # height profile table resolution
+SLOPE_BLEND_M = 0.3  # height profile: slope changes are blended over this distance
+HEIGHT_GRID_M = 0.01  # height profile table resolution
 STAIRWELL_RADIUS_M = 0.6
 
 
@@ -75,7 +76,9 @@ class Polyline:
                 continue
             r = radii[i]
             # a segment is shared with the corner at its other end, if there is one
-            room = min(seg_len[i - 1] * (0.5 if turn[i - 1] else 1.0), seg_len[i] * (0.5 if turn[i + 1] else 1.0))
+            room = min(
+                seg_len[i - 1] * (0.5 if turn[i - 1] else 1.0), seg_len[i] * (0.5 if turn[i + 1] else 1.0)
+            )
             r = min(r, room / math.tan(0.5 * abs(turn[i])))
             rad[i] = r
             tan_d[i] = r * math.tan(0.5 * abs(turn[i]))
@@ -154,9 +157,9 @@ class Flight:
 @dataclass
 class Leg:
     path: Polyline
-    z0_m: float                       # level of the walking surface at the leg's start [m above floor 0]
+    z0_m: float  # level of the walking surface at the leg's start [m above floor 0]
     flights: list[Flight] = field(default_factory=list)
-    length_m: float = 0.0             # walked length (<= path length; 0 = the whole path)
+    length_m: float = 0.0  # walked length (<= path length; 0 = the whole path)
 
     def __post_init__(self):
         if self.length_m <= 0:
@@ -183,15 +186,18 @@ class Leg:
     def height(self, d_m):
         """Walking-surface level h, dh/dd and d²h/dd² at distances ``d_m`` along the leg."""
         d = np.asarray(d_m, dtype=float)
-        return (np.interp(d, self._grid, self._h), np.interp(d, self._grid, self._dh),
-                np.interp(d, self._grid, self._d2h))
+        return (
+            np.interp(d, self._grid, self._h),
+            np.interp(d, self._grid, self._dh),
+            np.interp(d, self._grid, self._d2h),
+        )
 
 
 @dataclass(frozen=True)
 class SurveyStop:
     """A calibration point where the surveyor stands, turns in place and scans."""
 
-    index: int           # into the route's survey points
+    index: int  # into the route's survey points
     x_m: float
     y_m: float
     floor: int
@@ -201,7 +207,7 @@ class SurveyStop:
 class LegBreak:
     """What happens between leg i and leg i + 1 (the walker stands; ``dz_m`` = elevator ride)."""
 
-    kind: str            # "elevator", "turn" or "survey" (a SurveyStop at the end of leg i)
+    kind: str  # "elevator", "turn" or "survey" (a SurveyStop at the end of leg i)
     dz_m: float = 0.0
     stop: SurveyStop | None = None
 
@@ -210,15 +216,15 @@ class LegBreak:
 class Route:
     name: str
     legs: list[Leg]
-    breaks: list[LegBreak]           # len(legs) - 1
-    radius_m: float                   # corridor corner radius
-    lap_m: float = 0.0                # length of one corridor lap (for reference)
-    tread_m: float = 0.28             # stair tread (one step per stair)
+    breaks: list[LegBreak]  # len(legs) - 1
+    radius_m: float  # corridor corner radius
+    lap_m: float = 0.0  # length of one corridor lap (for reference)
+    tread_m: float = 0.28  # stair tread (one step per stair)
     gait_zones: list[tuple[float, float, str]] = field(default_factory=list)  # global (s_a, s_b, mode)
-    marks: list[tuple[float, float, float]] = field(default_factory=list)       # reference points: (s_m, x_m, y_m)
-    start_stop: SurveyStop | None = None      # survey at the start point (before leg 0)
-    end_stop: SurveyStop | None = None        # survey at the end point (after the last leg)
-    survey_points: np.ndarray | None = None   # (n, 3) x, y, floor of the stops, in survey order
+    marks: list[tuple[float, float, float]] = field(default_factory=list)  # reference points: (s_m, x_m, y_m)
+    start_stop: SurveyStop | None = None  # survey at the start point (before leg 0)
+    end_stop: SurveyStop | None = None  # survey at the end point (after the last leg)
+    survey_points: np.ndarray | None = None  # (n, 3) x, y, floor of the stops, in survey order
 
     @property
     def leg_starts_m(self) -> np.ndarray:
@@ -274,27 +280,47 @@ def tour_route(world: World, radius_m: float) -> Route:
     f1a, f1b, f2a, f2b = st.flight1_start, st.flight1_end, st.flight2_start, st.flight2_end
     landing_y = st.landing_y_m
     lap0 = [(x0, world.tour_start_y_m), (x0, y0), (x1, y0), (x1, y1), (x0, y1)]
-    to_stairs = [(x0, door_y), (f1a[0], door_y, rs), f1a, f1b, (f1b[0], landing_y, rs),
-                 (f2a[0], landing_y, rs), f2a, f2b, (f2b[0], door_y, rs), (x0, door_y)]
+    to_stairs = [
+        (x0, door_y),
+        (f1a[0], door_y, rs),
+        f1a,
+        f1b,
+        (f1b[0], landing_y, rs),
+        (f2a[0], landing_y, rs),
+        f2a,
+        f2b,
+        (f2b[0], door_y, rs),
+        (x0, door_y),
+    ]
     lap1 = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, el.door_y_m), (el.x_m, el.door_y_m)]
     path1 = Polyline(lap0 + to_stairs + lap1, radius_m)
     # the flights run between waypoints 7-8 and 11-12 of path1
     i_f1 = len(lap0) + 2
     i_f2 = len(lap0) + 6
     v = path1.vertex_d
-    flights = [Flight(float(v[i_f1]), float(v[i_f1 + 1]), st.flight_rise_m),
-               Flight(float(v[i_f2]), float(v[i_f2 + 1]), world.storey_m - st.flight_rise_m)]
+    flights = [
+        Flight(float(v[i_f1]), float(v[i_f1 + 1]), st.flight_rise_m),
+        Flight(float(v[i_f2]), float(v[i_f2 + 1]), world.storey_m - st.flight_rise_m),
+    ]
     leg1 = Leg(path=path1, z0_m=0.0, flights=flights)
-    path2 = Polyline([(el.x_m, el.door_y_m), (x0, el.door_y_m), (x0, y0), (x1, y0),
-                      (x1, world.tour_end_y_m)], radius_m)
+    path2 = Polyline(
+        [(el.x_m, el.door_y_m), (x0, el.door_y_m), (x0, y0), (x1, y0), (x1, world.tour_end_y_m)], radius_m
+    )
     leg2 = Leg(path=path2, z0_m=0.0)
     zones = []
     for f in flights:
         zones.append((f.d_a - 0.15, f.d_b, "stairs"))
     zones.append((flights[0].d_a - 2.2, flights[-1].d_b + 1.6, "slow"))
     lap = Polyline(_loop_points(world, (x0 + 4.0, y0), 1), radius_m).length_m
-    return Route(name="tour", legs=[leg1, leg2], breaks=[LegBreak("elevator", dz_m=-leg1.z_end_m)],
-                 radius_m=radius_m, lap_m=lap, tread_m=st.tread_m, gait_zones=zones)
+    return Route(
+        name="tour",
+        legs=[leg1, leg2],
+        breaks=[LegBreak("elevator", dz_m=-leg1.z_end_m)],
+        radius_m=radius_m,
+        lap_m=lap,
+        tread_m=st.tread_m,
+        gait_zones=zones,
+    )
 
 
 def _project_on_straights(path: Polyline, x: float, y: float, tol_m: float = 1e-6) -> float:
@@ -404,7 +430,7 @@ def survey_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
     entry = np.asarray(world.start_xy_m, float)
     if world.elevator is not None:
         el = world.elevator
-        x_door = float(world.loop_corners_m[0][0])      # the corridor centre line in front of the cab door
+        x_door = float(world.loop_corners_m[0][0])  # the corridor centre line in front of the cab door
         door, cab = (x_door, el.door_y_m), (el.x_m, el.door_y_m)
     for fi, f in enumerate(floors):
         idx = np.flatnonzero(points[:, 2] == f)
@@ -424,7 +450,9 @@ def survey_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
             cand = sorted(left, key=lambda j: (round(float(dist[cur, j]), 6), rank_of[j]))
             nxt = cand[0]
             if not np.isfinite(dist[cur, nxt]):
-                raise ValueError(f"calibration points of floor {f} are not connected at {spacing_m} m spacing")
+                raise ValueError(
+                    f"calibration points of floor {f} are not connected at {spacing_m} m spacing"
+                )
             seq.append(nxt)
             left.remove(nxt)
             cur = nxt
@@ -436,14 +464,17 @@ def survey_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
         for j in seq:
             stop_of[(f, j)] = SurveyStop(index=len(order), x_m=float(xy[j, 0]), y_m=float(xy[j, 1]), floor=f)
             order.append(int(idx[j]))
-    pending_exit = None   # waypoints from the cab out to the corridor, after an elevator ride
+    pending_exit = None  # waypoints from the cab out to the corridor, after an elevator ride
     for fi, f in enumerate(floors):
         idx, xy, pred, seq = paths_per_floor[f]
         if pending_exit is not None:
             first = xy[seq[0]]
             near = int(np.argmin(np.hypot(*(xy - np.asarray(door)).T)))
-            way = pending_exit + [tuple(xy[k]) for k in _path_nodes(pred, near, seq[0])] if near != seq[0] \
+            way = (
+                pending_exit + [tuple(xy[k]) for k in _path_nodes(pred, near, seq[0])]
+                if near != seq[0]
                 else pending_exit + [tuple(first)]
+            )
             legs.append(Leg(path=Polyline(_clean(way), radius_m), z0_m=z[f]))
             breaks.append(LegBreak("survey", stop=stop_of[(f, seq[0])]))
         for a, b in zip(seq[:-1], seq[1:]):
@@ -453,15 +484,22 @@ def survey_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
         if fi + 1 < len(floors):
             near = int(np.argmin(np.hypot(*(xy - np.asarray(door)).T)))
             last = seq[-1]
-            way = ([tuple(xy[k]) for k in _path_nodes(pred, last, near)] if near != last else [tuple(xy[last])])
+            way = [tuple(xy[k]) for k in _path_nodes(pred, last, near)] if near != last else [tuple(xy[last])]
             legs.append(Leg(path=Polyline(_clean(way + [door, cab]), radius_m), z0_m=z[f]))
             breaks.append(LegBreak("elevator", dz_m=z[floors[fi + 1]] - z[f]))
             pending_exit = [cab, door]
     end_stop = breaks[-1].stop
-    breaks = breaks[:-1]          # the last stop comes after the last leg
-    f0, (idx0, xy0, _, seq0) = floors[0], paths_per_floor[floors[0]]
-    return Route(name="survey", legs=legs, breaks=breaks, radius_m=radius_m,
-                 start_stop=stop_of[(f0, seq0[0])], end_stop=end_stop, survey_points=points[order])
+    breaks = breaks[:-1]  # the last stop comes after the last leg
+    f0, (_, _, _, seq0) = floors[0], paths_per_floor[floors[0]]
+    return Route(
+        name="survey",
+        legs=legs,
+        breaks=breaks,
+        radius_m=radius_m,
+        start_stop=stop_of[(f0, seq0[0])],
+        end_stop=end_stop,
+        survey_points=points[order],
+    )
 
 
 def make_route(world: World, route: str, laps: float, radius_m: float) -> Route:

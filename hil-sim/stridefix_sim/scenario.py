@@ -20,115 +20,117 @@ person walks from calibration point to calibration point, and at each stands sti
 ``orientations`` headings (k·360°/n in the map frame, turning in place) and takes
 ``scans_per_orientation`` Wi-Fi scans in each; Wi-Fi scans happen only then (``walker.py``).
 """
+
 from __future__ import annotations
 
 import copy
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import tomllib
+
 # Built-in default scenario. Units are in the key names; comments give ranges.
 DEFAULTS: dict[str, Any] = {
     "seed": 1,
-    "duration_s": 0.0,               # 0: until the walk ends plus trailing_still_s
+    "duration_s": 0.0,  # 0: until the walk ends plus trailing_still_s
     "world": {
         "name": "default",
-        "map_rotation_deg": 20.0,    # map frame = magnetic east-north frame turned CCW by this angle
+        "map_rotation_deg": 20.0,  # map frame = magnetic east-north frame turned CCW by this angle
     },
     "walk": {
-        "route": "tour",             # "tour": two floors, stairs up, elevator down; "loop": laps of floor 0
-        "laps": 2.0,                 # route "loop" only: laps of the corridor loop (fractions allowed)
-        "pace": "normal",            # "slow" 1.5 Hz / 0.55 m, "normal" 1.8 Hz / 0.70 m, "fast" 2.1 Hz / 0.85 m
-        "start_still_s": 3.0,        # standing still before the first step
-        "trailing_still_s": 3.0,     # standing still after the last step (when duration_s = 0)
-        "cadence_hz": 0.0,           # > 0: mean step rate instead of pace x person
-        "cadence_jitter": 0.03,      # step-to-step relative std of the step period
-        "stride_m": 0.0,             # > 0: mean step length instead of pace x person
-        "stride_jitter": 0.04,       # step-to-step relative std of the step length
-        "speed_mps": 0.0,            # > 0: stride = speed_mps / cadence
-        "turn_radius_m": 0.8,        # corner radius of the route in the corridor (centre line)
-        "max_yaw_rate_dps": 120.0,   # corridor corners are widened so that speed/radius stays below this
-        "bounce_jitter": 0.08,       # step-to-step log-normal std of the vertical amplitude (Weinberg)
-        "pendulum_recovery": 0.65,   # inverted pendulum: fraction of potential energy returned as kinetic
-        "sway_mps2": 0.6,            # lateral acceleration amplitude (half the step rate)
-        "pause": [                   # [[walk.pause]] at_m (distance walked), duration_s
+        "route": "tour",  # "tour": two floors, stairs up, elevator down; "loop": laps of floor 0
+        "laps": 2.0,  # route "loop" only: laps of the corridor loop (fractions allowed)
+        "pace": "normal",  # "slow" 1.5 Hz / 0.55 m, "normal" 1.8 Hz / 0.70 m, "fast" 2.1 Hz / 0.85 m
+        "start_still_s": 3.0,  # standing still before the first step
+        "trailing_still_s": 3.0,  # standing still after the last step (when duration_s = 0)
+        "cadence_hz": 0.0,  # > 0: mean step rate instead of pace x person
+        "cadence_jitter": 0.03,  # step-to-step relative std of the step period
+        "stride_m": 0.0,  # > 0: mean step length instead of pace x person
+        "stride_jitter": 0.04,  # step-to-step relative std of the step length
+        "speed_mps": 0.0,  # > 0: stride = speed_mps / cadence
+        "turn_radius_m": 0.8,  # corner radius of the route in the corridor (centre line)
+        "max_yaw_rate_dps": 120.0,  # corridor corners are widened so that speed/radius stays below this
+        "bounce_jitter": 0.08,  # step-to-step log-normal std of the vertical amplitude (Weinberg)
+        "pendulum_recovery": 0.65,  # inverted pendulum: fraction of potential energy returned as kinetic
+        "sway_mps2": 0.6,  # lateral acceleration amplitude (half the step rate)
+        "pause": [  # [[walk.pause]] at_m (distance walked), duration_s
             {"at_m": 40.0, "duration_s": 5.0},
             {"at_m": 200.0, "duration_s": 4.0},
             {"at_m": 320.0, "duration_s": 6.0},
         ],
     },
-    "person": {                      # 0 = drawn from the seed (own random stream)
-        "weinberg_k": 0.0,           # step length = K (amax - amin)^(1/4); drawn 0.5 x stride_scale, 0.45..0.55
-        "stride_scale": 0.0,         # x the pace's stride; drawn N(1, 0.06) within 0.88..1.12
-        "cadence_scale": 0.0,        # x the pace's (and the stairs') cadence; drawn N(1, 0.04) within 0.92..1.08
+    "person": {  # 0 = drawn from the seed (own random stream)
+        "weinberg_k": 0.0,  # step length = K (amax - amin)^(1/4); drawn 0.5 x stride_scale, 0.45..0.55
+        "stride_scale": 0.0,  # x the pace's stride; drawn N(1, 0.06) within 0.88..1.12
+        "cadence_scale": 0.0,  # x the pace's (and the stairs') cadence; drawn N(1, 0.04) within 0.92..1.08
     },
     "stairs": {
-        "cadence_hz": 1.5,           # steps per second on a flight (x the person's cadence scale)
-        "bounce_p2p_mps2": 3.5,      # vertical acceleration peak-to-peak per stair step
+        "cadence_hz": 1.5,  # steps per second on a flight (x the person's cadence scale)
+        "bounce_p2p_mps2": 3.5,  # vertical acceleration peak-to-peak per stair step
     },
     "elevator": {
-        "speed_mps": 1.0,            # cruise speed
-        "accel_mps2": 0.8,           # peak acceleration (sin² ramps, jerk-limited)
-        "door_s": 4.0,               # standing in the cab before it moves (the turn happens here)
-        "exit_s": 2.0,               # standing in the cab after it stops
+        "speed_mps": 1.0,  # cruise speed
+        "accel_mps2": 0.8,  # peak acceleration (sin² ramps, jerk-limited)
+        "door_s": 4.0,  # standing in the cab before it moves (the turn happens here)
+        "exit_s": 2.0,  # standing in the cab after it stops
     },
-    "mounting": {                    # board axes relative to the body (x forward, y left, z up), ZYX
+    "mounting": {  # board axes relative to the body (x forward, y left, z up), ZYX
         "roll_deg": 0.0,
         "pitch_deg": 0.0,
         "yaw_deg": 0.0,
     },
     "imu": {
-        "accel_noise_mps2": 0.02,    # white noise std per sample
+        "accel_noise_mps2": 0.02,  # white noise std per sample
         "accel_bias_mps2": [0.03, -0.02, 0.05],
         "gyro_noise_dps": 0.05,
-        "gyro_bias_dps": [0.10, -0.08, 0.05],        # initial bias
-        "gyro_bias_rw_dps_per_sqrt_s": 0.002,        # bias random walk: std after t seconds = this x sqrt(t)
+        "gyro_bias_dps": [0.10, -0.08, 0.05],  # initial bias
+        "gyro_bias_rw_dps_per_sqrt_s": 0.002,  # bias random walk: std after t seconds = this x sqrt(t)
         "gyro_scale_error": [0.008, -0.006, 0.010],  # per board axis, fraction
     },
     "mag": {
-        "field_ut": 48.0,            # total intensity of the (undisturbed) earth field
-        "dip_deg": 60.0,             # inclination, positive = pointing down
+        "field_ut": 48.0,  # total intensity of the (undisturbed) earth field
+        "dip_deg": 60.0,  # inclination, positive = pointing down
         "noise_ut": 0.3,
         "hard_iron_ut": [0.8, -0.6, 0.5],
-        "disturbance_scale": 1.0,    # x the world's magnetic disturbance zones (0 = none)
+        "disturbance_scale": 1.0,  # x the world's magnetic disturbance zones (0 = none)
     },
     "baro": {
         "sea_level_pa": 101325.0,
-        "sensor_height_m": 1.1,      # board height above the floor
+        "sensor_height_m": 1.1,  # board height above the floor
         "noise_pa": 1.5,
-        "drift_pa_per_sqrt_h": 20.0, # weather: random walk, std after one hour [Pa]
-        "temperature_degc": 22.5,    # board temperature at start; warms by 2 degC with 2 min time constant
+        "drift_pa_per_sqrt_h": 20.0,  # weather: random walk, std after one hour [Pa]
+        "temperature_degc": 22.5,  # board temperature at start; warms by 2 degC with 2 min time constant
         "temperature_noise_degc": 0.05,
     },
     "radio": {
         "path_loss_exponent": 2.5,
-        "wall_loss_db": 5.0,         # per crossed wall
-        "floor_loss_db": 15.0,       # per floor between the AP and the receiver
-        "shadowing_db": 2.5,         # gaussian noise std per reading
-        "floor_dbm": -95.0,          # detection floor: weaker APs are not reported
+        "wall_loss_db": 5.0,  # per crossed wall
+        "floor_loss_db": 15.0,  # per floor between the AP and the receiver
+        "shadowing_db": 2.5,  # gaussian noise std per reading
+        "floor_dbm": -95.0,  # detection floor: weaker APs are not reported
         "scan_interval_min_s": 2.0,
         "scan_interval_max_s": 4.0,
-        "scan_duration_ms": 120,     # results are sent this long after the scan started
-        "body_loss_db": 0.0,         # body shadowing: + this x (1 - cos(AP bearing - facing)) / 2 dB loss
+        "scan_duration_ms": 120,  # results are sent this long after the scan started
+        "body_loss_db": 0.0,  # body shadowing: + this x (1 - cos(AP bearing - facing)) / 2 dB loss
     },
     "survey": {
-        "enabled": False,            # true: survey the calibration points instead of walking walk.route
-        "layout": "grid",            # "grid": spacing_m grid in the walkable area; "world": the world's own list
-        "spacing_m": 2.0,            # grid spacing (and the longest move between neighbouring points)
-        "margin_m": 0.5,             # calibration points keep this far from walls and block edges
-        "floor": -1,                 # -1: every floor of the world, else that floor only
-        "orientations": 4,           # headings per point: k x 360/n deg (0, 90, 180, 270), map frame
+        "enabled": False,  # true: survey the calibration points instead of walking walk.route
+        "layout": "grid",  # "grid": spacing_m grid in the walkable area; "world": the world's own list
+        "spacing_m": 2.0,  # grid spacing (and the longest move between neighbouring points)
+        "margin_m": 0.5,  # calibration points keep this far from walls and block edges
+        "floor": -1,  # -1: every floor of the world, else that floor only
+        "orientations": 4,  # headings per point: k x 360/n deg (0, 90, 180, 270), map frame
         "scans_per_orientation": 3,
-        "scan_interval_s": 1.0,      # between scan starts while facing one way
-        "settle_s": 0.5,             # standing after a turn before the first scan
+        "scan_interval_s": 1.0,  # between scan starts while facing one way
+        "settle_s": 0.5,  # standing after a turn before the first scan
     },
     "can": {
-        "loss_rate": 0.0,            # probability that a frame is lost between board and logger
+        "loss_rate": 0.0,  # probability that a frame is lost between board and logger
         "board_time_start_ms": 1_000_000,
         "boot_id": 7,
-        "latency_us": 300,           # board-to-host latency of the first frame of a burst
-        "frame_time_us": 130,        # bus time per frame (8-byte classic frame at 1 Mbit/s)
+        "latency_us": 300,  # board-to-host latency of the first frame of a burst
+        "frame_time_us": 130,  # bus time per frame (8-byte classic frame at 1 Mbit/s)
     },
 }
 
@@ -188,7 +190,9 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
             for i, p in enumerate(value):
                 for k in p:
                     if k not in ("at_m", "duration_s"):
-                        raise ScenarioError(source, f"unknown key '{name}[{i}].{k}' (known: at_m, duration_s)")
+                        raise ScenarioError(
+                            source, f"unknown key '{name}[{i}].{k}' (known: at_m, duration_s)"
+                        )
                 if set(p) != {"at_m", "duration_s"}:
                     raise ScenarioError(source, f"key '{name}[{i}]' needs both at_m and duration_s")
                 for k in p:
@@ -197,8 +201,11 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
                 pauses.append({"at_m": float(p["at_m"]), "duration_s": float(p["duration_s"])})
             out[key] = pauses
         elif isinstance(dflt, list):
-            if (not isinstance(value, list) or len(value) != len(dflt)
-                    or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)):
+            if (
+                not isinstance(value, list)
+                or len(value) != len(dflt)
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in value)
+            ):
                 raise ScenarioError(source, f"key '{name}' must be a list of {len(dflt)} numbers")
             out[key] = [float(v) for v in value]
         elif isinstance(dflt, bool):
@@ -234,25 +241,39 @@ def _validate_values(d: dict, source: str) -> None:
     check(d["duration_s"] >= 0, "duration_s", "must be >= 0")
     check(w["route"] in ("tour", "loop", "track"), "walk.route", "must be 'tour', 'loop' or 'track'")
     if not sv["enabled"]:
-        check(w["route"] != "tour" or (world.stairs is not None and world.elevator is not None), "walk.route",
-              f"'tour' needs stairs and an elevator (world {world.name!r} has none)")
-        check(w["route"] != "track" or world.track_m is not None, "walk.route",
-              f"'track' needs a world with a track (world {world.name!r} has none)")
+        check(
+            w["route"] != "tour" or (world.stairs is not None and world.elevator is not None),
+            "walk.route",
+            f"'tour' needs stairs and an elevator (world {world.name!r} has none)",
+        )
+        check(
+            w["route"] != "track" or world.track_m is not None,
+            "walk.route",
+            f"'track' needs a world with a track (world {world.name!r} has none)",
+        )
     check(sv["layout"] in ("grid", "world"), "survey.layout", "must be 'grid' or 'world'")
-    check(sv["layout"] != "world" or world.survey_points_m is not None, "survey.layout",
-          f"'world' needs a world with its own calibration points (world {world.name!r} has none)")
+    check(
+        sv["layout"] != "world" or world.survey_points_m is not None,
+        "survey.layout",
+        f"'world' needs a world with its own calibration points (world {world.name!r} has none)",
+    )
     check(0.5 <= sv["spacing_m"] <= 20.0, "survey.spacing_m", "must be in 0.5..20")
     check(0 <= sv["margin_m"] <= 2.0, "survey.margin_m", "must be in 0..2")
     check(-1 <= sv["floor"] < world.n_floors, "survey.floor", f"must be -1 (all) or 0..{world.n_floors - 1}")
     check(1 <= sv["orientations"] <= 8, "survey.orientations", "must be in 1..8")
     check(1 <= sv["scans_per_orientation"] <= 20, "survey.scans_per_orientation", "must be in 1..20")
     check(sv["settle_s"] >= 0, "survey.settle_s", "must be >= 0")
-    check(sv["scan_interval_s"] * 1000 > r["scan_duration_ms"], "survey.scan_interval_s",
-          "must be longer than radio.scan_duration_ms")
+    check(
+        sv["scan_interval_s"] * 1000 > r["scan_duration_ms"],
+        "survey.scan_interval_s",
+        "must be longer than radio.scan_duration_ms",
+    )
     check(0 <= r["body_loss_db"] <= 30, "radio.body_loss_db", "must be in 0..30")
     check(w["pace"] in ("slow", "normal", "fast"), "walk.pace", "must be 'slow', 'normal' or 'fast'")
     check(w["laps"] > 0, "walk.laps", "must be > 0")
-    check(w["cadence_hz"] == 0 or 0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be 0 or in 0.5..3.0")
+    check(
+        w["cadence_hz"] == 0 or 0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be 0 or in 0.5..3.0"
+    )
     check(w["stride_m"] == 0 or 0.2 <= w["stride_m"] <= 1.5, "walk.stride_m", "must be 0 or in 0.2..1.5")
     check(w["speed_mps"] == 0 or 0.2 <= w["speed_mps"] <= 3.0, "walk.speed_mps", "must be 0 or in 0.2..3.0")
     check(0 <= w["cadence_jitter"] <= 0.2, "walk.cadence_jitter", "must be in 0..0.2")
@@ -262,35 +283,60 @@ def _validate_values(d: dict, source: str) -> None:
     check(0 <= w["pendulum_recovery"] <= 1.0, "walk.pendulum_recovery", "must be in 0..1")
     check(0 <= w["bounce_jitter"] < 0.5, "walk.bounce_jitter", "must be in 0..0.5")
     check(0 <= w["sway_mps2"] <= 3.0, "walk.sway_mps2", "must be in 0..3")
-    check(p["weinberg_k"] == 0 or 0.2 <= p["weinberg_k"] <= 1.0, "person.weinberg_k", "must be 0 or in 0.2..1.0")
-    check(p["stride_scale"] == 0 or 0.5 <= p["stride_scale"] <= 1.5, "person.stride_scale", "must be 0 or in 0.5..1.5")
-    check(p["cadence_scale"] == 0 or 0.5 <= p["cadence_scale"] <= 1.5, "person.cadence_scale",
-          "must be 0 or in 0.5..1.5")
+    check(
+        p["weinberg_k"] == 0 or 0.2 <= p["weinberg_k"] <= 1.0, "person.weinberg_k", "must be 0 or in 0.2..1.0"
+    )
+    check(
+        p["stride_scale"] == 0 or 0.5 <= p["stride_scale"] <= 1.5,
+        "person.stride_scale",
+        "must be 0 or in 0.5..1.5",
+    )
+    check(
+        p["cadence_scale"] == 0 or 0.5 <= p["cadence_scale"] <= 1.5,
+        "person.cadence_scale",
+        "must be 0 or in 0.5..1.5",
+    )
     check(0.5 <= st["cadence_hz"] <= 3.0, "stairs.cadence_hz", "must be in 0.5..3.0")
     check(0 <= st["bounce_p2p_mps2"] <= 20.0, "stairs.bounce_p2p_mps2", "must be in 0..20")
     check(0.2 <= el["speed_mps"] <= 5.0, "elevator.speed_mps", "must be in 0.2..5")
     check(0.1 <= el["accel_mps2"] <= 3.0, "elevator.accel_mps2", "must be in 0.1..3")
     check(el["door_s"] >= 0 and el["exit_s"] >= 0, "elevator.door_s", "must be >= 0 (and exit_s too)")
     check(d["imu"]["gyro_bias_rw_dps_per_sqrt_s"] >= 0, "imu.gyro_bias_rw_dps_per_sqrt_s", "must be >= 0")
-    check(all(abs(v) < 0.2 for v in d["imu"]["gyro_scale_error"]), "imu.gyro_scale_error", "must be within ±0.2")
+    check(
+        all(abs(v) < 0.2 for v in d["imu"]["gyro_scale_error"]), "imu.gyro_scale_error", "must be within ±0.2"
+    )
     check(d["mag"]["disturbance_scale"] >= 0, "mag.disturbance_scale", "must be >= 0")
     check(d["baro"]["drift_pa_per_sqrt_h"] >= 0, "baro.drift_pa_per_sqrt_h", "must be >= 0")
     check(r["floor_loss_db"] >= 0, "radio.floor_loss_db", "must be >= 0")
     check(w["start_still_s"] >= 0 and w["trailing_still_s"] >= 0, "walk.start_still_s", "must be >= 0")
     for i, p in enumerate(w["pause"]):
-        check(p["at_m"] > 0 and p["duration_s"] >= 0, f"walk.pause[{i}]", "needs at_m > 0 and duration_s >= 0")
+        check(
+            p["at_m"] > 0 and p["duration_s"] >= 0, f"walk.pause[{i}]", "needs at_m > 0 and duration_s >= 0"
+        )
     check(0 <= c["loss_rate"] < 1, "can.loss_rate", "must be in 0..1")
     check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
     check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
-    check(0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"], "radio.scan_interval_min_s",
-          "must be > 0 and <= radio.scan_interval_max_s")
-    check(0 <= r["scan_duration_ms"] < 1000 * r["scan_interval_min_s"], "radio.scan_duration_ms",
-          "must be >= 0 and shorter than the scan interval")
+    check(
+        0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
+        "radio.scan_interval_min_s",
+        "must be > 0 and <= radio.scan_interval_max_s",
+    )
+    check(
+        0 <= r["scan_duration_ms"] < 1000 * r["scan_interval_min_s"],
+        "radio.scan_duration_ms",
+        "must be >= 0 and shorter than the scan interval",
+    )
 
 
 def _pace_scenario(pace: str) -> dict:
-    return {"walk": {"route": "loop", "laps": 2.0, "pace": pace,
-                     "pause": [{"at_m": 60.0, "duration_s": 4.0}, {"at_m": 170.0, "duration_s": 5.0}]}}
+    return {
+        "walk": {
+            "route": "loop",
+            "laps": 2.0,
+            "pace": pace,
+            "pause": [{"at_m": 60.0, "duration_s": 4.0}, {"at_m": 170.0, "duration_s": 5.0}],
+        }
+    }
 
 
 def _aadr2015_scenario(pace: str | None = None, survey: bool = False) -> dict:

@@ -21,6 +21,7 @@ in the body frame), so a board-frame vector is v_board = R_bmᵀ · v_body.
 
 Rates: IMU 100 Hz (every walker sample), magnetometer 50 Hz (every 2nd), barometer 20 Hz (every 5th).
 """
+
 from __future__ import annotations
 
 import math
@@ -32,22 +33,22 @@ from .walker import G_MPS2, Walk
 from .world import World
 
 IMU_RATE_HZ = 100
-MAG_DECIMATION = 2    # 50 Hz
-BARO_DECIMATION = 5   # 20 Hz
+MAG_DECIMATION = 2  # 50 Hz
+BARO_DECIMATION = 5  # 20 Hz
 
 
 @dataclass
 class SensorData:
-    accel_mps2: np.ndarray   # (N, 3) board frame, every IMU sample
-    gyro_dps: np.ndarray     # (N, 3)
-    mag_idx: np.ndarray      # IMU sample indices of the magnetometer samples
-    mag_ut: np.ndarray       # (M, 3)
-    baro_idx: np.ndarray     # IMU sample indices of the barometer samples
+    accel_mps2: np.ndarray  # (N, 3) board frame, every IMU sample
+    gyro_dps: np.ndarray  # (N, 3)
+    mag_idx: np.ndarray  # IMU sample indices of the magnetometer samples
+    mag_ut: np.ndarray  # (M, 3)
+    baro_idx: np.ndarray  # IMU sample indices of the barometer samples
     pressure_pa: np.ndarray  # (B,)
     temperature_degc: np.ndarray  # (B,)
-    gyro_bias_dps: np.ndarray | None = None   # (N, 3) the true gyro bias track
-    mag_zone_w: np.ndarray | None = None      # (M,) disturbance weight at each magnetometer sample (0 = clean)
-    baro_drift_pa: np.ndarray | None = None   # (B,) the true weather drift
+    gyro_bias_dps: np.ndarray | None = None  # (N, 3) the true gyro bias track
+    mag_zone_w: np.ndarray | None = None  # (M,) disturbance weight at each magnetometer sample (0 = clean)
+    baro_drift_pa: np.ndarray | None = None  # (B,) the true weather drift
 
 
 def mounting_matrix(roll_deg: float, pitch_deg: float, yaw_deg: float) -> np.ndarray:
@@ -65,7 +66,9 @@ def earth_field_map_ut(field_ut, dip_deg, map_rotation_deg) -> np.ndarray:
     psi_n = np.radians(90.0 - np.asarray(map_rotation_deg, float))
     dip = np.radians(np.asarray(dip_deg, float))
     h = field_ut * np.cos(dip)
-    return np.stack(np.broadcast_arrays(h * np.cos(psi_n), h * np.sin(psi_n), -field_ut * np.sin(dip)), axis=-1)
+    return np.stack(
+        np.broadcast_arrays(h * np.cos(psi_n), h * np.sin(psi_n), -field_ut * np.sin(dip)), axis=-1
+    )
 
 
 def local_field_map_ut(world: World, mag: dict, x_m: np.ndarray, y_m: np.ndarray, floor: np.ndarray):
@@ -96,7 +99,11 @@ def simulate_sensors(sc: dict, world: World, walk: Walk, rng: np.random.Generato
 
     # accelerometer: the body is level, so gravity enters only on body z
     f_body = walk.accel_body_mps2 + np.array([0.0, 0.0, G_MPS2])
-    accel = f_body @ R_bm + np.asarray(imu["accel_bias_mps2"]) + imu["accel_noise_mps2"] * rng.standard_normal((n, 3))
+    accel = (
+        f_body @ R_bm
+        + np.asarray(imu["accel_bias_mps2"])
+        + imu["accel_noise_mps2"] * rng.standard_normal((n, 3))
+    )
 
     w_body = np.zeros((n, 3))
     w_body[:, 2] = np.degrees(walk.yaw_rate_radps)
@@ -104,15 +111,24 @@ def simulate_sensors(sc: dict, world: World, walk: Walk, rng: np.random.Generato
     steps = imu["gyro_bias_rw_dps_per_sqrt_s"] * math.sqrt(dt) * rng.standard_normal((n, 3))
     steps[0] = 0.0
     bias = np.asarray(imu["gyro_bias_dps"]) + np.cumsum(steps, axis=0)
-    gyro = ((w_body @ R_bm) * (1.0 + np.asarray(imu["gyro_scale_error"])) + bias
-            + imu["gyro_noise_dps"] * rng.standard_normal((n, 3)))
+    gyro = (
+        (w_body @ R_bm) * (1.0 + np.asarray(imu["gyro_scale_error"]))
+        + bias
+        + imu["gyro_noise_dps"] * rng.standard_normal((n, 3))
+    )
 
     mag_idx = np.arange(0, n, MAG_DECIMATION)
     m_map, zone_w = local_field_map_ut(world, mag, walk.x_m[mag_idx], walk.y_m[mag_idx], walk.floor[mag_idx])
     psi = walk.heading_rad[mag_idx]
     c, s = np.cos(psi), np.sin(psi)
-    m_body = np.stack([c * m_map[:, 0] + s * m_map[:, 1], -s * m_map[:, 0] + c * m_map[:, 1], m_map[:, 2]], axis=1)
-    mag_ut = m_body @ R_bm + np.asarray(mag["hard_iron_ut"]) + mag["noise_ut"] * rng.standard_normal((len(mag_idx), 3))
+    m_body = np.stack(
+        [c * m_map[:, 0] + s * m_map[:, 1], -s * m_map[:, 0] + c * m_map[:, 1], m_map[:, 2]], axis=1
+    )
+    mag_ut = (
+        m_body @ R_bm
+        + np.asarray(mag["hard_iron_ut"])
+        + mag["noise_ut"] * rng.standard_normal((len(mag_idx), 3))
+    )
 
     baro_idx = np.arange(0, n, BARO_DECIMATION)
     t = walk.t_s[baro_idx]
@@ -123,8 +139,20 @@ def simulate_sensors(sc: dict, world: World, walk: Walk, rng: np.random.Generato
     knots = np.concatenate([[0.0], np.cumsum(sigma * rng.standard_normal(n_knots - 1))])
     drift = np.interp(t, np.arange(n_knots) * knot_s, knots)
     p = pressure_pa(h, baro["sea_level_pa"]) + drift + baro["noise_pa"] * rng.standard_normal(len(baro_idx))
-    temp = (baro["temperature_degc"] + 2.0 * (1.0 - np.exp(-t / 120.0))
-            + baro["temperature_noise_degc"] * rng.standard_normal(len(baro_idx)))
-    return SensorData(accel_mps2=accel, gyro_dps=gyro, mag_idx=mag_idx, mag_ut=mag_ut,
-                      baro_idx=baro_idx, pressure_pa=p, temperature_degc=temp,
-                      gyro_bias_dps=bias, mag_zone_w=zone_w, baro_drift_pa=drift)
+    temp = (
+        baro["temperature_degc"]
+        + 2.0 * (1.0 - np.exp(-t / 120.0))
+        + baro["temperature_noise_degc"] * rng.standard_normal(len(baro_idx))
+    )
+    return SensorData(
+        accel_mps2=accel,
+        gyro_dps=gyro,
+        mag_idx=mag_idx,
+        mag_ut=mag_ut,
+        baro_idx=baro_idx,
+        pressure_pa=p,
+        temperature_degc=temp,
+        gyro_bias_dps=bias,
+        mag_zone_w=zone_w,
+        baro_drift_pa=drift,
+    )

@@ -46,6 +46,7 @@ activity per sample: still, walking, stairs (steps on a flight) or elevator (whi
 Body frame: x forward, y left, z up; the body stays level and faces the walking direction. Outputs are
 arrays at the IMU rate (no per-sample Python loops).
 """
+
 from __future__ import annotations
 
 import math
@@ -62,12 +63,12 @@ ACTIVITIES = ("still", "walking", "stairs", "elevator")
 ACT_STILL, ACT_WALK, ACT_STAIRS, ACT_ELEVATOR = range(4)
 MODE_WALK, MODE_SLOW, MODE_STAIRS = 0, 1, 2
 STAIRS_PENDULUM_FACTOR = 1.0 / 7.0
-SLOW_CADENCE, SLOW_STRIDE = 0.9, 0.85   # around a staircase
-TAIL_M = 5.0                 # the last metres of a bout absorb the distance correction
-TURN_RATE_DPS = 90.0         # mean turn rate in place
-SURVEY_TURN_LEAD_S = 0.2     # survey: standing before a turn in place starts
-SURVEY_TURN_MIN_S = 0.8      # survey: shortest turn in place
-SURVEY_AFTER_SCAN_S = 0.2    # survey: standing after the last scan's results before turning on
+SLOW_CADENCE, SLOW_STRIDE = 0.9, 0.85  # around a staircase
+TAIL_M = 5.0  # the last metres of a bout absorb the distance correction
+TURN_RATE_DPS = 90.0  # mean turn rate in place
+SURVEY_TURN_LEAD_S = 0.2  # survey: standing before a turn in place starts
+SURVEY_TURN_MIN_S = 0.8  # survey: shortest turn in place
+SURVEY_AFTER_SCAN_S = 0.2  # survey: standing after the last scan's results before turning on
 
 
 def _gait_shape(n: int = 2048):
@@ -86,14 +87,23 @@ def _gait_shape(n: int = 2048):
     zs[1:] = -spec[1:] / w[1:] ** 2
     z = np.fft.irfft(zs, n)
     dz = np.fft.irfft(1j * w * zs, n)
-    i0 = int(np.argmax(z))            # start the step at mid-stance (highest point, v_z = 0)
+    i0 = int(np.argmax(z))  # start the step at mid-stance (highest point, v_z = 0)
     f, z, dz = (np.roll(a, -i0) for a in (f, z, dz))
     z = z - z[0]
     p2p = f.max() - f.min()
     f, z, dz = f / p2p, z / p2p, dz / p2p
-    close = (lambda a: np.append(a, a[0]))
-    return (np.linspace(0.0, 1.0, n + 1), close(f), close(dz), close(z),
-            float(np.argmax(f)) / n, float(z.mean()))
+
+    def close(a):
+        return np.append(a, a[0])
+
+    return (
+        np.linspace(0.0, 1.0, n + 1),
+        close(f),
+        close(dz),
+        close(z),
+        float(np.argmax(f)) / n,
+        float(z.mean()),
+    )
 
 
 GAIT_U, GAIT_F, GAIT_DZ, GAIT_Z, GAIT_U_PEAK, GAIT_Z_MEAN = _gait_shape()
@@ -102,8 +112,8 @@ GAIT_U, GAIT_F, GAIT_DZ, GAIT_Z, GAIT_U_PEAK, GAIT_Z_MEAN = _gait_shape()
 @dataclass(frozen=True)
 class Person:
     pace: str
-    cadence_hz: float      # walking cadence at this pace
-    stride_m: float        # walking step length at this pace
+    cadence_hz: float  # walking cadence at this pace
+    stride_m: float  # walking step length at this pace
     weinberg_k: float
     stride_scale: float
     cadence_scale: float
@@ -115,7 +125,7 @@ class Person:
 def make_person(sc: dict, rng: np.random.Generator) -> Person:
     """The walker's body: drawn from ``rng`` (always the same three draws), scenario values override."""
     p, w = sc["person"], sc["walk"]
-    n_stride, n_cadence, n_k = rng.standard_normal(3)   # always three draws: same seed, same person
+    n_stride, n_cadence, n_k = rng.standard_normal(3)  # always three draws: same seed, same person
     stride_scale = p["stride_scale"] or float(np.clip(1.0 + 0.06 * n_stride, 0.88, 1.12))
     cadence_scale = p["cadence_scale"] or float(np.clip(1.0 + 0.04 * n_cadence, 0.92, 1.08))
     # Weinberg's K grows with leg length, as the stride does: 0.5 x stride scale, ±3 %, within 0.45..0.55
@@ -123,8 +133,14 @@ def make_person(sc: dict, rng: np.random.Generator) -> Person:
     c0, l0 = PACES[w["pace"]]
     cadence = w["cadence_hz"] or c0 * cadence_scale
     stride = w["speed_mps"] / cadence if w["speed_mps"] > 0 else (w["stride_m"] or l0 * stride_scale)
-    return Person(pace=w["pace"], cadence_hz=cadence, stride_m=stride, weinberg_k=k,
-                  stride_scale=stride_scale, cadence_scale=cadence_scale)
+    return Person(
+        pace=w["pace"],
+        cadence_hz=cadence,
+        stride_m=stride,
+        weinberg_k=k,
+        stride_scale=stride_scale,
+        cadence_scale=cadence_scale,
+    )
 
 
 @dataclass
@@ -134,25 +150,25 @@ class Walk:
     t_s: np.ndarray
     x_m: np.ndarray
     y_m: np.ndarray
-    heading_rad: np.ndarray      # unwrapped, CCW from map +x: the body's (= walking) direction
-    speed_mps: np.ndarray        # horizontal speed
+    heading_rad: np.ndarray  # unwrapped, CCW from map +x: the body's (= walking) direction
+    speed_mps: np.ndarray  # horizontal speed
     yaw_rate_radps: np.ndarray
     accel_body_mps2: np.ndarray  # (N, 3) kinematic acceleration in the (level) body frame, gravity excluded
-    height_m: np.ndarray         # body height above its standing height on floor 0 (level + gait bounce)
-    level_m: np.ndarray          # walking-surface level under the person [m above floor 0]
-    vz_mps: np.ndarray           # vertical velocity of the body
-    floor: np.ndarray            # true floor index (int)
-    activity: np.ndarray         # ACT_* per sample (int8)
-    s_m: np.ndarray              # distance walked (horizontal)
-    step_t_s: np.ndarray         # time of each step event (heel-strike peak of the vertical acceleration)
-    step_len_m: np.ndarray       # horizontal distance covered during each step
-    step_p2p_mps2: np.ndarray    # vertical acceleration peak-to-peak (A_k) of each step
-    step_mode: np.ndarray        # MODE_* of each step
-    walk_end_s: float            # time the last step ends
+    height_m: np.ndarray  # body height above its standing height on floor 0 (level + gait bounce)
+    level_m: np.ndarray  # walking-surface level under the person [m above floor 0]
+    vz_mps: np.ndarray  # vertical velocity of the body
+    floor: np.ndarray  # true floor index (int)
+    activity: np.ndarray  # ACT_* per sample (int8)
+    s_m: np.ndarray  # distance walked (horizontal)
+    step_t_s: np.ndarray  # time of each step event (heel-strike peak of the vertical acceleration)
+    step_len_m: np.ndarray  # horizontal distance covered during each step
+    step_p2p_mps2: np.ndarray  # vertical acceleration peak-to-peak (A_k) of each step
+    step_mode: np.ndarray  # MODE_* of each step
+    walk_end_s: float  # time the last step ends
     route: Route
     person: Person
-    rides: list = field(default_factory=list)   # (t_start, t_end, dz_m, break index) of the elevator rides
-    stops: list = field(default_factory=list)   # survey: one dict per calibration point (see plan_walk)
+    rides: list = field(default_factory=list)  # (t_start, t_end, dz_m, break index) of the elevator rides
+    stops: list = field(default_factory=list)  # survey: one dict per calibration point (see plan_walk)
     scan_plan: list = field(default_factory=list)  # survey: (t_ms, stop index, orientation_deg, k) per scan
 
 
@@ -166,8 +182,8 @@ def _elevator(t_rel: np.ndarray, dz: float, v_max: float, a_max: float):
     sgn = 1.0 if dz >= 0 else -1.0
     D = abs(dz)
     v = min(v_max, math.sqrt(D * a_max / 2.0))
-    tau = 2.0 * v / a_max                       # acceleration phase: a = a_max sin²(π t / τ)
-    t_c = (D - v * tau) / v                     # cruise
+    tau = 2.0 * v / a_max  # acceleration phase: a = a_max sin²(π t / τ)
+    t_c = (D - v * tau) / v  # cruise
     T = 2 * tau + t_c
 
     def acc_phase(t):
@@ -175,7 +191,7 @@ def _elevator(t_rel: np.ndarray, dz: float, v_max: float, a_max: float):
         ph = 2 * math.pi * t / tau
         a = a_max * np.sin(math.pi * t / tau) ** 2
         vv = a_max * (t / 2 - tau / (4 * math.pi) * np.sin(ph))
-        z = a_max * (t * t / 4 + tau * tau / (8 * math.pi ** 2) * (np.cos(ph) - 1))
+        z = a_max * (t * t / 4 + tau * tau / (8 * math.pi**2) * (np.cos(ph) - 1))
         return z, vv, a
 
     t = np.asarray(t_rel, float)
@@ -198,13 +214,19 @@ def _plan_bout(length: float, s0: float, route: Route, person: Person, sc: dict,
     L, T, M, pos_at = [], [], [], []
     pos = 0.0
     while True:
-        mode = {"walk": MODE_WALK, "slow": MODE_SLOW, "stairs": MODE_STAIRS}[route.gait_mode(s0 + min(pos, length))]
+        mode = {"walk": MODE_WALK, "slow": MODE_SLOW, "stairs": MODE_STAIRS}[
+            route.gait_mode(s0 + min(pos, length))
+        ]
         if mode == MODE_STAIRS:
             cad = st["cadence_hz"] * person.cadence_scale
             lk = tread * (1.0 + 0.01 * rng.standard_normal())
         else:
             cad = person.cadence_hz * (SLOW_CADENCE if mode == MODE_SLOW else 1.0)
-            lk = person.stride_m * (SLOW_STRIDE if mode == MODE_SLOW else 1.0) * (1.0 + w["stride_jitter"] * rng.standard_normal())
+            lk = (
+                person.stride_m
+                * (SLOW_STRIDE if mode == MODE_SLOW else 1.0)
+                * (1.0 + w["stride_jitter"] * rng.standard_normal())
+            )
         tk = float(np.clip((1.0 + w["cadence_jitter"] * rng.standard_normal()) / cad, 0.6 / cad, 1.4 / cad))
         L.append(lk)
         T.append(tk)
@@ -234,10 +256,10 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     total = route.length_m
     leg_s = route.leg_starts_m
     cuts = {}
-    for p in (w["pause"] if route.name != "survey" else []):
+    for p in w["pause"] if route.name != "survey" else []:
         if 0 < p["at_m"] < total:
             cuts.setdefault(round(p["at_m"], 9), []).append(("pause", p["duration_s"]))
-    for i, br in enumerate(route.breaks):
+    for i, _br in enumerate(route.breaks):
         cuts.setdefault(round(float(leg_s[i + 1]), 9), []).append(("leg", i))
     bounds = [0.0] + sorted(cuts) + [total]
 
@@ -282,7 +304,9 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
                 continue
             i = arg
             if route.breaks[i].kind == "survey":
-                t = _plan_stop(sc, route.breaks[i].stop, hd_end[i], hd_start[i + 1], t, i, turns, stops, scan_plan)
+                t = _plan_stop(
+                    sc, route.breaks[i].stop, hd_end[i], hd_start[i + 1], t, i, turns, stops, scan_plan
+                )
                 switches.append(t)
                 continue
             dpsi = math.atan2(math.sin(hd_start[i + 1] - hd_end[i]), math.cos(hd_start[i + 1] - hd_end[i]))
@@ -317,11 +341,24 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     cat["va"], cat["vb"] = va, vb
     cat["d"] = cat["T"] * (va + vb) / 2
     bout_len = np.diff(np.asarray(bounds))
-    start_turns = [tr[2] for tr in turns if tr[3] == 0 and route.start_stop is not None
-                   and tr[0] < (stops[0]["t_leave"] if stops else 0.0)]
-    return {"steps": cat, "bout_len": bout_len, "walk_end": t, "switches": switches, "turns": turns,
-            "rides": rides, "hd_start": hd_start, "hd_end": hd_end, "stops": stops, "scan_plan": scan_plan,
-            "hd_offset0": -_fsum_exact(start_turns) if start_turns else 0.0}
+    start_turns = [
+        tr[2]
+        for tr in turns
+        if tr[3] == 0 and route.start_stop is not None and tr[0] < (stops[0]["t_leave"] if stops else 0.0)
+    ]
+    return {
+        "steps": cat,
+        "bout_len": bout_len,
+        "walk_end": t,
+        "switches": switches,
+        "turns": turns,
+        "rides": rides,
+        "hd_start": hd_start,
+        "hd_end": hd_end,
+        "stops": stops,
+        "scan_plan": scan_plan,
+        "hd_offset0": -_fsum_exact(start_turns) if start_turns else 0.0,
+    }
 
 
 def _fsum_exact(values) -> float:
@@ -332,8 +369,18 @@ def _fsum_exact(values) -> float:
     return 0.0 if out is None else out
 
 
-def _plan_stop(sc: dict, stop: SurveyStop, arrive: float | None, depart: float | None, t: float, leg: int,
-               turns: list, stops: list, scan_plan: list, t_arrive: float | None = None) -> float:
+def _plan_stop(
+    sc: dict,
+    stop: SurveyStop,
+    arrive: float | None,
+    depart: float | None,
+    t: float,
+    leg: int,
+    turns: list,
+    stops: list,
+    scan_plan: list,
+    t_arrive: float | None = None,
+) -> float:
     """A survey stop from time ``t`` (standing at the point, facing ``arrive``; None = the start): turn in
     place to each of the ``survey.orientations`` headings k·360°/n (map frame; first the one nearest the
     arrival heading, then round in the direction that ends nearest the next leg's heading), take
@@ -352,7 +399,7 @@ def _plan_stop(sc: dict, stop: SurveyStop, arrive: float | None, depart: float |
         return min(range(n), key=lambda k: (round(abs(wrap(o[k] - h)), 9), k))
 
     if arrive is None:
-        i0, step = (nearest(depart) + 1) % n, 1                 # round CCW, ending at the departure heading
+        i0, step = (nearest(depart) + 1) % n, 1  # round CCW, ending at the departure heading
     else:
         i0 = nearest(arrive)
         step = 1
@@ -380,14 +427,28 @@ def _plan_stop(sc: dict, stop: SurveyStop, arrive: float | None, depart: float |
         t = t_ms / 1000.0 + scan_s + SURVEY_AFTER_SCAN_S
     if depart is not None:
         t = turn(wrap(depart - cur), t)
-    stops.append({"index": stop.index, "x_m": stop.x_m, "y_m": stop.y_m, "floor": stop.floor,
-                  "t_arrive": t_arr, "t_leave": t,
-                  "orientations_deg": [round(math.degrees(h) % 360.0, 6) for h in seq]})
+    stops.append(
+        {
+            "index": stop.index,
+            "x_m": stop.x_m,
+            "y_m": stop.y_m,
+            "floor": stop.floor,
+            "t_arrive": t_arr,
+            "t_leave": t,
+            "orientations_deg": [round(math.degrees(h) % 360.0, 6) for h in seq],
+        }
+    )
     return t
 
 
-def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: float = 100.0,
-                  duration_s: float | None = None, person: Person | None = None) -> Walk:
+def simulate_walk(
+    sc: dict,
+    world: World,
+    rng: np.random.Generator,
+    rate_hz: float = 100.0,
+    duration_s: float | None = None,
+    person: Person | None = None,
+) -> Walk:
     """Simulate the walk of scenario ``sc`` (Scenario.data) in ``world``; ``duration_s`` None = auto."""
     w, el = sc["walk"], sc["elevator"]
     if person is None:
@@ -433,15 +494,15 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
     F = np.interp(u, GAIT_U, GAIT_F)
     Zp = np.interp(u, GAIT_U, GAIT_DZ)
     Z = np.interp(u, GAIT_U, GAIT_Z)
-    zb = np.where(valid, Ak * Tk ** 2 * Z, 0.0)
+    zb = np.where(valid, Ak * Tk**2 * Z, 0.0)
     vzb = np.where(valid, Ak * Tk * Zp, 0.0)
     azb = np.where(valid, Ak * F, 0.0)
     h, dh = _smoothstep(u)
     dh = dh / Tk
     vbar = a + (b - a) * h
-    p = -etak * G_MPS2 * (zb - Ak * Tk ** 2 * GAIT_Z_MEAN) / vkk ** 2
+    p = -etak * G_MPS2 * (zb - Ak * Tk**2 * GAIT_Z_MEAN) / vkk**2
     v = np.where(valid, vbar * (1.0 + p), 0.0)
-    dv = np.where(valid, (b - a) * dh * (1.0 + p) + vbar * (-etak * G_MPS2 * vzb / vkk ** 2), 0.0)
+    dv = np.where(valid, (b - a) * dh * (1.0 + p) + vbar * (-etak * G_MPS2 * vzb / vkk**2), 0.0)
 
     # scale each bout's speeds to cover exactly its planned distance (removes integration residue)
     if nst:
@@ -461,16 +522,21 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
     d = s - leg_s[leg]
     x, y, hd, kap = (np.zeros(n_full) for _ in range(4))
     lvl, dlvl, d2lvl = (np.zeros(n_full) for _ in range(3))
-    off = plan["hd_offset0"]          # 0 unless a survey stop turns the walker before the first leg
+    off = plan["hd_offset0"]  # 0 unless a survey stop turns the walker before the first leg
     offsets = []
     turn_sum: dict[int, list] = {}
     for tr in plan["turns"]:
         turn_sum.setdefault(tr[3], []).append(tr[2])
     for i, lg in enumerate(route.legs):
         if i > 0:
-            off = plan["hd_end"][i - 1] + offsets[-1] + _fsum_exact(turn_sum.get(i - 1, [])) - plan["hd_start"][i]
+            off = (
+                plan["hd_end"][i - 1]
+                + offsets[-1]
+                + _fsum_exact(turn_sum.get(i - 1, []))
+                - plan["hd_start"][i]
+            )
         offsets.append(off)
-        m = slice(*np.searchsorted(leg, [i, i + 1]))   # ``leg`` never decreases: leg i is one run
+        m = slice(*np.searchsorted(leg, [i, i + 1]))  # ``leg`` never decreases: leg i is one run
         if m.start == m.stop:
             continue
         dd = np.clip(d[m], 0.0, lg.length_m)
@@ -492,7 +558,7 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
             r, dr = _smoothstep((t - ts) / dur)
             hd += np.where(before, dpsi * r, 0.0)
             yaw_rate += np.where(before, dpsi * dr / dur, 0.0)
-    for st in plan["stops"]:        # survey: exactly at the calibration point while standing there
+    for st in plan["stops"]:  # survey: exactly at the calibration point while standing there
         m = slice(int(np.searchsorted(t, st["t_arrive"] - 1e-9)), int(np.searchsorted(t, st["t_leave"])))
         x[m], y[m] = st["x_m"], st["y_m"]
     vz_lvl = dlvl * v
@@ -521,12 +587,31 @@ def simulate_walk(sc: dict, world: World, rng: np.random.Generator, rate_hz: flo
 
     sl = slice(0, n)
     d_scaled = stp["d"] * (scale[stp["bout"]] if nst else 1.0)
-    return Walk(t_s=t[sl], x_m=x[sl], y_m=y[sl], heading_rad=hd[sl], speed_mps=v[sl],
-                yaw_rate_radps=yaw_rate[sl], accel_body_mps2=acc[sl], height_m=(lvl + zb)[sl],
-                level_m=lvl[sl], vz_mps=(vz_lvl + vzb)[sl], floor=floor[sl], activity=activity[sl],
-                s_m=s[sl], step_t_s=t0 + GAIT_U_PEAK * T, step_len_m=d_scaled, step_p2p_mps2=A,
-                step_mode=mode, walk_end_s=walk_end, route=route, person=person, rides=plan["rides"],
-                stops=plan["stops"], scan_plan=plan["scan_plan"])
+    return Walk(
+        t_s=t[sl],
+        x_m=x[sl],
+        y_m=y[sl],
+        heading_rad=hd[sl],
+        speed_mps=v[sl],
+        yaw_rate_radps=yaw_rate[sl],
+        accel_body_mps2=acc[sl],
+        height_m=(lvl + zb)[sl],
+        level_m=lvl[sl],
+        vz_mps=(vz_lvl + vzb)[sl],
+        floor=floor[sl],
+        activity=activity[sl],
+        s_m=s[sl],
+        step_t_s=t0 + GAIT_U_PEAK * T,
+        step_len_m=d_scaled,
+        step_p2p_mps2=A,
+        step_mode=mode,
+        walk_end_s=walk_end,
+        route=route,
+        person=person,
+        rides=plan["rides"],
+        stops=plan["stops"],
+        scan_plan=plan["scan_plan"],
+    )
 
 
 def make_walk_route(sc: dict, world: World, radius_m: float) -> Route:

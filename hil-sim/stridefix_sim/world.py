@@ -40,6 +40,7 @@ from magnetic axes by ``map_rotation_deg``: the map frame is the magnetic east-n
 counter-clockwise by that angle, so magnetic north lies along map heading ``90 deg - map_rotation_deg``.
 Heights: metres above the floor-0 walking surface; floor f's surface is at f · STOREY_M.
 """
+
 from __future__ import annotations
 
 import math
@@ -53,17 +54,17 @@ FLOOR_H_M = 30.0
 LOOP_X0_M, LOOP_X1_M = 8.0, 52.0
 LOOP_Y0_M, LOOP_Y1_M = 5.0, 25.0
 CORRIDOR_HALF_W_M = 1.0
-STOREY_M = 3.5           # floor-to-floor height
+STOREY_M = 3.5  # floor-to-floor height
 N_FLOORS = 2
 
 
 @dataclass(frozen=True)
 class AccessPoint:
-    bssid: int            # 48-bit MAC as an integer (aa:bb:cc:dd:ee:ff = 0xaabbccddeeff)
-    channel: int          # 1..14 (2.4 GHz) or 36..165 (5 GHz)
+    bssid: int  # 48-bit MAC as an integer (aa:bb:cc:dd:ee:ff = 0xaabbccddeeff)
+    channel: int  # 1..14 (2.4 GHz) or 36..165 (5 GHz)
     x_m: float
     y_m: float
-    tx_power_dbm: float   # EIRP
+    tx_power_dbm: float  # EIRP
     floor: int = 0
 
     @property
@@ -77,10 +78,10 @@ class AccessPoint:
 class Stairs:
     """A dog-leg staircase between floor 0 and floor 1 (plan coordinates, metres)."""
 
-    door_y_m: float                        # the stairwell door on the corridor's west wall
+    door_y_m: float  # the stairwell door on the corridor's west wall
     flight1_start: tuple[float, float]
     flight1_end: tuple[float, float]
-    landing_y_m: float                     # centre line of the landing between the flights
+    landing_y_m: float  # centre line of the landing between the flights
     flight2_start: tuple[float, float]
     flight2_end: tuple[float, float]
     risers_per_flight: int = 10
@@ -94,8 +95,8 @@ class Stairs:
 
 @dataclass(frozen=True)
 class Elevator:
-    x_m: float          # cab centre
-    door_y_m: float     # cab centre y = door y (the cab door faces east, onto the corridor)
+    x_m: float  # cab centre
+    door_y_m: float  # cab centre y = door y (the cab door faces east, onto the corridor)
     half_m: float = 1.25
 
 
@@ -108,12 +109,12 @@ class MagZone:
     y_m: float
     radius_m: float
     floors: tuple[int, ...]
-    gain: float           # field intensity factor at the centre
-    azimuth_deg: float    # horizontal direction change at the centre (CCW)
-    dip_deg: float        # inclination change at the centre (+ = steeper)
+    gain: float  # field intensity factor at the centre
+    azimuth_deg: float  # horizontal direction change at the centre (CCW)
+    dip_deg: float  # inclination change at the centre (+ = steeper)
 
     def weight(self, x_m: np.ndarray, y_m: np.ndarray, floor: np.ndarray) -> np.ndarray:
-        q = ((np.asarray(x_m) - self.x_m) ** 2 + (np.asarray(y_m) - self.y_m) ** 2) / self.radius_m ** 2
+        q = ((np.asarray(x_m) - self.x_m) ** 2 + (np.asarray(y_m) - self.y_m) ** 2) / self.radius_m**2
         w = np.where(q < 1.0, (1.0 - np.minimum(q, 1.0)) ** 2, 0.0)
         return np.where(np.isin(floor, self.floors), w, 0.0)
 
@@ -123,28 +124,28 @@ class World:
     name: str
     floor_w_m: float
     floor_h_m: float
-    walls_m: np.ndarray          # (n_wall, 4): x0, y0, x1, y1 — the plan of every floor
+    walls_m: np.ndarray  # (n_wall, 4): x0, y0, x1, y1 — the plan of every floor
     aps: tuple[AccessPoint, ...]
-    loop_corners_m: np.ndarray   # (4, 2) corridor centre-line rectangle, counter-clockwise
-    start_xy_m: tuple[float, float]   # start of the ``loop`` route (bottom straight)
+    loop_corners_m: np.ndarray  # (4, 2) corridor centre-line rectangle, counter-clockwise
+    start_xy_m: tuple[float, float]  # start of the ``loop`` route (bottom straight)
     map_rotation_deg: float = 20.0
-    ground_z_m: float = 0.0      # height of floor 0 above the pressure reference [m]
+    ground_z_m: float = 0.0  # height of floor 0 above the pressure reference [m]
     n_floors: int = N_FLOORS
     storey_m: float = STOREY_M
     stairs: Stairs | None = None
     elevator: Elevator | None = None
     mag_zones: tuple[MagZone, ...] = ()
-    tour_start_y_m: float = 13.0      # the ``tour`` route starts at (loop x0, this), heading south
-    tour_end_y_m: float = 15.0        # and ends at (loop x1, this)
+    tour_start_y_m: float = 13.0  # the ``tour`` route starts at (loop x0, this), heading south
+    tour_end_y_m: float = 15.0  # and ends at (loop x1, this)
     extra: dict = field(default_factory=dict)
-    walls_loss_db: np.ndarray | None = None     # (n_wall,) own loss per wall [dB]; NaN/None = radio.wall_loss_db
-    walkable_m: np.ndarray | None = None        # (k, 4) x0, y0, x1, y1: where calibration points may lie
-    blocked_m: np.ndarray | None = None         # (k, 4) solid blocks (no calibration point inside)
-    grid_origin_m: tuple[float, float] = (0.0, 0.0)   # the survey grid passes through this point
-    survey_points_m: np.ndarray | None = None   # (n, 3) x, y, floor: the world's own calibration points
-    track_m: tuple | None = None                # waypoints of the ``track`` route (starts at the first)
-    reference_points_m: np.ndarray | None = None   # (n, 2) surveyed reference points on the track
-    poor_coverage_m: tuple | None = None        # (x0, y0, x1, y1) the spot of poor Wi-Fi coverage
+    walls_loss_db: np.ndarray | None = None  # (n_wall,) own loss per wall [dB]; NaN/None = radio.wall_loss_db
+    walkable_m: np.ndarray | None = None  # (k, 4) x0, y0, x1, y1: where calibration points may lie
+    blocked_m: np.ndarray | None = None  # (k, 4) solid blocks (no calibration point inside)
+    grid_origin_m: tuple[float, float] = (0.0, 0.0)  # the survey grid passes through this point
+    survey_points_m: np.ndarray | None = None  # (n, 3) x, y, floor: the world's own calibration points
+    track_m: tuple | None = None  # waypoints of the ``track`` route (starts at the first)
+    reference_points_m: np.ndarray | None = None  # (n, 2) surveyed reference points on the track
+    poor_coverage_m: tuple | None = None  # (x0, y0, x1, y1) the spot of poor Wi-Fi coverage
     description: str = ""
 
     @property
@@ -164,7 +165,9 @@ def _point_segment_distance(p: np.ndarray, walls: np.ndarray) -> np.ndarray:
     return d.min(axis=1)
 
 
-def survey_points(world: World, spacing_m: float, margin_m: float, floors, layout: str = "grid") -> np.ndarray:
+def survey_points(
+    world: World, spacing_m: float, margin_m: float, floors, layout: str = "grid"
+) -> np.ndarray:
     """Calibration points (n, 3: x, y, floor) of ``floors``: the world's own list (``layout`` "world") or a
     grid of ``spacing_m`` through ``grid_origin_m``, inside a walkable rectangle shrunk by ``margin_m``, at
     least ``margin_m`` from every wall and outside every solid block grown by ``margin_m``. Ordered by
@@ -172,28 +175,48 @@ def survey_points(world: World, spacing_m: float, margin_m: float, floors, layou
     floors = list(floors)
     if layout == "world":
         if world.survey_points_m is None:
-            raise ValueError(f"world {world.name!r} has no calibration point list (use survey.layout = 'grid')")
+            raise ValueError(
+                f"world {world.name!r} has no calibration point list (use survey.layout = 'grid')"
+            )
         pts = np.asarray(world.survey_points_m, float)
         pts = pts[np.isin(pts[:, 2], floors)]
     else:
         ox, oy = world.grid_origin_m
-        xs = ox + spacing_m * np.arange(math.floor(-ox / spacing_m), math.ceil((world.floor_w_m - ox) / spacing_m) + 1)
-        ys = oy + spacing_m * np.arange(math.floor(-oy / spacing_m), math.ceil((world.floor_h_m - oy) / spacing_m) + 1)
+        xs = ox + spacing_m * np.arange(
+            math.floor(-ox / spacing_m), math.ceil((world.floor_w_m - ox) / spacing_m) + 1
+        )
+        ys = oy + spacing_m * np.arange(
+            math.floor(-oy / spacing_m), math.ceil((world.floor_h_m - oy) / spacing_m) + 1
+        )
         gx, gy = np.meshgrid(np.round(xs, 9), np.round(ys, 9))
         xy = np.stack([gx.ravel(), gy.ravel()], axis=1)
-        walk = world.walkable_m if world.walkable_m is not None else \
-            np.array([[0.0, 0.0, world.floor_w_m, world.floor_h_m]])
+        walk = (
+            world.walkable_m
+            if world.walkable_m is not None
+            else np.array([[0.0, 0.0, world.floor_w_m, world.floor_h_m]])
+        )
         inside = np.zeros(len(xy), bool)
         for x0, y0, x1, y1 in walk:
-            inside |= ((xy[:, 0] >= x0 + margin_m - 1e-9) & (xy[:, 0] <= x1 - margin_m + 1e-9)
-                       & (xy[:, 1] >= y0 + margin_m - 1e-9) & (xy[:, 1] <= y1 - margin_m + 1e-9))
-        for x0, y0, x1, y1 in (world.blocked_m if world.blocked_m is not None else []):
-            inside &= ~((xy[:, 0] > x0 - margin_m) & (xy[:, 0] < x1 + margin_m)
-                        & (xy[:, 1] > y0 - margin_m) & (xy[:, 1] < y1 + margin_m))
+            inside |= (
+                (xy[:, 0] >= x0 + margin_m - 1e-9)
+                & (xy[:, 0] <= x1 - margin_m + 1e-9)
+                & (xy[:, 1] >= y0 + margin_m - 1e-9)
+                & (xy[:, 1] <= y1 - margin_m + 1e-9)
+            )
+        for x0, y0, x1, y1 in world.blocked_m if world.blocked_m is not None else []:
+            inside &= ~(
+                (xy[:, 0] > x0 - margin_m)
+                & (xy[:, 0] < x1 + margin_m)
+                & (xy[:, 1] > y0 - margin_m)
+                & (xy[:, 1] < y1 + margin_m)
+            )
         inside &= _point_segment_distance(xy, world.walls_m) >= margin_m - 1e-9
         xy = xy[inside]
-        pts = np.concatenate([np.column_stack([xy, np.full(len(xy), f, float)]) for f in floors]) \
-            if floors else np.zeros((0, 3))
+        pts = (
+            np.concatenate([np.column_stack([xy, np.full(len(xy), f, float)]) for f in floors])
+            if floors
+            else np.zeros((0, 3))
+        )
     order = np.lexsort((pts[:, 0], pts[:, 1], pts[:, 2]))
     return pts[order]
 
@@ -232,11 +255,14 @@ def _default_walls() -> np.ndarray:
     ox1, oy1 = LOOP_X1_M + CORRIDOR_HALF_W_M, LOOP_Y1_M + CORRIDOR_HALF_W_M
     ix0, iy0 = LOOP_X0_M + CORRIDOR_HALF_W_M, LOOP_Y0_M + CORRIDOR_HALF_W_M
     ix1, iy1 = LOOP_X1_M - CORRIDOR_HALF_W_M, LOOP_Y1_M - CORRIDOR_HALF_W_M
-    outer_doors = [("bottom", x, 1.0) for x in (14.0, 26.0, 38.0, 48.0)] + \
-                  [("top", x, 1.0) for x in (12.0, 24.0, 36.0, 46.0)] + \
-                  [("left", 15.0, 1.2), ("left", 22.5, 1.2), ("right", 15.0, 1.0)]
-    inner_doors = [("bottom", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)] + \
-                  [("top", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)]
+    outer_doors = (
+        [("bottom", x, 1.0) for x in (14.0, 26.0, 38.0, 48.0)]
+        + [("top", x, 1.0) for x in (12.0, 24.0, 36.0, 46.0)]
+        + [("left", 15.0, 1.2), ("left", 22.5, 1.2), ("right", 15.0, 1.0)]
+    )
+    inner_doors = [("bottom", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)] + [
+        ("top", x, 1.0) for x in (13.0, 21.0, 29.0, 37.0, 45.0)
+    ]
     w += list(_rect(ox0, oy0, ox1, oy1, outer_doors))
     w += list(_rect(ix0, iy0, ix1, iy1, inner_doors))
     # inner rooms: a spine wall and partitions every 8 m
@@ -260,10 +286,22 @@ def _default_walls() -> np.ndarray:
 def _default_aps() -> tuple[AccessPoint, ...]:
     # (x_m, y_m, channel, tx_power_dbm); BSSIDs share a vendor OUI, last octets differ
     spec = [
-        (5.0, 3.0, 1, 18.0), (16.0, 2.0, 6, 17.0), (27.0, 2.5, 11, 18.0), (40.0, 2.0, 36, 20.0),
-        (55.0, 3.0, 6, 17.0), (57.0, 15.0, 44, 20.0), (55.0, 27.0, 1, 18.0), (40.0, 28.0, 149, 20.0),
-        (26.0, 27.5, 6, 17.0), (14.0, 28.0, 11, 18.0), (3.0, 26.0, 40, 20.0), (3.0, 14.0, 6, 16.0),
-        (17.0, 11.0, 1, 15.0), (33.0, 19.0, 11, 15.0), (45.0, 10.0, 48, 18.0), (30.0, 5.0, 157, 20.0),
+        (5.0, 3.0, 1, 18.0),
+        (16.0, 2.0, 6, 17.0),
+        (27.0, 2.5, 11, 18.0),
+        (40.0, 2.0, 36, 20.0),
+        (55.0, 3.0, 6, 17.0),
+        (57.0, 15.0, 44, 20.0),
+        (55.0, 27.0, 1, 18.0),
+        (40.0, 28.0, 149, 20.0),
+        (26.0, 27.5, 6, 17.0),
+        (14.0, 28.0, 11, 18.0),
+        (3.0, 26.0, 40, 20.0),
+        (3.0, 14.0, 6, 16.0),
+        (17.0, 11.0, 1, 15.0),
+        (33.0, 19.0, 11, 15.0),
+        (45.0, 10.0, 48, 18.0),
+        (30.0, 5.0, 157, 20.0),
     ]
     aps = []
     for floor in range(N_FLOORS):
@@ -285,17 +323,28 @@ def _default_mag_zones() -> tuple[MagZone, ...]:
 def _corridor_band() -> np.ndarray:
     """The office's walkable corridor: four 2 m wide rectangles around the loop's centre line."""
     h = CORRIDOR_HALF_W_M
-    return np.array([[LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y0_M + h],
-                     [LOOP_X0_M - h, LOOP_Y1_M - h, LOOP_X1_M + h, LOOP_Y1_M + h],
-                     [LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X0_M + h, LOOP_Y1_M + h],
-                     [LOOP_X1_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y1_M + h]])
+    return np.array(
+        [
+            [LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y0_M + h],
+            [LOOP_X0_M - h, LOOP_Y1_M - h, LOOP_X1_M + h, LOOP_Y1_M + h],
+            [LOOP_X0_M - h, LOOP_Y0_M - h, LOOP_X0_M + h, LOOP_Y1_M + h],
+            [LOOP_X1_M - h, LOOP_Y0_M - h, LOOP_X1_M + h, LOOP_Y1_M + h],
+        ]
+    )
 
 
 def default_world(map_rotation_deg: float = 20.0) -> World:
-    corners = np.array([[LOOP_X0_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y0_M],
-                        [LOOP_X1_M, LOOP_Y1_M], [LOOP_X0_M, LOOP_Y1_M]])
-    stairs = Stairs(door_y_m=15.0, flight1_start=(4.8, 14.0), flight1_end=(4.8, 11.2), landing_y_m=10.6,
-                    flight2_start=(2.2, 11.2), flight2_end=(2.2, 14.0))
+    corners = np.array(
+        [[LOOP_X0_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y0_M], [LOOP_X1_M, LOOP_Y1_M], [LOOP_X0_M, LOOP_Y1_M]]
+    )
+    stairs = Stairs(
+        door_y_m=15.0,
+        flight1_start=(4.8, 14.0),
+        flight1_end=(4.8, 11.2),
+        landing_y_m=10.6,
+        flight2_start=(2.2, 11.2),
+        flight2_end=(2.2, 14.0),
+    )
     return World(
         name="default",
         floor_w_m=FLOOR_W_M,
@@ -316,18 +365,45 @@ def default_world(map_rotation_deg: float = 20.0) -> World:
 
 # --- the aadr2015 foyer (Jäger, Süß, Becker: 8 APs, 67 calibration points, 70 m track, 14 reference points)
 FOYER_W_M, FOYER_H_M = 20.0, 14.0
-FOYER_CORE_M = (12.0, 6.0, 14.0, 12.0)          # concrete core (lift and service shaft)
-FOYER_PILLARS_M = ((6.0, 10.0), (14.0, 4.0))     # 0.5 m concrete pillars (between grid lines)
-CONCRETE_LOSS_DB = 15.0                          # per concrete wall (core), cf. ITU-R P.2040 ~10-20 dB
+FOYER_CORE_M = (12.0, 6.0, 14.0, 12.0)  # concrete core (lift and service shaft)
+FOYER_PILLARS_M = ((6.0, 10.0), (14.0, 4.0))  # 0.5 m concrete pillars (between grid lines)
+CONCRETE_LOSS_DB = 15.0  # per concrete wall (core), cf. ITU-R P.2040 ~10-20 dB
 PILLAR_LOSS_DB = 10.0
 # the track: from the entrance (south doors) round the foyer, past the steel staircase and through the
 # poor-coverage spot east of the core, back west; corners are filleted by the route (radius <= 1 m)
-FOYER_TRACK_M = ((10.0, 1.0), (10.0, 4.0), (2.0, 4.0), (2.0, 8.5), (10.5, 8.5), (10.5, 13.0), (16.0, 13.0),
-                 (16.0, 4.5), (18.5, 4.5), (18.5, 1.5), (4.5, 1.5), (4.5, 6.3), (11.2, 6.3))
+FOYER_TRACK_M = (
+    (10.0, 1.0),
+    (10.0, 4.0),
+    (2.0, 4.0),
+    (2.0, 8.5),
+    (10.5, 8.5),
+    (10.5, 13.0),
+    (16.0, 13.0),
+    (16.0, 4.5),
+    (18.5, 4.5),
+    (18.5, 1.5),
+    (4.5, 1.5),
+    (4.5, 6.3),
+    (11.2, 6.3),
+)
 # 14 reference points on straight stretches of the track (>= 1.2 m from every corner), in walking order,
 # about 5 m apart; (16, 11.8) is beside the steel staircase, (16, 7.1) in the poor-coverage spot
-FOYER_REFERENCE_M = ((10.0, 2.8), (5.3, 4.0), (2.0, 6.1), (4.9, 8.5), (9.3, 8.5), (11.7, 13.0), (16.0, 11.8),
-                     (16.0, 7.1), (18.5, 3.3), (15.8, 1.5), (10.4, 1.5), (5.7, 1.5), (5.7, 6.3), (9.9, 6.3))
+FOYER_REFERENCE_M = (
+    (10.0, 2.8),
+    (5.3, 4.0),
+    (2.0, 6.1),
+    (4.9, 8.5),
+    (9.3, 8.5),
+    (11.7, 13.0),
+    (16.0, 11.8),
+    (16.0, 7.1),
+    (18.5, 3.3),
+    (15.8, 1.5),
+    (10.4, 1.5),
+    (5.7, 1.5),
+    (5.7, 6.3),
+    (9.9, 6.3),
+)
 
 
 def _foyer_walls() -> tuple[np.ndarray, np.ndarray]:
@@ -338,29 +414,50 @@ def _foyer_walls() -> tuple[np.ndarray, np.ndarray]:
             walls.append(seg)
             loss.append(db)
 
-    add(_rect(0.0, 0.0, FOYER_W_M, FOYER_H_M, [("bottom", 10.0, 2.4)]))   # facade, glass entrance doors
+    add(_rect(0.0, 0.0, FOYER_W_M, FOYER_H_M, [("bottom", 10.0, 2.4)]))  # facade, glass entrance doors
     add(_rect(*FOYER_CORE_M), CONCRETE_LOSS_DB)
     for x, y in FOYER_PILLARS_M:
         add(_rect(x - 0.25, y - 0.25, x + 0.25, y + 0.25), PILLAR_LOSS_DB)
-    add([(0.0, 10.0, 4.0, 10.0), (4.0, 10.0, 4.0, 12.6)])               # cloakroom (drywall), door north-east
+    add([(0.0, 10.0, 4.0, 10.0), (4.0, 10.0, 4.0, 12.6)])  # cloakroom (drywall), door north-east
     return np.asarray(walls, float), np.asarray(loss, float)
 
 
 def _foyer_aps() -> tuple[AccessPoint, ...]:
     # (x_m, y_m, channel, tx_power_dbm): on the facade and walls, one on the ceiling west of the core;
     # none in the north-east, so the spot east of the core hears most APs through the core only
-    spec = [(1.0, 1.0, 1, 17.0), (7.0, 0.5, 36, 20.0), (0.5, 7.0, 6, 17.0), (6.0, 13.5, 11, 17.0),
-            (10.0, 13.5, 44, 20.0), (10.0, 7.0, 6, 16.0), (17.0, 0.5, 1, 17.0), (19.5, 5.0, 149, 20.0)]
-    return tuple(AccessPoint(bssid=0x00_1A_2B_30_00_00 + (i << 4) + (1 if ch > 14 else 0), channel=ch,
-                             x_m=x, y_m=y, tx_power_dbm=p, floor=0) for i, (x, y, ch, p) in enumerate(spec))
+    spec = [
+        (1.0, 1.0, 1, 17.0),
+        (7.0, 0.5, 36, 20.0),
+        (0.5, 7.0, 6, 17.0),
+        (6.0, 13.5, 11, 17.0),
+        (10.0, 13.5, 44, 20.0),
+        (10.0, 7.0, 6, 16.0),
+        (17.0, 0.5, 1, 17.0),
+        (19.5, 5.0, 149, 20.0),
+    ]
+    return tuple(
+        AccessPoint(
+            bssid=0x00_1A_2B_30_00_00 + (i << 4) + (1 if ch > 14 else 0),
+            channel=ch,
+            x_m=x,
+            y_m=y,
+            tx_power_dbm=p,
+            floor=0,
+        )
+        for i, (x, y, ch, p) in enumerate(spec)
+    )
 
 
 def aadr2015_world(map_rotation_deg: float = 20.0) -> World:
     walls, loss = _foyer_walls()
     blocked = [FOYER_CORE_M] + [(x - 0.25, y - 0.25, x + 0.25, y + 0.25) for x, y in FOYER_PILLARS_M]
     # the paper's 67 calibration points: the 2 m grid (1, 1) .. (19, 13) without the 3 inside the core
-    cal = [(x, y, 0.0) for y in range(1, 14, 2) for x in range(1, 20, 2)
-           if not (FOYER_CORE_M[0] < x < FOYER_CORE_M[2] and FOYER_CORE_M[1] < y < FOYER_CORE_M[3])]
+    cal = [
+        (x, y, 0.0)
+        for y in range(1, 14, 2)
+        for x in range(1, 20, 2)
+        if not (FOYER_CORE_M[0] < x < FOYER_CORE_M[2] and FOYER_CORE_M[1] < y < FOYER_CORE_M[3])
+    ]
     return World(
         name="aadr2015",
         floor_w_m=FOYER_W_M,
@@ -372,7 +469,9 @@ def aadr2015_world(map_rotation_deg: float = 20.0) -> World:
         start_xy_m=(8.0, 2.5),
         map_rotation_deg=map_rotation_deg,
         n_floors=1,
-        mag_zones=(MagZone("steel staircase", 16.5, 12.2, 2.5, (0,), gain=1.5, azimuth_deg=45.0, dip_deg=-15.0),),
+        mag_zones=(
+            MagZone("steel staircase", 16.5, 12.2, 2.5, (0,), gain=1.5, azimuth_deg=45.0, dip_deg=-15.0),
+        ),
         blocked_m=np.asarray(blocked, float),
         grid_origin_m=(1.0, 1.0),
         survey_points_m=np.asarray(cal, float),

@@ -19,6 +19,7 @@ precision, so the files are byte-identical when behaviour is.
 writes DIR/<case>.csv; ``make change-indication`` writes them here, and the pytest case
 ``tests/python/change_indication`` compares a fresh run with the committed files.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -38,8 +39,7 @@ MSINDOOR_HELD = "5dda5a8b9191710006b573da"  # the floor's largest trace: the rep
 MSINDOOR_MAP_WALKS = 12  # the first walks by name (the held-out one excepted) build its map
 GSD = DATA / "gsd"
 
-HEADER = ("t_s,scheme,x_m,y_m,floor,heading_rad,sigma_m,step_count,"
-          "fixes_accepted,fixes_rejected,last_reason\n")
+HEADER = "t_s,scheme,x_m,y_m,floor,heading_rad,sigma_m,step_count,fixes_accepted,fixes_rejected,last_reason\n"
 
 
 class ChangeIndicationError(RuntimeError):
@@ -49,8 +49,9 @@ class ChangeIndicationError(RuntimeError):
 def _run(cmd: list[str]) -> None:
     proc = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
     if proc.returncode != 0:
-        raise ChangeIndicationError(f"{' '.join(map(str, cmd))} exited {proc.returncode}:\n"
-                                    f"{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+        raise ChangeIndicationError(
+            f"{' '.join(map(str, cmd))} exited {proc.returncode}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}"
+        )
 
 
 def _stridefix() -> str:
@@ -100,20 +101,36 @@ def state_csv(fw_log: Path) -> str:
             if p is None:
                 out.append(f"{t_s},{s},,,,,,,{a},{r},{last}\n")
                 continue
-            out.append(f"{t_s},{s},{p.x_m:.3f},{p.y_m:.3f},{p.floor},{p.heading_rad:.4f},"
-                       f"{p.sigma_m:.3f},{p.step_count},{a},{r},{last}\n")
+            out.append(
+                f"{t_s},{s},{p.x_m:.3f},{p.y_m:.3f},{p.floor},{p.heading_rad:.4f},"
+                f"{p.sigma_m:.3f},{p.step_count},{a},{r},{last}\n"
+            )
     return "".join(out)
 
 
 def _sim_case(work: Path, stridefixd: Path, survey: str, walk_args: list[str]) -> Path:
     import json
+
     sv = work / "survey"
     _run([_stridefix(), "sim", "--scenario", survey, "--seed", "1000", "--out", sv])
     _run([stridefixd, "--input", sv / "board.candump", "--log", sv / "fw.lcmlog", "-q"])
     rot = json.loads((sv / "sim_summary.json").read_text())["map_rotation_deg"]
     site = work / "site.sfsite"
-    _run([_stridefix(), "radiomap", "build", sv / "fw.lcmlog", sv / "truth.lcmlog", "--mode", "survey",
-          "--map-rotation-deg", str(rot), "--out", site])
+    _run(
+        [
+            _stridefix(),
+            "radiomap",
+            "build",
+            sv / "fw.lcmlog",
+            sv / "truth.lcmlog",
+            "--mode",
+            "survey",
+            "--map-rotation-deg",
+            str(rot),
+            "--out",
+            site,
+        ]
+    )
     wk = work / "walk"
     _run([_stridefix(), "sim", *walk_args, "--out", wk])
     log = work / "run.lcmlog"
@@ -141,7 +158,9 @@ def case_msindoor(work: Path, stridefixd: Path) -> Path:
     held = MSINDOOR_FLOOR / f"{MSINDOOR_HELD}.txt"
     others = [t for t in sorted(MSINDOOR_FLOOR.glob("*.txt")) if t != held][:MSINDOOR_MAP_WALKS]
     if not held.is_file() or len(others) < MSINDOOR_MAP_WALKS:
-        raise ChangeIndicationError(f"{MSINDOOR_FLOOR}: needs {held.name} and {MSINDOOR_MAP_WALKS} more traces")
+        raise ChangeIndicationError(
+            f"{MSINDOOR_FLOOR}: needs {held.name} and {MSINDOOR_MAP_WALKS} more traces"
+        )
     chosen = [held, *others]
     imp = work / "import"
     _run([_stridefix(), "import", "msindoor", *chosen, "--out", imp])
@@ -192,8 +211,11 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=HERE, help="folder for <case>.csv (default: here)")
     ap.add_argument("--case", action="append", choices=sorted(CASES), help="run only these (repeatable)")
-    ap.add_argument("--stridefixd", type=Path,
-                    default=Path(os.environ.get("STRIDEFIXD", REPO / "build" / "firmware" / "stridefixd")))
+    ap.add_argument(
+        "--stridefixd",
+        type=Path,
+        default=Path(os.environ.get("STRIDEFIXD", REPO / "build" / "firmware" / "stridefixd")),
+    )
     args = ap.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
     for name in args.case or list(CASES):

@@ -1,4 +1,5 @@
 """Fixtures shared by every Python test folder: the built stridefixd and the `stridefix` console script."""
+
 from __future__ import annotations
 
 import os

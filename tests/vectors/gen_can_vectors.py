@@ -12,6 +12,7 @@ DBC range. One line per vector:
 with values printed by repr() (round-trips a double exactly). tests/c/test_can_vectors.c unpacks
 each line with the C that cantools generates and compares.
 """
+
 import math
 import random
 import sys

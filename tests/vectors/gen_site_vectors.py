@@ -18,6 +18,7 @@ script runs from a fresh build without an installed package. Writes into OUT_DIR
 
 tests/python/sitefile/ imports this module for the same variants.
 """
+
 from __future__ import annotations
 
 import os
@@ -32,29 +33,60 @@ if __name__ == "__main__":
 from stridefix import site_t, truth_t  # noqa: E402
 from stridefix_analyzer import sitefile  # noqa: E402
 
-_SCALAR_FIELDS = ("name", "source", "map_rotation_deg", "has_geo", "origin_lat_deg", "origin_lon_deg",
-                  "lowest_floor", "cell_size_m")
-_ARRAY_FIELDS = ("floor_height_m", "ap_bssid", "rp_x_m", "rp_y_m", "rp_floor", "rp_scans", "entry_ap",
-                 "entry_rp", "entry_mean_dbm", "entry_std_db", "entry_count")
+_SCALAR_FIELDS = (
+    "name",
+    "source",
+    "map_rotation_deg",
+    "has_geo",
+    "origin_lat_deg",
+    "origin_lon_deg",
+    "lowest_floor",
+    "cell_size_m",
+)
+_ARRAY_FIELDS = (
+    "floor_height_m",
+    "ap_bssid",
+    "rp_x_m",
+    "rp_y_m",
+    "rp_floor",
+    "rp_scans",
+    "entry_ap",
+    "entry_rp",
+    "entry_mean_dbm",
+    "entry_std_db",
+    "entry_count",
+)
 
 
 def vector_site() -> site_t:
     """A small site touching every corner: a negative lowest floor, geo-reference, BSSIDs at both
     ends of the 48-bit range, an AP with no entry (AP 2) and an RP with none (RP 5)."""
     return sitefile.new_site(
-        name="vector site \u00fc", source="tests/vectors/gen_site_vectors.py", map_rotation_deg=12.5,
-        has_geo=True, origin_lat_deg=47.3769, origin_lon_deg=8.5417, lowest_floor=-1,
+        name="vector site \u00fc",
+        source="tests/vectors/gen_site_vectors.py",
+        map_rotation_deg=12.5,
+        has_geo=True,
+        origin_lat_deg=47.3769,
+        origin_lon_deg=8.5417,
+        lowest_floor=-1,
         floor_height_m=[-3.5, 0.0, 4.25],
-        ap_bssid=[0x000000000001, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFE, 0xFFFFFFFFFFFF], cell_size_m=2.0,
-        rp_x_m=[0.5, 2.25, -1.75, 10.125, 3.3, 7.0], rp_y_m=[1.0, -4.5, 0.0, 6.75, 2.2, -2.0],
-        rp_floor=[-1, 0, 0, 1, 1, 1], rp_scans=[3, 4, 1, 2, 5, 2],
-        entry_ap=[0, 0, 0, 1, 1, 3, 3], entry_rp=[0, 1, 3, 1, 4, 2, 4],
+        ap_bssid=[0x000000000001, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFE, 0xFFFFFFFFFFFF],
+        cell_size_m=2.0,
+        rp_x_m=[0.5, 2.25, -1.75, 10.125, 3.3, 7.0],
+        rp_y_m=[1.0, -4.5, 0.0, 6.75, 2.2, -2.0],
+        rp_floor=[-1, 0, 0, 1, 1, 1],
+        rp_scans=[3, 4, 1, 2, 5, 2],
+        entry_ap=[0, 0, 0, 1, 1, 3, 3],
+        entry_rp=[0, 1, 3, 1, 4, 2, 4],
         entry_mean_dbm=[-45.5, -60.25, -70.1, -80.0, -55.5, -90.0, -33.3],
-        entry_std_db=[1.25, 0.0, 2.5, 3.0, 0.5, 0.0, 1.1], entry_count=[3, 4, 1, 2, 5, 1, 5])
+        entry_std_db=[1.25, 0.0, 2.5, 3.0, 0.5, 0.0, 1.1],
+        entry_count=[3, 4, 1, 2, 5, 1, 5],
+    )
 
 
-def frame(payload: bytes, magic=sitefile.MAGIC, version=sitefile.FORMAT_VERSION, length=None, crc=None,
-          reserved=0) -> bytes:
+def frame(
+    payload: bytes, magic=sitefile.MAGIC, version=sitefile.FORMAT_VERSION, length=None, crc=None, reserved=0
+) -> bytes:
     """Header (any field overridable) + payload."""
     length = len(payload) if length is None else length
     crc = zlib.crc32(payload) if crc is None else crc
@@ -93,7 +125,7 @@ def _with_count(field: str, value: int) -> bytes:
     payload = bytearray(s.encode())
     at = _count_offset(s, field)
     assert struct.unpack_from(">i", payload, at)[0] == getattr(s, field)
-    payload[at:at + 4] = struct.pack(">i", value)
+    payload[at : at + 4] = struct.pack(">i", value)
     return frame(bytes(payload))
 
 
@@ -104,7 +136,7 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
     message must contain that text and the Python reader must fail with ``kind``.
     """
     good = sitefile.encode_site_file(vector_site())
-    payload = good[sitefile.HEADER_SIZE:]
+    payload = good[sitefile.HEADER_SIZE :]
     flipped = bytearray(good)
     flipped[sitefile.HEADER_SIZE + len(payload) // 2] ^= 0x10
     truth = truth_t()
@@ -129,11 +161,14 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("entries_duplicate", _edited(entry_rp=[0, 1, 1, 1, 4, 2, 4]), "field", None),
         ("count_above_scans", _edited(entry_count=[3, 5, 1, 2, 5, 1, 5]), "field", None),
         ("count_zero", _edited(entry_count=[3, 4, 1, 0, 5, 1, 5]), "field", None),
-        ("mean_inf", _edited(entry_mean_dbm=[-45.5, float("inf"), -70.1, -80, -55.5, -90, -33.3]),
-         "field", None),
+        (
+            "mean_inf",
+            _edited(entry_mean_dbm=[-45.5, float("inf"), -70.1, -80, -55.5, -90, -33.3]),
+            "field",
+            None,
+        ),
         ("std_negative", _edited(entry_std_db=[1.25, 0.0, -2.5, 3.0, 0.5, 0.0, 1.1]), "field", None),
-        ("bssid_order", _edited(ap_bssid=[1, 0xFFFFFFFFFFFE, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFF]),
-         "field", None),
+        ("bssid_order", _edited(ap_bssid=[1, 0xFFFFFFFFFFFE, 0x0A1B2C3D4E5F, 0xFFFFFFFFFFFF]), "field", None),
         ("bssid_range", _edited(ap_bssid=[1, 2, 3, 1 << 48]), "field", None),
         ("floor_heights", _edited(floor_height_m=[-3.5, 0.0, 0.0]), "field", None),
         ("no_floors", _edited(floor_height_m=[]), "field", None),
@@ -151,8 +186,9 @@ def dump(site: site_t) -> str:
     lines = []
     for name in _SCALAR_FIELDS:
         v = getattr(site, name)
-        lines.append(f"{name} {int(v) if isinstance(v, bool) else v!r}" if not isinstance(v, str)
-                     else f"{name} {v}")
+        lines.append(
+            f"{name} {int(v) if isinstance(v, bool) else v!r}" if not isinstance(v, str) else f"{name} {v}"
+        )
     for name in _ARRAY_FIELDS:
         lines.append(" ".join([name, *(repr(v) for v in getattr(site, name))]))
     return "\n".join(lines) + "\n"
@@ -173,7 +209,9 @@ def main(out_dir: str) -> int:
             sitefile.decode_site_file(data, vpath)
         except sitefile.SiteFileError as exc:
             if exc.kind != kind:
-                raise SystemExit(f"variant {name}: Python reader says {exc.kind} ({exc}), want {kind}")
+                raise SystemExit(
+                    f"variant {name}: Python reader says {exc.kind} ({exc}), want {kind}"
+                ) from exc
             text = exc.reason if c_text is None else c_text
         else:
             raise SystemExit(f"variant {name}: the Python reader accepted it")

@@ -6,6 +6,7 @@ either one log per input into a directory (``--out DIR``: ``DIR/<input-stem>.lcm
 input, one named file (``-o/--output FILE``): :func:`add_output_arguments`, :func:`output_paths`.
 Exit status: 0 success, 1 the import failed, 2 bad usage or a missing/unreadable input.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -23,10 +24,12 @@ FORMATS = {
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Declare ``stridefix import`` and one sub-command per format."""
     p = subparsers.add_parser(
-        "import", help="import real data sets into raw-sensor LCM logs for stridefixd",
+        "import",
+        help="import real data sets into raw-sensor LCM logs for stridefixd",
         description="Import files of a public data set into raw-sensor LCM event logs "
-                    "(IMU, MAG, BARO, WIFI, GNSS, TRUTH) that `stridefixd --input lcmlog:FILE` "
-                    f"replays. Formats: {', '.join(FORMATS)}.")
+        "(IMU, MAG, BARO, WIFI, GNSS, TRUTH) that `stridefixd --input lcmlog:FILE` "
+        f"replays. Formats: {', '.join(FORMATS)}.",
+    )
     sub = p.add_subparsers(dest="format", metavar="FORMAT", required=True)
     for module_name in FORMATS.values():
         module = importlib.import_module(module_name)
@@ -43,25 +46,29 @@ def run(args) -> int:
 def add_output_arguments(p: argparse.ArgumentParser) -> None:
     """``--out DIR`` (one log per input) or ``-o/--output FILE`` (a single input): one is required."""
     g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--out", metavar="DIR",
-                   help="output directory (created): DIR/<input-stem>.lcmlog per input")
-    g.add_argument("-o", "--output", metavar="FILE",
-                   help="output log file (a single input only)")
+    g.add_argument(
+        "--out", metavar="DIR", help="output directory (created): DIR/<input-stem>.lcmlog per input"
+    )
+    g.add_argument("-o", "--output", metavar="FILE", help="output log file (a single input only)")
 
 
 def output_paths(inputs: list, args, prog: str) -> list[Path] | None:
     """The output log of each input, or None after printing a usage error (``-o`` with several)."""
     if args.output is not None:
         if len(inputs) != 1:
-            print(f"{prog}: error: -o/--output takes a single input ({len(inputs)} given); "
-                  "use --out DIR for several", file=sys.stderr)
+            print(
+                f"{prog}: error: -o/--output takes a single input ({len(inputs)} given); "
+                "use --out DIR for several",
+                file=sys.stderr,
+            )
             return None
         return [Path(args.output)]
     return [Path(args.out) / (Path(i).stem + ".lcmlog") for i in inputs]
 
 
-def run_imports(args, prog: str, inputs: list, do_import, read_error: type, format_summary,
-                json_keys: tuple, noun: str) -> int:
+def run_imports(
+    args, prog: str, inputs: list, do_import, read_error: type, format_summary, json_keys: tuple, noun: str
+) -> int:
     """The import loop every format shares: one input at a time, malformed-line warnings on stderr,
     a progress line and a JSON summary line per input, ``--json`` with all summaries.
 
@@ -98,8 +105,10 @@ def run_imports(args, prog: str, inputs: list, do_import, read_error: type, form
             status = 2
             continue
         summaries.append(s)
-        print(f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
-              file=sys.stderr)
+        print(
+            f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
+            file=sys.stderr,
+        )
         print(json.dumps({k: s[k] for k in json_keys}))
     if args.json:
         Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")

@@ -40,6 +40,7 @@ raises :class:`LogHeaderError`.
 
 Cost: one pass over the text (~0.5 s per 10⁵ lines), memory ∝ the samples of one log.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -53,8 +54,18 @@ import numpy as np
 from .lines import LineReader, MalformedLineWarning
 from .msindoor import DEFAULT_MAX_WIFI_AGE_S, _dedupe_sorted, bssid_to_int
 
-__all__ = ["GsdLog", "LogReadError", "LogHeaderError", "MalformedLineWarning", "read_log",
-           "write_lcmlog", "import_log", "import_trace", "project", "parse_origin"]
+__all__ = [
+    "GsdLog",
+    "LogReadError",
+    "LogHeaderError",
+    "MalformedLineWarning",
+    "read_log",
+    "write_lcmlog",
+    "import_log",
+    "import_trace",
+    "project",
+    "parse_origin",
+]
 
 #: Bump when the log content for the same input changes (caches compare it).
 IMPORTER_VERSION = 1
@@ -68,7 +79,7 @@ CLOCK_ALIGN_S = 10.0
 WGS84_A = 6378137.0
 WGS84_E2 = 6.69437999014e-3
 
-CHANNELS = ("IMU", "MAG", "BARO", "GNSS", "WIFI", "TRUTH")   # also the tie-break order of equal times
+CHANNELS = ("IMU", "MAG", "BARO", "GNSS", "WIFI", "TRUTH")  # also the tie-break order of equal times
 
 # record type -> number of ';'-separated fields, the tag included (WIFI: at least; an SSID may hold ';')
 _FIELDS = {"ACCE": 7, "GYRO": 7, "MAGN": 7, "PRES": 5, "GNSS": 11, "WIFI": 7, "POSI": 7}
@@ -102,7 +113,7 @@ def project(lat_deg, lon_deg, origin_lat_deg: float, origin_lon_deg: float) -> t
     phi0 = math.radians(origin_lat_deg)
     w = 1.0 - WGS84_E2 * math.sin(phi0) ** 2
     n = WGS84_A / math.sqrt(w)
-    m = WGS84_A * (1.0 - WGS84_E2) / w ** 1.5
+    m = WGS84_A * (1.0 - WGS84_E2) / w**1.5
     lat = np.asarray(lat_deg, dtype=np.float64)
     lon = np.asarray(lon_deg, dtype=np.float64)
     x = n * math.cos(phi0) * np.radians(lon - origin_lon_deg)
@@ -176,8 +187,11 @@ class GsdLog:
 
     def time_span_us(self) -> tuple[int, int] | None:
         """(first, last) time of anything written [µs], or None for an empty log."""
-        ts = [a for a in (self.imu_t_us, self.mag_t_us, self.baro_t_us, self.gnss_t_us,
-                          self.truth_t_us) if len(a)]
+        ts = [
+            a
+            for a in (self.imu_t_us, self.mag_t_us, self.baro_t_us, self.gnss_t_us, self.truth_t_us)
+            if len(a)
+        ]
         ts += [np.array([s.t_us for s in self.scans])] if self.scans else []
         if not ts:
             return None
@@ -201,12 +215,18 @@ class GsdLog:
             "building_ids": list(self.building_ids),
             "floors": floors,
             "floor": floors[0] if len(floors) == 1 else None,
-            "origin": None if self.origin is None else {
-                "lat_deg": self.origin[0], "lon_deg": self.origin[1], "source": self.origin_source},
+            "origin": None
+            if self.origin is None
+            else {"lat_deg": self.origin[0], "lon_deg": self.origin[1], "source": self.origin_source},
             "projection": "local tangent plane, WGS-84 radii at the origin; x east, y north [m]",
-            "messages": {"IMU": len(self.imu_t_us), "MAG": len(self.mag_t_us),
-                         "BARO": len(self.baro_t_us), "GNSS": len(self.gnss_t_us),
-                         "WIFI": len(self.scans), "TRUTH": len(self.truth_t_us)},
+            "messages": {
+                "IMU": len(self.imu_t_us),
+                "MAG": len(self.mag_t_us),
+                "BARO": len(self.baro_t_us),
+                "GNSS": len(self.gnss_t_us),
+                "WIFI": len(self.scans),
+                "TRUTH": len(self.truth_t_us),
+            },
             "waypoints": len(self.truth_t_us),
             "t_start_us": None if span is None else span[0],
             "t_end_us": None if span is None else span[1],
@@ -241,15 +261,19 @@ def _header_units(header_lines: list[tuple[int, str]], path: str) -> tuple[float
         m = re.search(r"Pres\(([^)]*)\)", text)
         unit = m.group(1).strip() if m else ""
         if unit.lower() not in _PRESSURE_TO_PA:
-            raise LogHeaderError(path, f"line {line_no}: pressure unit {unit!r} is not one of "
-                                       "mbar, hPa, kPa, Pa")
+            raise LogHeaderError(
+                path, f"line {line_no}: pressure unit {unit!r} is not one of mbar, hPa, kPa, Pa"
+            )
         return _PRESSURE_TO_PA[unit.lower()], unit, line_no
     return 100.0, None, 0
 
 
-def read_log(path, origin: tuple[float, float] | None = None,
-             max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
-             max_line_warnings: int = MAX_LINE_WARNINGS) -> GsdLog:
+def read_log(
+    path,
+    origin: tuple[float, float] | None = None,
+    max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
+    max_line_warnings: int = MAX_LINE_WARNINGS,
+) -> GsdLog:
     """Parse one GetSensorData logfile.
 
     Parameters
@@ -273,7 +297,7 @@ def read_log(path, origin: tuple[float, float] | None = None,
     """
     reader = LineReader(path, LogReadError, max_line_warnings)
     path = reader.path
-    inertial = {k: [] for k in _INERTIAL}      # (app, sensor, x, y, z)
+    inertial = {k: [] for k in _INERTIAL}  # (app, sensor, x, y, z)
     pres, gnss, wifi, posi = [], [], [], []
     header_lines: list[tuple[int, str]] = []
     header: dict[str, str] = {}
@@ -282,8 +306,12 @@ def read_log(path, origin: tuple[float, float] | None = None,
         if line.startswith("%"):
             header_lines.append((line_no, line))
             key, sep, value = line[1:].partition(":")
-            if sep and key.strip() in ("Manufacturer", "Model", "API Android version",
-                                       "Android version Release"):
+            if sep and key.strip() in (
+                "Manufacturer",
+                "Model",
+                "API Android version",
+                "Android version Release",
+            ):
                 header[key.strip()] = value.strip()
             continue
         parts = line.split(";")
@@ -296,7 +324,7 @@ def read_log(path, origin: tuple[float, float] | None = None,
             continue
         n = _FIELDS[kind]
         if len(parts) > n and parts[-1] == "":
-            parts.pop()                 # a trailing ';' (the header writes WIFI and POSI so)
+            parts.pop()  # a trailing ';' (the header writes WIFI and POSI so)
         if len(parts) != n and not (kind == "WIFI" and len(parts) > n):
             bad(line_no, f"{kind} with {len(parts)} fields, expected {n}")
             continue
@@ -313,9 +341,10 @@ def read_log(path, origin: tuple[float, float] | None = None,
                 gnss.append((app, sensor, lat, lon, alt, acc))
             elif kind == "WIFI":
                 app, sensor = _finite(parts[1:3])
-                wifi.append((app, sensor, bssid_to_int(parts[-3].strip()),
-                             _finite(parts[-1:])[0], int(parts[-2])))
-            else:   # POSI
+                wifi.append(
+                    (app, sensor, bssid_to_int(parts[-3].strip()), _finite(parts[-1:])[0], int(parts[-2]))
+                )
+            else:  # POSI
                 app, lat, lon = _finite([parts[1], parts[3], parts[4]])
                 if not (-90 <= lat <= 90 and -180 <= lon <= 180):
                     raise ValueError(f"latitude/longitude {lat}, {lon} out of range")
@@ -329,8 +358,11 @@ def read_log(path, origin: tuple[float, float] | None = None,
     pa_per_unit, unit, _ = _header_units(header_lines, path)
     if unit is None and pres:
         notes.append("no PRES format line in the header: pressure taken as mbar")
-    stats: dict = {"lines": n_lines, "ignored_lines_by_type": dict(sorted(ignored.items())),
-                   "pressure_unit": unit or "mbar (assumed)"}
+    stats: dict = {
+        "lines": n_lines,
+        "ignored_lines_by_type": dict(sorted(ignored.items())),
+        "pressure_unit": unit or "mbar (assumed)",
+    }
 
     # --- inertial samples on their sensor clock, aligned to the app clock at the start
     arrays = {k: np.asarray(v, dtype=np.float64).reshape(-1, 5) for k, v in inertial.items()}
@@ -346,13 +378,14 @@ def read_log(path, origin: tuple[float, float] | None = None,
         offset = float(np.median(start[:, 0] - start[:, 1]))
     offsets = {}
     for k, off in per_type.items():
-        if abs(off - offset) > 1.0:     # a sensor on another clock: align it on its own
-            notes.append(f"{k} SensorTimestamps are {off - offset:+.3f} s off the inertial clock: "
-                         "aligned separately")
+        if abs(off - offset) > 1.0:  # a sensor on another clock: align it on its own
+            notes.append(
+                f"{k} SensorTimestamps are {off - offset:+.3f} s off the inertial clock: aligned separately"
+            )
             offsets[k] = off
         else:
             offsets[k] = offset
-    stats["clock_offset_s"] = offset            # app time = sensor time + offset
+    stats["clock_offset_s"] = offset  # app time = sensor time + offset
     stats["clock_align_s"] = CLOCK_ALIGN_S
 
     def sensor_times(k: str) -> tuple[np.ndarray, np.ndarray]:
@@ -382,8 +415,7 @@ def read_log(path, origin: tuple[float, float] | None = None,
 
     # --- barometer and GNSS on the app clock
     p = np.asarray(pres, dtype=np.float64).reshape(-1, 3)
-    baro_t, baro, dup_p = _dedupe_sorted(np.round(p[:, 0] * 1e6).astype(np.int64),
-                                         p[:, 2] * pa_per_unit)
+    baro_t, baro, dup_p = _dedupe_sorted(np.round(p[:, 0] * 1e6).astype(np.int64), p[:, 2] * pa_per_unit)
     stats["duplicate_times_dropped"] = {"ACCE": dup_a, "GYRO": dup_g, "MAGN": dup_m, "PRES": dup_p}
 
     gnss.sort(key=lambda r: r[0])
@@ -419,7 +451,7 @@ def read_log(path, origin: tuple[float, float] | None = None,
     for rows in groups:
         t_scan = rows[0][0]
         best: dict[int, tuple] = {}
-        for app, sensor, bssid, rssi, freq in rows:
+        for _app, sensor, bssid, rssi, freq in rows:
             age = math.nan if wifi_offset is None else (t_scan - (sensor + wifi_offset)) * 1e3
             if age > max_age_ms:
                 stale += 1
@@ -433,15 +465,25 @@ def read_log(path, origin: tuple[float, float] | None = None,
             empty += 1
             continue
         ap = sorted(best.values())
-        scans.append(WifiScan(t_us=int(round(t_scan * 1e6)),
-                              bssid=np.array([r[0] for r in ap], dtype=np.int64),
-                              rssi_dbm=np.array([r[1] for r in ap], dtype=np.float32),
-                              freq_mhz=np.array([r[2] for r in ap], dtype=np.int32),
-                              age_ms=np.array([r[3] for r in ap], dtype=np.float64)))
-    stats.update(wifi_lines=len(wifi), wifi_scans_in_file=len(groups),
-                 wifi_aps_written=sum(len(s.bssid) for s in scans), wifi_aps_stale_dropped=stale,
-                 wifi_aps_duplicate_dropped=dup_ap, wifi_scans_empty=empty,
-                 max_wifi_age_s=max_wifi_age_s, wifi_group_s=WIFI_GROUP_S)
+        scans.append(
+            WifiScan(
+                t_us=int(round(t_scan * 1e6)),
+                bssid=np.array([r[0] for r in ap], dtype=np.int64),
+                rssi_dbm=np.array([r[1] for r in ap], dtype=np.float32),
+                freq_mhz=np.array([r[2] for r in ap], dtype=np.int32),
+                age_ms=np.array([r[3] for r in ap], dtype=np.float64),
+            )
+        )
+    stats.update(
+        wifi_lines=len(wifi),
+        wifi_scans_in_file=len(groups),
+        wifi_aps_written=sum(len(s.bssid) for s in scans),
+        wifi_aps_stale_dropped=stale,
+        wifi_aps_duplicate_dropped=dup_ap,
+        wifi_scans_empty=empty,
+        max_wifi_age_s=max_wifi_age_s,
+        wifi_group_s=WIFI_GROUP_S,
+    )
 
     # --- truth: POSI → local metres about the origin
     origin_source = None
@@ -463,12 +505,30 @@ def read_log(path, origin: tuple[float, float] | None = None,
         xy = np.zeros((0, 2))
     stats["posi_lines"] = len(posi)
 
-    return GsdLog(path=path, header=header, imu_t_us=acc_t, accel_mps2=acc, gyro_radps=gyro,
-                  mag_t_us=mag_t, mag_ut=mag, baro_t_us=baro_t, baro_pa=baro,
-                  gnss_t_us=gnss_t, gnss=gnss_v, scans=scans, truth_t_us=truth_t, truth_xy_m=xy,
-                  truth_floor=np.array([r[3] for r in posi], dtype=np.int64), truth_latlon=latlon,
-                  building_ids=building_ids, origin=origin, origin_source=origin_source,
-                  stats=stats, skipped=skipped, notes=notes)
+    return GsdLog(
+        path=path,
+        header=header,
+        imu_t_us=acc_t,
+        accel_mps2=acc,
+        gyro_radps=gyro,
+        mag_t_us=mag_t,
+        mag_ut=mag,
+        baro_t_us=baro_t,
+        baro_pa=baro,
+        gnss_t_us=gnss_t,
+        gnss=gnss_v,
+        scans=scans,
+        truth_t_us=truth_t,
+        truth_xy_m=xy,
+        truth_floor=np.array([r[3] for r in posi], dtype=np.int64),
+        truth_latlon=latlon,
+        building_ids=building_ids,
+        origin=origin,
+        origin_source=origin_source,
+        stats=stats,
+        skipped=skipped,
+        notes=notes,
+    )
 
 
 def write_lcmlog(log: GsdLog, out_path) -> int:
@@ -541,8 +601,9 @@ def write_lcmlog(log: GsdLog, out_path) -> int:
     return len(order)
 
 
-def import_log(path, out_path, origin: tuple[float, float] | None = None,
-               max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S) -> dict:
+def import_log(
+    path, out_path, origin: tuple[float, float] | None = None, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S
+) -> dict:
     """Read one logfile and write its LCM log; return :meth:`GsdLog.summary` plus ``out``, ``events``.
 
     Raises
@@ -571,18 +632,22 @@ def format_summary(s: dict) -> str:
     o = s["origin"]
     origin = "-" if o is None else f"{o['lat_deg']:.9f},{o['lon_deg']:.9f} ({o['source']})"
     floors = ",".join(str(f) for f in s["floors"]) or "-"
-    return (f"{os.path.basename(s['trace'])}: {s['duration_s']:.1f} s, building "
-            f"{s['building_id'] or ','.join(s['building_ids']) or '-'}, floor(s) {floors}, "
-            f"IMU {m['IMU']} ({rate}), MAG {m['MAG']}, BARO {m['BARO']}, GNSS {m['GNSS']}, "
-            f"WIFI {m['WIFI']} scans / {s['wifi_aps_written']} APs "
-            f"({s['wifi_aps_stale_dropped']} cached dropped), TRUTH {m['TRUTH']} POSI, "
-            f"origin {origin}, {s['skipped_lines']} malformed line(s) skipped")
+    return (
+        f"{os.path.basename(s['trace'])}: {s['duration_s']:.1f} s, building "
+        f"{s['building_id'] or ','.join(s['building_ids']) or '-'}, floor(s) {floors}, "
+        f"IMU {m['IMU']} ({rate}), MAG {m['MAG']}, BARO {m['BARO']}, GNSS {m['GNSS']}, "
+        f"WIFI {m['WIFI']} scans / {s['wifi_aps_written']} APs "
+        f"({s['wifi_aps_stale_dropped']} cached dropped), TRUTH {m['TRUTH']} POSI, "
+        f"origin {origin}, {s['skipped_lines']} malformed line(s) skipped"
+    )
 
 
 # --- `stridefix import gsd` ----------------------------------------------------------------------
 
+
 def _origin_arg(text: str) -> tuple[float, float]:
     import argparse
+
     try:
         return parse_origin(text)
     except ValueError as exc:
@@ -594,20 +659,32 @@ def add_parser(subparsers):
     from .cli import add_output_arguments
 
     p = subparsers.add_parser(
-        "gsd", help="GetSensorData / IPIN Track 3 logfiles (*.txt)",
+        "gsd",
+        help="GetSensorData / IPIN Track 3 logfiles (*.txt)",
         description="Import GetSensorData logfiles (IPIN competition Track 3 format): one raw-sensor "
-                    "LCM log per logfile (IMU, MAG, BARO, GNSS, WIFI, TRUTH from the POSI records in "
-                    "local metres, x east, y north, about --origin), for "
-                    "`stridefixd --input lcmlog:FILE`.")
+        "LCM log per logfile (IMU, MAG, BARO, GNSS, WIFI, TRUTH from the POSI records in "
+        "local metres, x east, y north, about --origin), for "
+        "`stridefixd --input lcmlog:FILE`.",
+    )
     p.add_argument("logs", nargs="+", metavar="LOGFILE.txt", help="logfile(s)")
     add_output_arguments(p)
-    p.add_argument("--origin", type=_origin_arg, default=None, metavar="LAT,LON",
-                   help="origin of the truth's local metres [deg] (default: the file's first POSI; "
-                        "give one origin for all walks of a building; a negative latitude needs "
-                        "the = form: --origin=-33.9,151.2)")
-    p.add_argument("--max-wifi-age-s", type=float, default=DEFAULT_MAX_WIFI_AGE_S, metavar="S",
-                   help="drop Wi-Fi entries last seen more than S before the scan time "
-                        f"(cached results; default {DEFAULT_MAX_WIFI_AGE_S:g})")
+    p.add_argument(
+        "--origin",
+        type=_origin_arg,
+        default=None,
+        metavar="LAT,LON",
+        help="origin of the truth's local metres [deg] (default: the file's first POSI; "
+        "give one origin for all walks of a building; a negative latitude needs "
+        "the = form: --origin=-33.9,151.2)",
+    )
+    p.add_argument(
+        "--max-wifi-age-s",
+        type=float,
+        default=DEFAULT_MAX_WIFI_AGE_S,
+        metavar="S",
+        help="drop Wi-Fi entries last seen more than S before the scan time "
+        f"(cached results; default {DEFAULT_MAX_WIFI_AGE_S:g})",
+    )
     p.add_argument("--json", metavar="FILE", help="also write the summaries as JSON to FILE")
     return p
 
@@ -616,9 +693,23 @@ def run(args) -> int:
     """Import every logfile; exit 0, or 2 when one was missing/unreadable or output failed."""
     from .cli import run_imports
 
-    return run_imports(args, "stridefix import gsd", args.logs,
-                       lambda log, out: import_log(log, out, args.origin, args.max_wifi_age_s),
-                       LogReadError, format_summary,
-                       ("trace", "out", "messages", "skipped_lines", "duration_s", "waypoints",
-                        "building_id", "floors", "origin"), "logfile")
-
+    return run_imports(
+        args,
+        "stridefix import gsd",
+        args.logs,
+        lambda log, out: import_log(log, out, args.origin, args.max_wifi_age_s),
+        LogReadError,
+        format_summary,
+        (
+            "trace",
+            "out",
+            "messages",
+            "skipped_lines",
+            "duration_s",
+            "waypoints",
+            "building_id",
+            "floors",
+            "origin",
+        ),
+        "logfile",
+    )

@@ -6,6 +6,7 @@ A malformed line is never fatal: :meth:`LineReader.bad` records (line number, re
 loop, :meth:`LineReader.finish` sums the rest up in one warning. Lines of a known but unused record
 type are counted per type (:meth:`LineReader.ignore`), not reported.
 """
+
 from __future__ import annotations
 
 import os
@@ -49,8 +50,11 @@ class LineReader:
         """Skip a malformed line (stacklevel: the warning points at the importer's caller)."""
         self.skipped.append((line_no, reason))
         if len(self.skipped) <= self.max_line_warnings:
-            warnings.warn(f"{self.path}:{line_no}: skipped malformed line ({reason})",
-                          MalformedLineWarning, stacklevel=3)
+            warnings.warn(
+                f"{self.path}:{line_no}: skipped malformed line ({reason})",
+                MalformedLineWarning,
+                stacklevel=3,
+            )
 
     def ignore(self, kind: str) -> None:
         """Count a line of a known record type the importer does not use."""
@@ -59,6 +63,9 @@ class LineReader:
     def finish(self) -> None:
         """After the loop: one warning for the malformed lines beyond ``max_line_warnings``."""
         if len(self.skipped) > self.max_line_warnings:
-            warnings.warn(f"{self.path}: {len(self.skipped) - self.max_line_warnings} more malformed "
-                          f"line(s) skipped ({len(self.skipped)} in all)", MalformedLineWarning,
-                          stacklevel=3)
+            warnings.warn(
+                f"{self.path}: {len(self.skipped) - self.max_line_warnings} more malformed "
+                f"line(s) skipped ({len(self.skipped)} in all)",
+                MalformedLineWarning,
+                stacklevel=3,
+            )

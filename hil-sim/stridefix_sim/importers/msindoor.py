@@ -29,6 +29,7 @@ mapped to a floor index raises :class:`TraceHeaderError` unless the floor is giv
 
 Cost: one pass over the text (~1 s per 10⁵ lines), memory ∝ the samples of one trace.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -39,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .lines import LineReader, MalformedLineWarning
+from .lines import LineReader, MalformedLineWarning  # noqa: F401  (re-exported for callers)
 
 #: Bump when the log content for the same input changes (caches compare it).
 IMPORTER_VERSION = 1
@@ -49,13 +50,17 @@ DEFAULT_MAX_WIFI_AGE_S = 2.0
 #: Malformed lines reported one by one per file; the rest are summed up in one warning.
 MAX_LINE_WARNINGS = 20
 
-CHANNELS = ("IMU", "MAG", "WIFI", "TRUTH")   # also the tie-break order of equal times
+CHANNELS = ("IMU", "MAG", "WIFI", "TRUTH")  # also the tie-break order of equal times
 
-_SENSOR_TYPES = {"TYPE_ACCELEROMETER": "accel", "TYPE_GYROSCOPE": "gyro",
-                 "TYPE_MAGNETIC_FIELD": "mag"}
+_SENSOR_TYPES = {"TYPE_ACCELEROMETER": "accel", "TYPE_GYROSCOPE": "gyro", "TYPE_MAGNETIC_FIELD": "mag"}
 # record type -> number of tab-separated fields, time and type included
-_FIELDS = {"TYPE_ACCELEROMETER": 6, "TYPE_GYROSCOPE": 6, "TYPE_MAGNETIC_FIELD": 6,
-           "TYPE_WIFI": 7, "TYPE_WAYPOINT": 4}
+_FIELDS = {
+    "TYPE_ACCELEROMETER": 6,
+    "TYPE_GYROSCOPE": 6,
+    "TYPE_MAGNETIC_FIELD": 6,
+    "TYPE_WIFI": 7,
+    "TYPE_WAYPOINT": 4,
+}
 _BSSID_RE = re.compile(r"^[0-9A-Fa-f]{2}(:[0-9A-Fa-f]{2}){5}$")
 
 
@@ -70,8 +75,6 @@ class TraceReadError(Exception):
 
 class TraceHeaderError(TraceReadError):
     """The trace's header lacks what the import needs (e.g. an unknown FloorName)."""
-
-
 
 
 def floor_index(name: str) -> int:
@@ -162,8 +165,12 @@ class Trace:
             "site_id": self.header.get("SiteID"),
             "floor_name": self.floor_name,
             "floor": self.floor,
-            "messages": {"IMU": len(self.imu_t_ms), "MAG": len(self.mag_t_ms),
-                         "WIFI": len(self.scans), "TRUTH": len(self.waypoint_t_ms)},
+            "messages": {
+                "IMU": len(self.imu_t_ms),
+                "MAG": len(self.mag_t_ms),
+                "WIFI": len(self.scans),
+                "TRUTH": len(self.waypoint_t_ms),
+            },
             "waypoints": len(self.waypoint_t_ms),
             "t_start_us": None if span is None else span[0] * 1000,
             "t_end_us": None if span is None else span[1] * 1000,
@@ -195,8 +202,12 @@ def _finite(values: list[str]) -> list[float]:
     return out
 
 
-def read_trace(path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int | None = None,
-               max_line_warnings: int = MAX_LINE_WARNINGS) -> Trace:
+def read_trace(
+    path,
+    max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
+    floor: int | None = None,
+    max_line_warnings: int = MAX_LINE_WARNINGS,
+) -> Trace:
     """Parse one trace file.
 
     Parameters
@@ -251,8 +262,7 @@ def read_trace(path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int 
         t_ms = int(parts[0])
         try:
             if kind == "TYPE_WIFI":
-                entry = (bssid_to_int(parts[3]), _finite(parts[4:5])[0],
-                         int(parts[5]), int(parts[6]))
+                entry = (bssid_to_int(parts[3]), _finite(parts[4:5])[0], int(parts[5]), int(parts[6]))
                 wifi.setdefault(t_ms, []).append(entry)
             elif kind == "TYPE_WAYPOINT":
                 waypoints.append((t_ms, *_finite(parts[2:4])))
@@ -268,8 +278,7 @@ def read_trace(path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int 
         try:
             floor = floor_index(floor_name)
         except ValueError as exc:
-            raise TraceHeaderError(path, f"no floor index: {exc} (pass the floor explicitly)") \
-                from None
+            raise TraceHeaderError(path, f"no floor index: {exc} (pass the floor explicitly)") from None
     notes: list[str] = []
     stats: dict = {"lines": n_lines, "ignored_lines_by_type": dict(sorted(ignored.items()))}
 
@@ -315,22 +324,45 @@ def read_trace(path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int 
             empty += 1
             continue
         rows = sorted(best.values())
-        scans.append(WifiScan(t_ms=t_ms, bssid=np.array([r[0] for r in rows], dtype=np.int64),
-                              rssi_dbm=np.array([r[1] for r in rows], dtype=np.float32),
-                              freq_mhz=np.array([r[2] for r in rows], dtype=np.int32),
-                              age_ms=np.array([r[3] for r in rows], dtype=np.int64)))
-    stats.update(wifi_lines=sum(len(v) for v in wifi.values()), wifi_scans_in_file=len(wifi),
-                 wifi_aps_written=sum(len(s.bssid) for s in scans), wifi_aps_stale_dropped=stale,
-                 wifi_aps_duplicate_dropped=dup_ap, wifi_scans_empty=empty,
-                 max_wifi_age_s=max_wifi_age_s)
+        scans.append(
+            WifiScan(
+                t_ms=t_ms,
+                bssid=np.array([r[0] for r in rows], dtype=np.int64),
+                rssi_dbm=np.array([r[1] for r in rows], dtype=np.float32),
+                freq_mhz=np.array([r[2] for r in rows], dtype=np.int32),
+                age_ms=np.array([r[3] for r in rows], dtype=np.int64),
+            )
+        )
+    stats.update(
+        wifi_lines=sum(len(v) for v in wifi.values()),
+        wifi_scans_in_file=len(wifi),
+        wifi_aps_written=sum(len(s.bssid) for s in scans),
+        wifi_aps_stale_dropped=stale,
+        wifi_aps_duplicate_dropped=dup_ap,
+        wifi_scans_empty=empty,
+        max_wifi_age_s=max_wifi_age_s,
+    )
 
     waypoints.sort(key=lambda w: w[0])
     wp_t = np.array([w[0] for w in waypoints], dtype=np.int64)
     wp_xy = np.array([w[1:] for w in waypoints], dtype=np.float64).reshape(-1, 2)
-    return Trace(path=path, header=header, floor_name=floor_name, floor=int(floor),
-                 imu_t_ms=acc_t, accel_mps2=acc, gyro_radps=gyro, mag_t_ms=mag_t, mag_ut=mag,
-                 scans=scans, waypoint_t_ms=wp_t, waypoint_xy_m=wp_xy, stats=stats,
-                 skipped=skipped, notes=notes)
+    return Trace(
+        path=path,
+        header=header,
+        floor_name=floor_name,
+        floor=int(floor),
+        imu_t_ms=acc_t,
+        accel_mps2=acc,
+        gyro_radps=gyro,
+        mag_t_ms=mag_t,
+        mag_ut=mag,
+        scans=scans,
+        waypoint_t_ms=wp_t,
+        waypoint_xy_m=wp_xy,
+        stats=stats,
+        skipped=skipped,
+        notes=notes,
+    )
 
 
 def write_lcmlog(trace: Trace, out_path) -> int:
@@ -391,8 +423,9 @@ def write_lcmlog(trace: Trace, out_path) -> int:
     return len(order)
 
 
-def import_trace(path, out_path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
-                 floor: int | None = None) -> dict:
+def import_trace(
+    path, out_path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S, floor: int | None = None
+) -> dict:
     """Read one trace and write its LCM log; return :meth:`Trace.summary` plus ``out`` and ``events``.
 
     Raises
@@ -413,30 +446,45 @@ def format_summary(s: dict) -> str:
     """One line for the terminal."""
     m = s["messages"]
     rate = "-" if s["imu_rate_hz"] is None else f"{s['imu_rate_hz']:.0f} Hz"
-    return (f"{os.path.basename(s['trace'])}: {s['duration_s']:.1f} s, floor {s['floor_name']} "
-            f"({s['floor']}), IMU {m['IMU']} ({rate}), MAG {m['MAG']}, WIFI {m['WIFI']} scans / "
-            f"{s['wifi_aps_written']} APs ({s['wifi_aps_stale_dropped']} cached dropped), "
-            f"TRUTH {m['TRUTH']} waypoints, {s['skipped_lines']} malformed line(s) skipped")
+    return (
+        f"{os.path.basename(s['trace'])}: {s['duration_s']:.1f} s, floor {s['floor_name']} "
+        f"({s['floor']}), IMU {m['IMU']} ({rate}), MAG {m['MAG']}, WIFI {m['WIFI']} scans / "
+        f"{s['wifi_aps_written']} APs ({s['wifi_aps_stale_dropped']} cached dropped), "
+        f"TRUTH {m['TRUTH']} waypoints, {s['skipped_lines']} malformed line(s) skipped"
+    )
 
 
 # --- `stridefix import msindoor` -----------------------------------------------------------------
+
 
 def add_parser(subparsers):
     """Declare ``stridefix import msindoor``."""
     from .cli import add_output_arguments
 
     p = subparsers.add_parser(
-        "msindoor", help="Microsoft Indoor Location Competition 2.0 traces (*.txt)",
+        "msindoor",
+        help="Microsoft Indoor Location Competition 2.0 traces (*.txt)",
         description="Import Indoor Location Competition 2.0 traces: one raw-sensor LCM log "
-                    "DIR/<trace-stem>.lcmlog per trace, or FILE (-o) for a single trace (IMU, MAG, "
-                    "WIFI, TRUTH from waypoints), for `stridefixd --input lcmlog:FILE`.")
+        "DIR/<trace-stem>.lcmlog per trace, or FILE (-o) for a single trace (IMU, MAG, "
+        "WIFI, TRUTH from waypoints), for `stridefixd --input lcmlog:FILE`.",
+    )
     p.add_argument("traces", nargs="+", metavar="TRACE.txt", help="trace file(s)")
     add_output_arguments(p)
-    p.add_argument("--max-wifi-age-s", type=float, default=DEFAULT_MAX_WIFI_AGE_S, metavar="S",
-                   help="drop Wi-Fi entries last seen more than S before the scan time "
-                        f"(cached results; default {DEFAULT_MAX_WIFI_AGE_S:g})")
-    p.add_argument("--floor", type=int, default=None, metavar="N",
-                   help="floor index of the waypoints (default: from the FloorName header)")
+    p.add_argument(
+        "--max-wifi-age-s",
+        type=float,
+        default=DEFAULT_MAX_WIFI_AGE_S,
+        metavar="S",
+        help="drop Wi-Fi entries last seen more than S before the scan time "
+        f"(cached results; default {DEFAULT_MAX_WIFI_AGE_S:g})",
+    )
+    p.add_argument(
+        "--floor",
+        type=int,
+        default=None,
+        metavar="N",
+        help="floor index of the waypoints (default: from the FloorName header)",
+    )
     p.add_argument("--json", metavar="FILE", help="also write the summaries as JSON to FILE")
     return p
 
@@ -445,8 +493,13 @@ def run(args) -> int:
     """Import every trace; exit 0, or 2 when a trace was missing/unreadable or output failed."""
     from .cli import run_imports
 
-    return run_imports(args, "stridefix import msindoor", args.traces,
-                       lambda trace, out: import_trace(trace, out, args.max_wifi_age_s, args.floor),
-                       TraceReadError, format_summary,
-                       ("trace", "out", "messages", "skipped_lines", "duration_s", "waypoints"), "trace")
-
+    return run_imports(
+        args,
+        "stridefix import msindoor",
+        args.traces,
+        lambda trace, out: import_trace(trace, out, args.max_wifi_age_s, args.floor),
+        TraceReadError,
+        format_summary,
+        ("trace", "out", "messages", "skipped_lines", "duration_s", "waypoints"),
+        "trace",
+    )

@@ -1,4 +1,5 @@
 """Fixtures for the analyzer tests: synthetic LCM logs written with the real generated types."""
+
 from __future__ import annotations
 
 import importlib
@@ -7,9 +8,7 @@ import types
 import lcm
 import numpy as np
 import pytest
-
 from stridefix import config_t, health_t, pose_t, step_t, truth_t
-
 from stridefix_analyzer import cli
 
 
@@ -36,8 +35,7 @@ def make_step(t_us, index, length_m=0.7):
 
 def make_health(t_us, frames):
     m = health_t()
-    m.t_us, m.host_t_us, m.frames_total, m.frames_ok = int(t_us), 1_700_000_000_000_000 + t_us, \
-        frames, frames
+    m.t_us, m.host_t_us, m.frames_total, m.frames_ok = int(t_us), 1_700_000_000_000_000 + t_us, frames, frames
     m.loop_mean_us, m.loop_max_us = 12.5, 80.0
     return m
 
@@ -55,6 +53,7 @@ def write_log(tmp_path):
 
     Events are written in list order; the log timestamp is the message's t_us when it has one.
     """
+
     def _write(name, events):
         path = tmp_path / name
         log = lcm.EventLog(str(path), "w", overwrite=True)
@@ -63,6 +62,7 @@ def write_log(tmp_path):
             log.write_event(int(getattr(msg, "t_us", i)), channel, data)
         log.close()
         return path
+
     return _write
 
 
@@ -99,8 +99,9 @@ def cli_main(monkeypatch):
 def msg():
     """Message builders with the real generated types: ``msg.truth(t_us, x_m, y_m, ...)``,
     ``msg.pose(...)``, ``msg.step(...)``, ``msg.health(...)``, ``msg.config({key: value})``."""
-    return types.SimpleNamespace(truth=make_truth, pose=make_pose, step=make_step,
-                                 health=make_health, config=make_config)
+    return types.SimpleNamespace(
+        truth=make_truth, pose=make_pose, step=make_step, health=make_health, config=make_config
+    )
 
 
 @pytest.fixture
@@ -113,10 +114,13 @@ def walk_logs(write_log, straight_walk):
     """
     t, x, y = straight_walk
     fw = [("CONFIG", make_config({"fusion.mode": "adaptive"})), ("HEALTH", make_health(t[-1], 99))]
-    fw += [("POSE", make_pose(ti + 20_000, xi, yi + 1.0, step_count=k))
-           for k, (ti, xi, yi) in enumerate(zip(t, x, y))]
-    fw += [("POSE", make_pose(ti + 20_000, xi + 2.0, yi, scheme=pose_t.SCHEME_PDR_ONLY))
-           for ti, xi, yi in zip(t, x, y)]
-    sim = [("TRUTH", make_truth(ti, xi, yi, step_count=k)) for k, (ti, xi, yi) in
-           enumerate(zip(t, x, y))]
+    fw += [
+        ("POSE", make_pose(ti + 20_000, xi, yi + 1.0, step_count=k))
+        for k, (ti, xi, yi) in enumerate(zip(t, x, y))
+    ]
+    fw += [
+        ("POSE", make_pose(ti + 20_000, xi + 2.0, yi, scheme=pose_t.SCHEME_PDR_ONLY))
+        for ti, xi, yi in zip(t, x, y)
+    ]
+    sim = [("TRUTH", make_truth(ti, xi, yi, step_count=k)) for k, (ti, xi, yi) in enumerate(zip(t, x, y))]
     return write_log("fw.lcmlog", fw), write_log("sim.lcmlog", sim)

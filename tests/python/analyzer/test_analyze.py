@@ -1,4 +1,5 @@
 """analyze sub-command: outputs, exit statuses."""
+
 import json
 
 import numpy as np
@@ -10,17 +11,27 @@ def test_analyze_writes_metrics_and_series(walk_logs, tmp_path, cli_main, capsys
     out = tmp_path / "an"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
     m = json.loads((out / "metrics.json").read_text())
-    for key in ("inputs", "position_error_m", "unscored", "floor_hit_rate", "steps",
-                "distance_walked_m", "final_error_m", "final_error_pct_of_distance", "per_scheme",
-                "messages", "health", "config"):
+    for key in (
+        "inputs",
+        "position_error_m",
+        "unscored",
+        "floor_hit_rate",
+        "steps",
+        "distance_walked_m",
+        "final_error_m",
+        "final_error_pct_of_distance",
+        "per_scheme",
+        "messages",
+        "health",
+        "config",
+    ):
         assert key in m, key
     # poses come 20 ms after their truth sample: the first truth sample is unscored, and each later
     # one is scored against the pose of the previous sample (0.1 m behind along x)
     assert m["unscored"] == 1 and m["position_error_m"]["n"] == 99
     assert_allclose(m["position_error_m"]["median"], np.hypot(0.1, 1.0), rtol=1e-9)
     assert_allclose(m["per_scheme"]["pdr_only"]["position_error_m"]["max"], 1.9, rtol=1e-9)
-    assert m["steps"] == {"detected": 99, "step_messages": 0, "truth": 99, "error": 0,
-                          "error_pct": 0.0}
+    assert m["steps"] == {"detected": 99, "step_messages": 0, "truth": 99, "error": 0, "error_pct": 0.0}
     assert m["messages"] == {"CONFIG": 1, "HEALTH": 1, "POSE": 200, "TRUTH": 100}
     assert m["health"]["frames_total"] == 99
     assert m["config"]["params"] == {"fusion.mode": "adaptive"}

@@ -1,39 +1,42 @@
 """logread: decoding, merging, counting bad data, truncated and missing files."""
-import os
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from stridefix import wifi_scan_t
 from stridefix_analyzer.logread import LogReadError, LogTruncatedWarning, read_logs
 
 
-
 def test_columns_and_sorting(msg, write_log):
     # poses written out of time order come back sorted by t_us
-    path = write_log("a.lcmlog", [("POSE", msg.pose(3_000, 3, 0, step_count=3)),
-                                  ("POSE", msg.pose(1_000, 1, 0, step_count=1)),
-                                  ("STEP", msg.step(1_000, 1, 0.7)),
-                                  ("TRUTH", msg.truth(2_000, 2, 5, floor=1, step_count=2))])
+    path = write_log(
+        "a.lcmlog",
+        [
+            ("POSE", msg.pose(3_000, 3, 0, step_count=3)),
+            ("POSE", msg.pose(1_000, 1, 0, step_count=1)),
+            ("STEP", msg.step(1_000, 1, 0.7)),
+            ("TRUTH", msg.truth(2_000, 2, 5, floor=1, step_count=2)),
+        ],
+    )
     d = read_logs([path])
     pose = d.table("POSE")
-    assert pose.names == ["t_us", "x_m", "y_m", "floor", "heading_rad", "sigma_m", "step_count",
-                          "scheme"]
+    assert pose.names == ["t_us", "x_m", "y_m", "floor", "heading_rad", "sigma_m", "step_count", "scheme"]
     assert_array_equal(pose["t_us"], [1_000, 3_000])
     assert_allclose(pose["x_m"], [1.0, 3.0])
     assert pose["t_us"].dtype == np.int64
     truth = d.table("TRUTH")
     assert truth["floor"][0] == 1 and truth["step_count"][0] == 2
-    assert_allclose(d.table("STEP")["length_m"], [0.7], rtol=1e-6)   # float32 on the wire
+    assert_allclose(d.table("STEP")["length_m"], [0.7], rtol=1e-6)  # float32 on the wire
     assert d.messages == {"POSE": 2, "STEP": 1, "TRUTH": 1}
     assert d.warnings == []
 
 
 def test_merges_firmware_and_truth_logs(msg, write_log):
     fw = write_log("fw.lcmlog", [("POSE", msg.pose(t, t / 1e6, 0)) for t in (0, 2_000_000)])
-    sim = write_log("sim.lcmlog", [("TRUTH", msg.truth(t, t / 1e6, 0)) for t in (1_000_000,)]
-                    + [("POSE", msg.pose(1_000_000, 1, 0))])
+    sim = write_log(
+        "sim.lcmlog",
+        [("TRUTH", msg.truth(t, t / 1e6, 0)) for t in (1_000_000,)] + [("POSE", msg.pose(1_000_000, 1, 0))],
+    )
     d = read_logs([fw, sim])
     assert_array_equal(d.table("POSE")["t_us"], [0, 1_000_000, 2_000_000])
     assert len(d.table("TRUTH")) == 1
@@ -41,11 +44,16 @@ def test_merges_firmware_and_truth_logs(msg, write_log):
 
 
 def test_unknown_channel_and_decode_error_are_counted(msg, write_log):
-    path = write_log("bad.lcmlog", [("POSE", msg.pose(1, 0, 0)),
-                                    ("POSE", msg.truth(2, 0, 0)),      # wrong type on POSE
-                                    ("TRUTH", b"\x00garbage"),           # not a message at all
-                                    ("CAMERA", b"\x01\x02"),
-                                    ("CAMERA", b"\x01\x02")])
+    path = write_log(
+        "bad.lcmlog",
+        [
+            ("POSE", msg.pose(1, 0, 0)),
+            ("POSE", msg.truth(2, 0, 0)),  # wrong type on POSE
+            ("TRUTH", b"\x00garbage"),  # not a message at all
+            ("CAMERA", b"\x01\x02"),
+            ("CAMERA", b"\x01\x02"),
+        ],
+    )
     d = read_logs([path])
     assert len(d.table("POSE")) == 1
     assert d.table("TRUTH") is None
@@ -59,7 +67,7 @@ def test_truncated_log_reads_whole_records(msg, write_log, tmp_path):
     path = write_log("full.lcmlog", [("POSE", msg.pose(i * 1000, i, 0)) for i in range(10)])
     data = path.read_bytes()
     cut = tmp_path / "cut.lcmlog"
-    cut.write_bytes(data[:-7])          # lose the tail of the last record
+    cut.write_bytes(data[:-7])  # lose the tail of the last record
     with pytest.warns(LogTruncatedWarning, match="cut.lcmlog"):
         d = read_logs([cut])
     assert_array_equal(d.table("POSE")["t_us"], np.arange(9) * 1000)
@@ -99,11 +107,15 @@ def test_health_config_and_wifi(msg, write_log):
     scan = wifi_scan_t()
     scan.t_us, scan.scan_id, scan.complete, scan.n_ap = 5, 7, True, 2
     scan.bssid, scan.rssi_dbm, scan.freq_mhz = [0xAABBCCDDEEFF, 1], [-60.0, -72.5], [2412, 5180]
-    path = write_log("h.lcmlog", [("CONFIG", msg.config({"fusion.mode": "adaptive",
-                                                          "step.threshold": "1.2"})),
-                                  ("HEALTH", msg.health(1_000, 10)),
-                                  ("HEALTH", msg.health(2_000, 25)),
-                                  ("WIFI", scan)])
+    path = write_log(
+        "h.lcmlog",
+        [
+            ("CONFIG", msg.config({"fusion.mode": "adaptive", "step.threshold": "1.2"})),
+            ("HEALTH", msg.health(1_000, 10)),
+            ("HEALTH", msg.health(2_000, 25)),
+            ("WIFI", scan),
+        ],
+    )
     d = read_logs([path])
     assert d.health["frames_total"] == 25 and d.health["t_us"] == 2_000
     assert_allclose(d.health["loop_max_us"], 80.0)
@@ -127,7 +139,7 @@ def test_garbage_between_records_is_skipped_and_reported(write_log, tmp_path, ms
     a = write_log("a.lcmlog", [("POSE", msg.pose(1, 1, 0))]).read_bytes()
     b = write_log("b.lcmlog", [("POSE", msg.pose(2, 2, 0))]).read_bytes()
     spliced = tmp_path / "spliced.lcmlog"
-    spliced.write_bytes(a + b"\x55" * 13 + b)        # 13 junk bytes between two whole records
+    spliced.write_bytes(a + b"\x55" * 13 + b)  # 13 junk bytes between two whole records
     with pytest.warns(LogTruncatedWarning, match="13 byte"):
         d = read_logs([spliced])
     assert_array_equal(d.table("POSE")["t_us"], [1, 2])
@@ -149,8 +161,7 @@ def test_junk_after_last_record_keeps_it(write_log, tmp_path, msg, junk):
 
 
 def test_several_corrupt_regions_lose_no_whole_record(write_log, tmp_path, msg):
-    records = [write_log(f"r{i}.lcmlog", [("POSE", msg.pose(i, i, 0))]).read_bytes()
-               for i in range(8)]
+    records = [write_log(f"r{i}.lcmlog", [("POSE", msg.pose(i, i, 0))]).read_bytes() for i in range(8)]
     junk = [b"", b"\x00" * 3, b"\xed\xa1\xda\x01garbage", b"", b"\xff" * 100, b"", b"\x01", b""]
     path = tmp_path / "patchy.lcmlog"
     path.write_bytes(b"".join(r + j for r, j in zip(records, junk)) + records[0][:20])

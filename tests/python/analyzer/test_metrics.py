@@ -1,14 +1,11 @@
 """metrics: the evaluation protocol of DESIGN.md, checked against numbers known in advance."""
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-
 from stridefix import pose_t
-from stridefix_analyzer.logread import read_logs
-from stridefix_analyzer.metrics import (MetricsInputError, error_stats, run_metrics, scheme_code,
-                                        step_metrics)
-from stridefix_analyzer.logread import Table
-
+from stridefix_analyzer.logread import Table, read_logs
+from stridefix_analyzer.metrics import MetricsInputError, error_stats, run_metrics, scheme_code, step_metrics
 
 STATS = ("mean", "median", "p75", "p90", "p95", "max", "rmse")
 
@@ -17,7 +14,7 @@ def test_constant_one_metre_offset(msg, write_log, straight_walk):
     t, x, y = straight_walk
     events = []
     for ti, xi, yi in zip(t, x, y):
-        events.append(("POSE", msg.pose(ti, xi, yi + 1.0)))   # published at the truth time
+        events.append(("POSE", msg.pose(ti, xi, yi + 1.0)))  # published at the truth time
         events.append(("TRUTH", msg.truth(ti, xi, yi)))
     m = run_metrics(read_logs([write_log("w.lcmlog", events)])).summary()
     e = m["position_error_m"]
@@ -31,7 +28,7 @@ def test_constant_one_metre_offset(msg, write_log, straight_walk):
 
 def test_known_error_distribution_matches_numpy(msg, write_log):
     rng = np.random.default_rng(4)
-    errors = rng.permutation(np.arange(1.0, 101.0))       # 1 … 100 m in a random order
+    errors = rng.permutation(np.arange(1.0, 101.0))  # 1 … 100 m in a random order
     events = []
     for k, err in enumerate(errors):
         t = 1_000_000 + k * 200_000
@@ -44,17 +41,19 @@ def test_known_error_distribution_matches_numpy(msg, write_log):
         assert_allclose(e[f"p{p}"], np.percentile(errors, p), rtol=1e-12)
     assert_allclose(e["mean"], 50.5, rtol=1e-12)
     assert_allclose(e["max"], 100.0, rtol=1e-12)
-    assert_allclose(e["rmse"], np.sqrt(np.mean(errors ** 2)), rtol=1e-12)
+    assert_allclose(e["rmse"], np.sqrt(np.mean(errors**2)), rtol=1e-12)
     assert_allclose(m.schemes[m.primary].match["error_m"], errors, rtol=1e-12)
 
 
 def test_causal_latest_pose_at_or_before_truth(msg, write_log):
-    events = [("TRUTH", msg.truth(500_000, 0, 0)),          # before any pose: unscored
-              ("POSE", msg.pose(1_000_000, 0, 0)),
-              ("TRUTH", msg.truth(1_000_000, 0, 2)),        # pose at the same time counts: 2 m
-              ("TRUTH", msg.truth(2_000_000, 0, 3)),        # still the 1 s pose: 3 m
-              ("POSE", msg.pose(2_000_001, 0, 3)),          # 1 µs late: not used for t = 2 s
-              ("TRUTH", msg.truth(3_000_000, 0, 7))]        # uses the 2.000001 s pose: 4 m
+    events = [
+        ("TRUTH", msg.truth(500_000, 0, 0)),  # before any pose: unscored
+        ("POSE", msg.pose(1_000_000, 0, 0)),
+        ("TRUTH", msg.truth(1_000_000, 0, 2)),  # pose at the same time counts: 2 m
+        ("TRUTH", msg.truth(2_000_000, 0, 3)),  # still the 1 s pose: 3 m
+        ("POSE", msg.pose(2_000_001, 0, 3)),  # 1 µs late: not used for t = 2 s
+        ("TRUTH", msg.truth(3_000_000, 0, 7)),
+    ]  # uses the 2.000001 s pose: 4 m
     m = run_metrics(read_logs([write_log("c.lcmlog", events)]))
     s = m.summary()
     assert s["unscored"] == 1 and s["position_error_m"]["n"] == 3
@@ -65,18 +64,20 @@ def test_causal_latest_pose_at_or_before_truth(msg, write_log):
 
 
 def test_equal_time_poses_latest_published_wins(msg, write_log):
-    events = [("POSE", msg.pose(1_000, 50, 0)), ("POSE", msg.pose(1_000, 1, 0)),
-              ("TRUTH", msg.truth(1_000, 0, 0))]
+    events = [
+        ("POSE", msg.pose(1_000, 50, 0)),
+        ("POSE", msg.pose(1_000, 1, 0)),
+        ("TRUTH", msg.truth(1_000, 0, 0)),
+    ]
     m = run_metrics(read_logs([write_log("eq.lcmlog", events)]))
     assert_allclose(m.summary()["position_error_m"]["mean"], 1.0)
 
 
 def test_floor_hit_rate(msg, write_log, straight_walk):
     t, x, y = straight_walk
-    truth_floor = np.where(np.arange(100) < 60, 0, 1)        # pose stays on floor 0
+    truth_floor = np.where(np.arange(100) < 60, 0, 1)  # pose stays on floor 0
     events = [("POSE", msg.pose(t[0], 0, 0, floor=0))]
-    events += [("TRUTH", msg.truth(ti, xi, yi, floor=f)) for ti, xi, yi, f in
-               zip(t, x, y, truth_floor)]
+    events += [("TRUTH", msg.truth(ti, xi, yi, floor=f)) for ti, xi, yi, f in zip(t, x, y, truth_floor)]
     s = run_metrics(read_logs([write_log("f.lcmlog", events)])).summary()
     assert_allclose(s["floor_hit_rate"], 0.6)
     assert s["floors_in_truth"] == [0, 1]
@@ -85,11 +86,11 @@ def test_floor_hit_rate(msg, write_log, straight_walk):
 def test_step_count_error(msg, write_log, straight_walk):
     t, x, y = straight_walk
     truth_steps = list(range(100))
-    truth_steps[-5:] = [-1] * 5                               # unknown at the end: last known 94
-    events = [("TRUTH", msg.truth(ti, xi, yi, step_count=s))
-              for ti, xi, yi, s in zip(t, x, y, truth_steps)]
-    events += [("POSE", msg.pose(ti, xi, yi, step_count=k * 90 // 99))
-               for k, (ti, xi, yi) in enumerate(zip(t, x, y))]
+    truth_steps[-5:] = [-1] * 5  # unknown at the end: last known 94
+    events = [("TRUTH", msg.truth(ti, xi, yi, step_count=s)) for ti, xi, yi, s in zip(t, x, y, truth_steps)]
+    events += [
+        ("POSE", msg.pose(ti, xi, yi, step_count=k * 90 // 99)) for k, (ti, xi, yi) in enumerate(zip(t, x, y))
+    ]
     events += [("STEP", msg.step(ti, k + 1)) for k, ti in enumerate(t[:90])]
     s = run_metrics(read_logs([write_log("s.lcmlog", events)])).summary()["steps"]
     assert s["detected"] == 90 and s["truth"] == 94 and s["error"] == -4
@@ -122,7 +123,7 @@ def test_schemes_scored_separately(msg, write_log, straight_walk):
         e = s["per_scheme"][name]["position_error_m"]
         assert_allclose([e[k] for k in STATS], expected, rtol=1e-12)
         assert s["per_scheme"][name]["n_pose"] == 100
-    assert s["primary_scheme"] == "adaptive"                 # tie on counts: preference order
+    assert s["primary_scheme"] == "adaptive"  # tie on counts: preference order
     assert_allclose(s["position_error_m"]["mean"], 1.0)
     s = run_metrics(data, scheme=scheme_code("pdr_only")).summary()
     assert s["primary_scheme"] == "pdr_only"
@@ -132,10 +133,12 @@ def test_schemes_scored_separately(msg, write_log, straight_walk):
 
 
 def test_scheme_first_pose_later_gives_its_own_unscored(msg, write_log):
-    events = [("POSE", msg.pose(0, 0, 0, scheme=pose_t.SCHEME_PDR_ONLY)),
-              ("TRUTH", msg.truth(10, 0, 0)),
-              ("POSE", msg.pose(15, 0, 0, scheme=pose_t.SCHEME_KALMAN)),
-              ("TRUTH", msg.truth(20, 0, 0))]
+    events = [
+        ("POSE", msg.pose(0, 0, 0, scheme=pose_t.SCHEME_PDR_ONLY)),
+        ("TRUTH", msg.truth(10, 0, 0)),
+        ("POSE", msg.pose(15, 0, 0, scheme=pose_t.SCHEME_KALMAN)),
+        ("TRUTH", msg.truth(20, 0, 0)),
+    ]
     s = run_metrics(read_logs([write_log("u.lcmlog", events)])).summary()["per_scheme"]
     assert s["pdr_only"]["unscored"] == 0 and s["kalman"]["unscored"] == 1
 
@@ -181,11 +184,12 @@ def test_truth_source_waypoint_scores_only_reference_points(msg, write_log, stra
     """10 Hz simulation truth plus a few WAYPOINT truths (the reference points of a walk): with
     truth_source='waypoint' only the reference points are scored."""
     from stridefix import truth_t
+
     t, x, y = straight_walk
     events = [("POSE", msg.pose(ti, xi, yi + 1.0)) for ti, xi, yi in zip(t, x, y)]
     events += [("TRUTH", msg.truth(ti, xi, yi)) for ti, xi, yi in zip(t, x, y)]
     for k in (10, 50, 90):
-        wp = msg.truth(t[k], x[k], y[k] + 3.0)   # the reference points sit 3 m off: error 2 m
+        wp = msg.truth(t[k], x[k], y[k] + 3.0)  # the reference points sit 3 m off: error 2 m
         wp.source = truth_t.SOURCE_WAYPOINT
         events.append(("TRUTH", wp))
     data = read_logs([write_log("wp.lcmlog", events)])

@@ -1,7 +1,7 @@
 """report sub-command: a self-contained HTML page with embedded PNG figures."""
+
 import base64
 import re
-
 
 
 def test_report_embeds_png_images(walk_logs, tmp_path, cli_main):
@@ -16,7 +16,7 @@ def test_report_embeds_png_images(walk_logs, tmp_path, cli_main):
         assert base64.b64decode(img).startswith(b"\x89PNG\r\n\x1a\n")
     for text in ("adaptive", "pdr_only", "frames_total", "fusion.mode", "<style>"):
         assert text in page
-    assert "http://" not in page and "https://" not in page    # nothing fetched from outside
+    assert "http://" not in page and "https://" not in page  # nothing fetched from outside
 
 
 def test_report_out_option(walk_logs, tmp_path, cli_main):

@@ -3,6 +3,7 @@
 A behaviour change (anything that moves a pose, a floor, a step or a fix verdict) shows up here as a
 diff. When the change is intended, regenerate with `make change-indication` and commit the CSVs with
 the change, so review sees what moved."""
+
 from __future__ import annotations
 
 import difflib
@@ -28,7 +29,10 @@ def test_replay_matches_committed_csv(case, stridefixd, tmp_path):
     fresh = replay.run_case(case, tmp_path, stridefixd)
     want, got = committed.read_text(), fresh.read_text()
     if want != got:
-        diff = list(difflib.unified_diff(want.splitlines(), got.splitlines(), "committed", "fresh",
-                                         lineterm="", n=0))
-        pytest.fail(f"{case}: behaviour changed ({len(diff)} diff lines; `make change-indication` "
-                    "regenerates the CSVs if intended):\n" + "\n".join(diff[:40]))
+        diff = list(
+            difflib.unified_diff(want.splitlines(), got.splitlines(), "committed", "fresh", lineterm="", n=0)
+        )
+        pytest.fail(
+            f"{case}: behaviour changed ({len(diff)} diff lines; `make change-indication` "
+            "regenerates the CSVs if intended):\n" + "\n".join(diff[:40])
+        )

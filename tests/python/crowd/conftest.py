@@ -1,4 +1,5 @@
 """Fixtures for the crowdsourced-model tests: hand-made scans, synthetic pairs, short SIL walks."""
+
 from __future__ import annotations
 
 import subprocess
@@ -14,10 +15,7 @@ NAN = np.nan
 @pytest.fixture
 def hand_scans() -> np.ndarray:
     """Four scans × three APs [dBm]; scans 0 and 2 share no AP."""
-    return np.array([[-50.0, -60.0, NAN],
-                     [-52.0, NAN, -70.0],
-                     [NAN, NAN, -80.0],
-                     [-50.0, -61.0, -75.0]])
+    return np.array([[-50.0, -60.0, NAN], [-52.0, NAN, -70.0], [NAN, NAN, -80.0], [-50.0, -61.0, -75.0]])
 
 
 @pytest.fixture
@@ -45,16 +43,45 @@ def sil_walks(tmp_path_factory, stridefixd) -> list[str]:
     procs = []
     for seed in (1, 2, 3):
         out = base / f"s{seed}"
-        procs.append((out, subprocess.Popen(
-            [str(Path(sys.executable).with_name("stridefix")), "sim", "--scenario", "pace_normal",
-             "--seed", str(seed), "--duration-s", "60", "--out", str(out)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)))
+        procs.append(
+            (
+                out,
+                subprocess.Popen(
+                    [
+                        str(Path(sys.executable).with_name("stridefix")),
+                        "sim",
+                        "--scenario",
+                        "pace_normal",
+                        "--seed",
+                        str(seed),
+                        "--duration-s",
+                        "60",
+                        "--out",
+                        str(out),
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.PIPE,
+                    text=True,
+                ),
+            )
+        )
     for out, p in procs:
         _, err = p.communicate()
         assert p.returncode == 0, err
-        fw = subprocess.run([str(stridefixd), "--input", str(out / "board.candump"), "--log",
-                             str(out / "stridefixd.lcmlog"), "-q", "--config",
-                             str(out / "init_truth.ini")], capture_output=True, text=True)
+        fw = subprocess.run(
+            [
+                str(stridefixd),
+                "--input",
+                str(out / "board.candump"),
+                "--log",
+                str(out / "stridefixd.lcmlog"),
+                "-q",
+                "--config",
+                str(out / "init_truth.ini"),
+            ],
+            capture_output=True,
+            text=True,
+        )
         assert fw.returncode == 0, fw.stderr
         specs.append(f"{out / 'stridefixd.lcmlog'},{out / 'truth.lcmlog'}")
     return specs

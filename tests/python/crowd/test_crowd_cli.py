@@ -4,12 +4,12 @@ GIVEN three 60 s walkers of the office loop replayed through stridefixd (conftes
 WHEN the model is fitted on their scans and their positions are solved from every 4th scan point
 THEN the model respects the bounds, the solve reports its solver and its error at the other points
 is bounded, and the crowd radio map is a valid site file."""
+
 from __future__ import annotations
 
 import json
 
 import pytest
-
 from stridefix_analyzer.sitefile import read_site
 
 
@@ -35,8 +35,19 @@ def test_fit_writes_model_within_bounds_and_plot(fitted):
 @pytest.mark.parametrize("ranges,bound_m", [("pdr", 3.0), ("both", 12.0)])
 def test_solve_reports_solver_and_bounded_error(fitted, sil_walks, cli, tmp_path, ranges, bound_m):
     out, _ = fitted
-    proc = cli("crowd", "solve", *sil_walks, "--model", str(out / "model.json"), "--anchors",
-               "every:4", "--ranges", ranges, "--out", str(tmp_path))
+    proc = cli(
+        "crowd",
+        "solve",
+        *sil_walks,
+        "--model",
+        str(out / "model.json"),
+        "--anchors",
+        "every:4",
+        "--ranges",
+        ranges,
+        "--out",
+        str(tmp_path),
+    )
     assert proc.returncode == 0, proc.stderr
     res = json.loads((tmp_path / "solve.json").read_text())
     assert res["solver"]["solver"].startswith(("stridefix_native", "scipy"))
@@ -48,9 +59,19 @@ def test_solve_reports_solver_and_bounded_error(fitted, sil_walks, cli, tmp_path
 
 def test_crowd_radiomap_writes_sites(fitted, sil_walks, cli, tmp_path):
     out, _ = fitted
-    proc = cli("crowd", "radiomap", *sil_walks, "--model", str(out / "model.json"), "--ranges",
-               "pdr", "--out", str(tmp_path / "crowd.sfsite"), "--truth-site",
-               str(tmp_path / "truth.sfsite"))
+    proc = cli(
+        "crowd",
+        "radiomap",
+        *sil_walks,
+        "--model",
+        str(out / "model.json"),
+        "--ranges",
+        "pdr",
+        "--out",
+        str(tmp_path / "crowd.sfsite"),
+        "--truth-site",
+        str(tmp_path / "truth.sfsite"),
+    )
     assert proc.returncode == 0, proc.stderr
     crowd, truth = read_site(str(tmp_path / "crowd.sfsite")), read_site(str(tmp_path / "truth.sfsite"))
     assert crowd.n_rp > 5 and truth.n_rp > 5 and crowd.n_ap > 0

@@ -1,4 +1,5 @@
 """Dissimilarity, streaming binning, the bounded fit and the reliability filter (crowd_model)."""
+
 from __future__ import annotations
 
 import math
@@ -6,7 +7,6 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from stridefix_analyzer import crowd_model as cm
 
 NAN = np.nan
@@ -14,10 +14,9 @@ NAN = np.nan
 
 def test_common_sum_on_hand_made_scans(hand_scans):
     D = cm.dissimilarity(hand_scans, mode="common_sum")
-    expected = np.array([[0, 2, NAN, 1],
-                         [2, 0, 10, math.sqrt(4 + 25)],
-                         [NAN, 10, 0, 5],
-                         [1, math.sqrt(29), 5, 0]])
+    expected = np.array(
+        [[0, 2, NAN, 1], [2, 0, 10, math.sqrt(4 + 25)], [NAN, 10, 0, 5], [1, math.sqrt(29), 5, 0]]
+    )
     assert_allclose(D, expected, rtol=0, atol=1e-12, equal_nan=True)
 
 
@@ -57,7 +56,7 @@ def test_pair_blocks_cover_each_pair_once_without_no_common(random_scans, block)
     expected = {(i, j) for i in range(len(R)) for j in range(i) if np.isfinite(full[i, j])}
     assert set(seen) == expected
     assert_allclose([seen[k] for k in sorted(seen)], [full[k] for k in sorted(seen)], atol=1e-12)
-    assert (5, 6) not in seen           # scans 5 and 6 share no AP
+    assert (5, 6) not in seen  # scans 5 and 6 share no AP
 
 
 @pytest.mark.parametrize("mode", cm.MODES)
@@ -84,8 +83,7 @@ def test_streaming_binning_equals_brute_force(random_scans, mode):
     assert_array_equal(bins.count, np.bincount(k, minlength=n))
     assert_allclose(bins.sum_x, np.bincount(k, weights=xs, minlength=n), rtol=1e-12, atol=1e-9)
     assert_allclose(bins.sum_d, np.bincount(k, weights=ds, minlength=n), rtol=1e-12, atol=1e-9)
-    assert_allclose(bins.sum_d2, np.bincount(k, weights=ds ** 2, minlength=n), rtol=1e-12,
-                    atol=1e-9)
+    assert_allclose(bins.sum_d2, np.bincount(k, weights=ds**2, minlength=n), rtol=1e-12, atol=1e-9)
     assert bins.min_d == pytest.approx(ds.min())
     coarse = bins.coarsen(4)
     assert coarse.count.sum() == len(xs)
@@ -112,8 +110,8 @@ def test_binned_fit_matches_pair_fit():
     x, d = _synthetic_pairs(X, noise=1.0)
     pair = cm.fit_distance_model(x, d)
     bins = cm.PairBins(width=0.25)
-    for s in range(0, len(x), 3000):           # streamed in blocks
-        bins.add(x[s:s + 3000], d[s:s + 3000])
+    for s in range(0, len(x), 3000):  # streamed in blocks
+        bins.add(x[s : s + 3000], d[s : s + 3000])
     binned = cm.fit_binned(bins)
     assert_allclose(binned.params, pair.params, atol=0.02)
     assert binned.rmse_m == pytest.approx(pair.rmse_m, rel=0.01)
@@ -153,12 +151,13 @@ def test_reliability_filter_keeps_model_distance_up_to_tau_max():
 
 
 def test_model_distance_is_floored_linear():
-    assert_allclose(cm.model_distance([0, 10, 20, NAN], (2.0, -1.0, 0.25)), [2.0, 2.0, 4.0, NAN],
-                    equal_nan=True)
+    assert_allclose(
+        cm.model_distance([0, 10, 20, NAN], (2.0, -1.0, 0.25)), [2.0, 2.0, 4.0, NAN], equal_nan=True
+    )
 
 
 def test_min_common_aps_excludes_pairs_sharing_fewer(hand_scans):
-    D = cm.dissimilarity(hand_scans)                 # thesis: one common AP is enough
+    D = cm.dissimilarity(hand_scans)  # thesis: one common AP is enough
     bins1 = cm.bin_pairs(hand_scans, np.zeros((4, 2)))
     bins2 = cm.bin_pairs(hand_scans, np.zeros((4, 2)), min_common=2)
     assert bins1.n_pairs == int(np.sum(np.isfinite(D[np.tril_indices(4, -1)])))

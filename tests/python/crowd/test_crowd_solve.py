@@ -2,15 +2,22 @@
 
 The 1-D thesis check lives in the native solver's tests; here: our problem construction (anchors,
 PDR rows, Wi-Fi rows, filter, weights) and the scipy reference recovering a known 2-D geometry."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from stridefix_analyzer import crowd_model as cm
-from stridefix_analyzer.crowd_solve import (Problem, build_problem, error_stats, make_points,
-                                            parse_anchors, solve, solve_scipy)
+from stridefix_analyzer.crowd_solve import (
+    Problem,
+    build_problem,
+    error_stats,
+    make_points,
+    parse_anchors,
+    solve,
+    solve_scipy,
+)
 from stridefix_analyzer.crowd_walks import CrowdInputError, Walk, pool_scans
 
 APS = np.array([[0.0, 0.0], [20.0, 0.0], [20.0, 10.0], [0.0, 10.0]])
@@ -36,11 +43,21 @@ def _walk(name, start, seed, n_steps=40, step_m=0.7):
             dist = np.hypot(*(p - ap))
             if dist < 18:
                 rows.append(i), bss.append(a + 1), rss.append(round(-40 - 20 * np.log10(1 + dist)))
-    return Walk(name=name, scan_t_us=scan_t, ap_scan=np.array(rows), ap_bssid=np.array(bss),
-                ap_rssi_dbm=np.array(rss, float), ap_freq_mhz=np.full(len(rows), 2412),
-                truth_t_us=t, truth_xy_m=pos, truth_floor=np.zeros(len(t), np.int64),
-                dense_truth=True, step_t_us=t[1:], step_length_m=np.hypot(*d.T),
-                step_heading_rad=np.arctan2(d[:, 1], d[:, 0]) + 0.3 * seed)
+    return Walk(
+        name=name,
+        scan_t_us=scan_t,
+        ap_scan=np.array(rows),
+        ap_bssid=np.array(bss),
+        ap_rssi_dbm=np.array(rss, float),
+        ap_freq_mhz=np.full(len(rows), 2412),
+        truth_t_us=t,
+        truth_xy_m=pos,
+        truth_floor=np.zeros(len(t), np.int64),
+        dense_truth=True,
+        step_t_us=t[1:],
+        step_length_m=np.hypot(*d.T),
+        step_heading_rad=np.arctan2(d[:, 1], d[:, 0]) + 0.3 * seed,
+    )
 
 
 @pytest.fixture
@@ -57,13 +74,12 @@ def test_anchor_specs():
 def test_pdr_rows_are_true_distances_and_anchors_every_fourth(walks):
     scans = pool_scans(walks, "all")
     pts = make_points(walks, scans)
-    prob = build_problem(walks, scans, pts, model=None, ranges="pdr", anchors="every:4",
-                         pdr_span=2)
+    prob = build_problem(walks, scans, pts, model=None, ranges="pdr", anchors="every:4", pdr_span=2)
     # each walk: 11 scan points; anchors at 0, 4, 8
     assert len(prob.anchor_index) == 9
     assert_array_equal(prob.anchor_index[:3], [0, 4, 8])
     true = np.hypot(*(pts.truth_xy_m[prob.pair_i] - pts.truth_xy_m[prob.pair_j]).T)
-    assert_allclose(prob.range_m, true, atol=1e-9)     # chord is heading-offset invariant
+    assert_allclose(prob.range_m, true, atol=1e-9)  # chord is heading-offset invariant
     assert np.all(np.abs(prob.pair_j - prob.pair_i) <= 2) and len(prob.pair_i) == 3 * (10 + 9)
     assert_allclose(prob.weight, 1 / (prob.range_m + 2))
 
@@ -71,8 +87,7 @@ def test_pdr_rows_are_true_distances_and_anchors_every_fourth(walks):
 def test_scipy_reference_recovers_geometry_from_exact_ranges(walks):
     scans = pool_scans(walks, "all")
     pts = make_points(walks, scans)
-    prob = build_problem(walks, scans, pts, model=None, ranges="pdr", anchors="every:4",
-                         pdr_span=0)
+    prob = build_problem(walks, scans, pts, model=None, ranges="pdr", anchors="every:4", pdr_span=0)
     prob.x0 = prob.x0 + np.random.default_rng(0).normal(0, 1.0, prob.x0.shape)
     xy, info = solve_scipy(prob)
     e = error_stats(xy, pts, prob)
@@ -90,8 +105,9 @@ def test_wifi_rows_pass_the_filter_and_skip_pairs_without_common_ap(walks):
     assert np.all(prob.range_m <= info["wifi_threshold_m"] + 1e-12)
     assert 0 < info["wifi_pairs"] < info["wifi_candidate_pairs"] - info["wifi_pairs_no_common_ap"]
     # without the filter: every candidate pair with a common AP
-    prob2 = build_problem(walks, scans, pts, model=model, ranges="wifi", anchors="every:4",
-                          tau=None, weights=None)
+    prob2 = build_problem(
+        walks, scans, pts, model=model, ranges="wifi", anchors="every:4", tau=None, weights=None
+    )
     assert prob2.info["wifi_pairs"] == info["wifi_candidate_pairs"] - info["wifi_pairs_no_common_ap"]
     assert_allclose(prob2.weight, 1.0)
 
@@ -121,9 +137,18 @@ def test_native_and_scipy_agree_when_native_is_built():
     i, j = np.triu_indices(12, 1)
     b = np.hypot(*(true[i] - true[j]).T)
     a = np.arange(0, 12, 4)
-    prob = Problem(n=12, anchor_index=a, anchor_xy=true[a], pair_i=i, pair_j=j, range_m=b,
-                   weight=1 / (b + 2), row_kind=np.zeros(len(i), np.int8),
-                   x0=true + rng.normal(0, 0.5, true.shape), info={})
+    prob = Problem(
+        n=12,
+        anchor_index=a,
+        anchor_xy=true[a],
+        pair_i=i,
+        pair_j=j,
+        range_m=b,
+        weight=1 / (b + 2),
+        row_kind=np.zeros(len(i), np.int8),
+        x0=true + rng.normal(0, 0.5, true.shape),
+        info={},
+    )
     xy_n, info_n = solve(prob, "native")
     xy_s, _ = solve(prob, "scipy")
     assert "native" in info_n["solver"]

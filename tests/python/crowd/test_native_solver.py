@@ -5,17 +5,21 @@ module is built by ``make build`` (CMake) and put on the venv's path by tools/de
 Tolerances: the 1-D check is exact to 1e-9 m; Ceres and scipy agree to 1e-6 m when both run to tight
 tolerances (1e-15) from the same start.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from numpy.testing import assert_allclose
-
 import stridefix_native as sn
 import stridefix_native_reference as ref
+from numpy.testing import assert_allclose
 
-TIGHT = {"function_tolerance": 1e-15, "gradient_tolerance": 1e-15, "parameter_tolerance": 1e-15,
-         "max_iterations": 500}
+TIGHT = {
+    "function_tolerance": 1e-15,
+    "gradient_tolerance": 1e-15,
+    "parameter_tolerance": 1e-15,
+    "max_iterations": 500,
+}
 # The reference with a dense Jacobian and exact trust-region steps: with a robust loss, scipy's LSMR
 # steps can stall where the rescaled Jacobian (rows in Huber's linear part) is nearly singular.
 REF = {"use_sparse": False}
@@ -30,21 +34,33 @@ def _cloud(n, seed, n_anchors=4, range_sigma_m=0.05, init_sigma_m=0.3, k_near=6)
     xy_gt = rng.uniform(0.0, 20.0, (n, 2))
     anchors = rng.choice(n, n_anchors, replace=False)
     d = np.linalg.norm(xy_gt[:, None] - xy_gt[None], axis=2)
-    near = np.argsort(d, axis=1)[:, 1:k_near + 1]
+    near = np.argsort(d, axis=1)[:, 1 : k_near + 1]
     pairs = np.unique(np.sort(np.c_[np.repeat(np.arange(n), k_near), near.ravel()], axis=1), axis=0)
     ranges = np.abs(d[pairs[:, 0], pairs[:, 1]] + range_sigma_m * rng.standard_normal(len(pairs)))
-    pb = {"n_points": n, "anchors_idx": anchors, "anchors_xy": xy_gt[anchors], "pairs": pairs,
-          "ranges_m": ranges, "init_xy": xy_gt + rng.normal(0.0, init_sigma_m, xy_gt.shape)}
+    pb = {
+        "n_points": n,
+        "anchors_idx": anchors,
+        "anchors_xy": xy_gt[anchors],
+        "pairs": pairs,
+        "ranges_m": ranges,
+        "init_xy": xy_gt + rng.normal(0.0, init_sigma_m, xy_gt.shape),
+    }
     return pb, xy_gt
 
 
 def _thesis_1d():
     """Thesis §3.1.4: true positions 1..5 on a line, the first known, unit ranges between neighbours."""
-    return {"n_points": 5, "anchors_idx": [0], "anchors_xy": [[1.0, 0.0]],
-            "pairs": [[0, 1], [1, 2], [2, 3], [3, 4]], "ranges_m": [1.0, 1.0, 1.0, 1.0]}
+    return {
+        "n_points": 5,
+        "anchors_idx": [0],
+        "anchors_xy": [[1.0, 0.0]],
+        "pairs": [[0, 1], [1, 2], [2, 3], [3, 4]],
+        "ranges_m": [1.0, 1.0, 1.0, 1.0],
+    }
 
 
 # --- the thesis's 1-D check -------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("init", ["default", "line"])
 @pytest.mark.parametrize("weighting", ["thesis", "unit"])
@@ -67,12 +83,20 @@ def test_non_monotone_1d_path_with_all_pairs():
     """Thesis note: for the path 1, 2, 1, 2, 1 every pairwise |x_i - x_j| is needed (zero ranges included)."""
     x_gt = np.array([1.0, 2.0, 1.0, 2.0, 1.0])
     i, j = np.triu_indices(5, k=1)
-    out = sn.solve_coordinates(5, [0], [[1.0, 0.0]], np.c_[i, j], np.abs(x_gt[i] - x_gt[j]),
-                               init_xy=np.c_[x_gt + 0.1 * np.array([0, 1, -1, 1, -1]), np.zeros(5)], **TIGHT)
+    out = sn.solve_coordinates(
+        5,
+        [0],
+        [[1.0, 0.0]],
+        np.c_[i, j],
+        np.abs(x_gt[i] - x_gt[j]),
+        init_xy=np.c_[x_gt + 0.1 * np.array([0, 1, -1, 1, -1]), np.zeros(5)],
+        **TIGHT,
+    )
     assert_allclose(out["xy"], np.c_[x_gt, np.zeros(5)], rtol=0, atol=1e-7)
 
 
 # --- Ceres equals scipy -----------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("n, seed", [(20, 1), (30, 2), (40, 3), (50, 4), (50, 5)])
 @pytest.mark.parametrize("robust_loss", ["none", "huber", "cauchy"])
@@ -114,9 +138,9 @@ def test_default_start_equals_reference_interpolation():
     got = sn.default_init(16, idx, a_xy)
     assert_allclose(got, ref.default_init(16, idx, a_xy), rtol=0, atol=1e-12)
     assert_allclose(got[3], [3.0, 5.0])
-    assert_allclose(got[5], [6.5, 1.5])                      # halfway between 3 and 7
-    assert_allclose(got[:3], np.tile([3.0, 5.0], (3, 1)))     # held before the first anchor
-    assert_allclose(got[13:], np.zeros((3, 2)))              # held after the last
+    assert_allclose(got[5], [6.5, 1.5])  # halfway between 3 and 7
+    assert_allclose(got[:3], np.tile([3.0, 5.0], (3, 1)))  # held before the first anchor
+    assert_allclose(got[13:], np.zeros((3, 2)))  # held after the last
     out = sn.solve_coordinates(16, idx, a_xy, [[0, 1]], [1.0], max_iterations=0)
     assert_allclose(out["xy"], got, rtol=0, atol=0)
 
@@ -130,6 +154,7 @@ def test_coincident_start_points_are_pushed_apart():
 
 
 # --- weights ----------------------------------------------------------------------------------------
+
 
 def test_thesis_weight_law_equals_explicit_weights():
     pb, _ = _cloud(40, 11)
@@ -150,7 +175,7 @@ def test_thesis_weight_law_equals_explicit_weights():
     p = explicit["xy"]
     r_range = (b - np.linalg.norm(p[pb["pairs"][:, 0]] - p[pb["pairs"][:, 1]], axis=1)) / (b + 2.0)
     r_anchor = p[pb["anchors_idx"]] - pb["anchors_xy"]
-    assert_allclose(explicit["cost"], 0.5 * (np.sum(r_range ** 2) + np.sum(r_anchor ** 2)), rtol=1e-9)
+    assert_allclose(explicit["cost"], 0.5 * (np.sum(r_range**2) + np.sum(r_anchor**2)), rtol=1e-9)
 
 
 def test_weight_law_must_stay_positive():
@@ -162,6 +187,7 @@ def test_weight_law_must_stay_positive():
 
 # --- robust loss ------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("robust_loss", ["huber", "cauchy"])
 def test_robust_loss_reduces_an_outlier_range(robust_loss):
     """GIVEN a clean problem WHEN one range is 5 m too long THEN the plain solution is pulled apart
@@ -172,7 +198,7 @@ def test_robust_loss_reduces_an_outlier_range(robust_loss):
     pb["ranges_m"][10] += 5.0
     plain = sn.solve_coordinates(**pb, **TIGHT)
     robust = sn.solve_coordinates(**pb, robust_loss=robust_loss, loss_scale=0.05, **TIGHT)
-    assert np.max(np.abs(plain["xy"] - robust["xy"])) > 0.05          # the loss changes the result
+    assert np.max(np.abs(plain["xy"] - robust["xy"])) > 0.05  # the loss changes the result
 
     def err(xy):
         return np.max(np.linalg.norm(xy - xy_gt, axis=1))
@@ -191,22 +217,27 @@ def test_robust_loss_reduces_an_outlier_range(robust_loss):
 
 # --- bad input --------------------------------------------------------------------------------------
 
+
 def test_bad_input_lists_every_problem():
     with pytest.raises(ValueError) as exc:
-        sn.solve_coordinates(4, [0, 9], [[0.0, 0.0], [1.0, 1.0]], [[0, 1], [2, 2], [3, 7]],
-                             [1.0, -1.0, np.nan])
+        sn.solve_coordinates(
+            4, [0, 9], [[0.0, 0.0], [1.0, 1.0]], [[0, 1], [2, 2], [3, 7]], [1.0, -1.0, np.nan]
+        )
     msg = str(exc.value)
     for part in ("anchor index", "pair index", "itself", "negative or non-finite"):
         assert part in msg, msg
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"anchors_idx": [0.5]}, "integers"),
-    ({"anchors_xy": [[1.0, 0.0, 0.0]]}, "shape"),
-    ({"pairs": [0, 1, 1, 2, 2, 3, 3, 4]}, "shape"),
-    ({"init_xy": np.zeros((4, 2))}, "init_xy"),
-    ({"anchors_idx": [], "anchors_xy": np.zeros((0, 2))}, "default start needs at least one anchor"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"anchors_idx": [0.5]}, "integers"),
+        ({"anchors_xy": [[1.0, 0.0, 0.0]]}, "shape"),
+        ({"pairs": [0, 1, 1, 2, 2, 3, 3, 4]}, "shape"),
+        ({"init_xy": np.zeros((4, 2))}, "init_xy"),
+        ({"anchors_idx": [], "anchors_xy": np.zeros((0, 2))}, "default start needs at least one anchor"),
+    ],
+)
 def test_bad_shapes_and_types(kwargs, match):
     pb = {**_thesis_1d(), **kwargs}
     with pytest.raises(ValueError, match=match):
@@ -219,6 +250,7 @@ def test_bad_loss_name():
 
 
 # --- timing harness ---------------------------------------------------------------------------------
+
 
 def test_benchmark_harness_runs():
     """The timing harness (its numbers are for make bench, not asserted). Its walk's minimum is flat

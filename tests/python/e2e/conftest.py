@@ -1,5 +1,6 @@
 """Fixtures for the end-to-end SIL tests: one default simulated walk (stridefixd and the CLI come
 from tests/python/conftest.py)."""
+
 from __future__ import annotations
 
 import json

@@ -5,6 +5,7 @@ GIVEN the aadr2015 foyer surveyed (a recording of its own) and turned into a sit
 `stridefix radiomap build`, WHEN stridefixd replays a walk of the track with that site, THEN every
 scheme judges every Wi-Fi scan (FIX audit records), every scheme publishes POSE from its first fix
 on, and the fused schemes beat Wi-Fi alone at the reference points."""
+
 from __future__ import annotations
 
 import json
@@ -19,8 +20,12 @@ from stridefix import fix_t, pose_t, wifi_scan_t
 
 
 def run_fw(stridefixd: Path, walk: Path, log: Path, *extra: str) -> subprocess.CompletedProcess:
-    return subprocess.run([str(stridefixd), "--input", str(walk / "board.candump"), "--log", str(log), "-q",
-                           *extra], capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [str(stridefixd), "--input", str(walk / "board.candump"), "--log", str(log), "-q", *extra],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -31,8 +36,18 @@ def site(stridefixd, cli, tmp_path_factory) -> Path:
     summary = json.loads((out / "sim_summary.json").read_text())
     assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
     site = out / "site.sfsite"
-    proc = cli("radiomap", "build", str(out / "fw.lcmlog"), str(out / "truth.lcmlog"), "--mode", "survey",
-               "--out", str(site), "--map-rotation-deg", str(summary["map_rotation_deg"]))
+    proc = cli(
+        "radiomap",
+        "build",
+        str(out / "fw.lcmlog"),
+        str(out / "truth.lcmlog"),
+        "--mode",
+        "survey",
+        "--out",
+        str(site),
+        "--map-rotation-deg",
+        str(summary["map_rotation_deg"]),
+    )
     assert proc.returncode == 0, proc.stderr
     return site
 
@@ -60,8 +75,11 @@ def test_every_scheme_judges_every_scan(walk):
         assert first.reason == fix_t.REASON_INITIALISED and first.accepted and first.alpha == 1.0
     for f in fixes:
         assert f.reason_text and 0.0 <= f.alpha <= 1.0
-        assert f.accepted == (f.reason in (fix_t.REASON_ACCEPTED, fix_t.REASON_INITIALISED,
-                                           fix_t.REASON_RECOVERY)) or f.reason == fix_t.REASON_SCHEME_IGNORES
+        assert (
+            f.accepted
+            == (f.reason in (fix_t.REASON_ACCEPTED, fix_t.REASON_INITIALISED, fix_t.REASON_RECOVERY))
+            or f.reason == fix_t.REASON_SCHEME_IGNORES
+        )
 
 
 def test_every_scheme_publishes_pose_after_its_first_fix(walk):
@@ -72,8 +90,15 @@ def test_every_scheme_publishes_pose_after_its_first_fix(walk):
 
 
 def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
-    proc = cli("analyze", str(walk["log"]), str(walk["dir"] / "truth.lcmlog"), "--truth-source", "waypoint",
-               "--out", str(tmp_path))
+    proc = cli(
+        "analyze",
+        str(walk["log"]),
+        str(walk["dir"] / "truth.lcmlog"),
+        "--truth-source",
+        "waypoint",
+        "--out",
+        str(tmp_path),
+    )
     assert proc.returncode == 0, proc.stderr
     per = json.loads((tmp_path / "metrics.json").read_text())["per_scheme"]
     n = {k: v["position_error_m"]["n"] for k, v in per.items()}
@@ -87,8 +112,10 @@ def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
 def test_same_input_same_fix_and_pose_records(walk, stridefixd, site, tmp_path):
     log = tmp_path / "again.lcmlog"
     assert run_fw(stridefixd, walk["dir"], log, "--site", str(site)).returncode == 0
+
     def records(events):
         return [(e.timestamp, e.channel, e.data) for e in events if e.channel in ("FIX", "POSE", "STEP")]
+
     assert records(lcm.EventLog(str(log), "r")) == records(walk["events"])
 
 
@@ -108,7 +135,6 @@ def test_bad_site_file_stops_startup(stridefixd, walk, site, tmp_path, damage):
         assert "CRC" in proc.stderr
 
 
-
 @pytest.fixture(scope="module")
 def office_walk(stridefixd, cli, default_walk, tmp_path_factory) -> list:
     """The default office walk replayed with a site from a survey of the office (seed 1000)."""
@@ -116,8 +142,18 @@ def office_walk(stridefixd, cli, default_walk, tmp_path_factory) -> list:
     assert cli("sim", "--scenario", "office_survey", "--seed", "1000", "--out", str(out)).returncode == 0
     assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
     site = out / "site.sfsite"
-    proc = cli("radiomap", "build", str(out / "fw.lcmlog"), str(out / "truth.lcmlog"), "--mode", "survey",
-               "--out", str(site), "--map-rotation-deg", "20")
+    proc = cli(
+        "radiomap",
+        "build",
+        str(out / "fw.lcmlog"),
+        str(out / "truth.lcmlog"),
+        "--mode",
+        "survey",
+        "--out",
+        str(site),
+        "--map-rotation-deg",
+        "20",
+    )
     assert proc.returncode == 0, proc.stderr
     log = out / "walk.lcmlog"
     proc = run_fw(stridefixd, default_walk["dir"], log, "--site", str(site))
@@ -130,8 +166,9 @@ def test_stride_is_recalibrated_from_fixes(office_walk):
     Kalman-accepted fixes over the corridors' straight stretches, within its bounds and by at most
     10 % a time."""
     from stridefix import step_t
+
     steps = [step_t.decode(e.data) for e in office_walk if e.channel == "STEP"]
-    k = np.array([s.length_m / s.accel_range_mps2 ** 0.25 for s in steps if s.accel_range_mps2 > 0])
+    k = np.array([s.length_m / s.accel_range_mps2**0.25 for s in steps if s.accel_range_mps2 > 0])
     assert abs(k[0] - 0.47) < 1e-3
     changes = np.flatnonzero(np.abs(np.diff(k)) > 1e-4)
     assert len(changes) >= 2

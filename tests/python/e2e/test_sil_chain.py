@@ -3,6 +3,7 @@
 GIVEN the default SIL walk, WHEN the real firmware binary replays its candump log, THEN every IMU
 sample the simulator sent is in the LCM log, nothing failed to decode, the step count is within 3 %
 of the truth, and the analyzer scores the log. Bad input lines are counted and skipped, not fatal."""
+
 from __future__ import annotations
 
 import json
@@ -17,8 +18,15 @@ from stridefix import health_t
 
 
 def run_stridefixd(stridefixd: Path, walk_dir: Path, log: Path, candump: Path | None = None, stdin=None):
-    cmd = [str(stridefixd), "--input", "-" if stdin is not None else str(candump or walk_dir / "board.candump"),
-           "--log", str(log), "--config", str(walk_dir / "init_truth.ini")]
+    cmd = [
+        str(stridefixd),
+        "--input",
+        "-" if stdin is not None else str(candump or walk_dir / "board.candump"),
+        "--log",
+        str(log),
+        "--config",
+        str(walk_dir / "init_truth.ini"),
+    ]
     return subprocess.run(cmd, input=stdin, capture_output=True, text=True, timeout=300)
 
 
@@ -80,10 +88,13 @@ def test_stdin_pipe_gives_the_same_log(stridefixd, default_walk, replay, tmp_pat
     log = tmp_path / "pipe.lcmlog"
     proc = run_stridefixd(stridefixd, default_walk["dir"], log, stdin=candump)
     assert proc.returncode == 0, proc.stderr
+
     # Event timestamps come from the candump lines, so the same input gives the same events; only
     # HEALTH differs, as it carries run-time measurements (loop timing, log writer progress).
     def events(path):
-        return [(e.timestamp, e.channel, e.data) for e in lcm.EventLog(str(path), "r") if e.channel != "HEALTH"]
+        return [
+            (e.timestamp, e.channel, e.data) for e in lcm.EventLog(str(path), "r") if e.channel != "HEALTH"
+        ]
 
     assert events(log) == events(replay["log"])
 
@@ -92,8 +103,12 @@ def test_lcm_logplayer_reads_the_log(replay):
     player = shutil.which("lcm-logplayer")
     if player is None:
         pytest.fail("lcm-logplayer not installed (liblcm-bin)")
-    proc = subprocess.run([player, "-v", "-s", "1000000", "-l", "memq://", str(replay["log"])],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [player, "-v", "-s", "1000000", "-l", "memq://", str(replay["log"])],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 0, proc.stderr
     total = sum(replay["counts"].values())
     played = len(re.findall(r"^\s*\d+.*IMU", proc.stdout + proc.stderr, flags=re.M))
@@ -101,7 +116,9 @@ def test_lcm_logplayer_reads_the_log(replay):
 
 
 def test_analyzer_scores_the_log(replay, default_walk, tmp_path, cli):
-    proc = cli("analyze", str(replay["log"]), str(default_walk["dir"] / "truth.lcmlog"), "--out", str(tmp_path))
+    proc = cli(
+        "analyze", str(replay["log"]), str(default_walk["dir"] / "truth.lcmlog"), "--out", str(tmp_path)
+    )
     assert proc.returncode == 0, proc.stderr
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     err = metrics["position_error_m"]
@@ -120,9 +137,9 @@ def test_bad_lines_are_counted_and_skipped(stridefixd, default_walk, tmp_path):
     t = lines[500].split(")")[0] + ")"
     bad = [
         "this is not a candump line\n",
-        f"{t} can0 7FF#0011223344556677\n",   # unknown id
-        f"{t} can0 100#001122\n",             # IMU_ACCEL truncated to 3 bytes
-        f"{t} can0 100#0011X2\n",             # bad hex
+        f"{t} can0 7FF#0011223344556677\n",  # unknown id
+        f"{t} can0 100#001122\n",  # IMU_ACCEL truncated to 3 bytes
+        f"{t} can0 100#0011X2\n",  # bad hex
     ]
     spliced = lines[:501] + bad + lines[501:]
     candump = tmp_path / "bad.candump"
@@ -138,8 +155,11 @@ def test_bad_lines_are_counted_and_skipped(stridefixd, default_walk, tmp_path):
 
 
 def test_missing_input_exits_2(stridefixd, tmp_path):
-    proc = subprocess.run([str(stridefixd), "--input", str(tmp_path / "nope.candump"), "--no-log"],
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [str(stridefixd), "--input", str(tmp_path / "nope.candump"), "--no-log"],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 2
     assert "nope.candump" in proc.stderr
 
@@ -172,12 +192,19 @@ def test_lost_frames_and_board_time_wrap(stridefixd, tmp_path, cli):
     # The board times of the received IMU samples are exactly those of the clean run (to 1 ms),
     # straight through the 32-bit wrap.
     from stridefix import imu_t
+
     clean_log = tmp_path / "clean.lcmlog"
     assert run_stridefixd(stridefixd, clean, clean_log).returncode == 0
-    t_clean = {imu_t.decode(e.data).seq: imu_t.decode(e.data).t_us
-               for e in lcm.EventLog(str(clean_log), "r") if e.channel == "IMU"}
-    t_lossy = [(imu_t.decode(e.data).seq, imu_t.decode(e.data).t_us)
-               for e in lcm.EventLog(str(log), "r") if e.channel == "IMU"]
+    t_clean = {
+        imu_t.decode(e.data).seq: imu_t.decode(e.data).t_us
+        for e in lcm.EventLog(str(clean_log), "r")
+        if e.channel == "IMU"
+    }
+    t_lossy = [
+        (imu_t.decode(e.data).seq, imu_t.decode(e.data).t_us)
+        for e in lcm.EventLog(str(log), "r")
+        if e.channel == "IMU"
+    ]
     assert max(t for _, t in t_lossy) > 2**32 * 1000  # past the wrap
     assert all(t_clean[seq] == t for seq, t in t_lossy)
     assert counts["STEP"] == pytest.approx(got["steps"], rel=0.03)

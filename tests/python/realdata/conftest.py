@@ -1,4 +1,5 @@
 """Fixtures for the real-data tests: handmade msindoor traces, the shared msindoor data, stridefixd."""
+
 from __future__ import annotations
 
 import json
@@ -56,8 +57,9 @@ def handmade_trace(tmp_path) -> Path:
 def real_trace() -> Path:
     """One real site1/F2 trace from ../shared/data/msindoor (skips when the data is absent)."""
     if not REAL_TRACE.is_file():
-        pytest.skip(f"real msindoor data not found at {REAL_TRACE} (needs ../shared/data beside "
-                    "the repository)")
+        pytest.skip(
+            f"real msindoor data not found at {REAL_TRACE} (needs ../shared/data beside the repository)"
+        )
     return REAL_TRACE
 
 
@@ -66,12 +68,21 @@ def realbench_small(request, tmp_path_factory, cli) -> dict:
     """GIVEN `stridefix realbench pdr-distance --limit 4` run on site1/F2: its output and JSON."""
     floor = MSINDOOR / "site1" / "F2"
     if not floor.is_dir():
-        pytest.skip(f"real msindoor data not found at {floor} (needs ../shared/data beside the "
-                    "repository)")
+        pytest.skip(f"real msindoor data not found at {floor} (needs ../shared/data beside the repository)")
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench")
-    proc = cli("realbench", "pdr-distance", "--floor", str(floor), "--limit", "4",
-               "--stridefixd", str(stridefixd), "--out", str(out))
+    proc = cli(
+        "realbench",
+        "pdr-distance",
+        "--floor",
+        str(floor),
+        "--limit",
+        "4",
+        "--stridefixd",
+        str(stridefixd),
+        "--out",
+        str(out),
+    )
     return {"proc": proc, "out": out, "floor": floor}
 
 
@@ -141,8 +152,9 @@ def gsd_log(tmp_path) -> Path:
 def real_gsd() -> Path:
     """One real IPIN 2023 logfile from ../shared/data/gsd (skips when the data is absent)."""
     if not REAL_GSD.is_file():
-        pytest.skip(f"real GetSensorData logs not found at {REAL_GSD} (needs ../shared/data beside "
-                    "the repository)")
+        pytest.skip(
+            f"real GetSensorData logs not found at {REAL_GSD} (needs ../shared/data beside the repository)"
+        )
     return REAL_GSD
 
 
@@ -152,13 +164,29 @@ def realbench_fusion_small(request, tmp_path_factory, cli) -> dict:
     leave-one-walk-out fusion benchmark on 5 real walks): its process, results and folders."""
     floor = MSINDOOR / "site1" / "F2"
     if not floor.is_dir():
-        pytest.skip(f"real msindoor data not found at {floor} (needs ../shared/data beside the "
-                    "repository)")
+        pytest.skip(f"real msindoor data not found at {floor} (needs ../shared/data beside the repository)")
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench_fusion")
     results = out / "results.json"
-    proc = cli("realbench", "--format", "msindoor", str(floor), "--limit", "5",
-               "--stridefixd", str(stridefixd), "--out", str(results), "--quiet")
+    proc = cli(
+        "realbench",
+        "--format",
+        "msindoor",
+        str(floor),
+        "--limit",
+        "5",
+        "--stridefixd",
+        str(stridefixd),
+        "--out",
+        str(results),
+        "--quiet",
+    )
     doc = json.loads(results.read_text()) if results.is_file() else None
-    return {"proc": proc, "out": out, "results": results, "doc": doc, "floor": floor,
-            "stridefixd": stridefixd}
+    return {
+        "proc": proc,
+        "out": out,
+        "results": results,
+        "doc": doc,
+        "floor": floor,
+        "stridefixd": stridefixd,
+    }

@@ -1,4 +1,5 @@
 """The msindoor importer: handmade trace with known content, and one real trace."""
+
 from __future__ import annotations
 
 import math
@@ -8,7 +9,6 @@ import lcm
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-
 from stridefix import imu_t, truth_t, wifi_scan_t
 from stridefix_analyzer.logread import read_logs
 from stridefix_sim.importers import msindoor
@@ -28,7 +28,7 @@ def test_handmade_counts_and_summary(handmade_trace, tmp_path):
     assert s["skipped_lines"] == 4
     assert s["ignored_lines_by_type"] == {"TYPE_ACCELEROMETER_UNCALIBRATED": 1}
     assert s["floor_name"] == "B1" and s["floor"] == -1
-    assert s["duration_s"] == pytest.approx(8.0)        # 1000 ms .. 9000 ms
+    assert s["duration_s"] == pytest.approx(8.0)  # 1000 ms .. 9000 ms
     assert s["wifi_aps_stale_dropped"] == 1 and s["wifi_aps_duplicate_dropped"] == 1
     assert s["wifi_aps_written"] == 3
     assert s["events"] == 3 + 2 + 2 + 2
@@ -58,8 +58,11 @@ def test_handmade_imu_pairs_gyro_interpolated_to_accel_times(handmade_trace, tmp
 
 def test_handmade_wifi_scans_grouped_cached_dropped(handmade_trace, tmp_path):
     _import(handmade_trace, tmp_path)
-    scans = [wifi_scan_t.decode(e.data) for e in lcm.EventLog(str(tmp_path / "out.lcmlog"), "r")
-             if e.channel == "WIFI"]
+    scans = [
+        wifi_scan_t.decode(e.data)
+        for e in lcm.EventLog(str(tmp_path / "out.lcmlog"), "r")
+        if e.channel == "WIFI"
+    ]
     assert [m.t_us for m in scans] == [5_000_000, 8_000_000]
     first, second = scans
     # 5000 ms: aa:..:02 was last seen 3.5 s before the scan -> cached, dropped
@@ -86,17 +89,23 @@ def test_handmade_waypoints_become_truth_in_time_order(handmade_trace, tmp_path)
     assert times == sorted(times)
     truth = [truth_t.decode(e.data) for e in events if e.channel == "TRUTH"]
     assert [(m.t_us, m.x_m, m.y_m, m.floor) for m in truth] == [
-        (1_000_000, 1.0, 2.0, -1), (9_000_000, 4.0, 6.0, -1)]
-    assert all(math.isnan(m.heading_rad) and m.step_count == -1
-               and m.source == truth_t.SOURCE_WAYPOINT for m in truth)
+        (1_000_000, 1.0, 2.0, -1),
+        (9_000_000, 4.0, 6.0, -1),
+    ]
+    assert all(
+        math.isnan(m.heading_rad) and m.step_count == -1 and m.source == truth_t.SOURCE_WAYPOINT
+        for m in truth
+    )
     # event timestamp = the message's t_us
     for e in events:
         if e.channel == "IMU":
             assert imu_t.decode(e.data).t_us == e.timestamp
 
 
-@pytest.mark.parametrize("name, index", [("F1", 0), ("F2", 1), ("F10", 9), ("B1", -1), ("B2", -2),
-                                         ("1F", 0), ("2B", -2), ("L3", 2), ("G", 0)])
+@pytest.mark.parametrize(
+    "name, index",
+    [("F1", 0), ("F2", 1), ("F10", 9), ("B1", -1), ("B2", -2), ("1F", 0), ("2B", -2), ("L3", 2), ("G", 0)],
+)
 def test_floor_index(name, index):
     assert msindoor.floor_index(name) == index
 
@@ -140,16 +149,16 @@ def test_many_malformed_lines_are_summed_up(tmp_path):
 
 def test_cli_imports_each_trace_and_names_missing_one(handmade_trace, tmp_path, cli):
     out = tmp_path / "logs"
-    proc = cli("import", "msindoor", str(handmade_trace), str(tmp_path / "missing.txt"),
-               "--out", str(out))
+    proc = cli("import", "msindoor", str(handmade_trace), str(tmp_path / "missing.txt"), "--out", str(out))
     assert proc.returncode == 2
     assert (out / "handmade.lcmlog").is_file()
     assert "missing.txt: no such file" in proc.stderr
-    assert f"{handmade_trace}:9:" in proc.stderr          # the malformed-line warning
+    assert f"{handmade_trace}:9:" in proc.stderr  # the malformed-line warning
     assert "[1/2]" in proc.stderr
 
 
 # --- one real trace ------------------------------------------------------------------------------
+
 
 def _count_type(path, kind: str) -> int:
     with open(path, encoding="utf-8") as f:
@@ -170,7 +179,7 @@ def test_real_trace(real_trace, tmp_path):
     assert 45 <= 1e6 / np.median(np.diff(mag["t_us"])) <= 55
     truth = data.table("TRUTH")
     assert len(truth) == s["waypoints"] == _count_type(real_trace, "TYPE_WAYPOINT")
-    assert set(truth["floor"].tolist()) == {1}          # FloorName F2
+    assert set(truth["floor"].tolist()) == {1}  # FloorName F2
     wifi = data.table("WIFI")
     assert len(wifi) >= 10 and np.all(wifi["n_ap"] > 0)
     # accelerometer magnitude of a phone held flat: about g on average
@@ -182,10 +191,12 @@ def test_default_wifi_age_limit_is_2_s(tmp_path):
     # issue 5: an entry last seen more than ~2 s before its scan is cached and dropped (was 3 s)
     assert msindoor.DEFAULT_MAX_WIFI_AGE_S == 2.0
     path = tmp_path / "ages.txt"
-    path.write_text("#\tFloorName:F1\n"
-                    "5000\tTYPE_WIFI\ta\taa:bb:cc:dd:ee:01\t-50\t2412\t3100\n"    # 1.9 s: kept
-                    "5000\tTYPE_WIFI\tb\taa:bb:cc:dd:ee:02\t-60\t2412\t2500\n",   # 2.5 s: cached
-                    encoding="utf-8")
+    path.write_text(
+        "#\tFloorName:F1\n"
+        "5000\tTYPE_WIFI\ta\taa:bb:cc:dd:ee:01\t-50\t2412\t3100\n"  # 1.9 s: kept
+        "5000\tTYPE_WIFI\tb\taa:bb:cc:dd:ee:02\t-60\t2412\t2500\n",  # 2.5 s: cached
+        encoding="utf-8",
+    )
     trace = msindoor.read_trace(path)
     assert trace.scans[0].bssid.tolist() == [0xAABBCCDDEE01]
     assert trace.stats["wifi_aps_stale_dropped"] == 1

@@ -1,4 +1,5 @@
 """The real-data PDR distance benchmark: calibration on synthetic segments, and a small real run."""
+
 from __future__ import annotations
 
 import json
@@ -7,11 +8,10 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-
 from stridefix_analyzer import realbench as rb
 
-
 # --- calibration and segments on synthetic data ---------------------------------------------------
+
 
 @pytest.fixture
 def three_walks():
@@ -53,31 +53,43 @@ def test_lowo_stride_is_median_of_other_walks():
 
 def _walk(waypoints, step_t_s, ranges, imu_s=(0.0, 100.0)):
     wp = np.asarray(waypoints, float)
-    return {"walk": "w", "trace": "w.txt", "error": None, "warnings": [],
-            "import": {"waypoints": len(wp), "imu_t_first_us": int(imu_s[0] * 1e6),
-                       "imu_t_last_us": int(imu_s[1] * 1e6)},
-            "waypoint_t_us": (wp[:, 0] * 1e6).astype(np.int64), "waypoint_xy_m": wp[:, 1:],
-            "step_t_us": (np.asarray(step_t_s) * 1e6).astype(np.int64),
-            "step_range_mps2": np.asarray(ranges, float),
-            "step_length_m": np.full(len(step_t_s), 0.7)}
+    return {
+        "walk": "w",
+        "trace": "w.txt",
+        "error": None,
+        "warnings": [],
+        "import": {
+            "waypoints": len(wp),
+            "imu_t_first_us": int(imu_s[0] * 1e6),
+            "imu_t_last_us": int(imu_s[1] * 1e6),
+        },
+        "waypoint_t_us": (wp[:, 0] * 1e6).astype(np.int64),
+        "waypoint_xy_m": wp[:, 1:],
+        "step_t_us": (np.asarray(step_t_s) * 1e6).astype(np.int64),
+        "step_range_mps2": np.asarray(ranges, float),
+        "step_length_m": np.full(len(step_t_s), 0.7),
+    }
 
 
 def test_segments_take_steps_after_start_up_to_end():
     # waypoints at 0 s (0,0), 10 s (6,8) = 10 m, 12 s (7,8) = 1 m (short), 200 s (7,20): no IMU
-    walk = _walk([(0, 0, 0), (10, 6, 8), (12, 7, 8), (200, 7, 20)],
-                 [0.0, 5.0, 10.0, 11.0], [16.0, 81.0, 1.0, 16.0])
+    walk = _walk(
+        [(0, 0, 0), (10, 6, 8), (12, 7, 8), (200, 7, 20)], [0.0, 5.0, 10.0, 11.0], [16.0, 81.0, 1.0, 16.0]
+    )
     seg = rb.build_segments([walk], min_segment_m=3.0)
     assert seg["true_m"].tolist() == pytest.approx([10.0, 1.0, 12.0])
     # t0 < t <= t1: the step at 0 s is not in segment 0, the one at 10 s is
     assert seg["n_steps"].tolist() == [2, 1, 0]
-    assert seg["weinberg"][0] == pytest.approx(3.0 + 1.0)       # 81^¼ + 1^¼
+    assert seg["weinberg"][0] == pytest.approx(3.0 + 1.0)  # 81^¼ + 1^¼
     assert seg["excluded"].tolist() == ["", "shorter than 3 m", "not covered by IMU data"]
 
 
 def test_score_segments_end_to_end_synthetic():
     # two walks, both K = 0.5 exactly: LOWO recovers it, errors vanish
-    walks = [_walk([(0, 0, 0), (10, 10, 0)], np.arange(1, 11), np.full(10, 16.0)),
-             _walk([(0, 0, 0), (10, 0, 5)], np.arange(1, 6), np.full(5, 16.0))]
+    walks = [
+        _walk([(0, 0, 0), (10, 10, 0)], np.arange(1, 11), np.full(10, 16.0)),
+        _walk([(0, 0, 0), (10, 0, 5)], np.arange(1, 6), np.full(5, 16.0)),
+    ]
     seg, fits = rb.score_segments(rb.build_segments(walks), 2)
     assert_allclose(fits["K"], [0.5, 0.5])
     assert_allclose(seg["err_pct"], [0.0, 0.0], atol=1e-9)
@@ -85,6 +97,7 @@ def test_score_segments_end_to_end_synthetic():
 
 
 # --- a small real run through the built stridefixd ------------------------------------------------
+
 
 def test_realbench_small_run(realbench_small):
     proc, out = realbench_small["proc"], realbench_small["out"]
@@ -123,8 +136,18 @@ def test_realbench_reuses_cached_imports(realbench_small, cli, stridefixd):
     out = realbench_small["out"]
     before = {p.name: p.stat().st_mtime_ns for p in (out / "cache").glob("*.lcmlog")}
     assert len(before) == 4
-    proc = cli("realbench", "pdr-distance", "--floor", str(realbench_small["floor"]), "--limit",
-               "2", "--stridefixd", str(stridefixd), "--out", str(out))
+    proc = cli(
+        "realbench",
+        "pdr-distance",
+        "--floor",
+        str(realbench_small["floor"]),
+        "--limit",
+        "2",
+        "--stridefixd",
+        str(stridefixd),
+        "--out",
+        str(out),
+    )
     assert proc.returncode == 0, proc.stderr
     after = {p.name: p.stat().st_mtime_ns for p in (out / "cache").glob("*.lcmlog")}
     assert after == before

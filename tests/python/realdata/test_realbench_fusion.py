@@ -4,6 +4,7 @@ Synthetic checks of the fold machinery (sufficient-statistics maps, rotation and
 learning), then a small real run (5 msindoor walks) checked for sanity, leakage, determinism, and
 against evo's APE on the same trajectories.
 """
+
 from __future__ import annotations
 
 import math
@@ -14,7 +15,6 @@ import lcm
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-
 from stridefix import truth_t, wifi_scan_t
 from stridefix_analyzer import radiomap as rm
 from stridefix_analyzer import realbench as rb
@@ -26,6 +26,7 @@ SCHEMES = ("pdr_only", "wifi_only", "overwrite", "static", "adaptive", "kalman")
 
 
 # --- synthetic walks with WIFI + TRUTH -------------------------------------------------------------
+
 
 def _truth(t_us, x, y, floor):
     m = truth_t()
@@ -56,7 +57,7 @@ def write_walk(path, seed: int, floor: int = 0, extra_ap: int | None = None):
     for k, t in enumerate(np.arange(1.0, 70.0, 2.0)):
         aps = [(0x100 + a, int(rng.integers(-90, -40))) for a in rng.choice(10, 6, replace=False)]
         if k == 3:
-            aps.append((aps[0][0], aps[0][1] + 5))          # the same BSSID twice: strongest kept
+            aps.append((aps[0][0], aps[0][1] + 5))  # the same BSSID twice: strongest kept
         if extra_ap is not None:
             aps.append((extra_ap, -60))
         events.append((t, "WIFI", _scan(t * 1e6, aps, complete=k != 5)))
@@ -69,15 +70,32 @@ def write_walk(path, seed: int, floor: int = 0, extra_ap: int | None = None):
 @pytest.fixture
 def synthetic_walks(tmp_path):
     """GIVEN five synthetic walks (one on floor 1, the last with a unique AP 0xBEEF): recordings."""
-    paths = [write_walk(tmp_path / f"w{i}.lcmlog", seed=i, floor=1 if i == 2 else 0,
-                        extra_ap=0xBEEF if i == 4 else None) for i in range(5)]
+    paths = [
+        write_walk(
+            tmp_path / f"w{i}.lcmlog", seed=i, floor=1 if i == 2 else 0, extra_ap=0xBEEF if i == 4 else None
+        )
+        for i in range(5)
+    ]
     return [rm.load_recordings([p])[0] for p in paths]
 
 
 def _site_arrays(site):
-    return {k: np.asarray(getattr(site, k)) for k in (
-        "ap_bssid", "rp_x_m", "rp_y_m", "rp_floor", "rp_scans", "entry_ap", "entry_rp",
-        "entry_mean_dbm", "entry_std_db", "entry_count", "floor_height_m")}
+    return {
+        k: np.asarray(getattr(site, k))
+        for k in (
+            "ap_bssid",
+            "rp_x_m",
+            "rp_y_m",
+            "rp_floor",
+            "rp_scans",
+            "entry_ap",
+            "entry_rp",
+            "entry_mean_dbm",
+            "entry_std_db",
+            "entry_count",
+            "floor_height_m",
+        )
+    }
 
 
 @pytest.mark.parametrize("held", [0, 2, 4])
@@ -88,14 +106,14 @@ def test_fold_map_equals_the_map_built_from_the_other_walks(synthetic_walks, hel
     # WHEN the fold's map is taken as total - held out walk
     fold, _ = (total - stats[held]).to_site(lowest_floor=0)
     # THEN it is the walk-mode map that build_site makes from scratch from the other walks
-    ref, _ = rm.build_site([r for i, r in enumerate(synthetic_walks) if i != held], mode="walk",
-                           lowest_floor=0)
+    ref, _ = rm.build_site(
+        [r for i, r in enumerate(synthetic_walks) if i != held], mode="walk", lowest_floor=0
+    )
     a, b = _site_arrays(fold), _site_arrays(ref)
-    for k in ("ap_bssid", "rp_floor", "rp_scans", "entry_ap", "entry_rp", "entry_count",
-              "floor_height_m"):
+    for k in ("ap_bssid", "rp_floor", "rp_scans", "entry_ap", "entry_rp", "entry_count", "floor_height_m"):
         assert_array_equal(a[k], b[k], err_msg=k)
     for k in ("rp_x_m", "rp_y_m", "entry_mean_dbm", "entry_std_db"):
-        assert_allclose(a[k], b[k], rtol=0, atol=1e-5, err_msg=k)   # float32 in the site
+        assert_allclose(a[k], b[k], rtol=0, atol=1e-5, err_msg=k)  # float32 in the site
     assert fold.n_entries > 50
 
 
@@ -116,8 +134,12 @@ def test_held_out_walk_never_contributes_to_its_own_site(synthetic_walks):
     # GIVEN walk 4 is the only one hearing AP 0xBEEF
     stats = [rm.WalkStats.from_recordings([r]) for r in synthetic_walks]
     total = rm.WalkStats.total(stats)
-    sites = [rf.fold_site(total, stats[i], name=f"w{i}", rotation_deg=0.0,
-                          floor_heights_m=[0.0, 4.0], lowest_floor=0)[0] for i in range(5)]
+    sites = [
+        rf.fold_site(
+            total, stats[i], name=f"w{i}", rotation_deg=0.0, floor_heights_m=[0.0, 4.0], lowest_floor=0
+        )[0]
+        for i in range(5)
+    ]
     # THEN its own fold's site does not know the AP, and every other fold's does
     assert 0xBEEF not in list(sites[4].ap_bssid)
     assert all(0xBEEF in list(sites[i].ap_bssid) for i in range(4))
@@ -135,12 +157,13 @@ def test_subtracting_a_walk_that_is_not_part_fails(synthetic_walks):
 
 # --- rotation and floor heights --------------------------------------------------------------------
 
+
 def synthetic_rotation_walk(rot_deg: float, seed: int, noise_deg: float = 8.0):
     """Waypoints on a zig-zag, a step every 0.5 s whose heading is the segment direction + rot +
     noise; the first 3 s of each segment turn smoothly from the previous direction (a corner)."""
     rng = np.random.default_rng(seed)
     wp = np.cumsum(rng.uniform(-25, 25, size=(7, 2)), axis=0)
-    wp_t = np.cumsum(np.r_[0.0, np.hypot(*np.diff(wp, axis=0).T) / 1.2])   # 1.2 m/s
+    wp_t = np.cumsum(np.r_[0.0, np.hypot(*np.diff(wp, axis=0).T) / 1.2])  # 1.2 m/s
     t_steps, head = [], []
     prev = None
     for k in range(len(wp) - 1):
@@ -152,8 +175,7 @@ def synthetic_rotation_walk(rot_deg: float, seed: int, noise_deg: float = 8.0):
             t_steps.append(t)
             head.append(h + math.radians(rot_deg) + math.radians(noise_deg) * rng.standard_normal())
         prev = d
-    return ((np.array(t_steps) * 1e6).astype(np.int64), np.array(head),
-            (wp_t * 1e6).astype(np.int64), wp)
+    return ((np.array(t_steps) * 1e6).astype(np.int64), np.array(head), (wp_t * 1e6).astype(np.int64), wp)
 
 
 @pytest.mark.parametrize("rot_deg", [-31.0, 0.0, 97.5, 179.0])
@@ -167,7 +189,7 @@ def test_rotation_learning_recovers_a_known_rotation(rot_deg):
 
 def test_rotation_of_a_fold_ignores_the_held_out_walk():
     stats = [rf.rotation_stats(*synthetic_rotation_walk(10.0, s)) for s in range(3)]
-    stats.append(rf.rotation_stats(*synthetic_rotation_walk(120.0, 9)))   # an outlier walk
+    stats.append(rf.rotation_stats(*synthetic_rotation_walk(120.0, 9)))  # an outlier walk
     assert abs(rf.learn_rotation_deg(stats, exclude=3) - 10.0) < 2.0
     assert abs(rf.learn_rotation_deg(stats) - 10.0) > 5.0
     assert math.isnan(rf.learn_rotation_deg(stats[:1], exclude=0))
@@ -196,6 +218,7 @@ def test_default_benchmark_is_fusion():
 
 
 # --- a small real run ------------------------------------------------------------------------------
+
 
 def test_end_to_end_on_five_real_walks(realbench_fusion_small):
     r = realbench_fusion_small
@@ -251,10 +274,22 @@ def test_replay_with_a_site_is_deterministic(realbench_fusion_small, tmp_path):
     streams = []
     for i in range(2):
         log = tmp_path / f"run{i}.lcmlog"
-        subprocess.run([str(r["stridefixd"]), "--input", f"lcmlog:{imp}", "--site",
-                        f"{row['dir']}/site.sfsite", "--set",
-                        f"stride.weinberg_k={row['fold']['K']:.6f}", "--log", str(log), "-q"],
-                       check=True, capture_output=True)
+        subprocess.run(
+            [
+                str(r["stridefixd"]),
+                "--input",
+                f"lcmlog:{imp}",
+                "--site",
+                f"{row['dir']}/site.sfsite",
+                "--set",
+                f"stride.weinberg_k={row['fold']['K']:.6f}",
+                "--log",
+                str(log),
+                "-q",
+            ],
+            check=True,
+            capture_output=True,
+        )
         streams.append(_pose_stream(log))
     a, b = streams
     assert len(a["t_us"]) > 100 and set(np.unique(a["scheme"])) == set(range(6))
@@ -267,7 +302,6 @@ def test_mean_and_rmse_equal_evo_ape(realbench_fusion_small, tmp_path):
     computes (APE, translation part, no alignment) from our TUM exports."""
     evo_metrics = pytest.importorskip("evo.core.metrics")
     from evo.tools import file_interface
-
     from stridefix_analyzer.analyze import run_analyze
     from stridefix_analyzer.tum import write_tum
 
@@ -275,22 +309,28 @@ def test_mean_and_rmse_equal_evo_ape(realbench_fusion_small, tmp_path):
     checked = 0
     for row in r["doc"]["groups"][0]["walk_rows"][:3]:
         imp = r["out"] / "cache" / "site1-F2" / f"{row['walk']}.lcmlog"
-        summary, metrics = run_analyze([f"{row['dir']}/stridefixd.lcmlog", str(imp)],
-                                       str(tmp_path / row["walk"]), truth_source="waypoint")
+        summary, metrics = run_analyze(
+            [f"{row['dir']}/stridefixd.lcmlog", str(imp)],
+            str(tmp_path / row["walk"]),
+            truth_source="waypoint",
+        )
         paths = write_tum(metrics, tmp_path / row["walk"] / "tum")
         for name, s in summary["per_scheme"].items():
             ours = s["position_error_m"]
             if ours["n"] < 2:
                 continue
             ref = file_interface.read_tum_trajectory_file(
-                paths["truth"] if "truth_" + name not in paths else paths["truth_" + name])
+                paths["truth"] if "truth_" + name not in paths else paths["truth_" + name]
+            )
             est = file_interface.read_tum_trajectory_file(paths[name])
             ape = evo_metrics.APE(evo_metrics.PoseRelation.translation_part)
             ape.process_data((ref, est))
-            assert_allclose(ape.get_statistic(evo_metrics.StatisticsType.mean), ours["mean"],
-                            rtol=0, atol=1e-6)
-            assert_allclose(ape.get_statistic(evo_metrics.StatisticsType.rmse), ours["rmse"],
-                            rtol=0, atol=1e-6)
+            assert_allclose(
+                ape.get_statistic(evo_metrics.StatisticsType.mean), ours["mean"], rtol=0, atol=1e-6
+            )
+            assert_allclose(
+                ape.get_statistic(evo_metrics.StatisticsType.rmse), ours["rmse"], rtol=0, atol=1e-6
+            )
             # and the per-walk numbers of results.json are these
             assert_allclose(row["fixes"][name]["mean"], ours["mean"], rtol=0, atol=1e-9)
             checked += 1

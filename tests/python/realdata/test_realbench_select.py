@@ -1,6 +1,7 @@
 """realbench's per-fold matcher choice by cross-validation inside the training walks
 (``stridefix_analyzer.realbench_select``): the fix-error arithmetic, the user's override, and a real
 run on 8 msindoor walks checked for the choice rule and for leakage of the held-out block."""
+
 from __future__ import annotations
 
 import json
@@ -9,7 +10,6 @@ import lcm
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-
 from stridefix import fix_t, pose_t
 from stridefix_analyzer import realbench_select as rs
 from stridefix_analyzer.sitefile import read_site
@@ -28,8 +28,12 @@ def test_fix_errors_against_interpolated_truth(tmp_path):
     # truth: (0,0) at 0 s → (10,0) at 10 s. Fixes at 2 s (2 schemes repeat it), 5 s, 12 s (outside).
     path = tmp_path / "fw.lcmlog"
     log = lcm.EventLog(str(path), "w", overwrite=True)
-    for m in (_fix(2_000_000, 2.0, 3.0, 1), _fix(2_000_000, 2.0, 3.0, 5),
-              _fix(5_000_000, 9.0, 0.0, 1), _fix(12_000_000, 0.0, 0.0, 1)):
+    for m in (
+        _fix(2_000_000, 2.0, 3.0, 1),
+        _fix(2_000_000, 2.0, 3.0, 5),
+        _fix(5_000_000, 9.0, 0.0, 1),
+        _fix(12_000_000, 0.0, 0.0, 1),
+    ):
         log.write_event(m.t_us, "FIX", m.encode())
     log.close()
     err = rs.fix_errors_m(path, [0, 10_000_000], [[0.0, 0.0], [10.0, 0.0]])
@@ -42,8 +46,7 @@ def test_pose_errors_are_causal_at_the_waypoints(tmp_path):
     # 2 s (latest pose (1,0) against (1,2): 2 m) and 3 s ((4,4) against (1,0): 5 m).
     path = tmp_path / "fw.lcmlog"
     log = lcm.EventLog(str(path), "w", overwrite=True)
-    for t, x, y, sigma in ((500_000, 0.0, 0.0, 1e6), (1_000_000, 1.0, 0.0, 2.0),
-                           (3_000_000, 4.0, 4.0, 2.0)):
+    for t, x, y, sigma in ((500_000, 0.0, 0.0, 1e6), (1_000_000, 1.0, 0.0, 2.0), (3_000_000, 4.0, 4.0, 2.0)):
         m = pose_t()
         m.t_us, m.x_m, m.y_m, m.sigma_m, m.scheme = t, x, y, sigma, pose_t.SCHEME_ADAPTIVE
         log.write_event(t, "POSE", m.encode())
@@ -63,8 +66,9 @@ def test_a_user_setting_replaces_the_candidates():
 
 def test_too_few_walks_keep_the_firmware_default():
     walks = [{"walk": str(i)} for i in range(rs.MIN_WALKS - 1)]
-    choice, report = rs.select(walks, None, stridefixd="x", work_dir="unused", base_sets=[],
-                               candidates=rs.MATCHER_VARIANTS)
+    choice, report = rs.select(
+        walks, None, stridefixd="x", work_dir="unused", base_sets=[], candidates=rs.MATCHER_VARIANTS
+    )
     assert choice == [next(iter(rs.MATCHER_VARIANTS))] * len(walks)
     assert report["chosen_by"].startswith("default")
     assert rs.n_tasks(rs.MIN_WALKS - 1, 2) == 0
@@ -75,8 +79,10 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
     """10 synthetic walks, 4 blocks (walk i in block i mod 4). Each walk's ``stats`` is a bit, so the
     removed statistics say exactly which walks a map left out. Fake replays report an error that
     favours "2 scans" only when block a is 1, so the choice must follow the block."""
-    walks = [{"walk": f"w{i}", "stats": 1 << i, "import_log": "-", "waypoint_t_us": [],
-              "waypoint_xy_m": []} for i in range(10)]
+    walks = [
+        {"walk": f"w{i}", "stats": 1 << i, "import_log": "-", "waypoint_t_us": [], "waypoint_xy_m": []}
+        for i in range(10)
+    ]
     sites = {}
 
     def build_site(removed, others, name, path):
@@ -88,23 +94,30 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
     def replay(task):
         replays.append(task)
         better = "2 scans, dBm" if task["a"] == 1 else "1 scan, dBm"
-        return {**task, "errors": np.array([1.0 if task["name"] == better else 2.0]),
-                "failure": None}
+        return {**task, "errors": np.array([1.0 if task["name"] == better else 2.0]), "failure": None}
 
-    choice, report = rs.select(walks, build_site, stridefixd="x", work_dir=tmp_path, base_sets=["k=v"],
-                               candidates=rs.MATCHER_VARIANTS, jobs=1, replay=replay)
+    choice, report = rs.select(
+        walks,
+        build_site,
+        stridefixd="x",
+        work_dir=tmp_path,
+        base_sets=["k=v"],
+        candidates=rs.MATCHER_VARIANTS,
+        jobs=1,
+        replay=replay,
+    )
     assert choice == ["2 scans, dBm" if i % 4 == 1 else "1 scan, dBm" for i in range(10)]
     assert len(replays) == rs.n_tasks(10, len(rs.MATCHER_VARIANTS)) == 3 * 10 * 6
     for t in replays:
         removed, others = sites[t["site"]]
         a = t["a"]
         walk = int(t["walk"][1:])
-        assert walk % 4 != a                                  # never a walk of the scored block
+        assert walk % 4 != a  # never a walk of the scored block
         left_out = {i for i in range(10) if removed >> i & 1}
         assert {i for i in range(10) if i % 4 == a} <= left_out  # the map never saw block a
-        assert walk in left_out                               # nor the replayed walk
+        assert walk in left_out  # nor the replayed walk
         assert not {int(w[1:]) for w in others} & left_out
-        assert t["sets"][0] == "k=v"                          # the user's settings come first
+        assert t["sets"][0] == "k=v"  # the user's settings come first
     for b in report["blocks"].values():
         assert b["candidates"]["1 scan, dBm"]["fixes"] > 0
 
@@ -118,8 +131,20 @@ def realbench_eight(request, tmp_path_factory, cli) -> dict:
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench_select")
     results = out / "results.json"
-    proc = cli("realbench", "--format", "msindoor", str(floor), "--limit", "8", "--no-report",
-               "--stridefixd", str(stridefixd), "--out", str(results), "--quiet")
+    proc = cli(
+        "realbench",
+        "--format",
+        "msindoor",
+        str(floor),
+        "--limit",
+        "8",
+        "--no-report",
+        "--stridefixd",
+        str(stridefixd),
+        "--out",
+        str(results),
+        "--quiet",
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     return {"doc": json.loads(results.read_text()), "out": out}
 

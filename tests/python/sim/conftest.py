@@ -1,5 +1,6 @@
 """Fixtures for the simulator tests: short simulated runs (via the CLI), the default walk simulated
 once in-process, a reference step detector and a candump parser."""
+
 from __future__ import annotations
 
 import argparse
@@ -7,11 +8,9 @@ import re
 import time
 from pathlib import Path
 
-import numpy as np
-
 import cantools
+import numpy as np
 import pytest
-
 from stridefix_sim import cli as sim_cli_module
 from stridefix_sim.board import DBC_PATH
 from stridefix_sim.pipeline import simulate
@@ -107,8 +106,9 @@ def default_result():
     return result, time.perf_counter() - t0
 
 
-def detect_steps(accel_mps2: np.ndarray, rate_hz: float = 100.0, threshold_mps2: float = 0.3,
-                 min_gap_s: float = 0.3) -> np.ndarray:
+def detect_steps(
+    accel_mps2: np.ndarray, rate_hz: float = 100.0, threshold_mps2: float = 0.3, min_gap_s: float = 0.3
+) -> np.ndarray:
     """Reference step detector (not the firmware's): project on the mean gravity direction (fixed
     mounting), remove the mean, keep samples above ``threshold_mps2`` that are the maximum within
     ±``min_gap_s``. Returns sample indices."""

@@ -1,11 +1,11 @@
 """Board emulator output: candump syntax, DBC decoding, frame order, seq/time counters, loss, wrap."""
+
 from __future__ import annotations
 
 import json
 
 import numpy as np
 import pytest
-
 from stridefix_sim.board import EPOCH_US, emulate_board
 from stridefix_sim.scenario import default_scenario
 from stridefix_sim.sensors import SensorData
@@ -147,17 +147,28 @@ def test_board_time_wraps_at_2_pow_32(wrap_run, dbc, candump):
 def test_values_are_clamped_into_dbc_range(dbc):
     n = 3
     sensors = SensorData(
-        accel_mps2=np.array([[1e4, -1e4, 9.8]] * n), gyro_dps=np.array([[5000.0, -5000.0, 0.0]] * n),
-        mag_idx=np.arange(n), mag_ut=np.array([[1e3, -1e3, 0.0]] * n),
-        baro_idx=np.arange(n), pressure_pa=np.array([2e5] * n), temperature_degc=np.array([400.0] * n))
+        accel_mps2=np.array([[1e4, -1e4, 9.8]] * n),
+        gyro_dps=np.array([[5000.0, -5000.0, 0.0]] * n),
+        mag_idx=np.arange(n),
+        mag_ut=np.array([[1e3, -1e3, 0.0]] * n),
+        baro_idx=np.arange(n),
+        pressure_pa=np.array([2e5] * n),
+        temperature_degc=np.array([400.0] * n),
+    )
     sc = default_scenario().data
     out = emulate_board(sensors, [], n, sc, np.random.default_rng(0))
-    acc = next(dbc.decode_message(0x100, bytes.fromhex(l.split("#")[1])) for l in out.lines if " 100#" in l)
+    acc = next(
+        dbc.decode_message(0x100, bytes.fromhex(ln.split("#")[1])) for ln in out.lines if " 100#" in ln
+    )
     assert acc["accel_x"] == pytest.approx(156.9016, abs=0.01)
     assert acc["accel_y"] == pytest.approx(-156.9064, abs=0.01)
-    gyr = next(dbc.decode_message(0x101, bytes.fromhex(l.split("#")[1])) for l in out.lines if " 101#" in l)
+    gyr = next(
+        dbc.decode_message(0x101, bytes.fromhex(ln.split("#")[1])) for ln in out.lines if " 101#" in ln
+    )
     assert gyr["gyro_x"] == pytest.approx(1999.94, abs=0.01)
-    baro = next(dbc.decode_message(0x120, bytes.fromhex(l.split("#")[1])) for l in out.lines if " 120#" in l)
+    baro = next(
+        dbc.decode_message(0x120, bytes.fromhex(ln.split("#")[1])) for ln in out.lines if " 120#" in ln
+    )
     assert baro["pressure"] == pytest.approx(167772.15)
     assert baro["temperature"] == pytest.approx(327.67)
 

@@ -1,6 +1,7 @@
 """Two floors: the true floor changes exactly on the stairs and in the elevator, the barometer sees
 the storey height, the elevator's ride is in the accelerometer, Wi-Fi is attenuated across floors,
 the TRUTH log carries floor and heading."""
+
 from __future__ import annotations
 
 import math
@@ -9,7 +10,6 @@ import lcm
 import numpy as np
 import pytest
 from stridefix import truth_t
-
 from stridefix_sim.pipeline import TRUTH_CHANNEL, write_truth_log
 from stridefix_sim.sensors import pressure_pa
 from stridefix_sim.walker import ACT_ELEVATOR, ACT_STAIRS, ACT_STILL, ACT_WALK, MODE_STAIRS, MODE_WALK
@@ -33,7 +33,7 @@ def test_floor_changes_exactly_on_the_stairs_and_in_the_elevator(default_result)
     moving_level = np.abs(np.gradient(w.level_m)) > 1e-6
     stairs = spans(w.activity == ACT_STAIRS)
     zone = np.zeros(len(w.t_s), bool)
-    zone[stairs[0][0] - 100: stairs[-1][1] + 100] = True  # flights, landing and the blends
+    zone[stairs[0][0] - 100 : stairs[-1][1] + 100] = True  # flights, landing and the blends
     assert np.all(zone[moving_level] | (w.activity[moving_level] == ACT_ELEVATOR))
     assert w.level_m[0] == 0.0 and w.level_m[-1] == 0.0
     assert w.level_m.max() == pytest.approx(r.world.storey_m, abs=1e-9)
@@ -55,7 +55,7 @@ def test_stairs_are_slower_and_shorter_with_the_right_vertical_speed(default_res
 def test_elevator_ride_shows_in_the_accelerometer(default_result):
     r, _ = default_result
     w = r.walk
-    (a, b), = spans(w.activity == ACT_ELEVATOR)
+    ((a, b),) = spans(w.activity == ACT_ELEVATOR)
     assert (b - a) / 100 == pytest.approx(6.0, abs=1.5)  # 3.5 m at ≤ 1 m/s with 0.8 m/s² ramps
     assert w.vz_mps[a:b].min() == pytest.approx(-1.0, abs=0.01)
     g = r.sensors.accel_mps2[:200].mean(axis=0)
@@ -65,7 +65,7 @@ def test_elevator_ride_shows_in_the_accelerometer(default_result):
     # going down: lighter while accelerating, heavier while braking
     assert ride.min() < -0.6 and ride.max() > 0.6
     assert np.argmin(ride) < np.argmax(ride)
-    before = vert[a - 100:a]
+    before = vert[a - 100 : a]
     assert np.abs(before).max() < 0.15  # standing still in the cab before it moves
     assert np.all(w.speed_mps[a:b] == 0)
 
@@ -84,11 +84,13 @@ def test_barometer_sees_the_storey_height(default_result):
     below = (t_b > t_up0 - 12) & (t_b < t_up0 - 2)
     above = (t_b > t_up1 + 2) & (t_b < t_up1 + 12)
     assert s.pressure_pa[below].mean() - s.pressure_pa[above].mean() == pytest.approx(expected, abs=5.0)
-    (a, b), = spans(w.activity == ACT_ELEVATOR)
+    ((a, b),) = spans(w.activity == ACT_ELEVATOR)
     ta, tb = w.t_s[a], w.t_s[b - 1]
     in_cab_up = (t_b > ta - 2.5) & (t_b < ta) & (act_b == ACT_STILL)
     in_cab_down = (t_b > tb) & (t_b < tb + 1.8) & (act_b == ACT_STILL)
-    assert s.pressure_pa[in_cab_down].mean() - s.pressure_pa[in_cab_up].mean() == pytest.approx(expected, abs=5.0)
+    assert s.pressure_pa[in_cab_down].mean() - s.pressure_pa[in_cab_up].mean() == pytest.approx(
+        expected, abs=5.0
+    )
 
 
 def test_barometer_drift_is_a_slow_random_walk(default_result):
@@ -122,8 +124,11 @@ def test_wifi_is_attenuated_across_floors(default_result):
 def test_truth_log_carries_floor_and_walking_heading(default_result, tmp_path):
     r, _ = default_result
     write_truth_log(r, tmp_path / "truth.lcmlog")
-    msgs = [truth_t.decode(e.data) for e in lcm.EventLog(str(tmp_path / "truth.lcmlog"), "r")
-            if e.channel == TRUTH_CHANNEL]
+    msgs = [
+        truth_t.decode(e.data)
+        for e in lcm.EventLog(str(tmp_path / "truth.lcmlog"), "r")
+        if e.channel == TRUTH_CHANNEL
+    ]
     idx = r.truth_indices()
     assert len(msgs) == len(idx)
     assert [m.floor for m in msgs] == r.walk.floor[idx].tolist()

@@ -1,18 +1,21 @@
 """Gait: the three paces (cadence, stride), the person drawn from the seed, Weinberg's law between the
 vertical acceleration and the step length, one step event per step, the inverted-pendulum phase."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.scenario import builtin_scenario
 from stridefix_sim.walker import ACT_WALK, MODE_WALK, make_person
 
 PACES = ("slow", "normal", "fast")
 # pace: (cadence range Hz, stride range m), the nominal values ± the person's scale
-RANGES = {"slow": ((1.35, 1.65), (0.47, 0.63)), "normal": ((1.62, 1.98), (0.60, 0.80)),
-          "fast": ((1.90, 2.30), (0.73, 0.97))}
+RANGES = {
+    "slow": ((1.35, 1.65), (0.47, 0.63)),
+    "normal": ((1.62, 1.98), (0.60, 0.80)),
+    "fast": ((1.90, 2.30), (0.73, 0.97)),
+}
 
 
 @pytest.fixture(scope="module")
@@ -47,8 +50,13 @@ def test_each_pace_has_its_cadence_and_stride(pace_runs, pace):
 
 
 def test_faster_pace_is_faster_longer_and_bouncier(pace_runs):
-    med = {p: (np.median(r.walk.step_len_m[interior_walking_steps(r)]),
-               np.median(r.walk.step_p2p_mps2[interior_walking_steps(r)])) for p, r in pace_runs.items()}
+    med = {
+        p: (
+            np.median(r.walk.step_len_m[interior_walking_steps(r)]),
+            np.median(r.walk.step_p2p_mps2[interior_walking_steps(r)]),
+        )
+        for p, r in pace_runs.items()
+    }
     assert med["slow"][0] < med["normal"][0] < med["fast"][0]
     assert med["slow"][1] < med["normal"][1] < med["fast"][1]
     # Weinberg: amplitude ~ length^4, so the fast pace bounces several times more than the slow one
@@ -83,10 +91,10 @@ def test_weinberg_law_relates_amplitude_and_step_length(pace_runs, pace):
         measured.append(az[m].max() - az[m].min())
     measured = np.asarray(measured)
     assert np.median(measured / w.step_p2p_mps2[k[1:]]) == pytest.approx(1.0, abs=0.07)
-    est = K * measured ** 0.25
+    est = K * measured**0.25
     assert np.median(est / w.step_len_m[k[1:]]) == pytest.approx(1.0, abs=0.03)
     # calibrating K on the walk recovers the true K
-    k_fit = w.step_len_m[k[1:]].sum() / (measured ** 0.25).sum()
+    k_fit = w.step_len_m[k[1:]].sum() / (measured**0.25).sum()
     assert k_fit == pytest.approx(K, rel=0.03)
     # step to step, the law holds within a few percent (amplitude noise ~8 % -> ~2 % in length)
     assert np.std(np.log(est / w.step_len_m[k[1:]])) < 0.06
@@ -122,7 +130,10 @@ def test_inverted_pendulum_forward_speed_lowest_when_body_highest(pace_runs, pac
     assert np.corrcoef(ax_board - ax_board.mean(), vz)[0, 1] < -0.5
     # speed and height within a step: speed minimum at the top
     bounce = (w.height_m - w.level_m)[m]
-    assert np.corrcoef(w.speed_mps[m] - np.convolve(w.speed_mps, np.ones(61) / 61, "same")[m], bounce)[0, 1] < -0.5
+    assert (
+        np.corrcoef(w.speed_mps[m] - np.convolve(w.speed_mps, np.ones(61) / 61, "same")[m], bounce)[0, 1]
+        < -0.5
+    )
 
 
 def test_lateral_sway_at_half_the_step_rate(pace_runs):

@@ -1,17 +1,26 @@
 """Scenario files: defaults, overrides, and clear errors (file and key named, exit status 2)."""
+
 from __future__ import annotations
 
 import json
 
 import pytest
-
-from stridefix_sim.scenario import (BUILTIN, DEFAULTS, ScenarioError, builtin_scenario, load_scenario,
-                                    parse_scenario, resolve_scenario)
+from stridefix_sim.scenario import (
+    BUILTIN,
+    DEFAULTS,
+    ScenarioError,
+    builtin_scenario,
+    load_scenario,
+    parse_scenario,
+    resolve_scenario,
+)
 
 
 def test_file_overrides_only_its_keys(tmp_path):
     f = tmp_path / "s.toml"
-    f.write_text('seed = 5\n[walk]\nlaps = 1\n[[walk.pause]]\nat_m = 10\nduration_s = 2\n[can]\nloss_rate = 0.01\n')
+    f.write_text(
+        "seed = 5\n[walk]\nlaps = 1\n[[walk.pause]]\nat_m = 10\nduration_s = 2\n[can]\nloss_rate = 0.01\n"
+    )
     sc = load_scenario(f)
     assert sc.seed == 5 and sc["walk"]["laps"] == 1.0 and sc["can"]["loss_rate"] == 0.01
     assert sc["walk"]["pause"] == [{"at_m": 10.0, "duration_s": 2.0}]
@@ -19,12 +28,15 @@ def test_file_overrides_only_its_keys(tmp_path):
     assert sc.source == str(f)
 
 
-@pytest.mark.parametrize("text, key", [
-    ("colour = 1\n", "colour"),
-    ("[walk]\nlapz = 2\n", "walk.lapz"),
-    ("[imu.extra]\nx = 1\n", "imu.extra"),
-    ("[[walk.pause]]\nat_m = 3\nduration_s = 1\nwhy = 'coffee'\n", "walk.pause[0].why"),
-])
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ("colour = 1\n", "colour"),
+        ("[walk]\nlapz = 2\n", "walk.lapz"),
+        ("[imu.extra]\nx = 1\n", "imu.extra"),
+        ("[[walk.pause]]\nat_m = 3\nduration_s = 1\nwhy = 'coffee'\n", "walk.pause[0].why"),
+    ],
+)
 def test_unknown_key_is_an_error_naming_file_and_key(tmp_path, text, key):
     f = tmp_path / "bad.toml"
     f.write_text(text)
@@ -33,17 +45,20 @@ def test_unknown_key_is_an_error_naming_file_and_key(tmp_path, text, key):
     assert str(f) in str(e.value) and f"'{key}'" in str(e.value)
 
 
-@pytest.mark.parametrize("text, key", [
-    ("[walk]\nlaps = 'two'\n", "walk.laps"),
-    ("[can]\nloss_rate = 1.5\n", "can.loss_rate"),
-    ("[can]\nboard_time_start_ms = 4294967296\n", "can.board_time_start_ms"),
-    ("[imu]\ngyro_bias_dps = [1, 2]\n", "imu.gyro_bias_dps"),
-    ("[world]\nname = 'mars'\n", "world.name"),
-    ("[walk]\npace = 'jog'\n", "walk.pace"),
-    ("[walk]\nroute = 'roof'\n", "walk.route"),
-    ("[walk]\nsurge = 0.1\n", "walk.surge"),
-    ("[person]\nweinberg_k = 2.0\n", "person.weinberg_k"),
-])
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ("[walk]\nlaps = 'two'\n", "walk.laps"),
+        ("[can]\nloss_rate = 1.5\n", "can.loss_rate"),
+        ("[can]\nboard_time_start_ms = 4294967296\n", "can.board_time_start_ms"),
+        ("[imu]\ngyro_bias_dps = [1, 2]\n", "imu.gyro_bias_dps"),
+        ("[world]\nname = 'mars'\n", "world.name"),
+        ("[walk]\npace = 'jog'\n", "walk.pace"),
+        ("[walk]\nroute = 'roof'\n", "walk.route"),
+        ("[walk]\nsurge = 0.1\n", "walk.surge"),
+        ("[person]\nweinberg_k = 2.0\n", "person.weinberg_k"),
+    ],
+)
 def test_bad_values_are_errors_naming_the_key(text, key):
     with pytest.raises(ScenarioError, match=f"x.toml: .*'{key}'"):
         parse_scenario(text, source="x.toml")
@@ -75,8 +90,17 @@ def test_cli_bad_override_exits_2(tmp_path, sim_cli, capsys):
 
 
 def test_builtin_named_scenarios():
-    assert set(BUILTIN) == {"default", "pace_slow", "pace_normal", "pace_fast", "office_survey",
-                            "aadr2015_slow", "aadr2015", "aadr2015_fast", "aadr2015_survey"}
+    assert set(BUILTIN) == {
+        "default",
+        "pace_slow",
+        "pace_normal",
+        "pace_fast",
+        "office_survey",
+        "aadr2015_slow",
+        "aadr2015",
+        "aadr2015_fast",
+        "aadr2015_survey",
+    }
     assert resolve_scenario(None).data == resolve_scenario("default").data == DEFAULTS
     assert DEFAULTS["walk"]["route"] == "tour" and DEFAULTS["walk"]["pace"] == "normal"
     for pace in ("slow", "normal", "fast"):

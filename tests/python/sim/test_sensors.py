@@ -1,11 +1,11 @@
 """Sensor imperfections: magnetic disturbance zones, gyro bias random walk and scale error."""
+
 from __future__ import annotations
 
 import math
 
 import numpy as np
 import pytest
-
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.scenario import builtin_scenario
 
@@ -40,9 +40,14 @@ def test_disturbance_scale_zero_leaves_the_field_clean():
 @pytest.fixture(scope="module")
 def drifting_gyro_run():
     """GIVEN a walk with a strongly drifting gyro bias (0.02 °/s/√s) and a 2 % z scale error."""
-    sc = builtin_scenario("pace_normal").with_overrides(**{
-        "duration_s": 120.0, "seed": 4, "imu.gyro_bias_rw_dps_per_sqrt_s": 0.02,
-        "imu.gyro_scale_error": [0.0, 0.0, 0.02]})
+    sc = builtin_scenario("pace_normal").with_overrides(
+        **{
+            "duration_s": 120.0,
+            "seed": 4,
+            "imu.gyro_bias_rw_dps_per_sqrt_s": 0.02,
+            "imu.gyro_scale_error": [0.0, 0.0, 0.02],
+        }
+    )
     return simulate(sc)
 
 

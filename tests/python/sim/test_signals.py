@@ -1,10 +1,10 @@
 """Physical plausibility of the simulated signals: one detectable vertical peak per step, none while
 standing, gyro yaw matching the heading change, magnetometer and barometer levels."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.scenario import default_scenario
 from stridefix_sim.sensors import earth_field_map_ut
@@ -13,10 +13,16 @@ from stridefix_sim.sensors import earth_field_map_ut
 @pytest.fixture(scope="module")
 def mounted_run():
     """GIVEN a board mounted tilted and turned on the body, 45 s including the first pause."""
-    sc = default_scenario().with_overrides(**{
-        "seed": 3, "duration_s": 45.0,
-        "mounting.roll_deg": 25.0, "mounting.pitch_deg": -15.0, "mounting.yaw_deg": 90.0,
-        "walk.pause": [{"at_m": 20.0, "duration_s": 6.0}]})
+    sc = default_scenario().with_overrides(
+        **{
+            "seed": 3,
+            "duration_s": 45.0,
+            "mounting.roll_deg": 25.0,
+            "mounting.pitch_deg": -15.0,
+            "mounting.yaw_deg": 90.0,
+            "walk.pause": [{"at_m": 20.0, "duration_s": 6.0}],
+        }
+    )
     return simulate(sc)
 
 
@@ -52,10 +58,14 @@ def test_magnetometer_and_barometer_levels(mounted_run):
     norm = np.linalg.norm(r.sensors.mag_ut - np.asarray(sc["hard_iron_ut"]), axis=1)
     assert norm[clean].mean() == pytest.approx(sc["field_ut"], abs=0.2)
     # the hard-iron offset is small: the raw norm stays within ~1.2 µT of the field outside zones
-    assert np.all(np.abs(np.linalg.norm(r.sensors.mag_ut[clean], axis=1) - sc["field_ut"]) < 1.2 + 5 * sc["noise_ut"])
+    assert np.all(
+        np.abs(np.linalg.norm(r.sensors.mag_ut[clean], axis=1) - sc["field_ut"]) < 1.2 + 5 * sc["noise_ut"]
+    )
     # at rest (start), tilt-compensated horizontal field points to magnetic north (heading 90° − rotation)
     field_map = earth_field_map_ut(sc["field_ut"], sc["dip_deg"], r.world.map_rotation_deg)
-    assert np.degrees(np.arctan2(field_map[1], field_map[0])) == pytest.approx(90.0 - r.world.map_rotation_deg)
+    assert np.degrees(np.arctan2(field_map[1], field_map[0])) == pytest.approx(
+        90.0 - r.world.map_rotation_deg
+    )
     p = r.sensors.pressure_pa - r.sensors.baro_drift_pa
     assert p.mean() == pytest.approx(101325.0 - 12.0 * 1.1, abs=1.0)
     assert 1.0 < p.std() < 2.5

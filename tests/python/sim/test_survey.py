@@ -1,6 +1,7 @@
 """Survey mode and the aadr2015 foyer: calibration points get exactly 4 orientations x 3 scans while the
 truth stands still on them; the foyer's geometry (Jäger, Süß, Becker); reference-point (WAYPOINT) truth;
 the poor-coverage spot next to the magnetic disturbance; determinism; the old scenarios' bytes."""
+
 from __future__ import annotations
 
 import hashlib
@@ -11,7 +12,6 @@ import lcm
 import numpy as np
 import pytest
 from stridefix import truth_t
-
 from stridefix_sim.board import load_dbc, pack
 from stridefix_sim.pipeline import simulate, write_truth_log
 from stridefix_sim.route import Polyline
@@ -20,10 +20,14 @@ from stridefix_sim.world import aadr2015_world, survey_points
 
 # sha256 of board.candump / truth.lcmlog of the built-in scenarios (seed 1) before survey mode existed
 OLD_BYTES = {
-    "default": ("a5c8a1bca3e22b037252c67bf2dedbd3e1694aca8484461999da9716a6e682ae",
-                "3957dc6dd3c02d9a1a197a6a34eb243e63b53366260639e9a053d0882ae22de9"),
-    "pace_fast": ("85fb529557d80ca7dd3eb950ab6aeacb96b00086e5f2c6538efbadb688fa745e",
-                  "71db26128e42f3b8e6829157861217bee57f664c9b1a322f873773eacdf6a7cb"),
+    "default": (
+        "a5c8a1bca3e22b037252c67bf2dedbd3e1694aca8484461999da9716a6e682ae",
+        "3957dc6dd3c02d9a1a197a6a34eb243e63b53366260639e9a053d0882ae22de9",
+    ),
+    "pace_fast": (
+        "85fb529557d80ca7dd3eb950ab6aeacb96b00086e5f2c6538efbadb688fa745e",
+        "71db26128e42f3b8e6829157861217bee57f664c9b1a322f873773eacdf6a7cb",
+    ),
 }
 
 
@@ -61,7 +65,9 @@ def foyer_track(sim_run):
     return sim_run("--scenario", "aadr2015")
 
 
-def test_survey_every_point_gets_4_orientations_x_3_scans_while_truth_stands_on_it(foyer_survey, candump, dbc):
+def test_survey_every_point_gets_4_orientations_x_3_scans_while_truth_stands_on_it(
+    foyer_survey, candump, dbc
+):
     s = summary(foyer_survey)
     assert s["n_points"] == 67 and s["scans_per_point"] == 12 and s["orientations"] == [0, 90, 180, 270]
     points = {(p["x_m"], p["y_m"], p["floor"]) for p in s["survey_points"]}
@@ -96,10 +102,12 @@ def test_survey_walks_between_points_and_stands_still_while_scanning(foyer_surve
     assert s["steps"] > 2 * 66 and 130 <= s["distance_m"] <= 200
     msgs = truth(foyer_survey)
     xy = np.array([[m.x_m, m.y_m] for m in msgs])
-    assert np.max(np.hypot(*np.diff(xy, axis=0).T)) < 0.25          # walks, never jumps
+    assert np.max(np.hypot(*np.diff(xy, axis=0).T)) < 0.25  # walks, never jumps
     assert np.all((xy >= 0.5) & (xy <= [19.5, 13.5]))
     core = aadr2015_world().blocked_m[0]
-    assert not np.any((xy[:, 0] > core[0]) & (xy[:, 0] < core[2]) & (xy[:, 1] > core[1]) & (xy[:, 1] < core[3]))
+    assert not np.any(
+        (xy[:, 0] > core[0]) & (xy[:, 0] < core[2]) & (xy[:, 1] > core[1]) & (xy[:, 1] < core[3])
+    )
 
 
 def test_aadr2015_geometry():
@@ -108,9 +116,9 @@ def test_aadr2015_geometry():
     assert len(w.aps) == 8 and len({a.bssid for a in w.aps}) == 8
     pts = survey_points(w, 2.0, 0.5, [0], "world")
     assert len(pts) == 67
-    assert np.allclose((pts[:, :2] - 1.0) % 2.0, 0.0)                 # a 2 m grid
+    assert np.allclose((pts[:, :2] - 1.0) % 2.0, 0.0)  # a 2 m grid
     assert np.array_equal(pts, survey_points(w, 2.0, 0.5, [0], "grid"))  # = the walkable-area grid
-    for r in (0.8, 1.0):                                              # the corner radius depends on the pace
+    for r in (0.8, 1.0):  # the corner radius depends on the pace
         assert 68.0 <= Polyline(w.track_m, r).length_m <= 72.0
     assert len(w.reference_points_m) == 14
 
@@ -131,7 +139,7 @@ def test_aadr2015_track_has_14_waypoint_truth_messages_in_order(foyer_track):
     assert np.allclose([[m.x_m, m.y_m] for m in wp], refs)
     assert [(r["x_m"], r["y_m"]) for r in s["reference_points"]] == [tuple(p) for p in refs.tolist()]
     s_ref = [r["s_m"] for r in s["reference_points"]]
-    assert all(b - a > 2.5 for a, b in zip(s_ref, s_ref[1:]))          # in order along the track
+    assert all(b - a > 2.5 for a, b in zip(s_ref, s_ref[1:]))  # in order along the track
     # each waypoint lies on the 10 Hz truth path at its time (walking <= 2 m/s: 100 ms < 0.2 m)
     t_sim = np.array([m.t_us for m in sim])
     xy_sim = np.array([[m.x_m, m.y_m] for m in sim])
@@ -164,7 +172,7 @@ def test_poor_coverage_spot_hears_less(foyer_survey, candump, dbc):
         (inside_n if inside else outside_n).append(sum(r > -70 for _, r in aps))
     assert len(inside_n) >= 4 * 12
     assert np.mean(inside_rssi) < np.mean(outside_rssi) - 8.0
-    assert np.mean(inside_n) < np.mean(outside_n) - 2.0          # fewer usable APs
+    assert np.mean(inside_n) < np.mean(outside_n) - 2.0  # fewer usable APs
 
 
 def test_magnetic_disturbance_next_to_the_poor_spot_and_on_the_track():
@@ -172,12 +180,12 @@ def test_magnetic_disturbance_next_to_the_poor_spot_and_on_the_track():
     x0, y0, x1, y1 = w.poor_coverage_m
     (zone,) = w.mag_zones
     gap = math.hypot(max(x0 - zone.x_m, 0, zone.x_m - x1), max(y0 - zone.y_m, 0, zone.y_m - y1))
-    assert gap < 2.5                                               # next to it
+    assert gap < 2.5  # next to it
     r = simulate(builtin_scenario("aadr2015"))
     wk = r.walk
     in_spot = (wk.x_m >= x0) & (wk.x_m <= x1) & (wk.y_m >= y0) & (wk.y_m <= y1)
-    assert in_spot.sum() > 200                                     # the track crosses the spot (> 2 s)
-    assert r.sensors.mag_zone_w.max() > 0.5                        # and the disturbance
+    assert in_spot.sum() > 200  # the track crosses the spot (> 2 s)
+    assert r.sensors.mag_zone_w.max() > 0.5  # and the disturbance
     field = np.linalg.norm(r.sensors.mag_ut - r.scenario["mag"]["hard_iron_ut"], axis=1)
     clean = r.sensors.mag_zone_w == 0
     assert abs(np.median(field[clean]) - 48.0) < 1.0
@@ -185,8 +193,10 @@ def test_magnetic_disturbance_next_to_the_poor_spot_and_on_the_track():
 
 
 def test_survey_and_track_are_deterministic(sim_run, foyer_survey, foyer_track):
-    for out, argv in ((foyer_survey, ("--seed", "1", "--scenario", "aadr2015_survey")),
-                      (foyer_track, ("--seed", "1", "--scenario", "aadr2015"))):
+    for out, argv in (
+        (foyer_survey, ("--seed", "1", "--scenario", "aadr2015_survey")),
+        (foyer_track, ("--seed", "1", "--scenario", "aadr2015")),
+    ):
         again = sim_run(*argv)
         assert again != out
         for name in ("board.candump", "truth.lcmlog"):
@@ -218,18 +228,21 @@ def test_office_survey_builtin_grid():
     sc = builtin_scenario("office_survey")
     assert sc["survey"]["enabled"] and sc["world"]["name"] == "default"
     pts = survey_points(__import__("stridefix_sim.world", fromlist=["x"]).default_world(), 2.0, 0.5, [0, 1])
-    assert len(pts) == 128                                      # 64 corridor points per floor
+    assert len(pts) == 128  # 64 corridor points per floor
     assert set(np.round((pts[:, 0] - 8) % 2, 9)) == {0} and set(np.round((pts[:, 1] - 5) % 2, 9)) == {0}
 
 
-@pytest.mark.parametrize("text, key", [
-    ("[survey]\nlayout = 'spiral'\n", "survey.layout"),
-    ("[survey]\nfloor = 5\n", "survey.floor"),
-    ("[survey]\nlayout = 'world'\n", "survey.layout"),       # the office has no explicit list
-    ("[survey]\nenabled = 1\n", "survey.enabled"),
-    ("[walk]\nroute = 'track'\n", "walk.route"),             # the office has no track
-    ("[world]\nname = 'aadr2015'\n", "walk.route"),          # the tour needs stairs
-])
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ("[survey]\nlayout = 'spiral'\n", "survey.layout"),
+        ("[survey]\nfloor = 5\n", "survey.floor"),
+        ("[survey]\nlayout = 'world'\n", "survey.layout"),  # the office has no explicit list
+        ("[survey]\nenabled = 1\n", "survey.enabled"),
+        ("[walk]\nroute = 'track'\n", "walk.route"),  # the office has no track
+        ("[world]\nname = 'aadr2015'\n", "walk.route"),  # the tour needs stairs
+    ],
+)
 def test_bad_survey_and_world_keys(text, key):
     with pytest.raises(ScenarioError, match=f"x.toml: .*'{key}'"):
         parse_scenario(text, source="x.toml")
@@ -256,12 +269,12 @@ def test_vectorised_pack_equals_cantools():
                 fields[sig.name] = rng.integers(int(lo), int(hi), n, endpoint=True)
             else:
                 v = rng.uniform(lo, hi, n)
-                v[:3] = [lo, hi, sig.scale * 2.5]                    # range ends and a tie (half to even)
+                v[:3] = [lo, hi, sig.scale * 2.5]  # range ends and a tie (half to even)
                 fields[sig.name] = v
         words = pack(msg, fields)
         for i in range(n):
             want = msg.encode({k: (v[i].item()) for k, v in fields.items()}, strict=False)
-            got = int(words[i]).to_bytes(8, "little")[:msg.length]
+            got = int(words[i]).to_bytes(8, "little")[: msg.length]
             assert got == want, (msg.name, i)
 
 

@@ -1,13 +1,14 @@
 """Truth outputs and determinism: the TRUTH log, the summary, init_truth.ini, same seed → same bytes."""
+
 from __future__ import annotations
 
 import configparser
 import json
+
 import lcm
 import numpy as np
 import pytest
 from stridefix import truth_t
-
 
 SHORT_S = 25.0  # conftest.SHORT_S
 WRAP_START_MS = 2**32 - 5_000  # conftest.WRAP_START_MS
@@ -65,10 +66,28 @@ def test_summary_steps_equal_truth_log_last_step_count(short_run):
     counts = [m.step_count for m in msgs]
     assert all(b >= a for a, b in zip(counts, counts[1:]))
     assert s["distance_m"] == pytest.approx(
-        sum(np.hypot(b.x_m - a.x_m, b.y_m - a.y_m) for a, b in zip(msgs, msgs[1:])), rel=0.02)
-    for key in ("seed", "duration_s", "distance_m", "steps", "imu_samples", "mag_samples", "baro_samples",
-                "wifi_scans", "wifi_ap_frames", "frames_total", "frames_dropped", "board_time_start_ms", "init",
-                "floors_visited", "activity_s", "pace", "weinberg_k", "map_rotation_deg"):
+        sum(np.hypot(b.x_m - a.x_m, b.y_m - a.y_m) for a, b in zip(msgs, msgs[1:])), rel=0.02
+    )
+    for key in (
+        "seed",
+        "duration_s",
+        "distance_m",
+        "steps",
+        "imu_samples",
+        "mag_samples",
+        "baro_samples",
+        "wifi_scans",
+        "wifi_ap_frames",
+        "frames_total",
+        "frames_dropped",
+        "board_time_start_ms",
+        "init",
+        "floors_visited",
+        "activity_s",
+        "pace",
+        "weinberg_k",
+        "map_rotation_deg",
+    ):
         assert key in s
 
 
@@ -90,8 +109,12 @@ def test_init_truth_ini_is_the_first_truth_pose(short_run):
     assert float(ini["init"]["y_m"]) == pytest.approx(first.y_m, abs=1e-3)
     assert float(ini["init"]["heading_rad"]) == pytest.approx(first.heading_rad, abs=1e-6)
     assert int(ini["init"]["floor"]) == 0
-    assert summary(short_run)["init"] == {"x_m": first.x_m, "y_m": first.y_m,
-                                          "heading_rad": pytest.approx(first.heading_rad, abs=1e-6), "floor": 0}
+    assert summary(short_run)["init"] == {
+        "x_m": first.x_m,
+        "y_m": first.y_m,
+        "heading_rad": pytest.approx(first.heading_rad, abs=1e-6),
+        "floor": 0,
+    }
 
 
 def test_default_scenario_is_the_two_floor_tour_and_fast(default_result):

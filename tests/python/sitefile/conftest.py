@@ -1,5 +1,6 @@
 """Fixtures for the site-file and radio-map tests: the C tests' vector site, and synthetic WIFI/TRUTH
 logs written with the real generated LCM types."""
+
 from __future__ import annotations
 
 import argparse
@@ -10,9 +11,7 @@ import types
 
 import lcm
 import pytest
-
 from stridefix import truth_t, wifi_scan_t
-
 from stridefix_analyzer import cli
 
 _VECTORS = pathlib.Path(__file__).resolve().parents[2] / "vectors" / "gen_site_vectors.py"
@@ -65,6 +64,7 @@ def msg():
 @pytest.fixture
 def write_log(tmp_path):
     """``write_log(name, [(channel, msg), ...]) -> path``: an LCM event log in tmp_path."""
+
     def _write(name, events):
         path = tmp_path / name
         log = lcm.EventLog(str(path), "w", overwrite=True)
@@ -72,6 +72,7 @@ def write_log(tmp_path):
             log.write_event(int(m.t_us), channel, m.encode())
         log.close()
         return path
+
     return _write
 
 
@@ -79,6 +80,7 @@ def write_log(tmp_path):
 def stridefix_main():
     """``stridefix_main([...]) -> exit status``: ``stridefix`` with only the radiomap sub-command
     (so these tests do not depend on the other sub-commands' modules importing)."""
+
     def _main(argv):
         parser = argparse.ArgumentParser(prog="stridefix")
         sub = parser.add_subparsers(dest="command", required=True)
@@ -86,4 +88,5 @@ def stridefix_main():
         module.add_parser(sub).set_defaults(_run=module.run)
         args = parser.parse_args([str(a) for a in argv])
         return int(args._run(args) or 0)
+
     return _main

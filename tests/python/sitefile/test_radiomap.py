@@ -1,5 +1,6 @@
 """radiomap build/show on synthetic logs with known RSSIs: a survey (exact means, stds, counts per
 surveyed point) and a walk with sparse truth waypoints (scans interpolated into the right cells)."""
+
 from __future__ import annotations
 
 import math
@@ -7,14 +8,13 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-
 from stridefix_analyzer import cli, radiomap, sitefile
 
 S = 1_000_000  # µs per s
 
 # --- survey: 4 points × 3 scans -------------------------------------------------------------------
 POINTS = [(0.0, 0.0, 0), (4.0, 0.0, 0), (0.0, 4.0, 1), (4.0, 4.0, 1)]
-BASE_A = [-40.0, -50.0, -60.0, -70.0]     # AP 0xA: BASE + (0, −2, +2) in the 3 scans
+BASE_A = [-40.0, -50.0, -60.0, -70.0]  # AP 0xA: BASE + (0, −2, +2) in the 3 scans
 AP_A, AP_B, AP_C, AP_D = 0xA, 0xB, 0xC, 0xD
 
 
@@ -47,8 +47,12 @@ def survey_log(write_log, msg):
 
 def _entries(site):
     """{(bssid, rp): (mean, std, count)}"""
-    return {(site.ap_bssid[a], r): (m, s, c) for a, r, m, s, c in zip(
-        site.entry_ap, site.entry_rp, site.entry_mean_dbm, site.entry_std_db, site.entry_count)}
+    return {
+        (site.ap_bssid[a], r): (m, s, c)
+        for a, r, m, s, c in zip(
+            site.entry_ap, site.entry_rp, site.entry_mean_dbm, site.entry_std_db, site.entry_count
+        )
+    }
 
 
 def test_survey_exact_statistics(survey_log, tmp_path, stridefix_main, capsys):
@@ -60,11 +64,11 @@ def test_survey_exact_statistics(survey_log, tmp_path, stridefix_main, capsys):
     assert site.n_rp == 4 and site.cell_size_m == 0.0
     assert [(x, y, f) for x, y, f in zip(site.rp_x_m, site.rp_y_m, site.rp_floor)] == POINTS
     assert list(site.rp_scans) == [3, 3, 3, 3]
-    assert list(site.ap_bssid) == [AP_A, AP_B, AP_D]              # C heard once: dropped
+    assert list(site.ap_bssid) == [AP_A, AP_B, AP_D]  # C heard once: dropped
     assert (site.lowest_floor, list(site.floor_height_m)) == (0, [0.0, 3.5])
     e = _entries(site)
     assert len(e) == 9
-    spread = math.sqrt(8.0 / 3.0)                                # population std of (0, −2, 2)
+    spread = math.sqrt(8.0 / 3.0)  # population std of (0, −2, 2)
     for k in range(4):
         assert_allclose(e[(AP_A, k)], (BASE_A[k], spread, 3), rtol=1e-6)
         assert_allclose(e[(AP_B, k)], (-72.0, 2.0, 2), rtol=1e-6)
@@ -81,6 +85,7 @@ def test_survey_min_count_one_keeps_single_hearings(survey_log, msg):
 
 # --- walk: waypoints (0,0) → (10,0) → (10,10), one scan per second --------------------------------
 
+
 def walk_position(t_s):
     return (t_s, 0.0) if t_s <= 10.0 else (10.0, t_s - 10.0)
 
@@ -92,17 +97,22 @@ def walk_rssi(x, y):
 def walk_logs(write_log, msg, prefix=""):
     """Firmware-style log with WIFI only and a separate truth log with 3 waypoints (the simulator's
     layout). Scans at 0.5 … 19.5 s; plus one before the truth, one after it, one incomplete."""
-    truth = [("TRUTH", msg.truth(0, 0, 0)), ("TRUTH", msg.truth(10 * S, 10, 0)),
-             ("TRUTH", msg.truth(20 * S, 10, 10))]
+    truth = [
+        ("TRUTH", msg.truth(0, 0, 0)),
+        ("TRUTH", msg.truth(10 * S, 10, 0)),
+        ("TRUTH", msg.truth(20 * S, 10, 10)),
+    ]
     scans = []
     for i in range(20):
         t = i + 0.5
         x, y = walk_position(t)
         aps = [(0x1, walk_rssi(x, y))] + ([(0x2, -80.0)] if x < 4 else [])
         scans.append(("WIFI", msg.scan(round(t * S), aps, scan_id=i)))
-    scans += [("WIFI", msg.scan(-1 * S, [(0x1, -1.0)], scan_id=100)),
-              ("WIFI", msg.scan(25 * S, [(0x1, -1.0)], scan_id=101)),
-              ("WIFI", msg.scan(round(5.25 * S), [(0x1, -1.0)], scan_id=102, complete=False))]
+    scans += [
+        ("WIFI", msg.scan(-1 * S, [(0x1, -1.0)], scan_id=100)),
+        ("WIFI", msg.scan(25 * S, [(0x1, -1.0)], scan_id=101)),
+        ("WIFI", msg.scan(round(5.25 * S), [(0x1, -1.0)], scan_id=102, complete=False)),
+    ]
     scans.sort(key=lambda e: e[1].t_us)
     return (write_log(f"{prefix}fw.lcmlog", scans), write_log(f"{prefix}truth.lcmlog", truth))
 
@@ -119,8 +129,25 @@ def expected_cells(cell_m=2.0):
 def test_walk_scans_interpolated_into_cells(write_log, msg, tmp_path, stridefix_main, capsys):
     fw, truth = walk_logs(write_log, msg)
     out = tmp_path / "walk.sfsite"
-    assert stridefix_main(["radiomap", "build", fw, truth, "--out", out, "--cell-size-m", "2",
-                           "--name", "corridor", "--map-rotation-deg", "-12.5"]) == 0
+    assert (
+        stridefix_main(
+            [
+                "radiomap",
+                "build",
+                fw,
+                truth,
+                "--out",
+                out,
+                "--cell-size-m",
+                "2",
+                "--name",
+                "corridor",
+                "--map-rotation-deg",
+                "-12.5",
+            ]
+        )
+        == 0
+    )
     text = capsys.readouterr().out
     assert "mode        walk" in text
     assert "skipped: incomplete 1, outside_truth 2" in text
@@ -136,7 +163,7 @@ def test_walk_scans_interpolated_into_cells(write_log, msg, tmp_path, stridefix_
     for r, positions in enumerate(cells.values()):
         rssi = [walk_rssi(x, y) for x, y in positions]
         assert_allclose(e[(0x1, r)], (np.mean(rssi), np.std(rssi), len(rssi)), rtol=1e-6)
-    assert {r for b, r in e if b == 0x2} == {0, 1}              # heard only at x < 4 m
+    assert {r for b, r in e if b == 0x2} == {0, 1}  # heard only at x < 4 m
 
 
 def test_recordings_with_commas_are_kept_apart(write_log, msg):
@@ -150,12 +177,17 @@ def test_recordings_with_commas_are_kept_apart(write_log, msg):
 
 
 def test_walk_skips_scans_between_floors(write_log, msg):
-    events = [("TRUTH", msg.truth(0, 0, 0, 0)), ("TRUTH", msg.truth(4 * S, 0, 0, 0)),
-              ("TRUTH", msg.truth(10 * S, 0, 0, 1)), ("TRUTH", msg.truth(14 * S, 0, 0, 1))]
+    events = [
+        ("TRUTH", msg.truth(0, 0, 0, 0)),
+        ("TRUTH", msg.truth(4 * S, 0, 0, 0)),
+        ("TRUTH", msg.truth(10 * S, 0, 0, 1)),
+        ("TRUTH", msg.truth(14 * S, 0, 0, 1)),
+    ]
     events += [("WIFI", msg.scan(t * S, [(0x1, -50.0)], scan_id=t)) for t in (1, 2, 3, 6, 7, 11, 12, 13)]
     log = write_log("stairs.lcmlog", sorted(events, key=lambda e: e[1].t_us))
-    site, summary = radiomap.build_site(radiomap.load_recordings([str(log)]), mode="walk",
-                                        floor_heights_m=[0.0, 4.2])
+    site, summary = radiomap.build_site(
+        radiomap.load_recordings([str(log)]), mode="walk", floor_heights_m=[0.0, 4.2]
+    )
     assert summary["scans"]["skipped_floor_change"] == 2
     assert list(site.rp_floor) == [0, 1] and list(site.rp_scans) == [3, 3]
     assert list(site.floor_height_m) == [0.0, 4.2]
@@ -171,15 +203,20 @@ def test_missing_truth_is_a_clear_error(write_log, msg, tmp_path, stridefix_main
     fw, _ = walk_logs(write_log, msg)
     assert stridefix_main(["radiomap", "build", fw, "--out", tmp_path / "x.sfsite"]) == 2
     assert "no TRUTH messages" in capsys.readouterr().err
-    assert stridefix_main(["radiomap", "build", tmp_path / "nope.lcmlog", "--out",
-                           tmp_path / "x.sfsite"]) == 2
+    assert (
+        stridefix_main(["radiomap", "build", tmp_path / "nope.lcmlog", "--out", tmp_path / "x.sfsite"]) == 2
+    )
     assert "nope.lcmlog" in capsys.readouterr().err
 
 
 def test_show_summary_and_png(survey_log, tmp_path, stridefix_main, capsys):
     out = tmp_path / "s.sfsite"
-    assert stridefix_main(["radiomap", "build", survey_log, "--out", out, "--lowest-floor", "-1",
-                           "--floor-height-m", "3"]) == 0
+    assert (
+        stridefix_main(
+            ["radiomap", "build", survey_log, "--out", out, "--lowest-floor", "-1", "--floor-height-m", "3"]
+        )
+        == 0
+    )
     capsys.readouterr()
     png = tmp_path / "plots" / "rps.png"
     assert stridefix_main(["radiomap", "show", out, "--png", png]) == 0

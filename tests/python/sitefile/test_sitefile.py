@@ -1,5 +1,6 @@
 """sitefile: write → read round trip, and every kind of corrupt or invalid file rejected with a
 message naming the file and the problem."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -9,7 +10,6 @@ import zlib
 
 import numpy as np
 import pytest
-
 from stridefix_analyzer import sitefile
 from stridefix_analyzer.sitefile import HEADER_SIZE, SiteFileError
 
@@ -23,11 +23,21 @@ def test_round_trip_every_value_equal(tmp_path, vector_site):
     size = sitefile.write_site(path, vector_site)
     assert size == path.stat().st_size
     got = sitefile.read_site(path)
-    for name in ("name", "source", "map_rotation_deg", "has_geo", "origin_lat_deg", "origin_lon_deg",
-                 "lowest_floor", "n_floors", "n_ap", "n_rp", "n_entries"):
+    for name in (
+        "name",
+        "source",
+        "map_rotation_deg",
+        "has_geo",
+        "origin_lat_deg",
+        "origin_lon_deg",
+        "lowest_floor",
+        "n_floors",
+        "n_ap",
+        "n_rp",
+        "n_entries",
+    ):
         assert getattr(got, name) == getattr(vector_site, name), name
-    for name in ("floor_height_m", "ap_bssid", "rp_floor", "rp_scans", "entry_ap", "entry_rp",
-                 "entry_count"):
+    for name in ("floor_height_m", "ap_bssid", "rp_floor", "rp_scans", "entry_ap", "entry_rp", "entry_count"):
         assert list(getattr(got, name)) == list(getattr(vector_site, name)), name
     # float32 fields come back as the float32 nearest to what was written, exactly
     for name in ("rp_x_m", "rp_y_m", "entry_mean_dbm", "entry_std_db"):
@@ -62,8 +72,7 @@ def _variant_params():
     spec = importlib.util.spec_from_file_location("gen_site_vectors", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return [pytest.param(name, data, kind, c_text, id=name)
-            for name, data, kind, c_text in module.variants()]
+    return [pytest.param(name, data, kind, c_text, id=name) for name, data, kind, c_text in module.variants()]
 
 
 @pytest.mark.parametrize("name,data,kind,c_text", _variant_params())
@@ -76,16 +85,19 @@ def test_variant_rejected(tmp_path, name, data, kind, c_text):
     assert str(info.value).startswith(f"{path}: ")
 
 
-@pytest.mark.parametrize("field,offset,value,kind,text", [
-    ("magic", 0, b"XFSITE\0\x01", "magic", "bad magic 58 46 53 49 54 45 00 01"),
-    ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 1"),
-    ("length", 12, struct.pack("<I", 5), "length", "length mismatch (trailing bytes): header says 5"),
-    ("crc", 16, struct.pack("<I", 0x12345678), "crc", "CRC-32 mismatch: header says 0x12345678"),
-    ("reserved", 20, struct.pack("<I", 1), "reserved", "reserved header field is 0x00000001"),
-])
+@pytest.mark.parametrize(
+    "field,offset,value,kind,text",
+    [
+        ("magic", 0, b"XFSITE\0\x01", "magic", "bad magic 58 46 53 49 54 45 00 01"),
+        ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 1"),
+        ("length", 12, struct.pack("<I", 5), "length", "length mismatch (trailing bytes): header says 5"),
+        ("crc", 16, struct.pack("<I", 0x12345678), "crc", "CRC-32 mismatch: header says 0x12345678"),
+        ("reserved", 20, struct.pack("<I", 1), "reserved", "reserved header field is 0x00000001"),
+    ],
+)
 def test_each_header_field_corrupted(tmp_path, vector_site, field, offset, value, kind, text):
     data = bytearray(sitefile.encode_site_file(vector_site))
-    data[offset:offset + len(value)] = value
+    data[offset : offset + len(value)] = value
     path = tmp_path / "site.sfsite"
     path.write_bytes(bytes(data))
     with pytest.raises(SiteFileError, match=text.replace("(", r"\(").replace(")", r"\)")) as info:
@@ -100,13 +112,16 @@ def test_truncation_at_every_length(vector_site):
             sitefile.decode_site_file(data[:n], "cut.sfsite")
         if n < HEADER_SIZE:
             assert info.value.kind == "short"
-            assert str(info.value) == (f"cut.sfsite: file has only {n} bytes; a site file starts "
-                                       f"with a 24-byte header")
+            assert str(info.value) == (
+                f"cut.sfsite: file has only {n} bytes; a site file starts with a 24-byte header"
+            )
         else:
             assert info.value.kind == "length"
-            assert str(info.value) == (f"cut.sfsite: length mismatch (truncated): header says "
-                                       f"{len(data) - HEADER_SIZE} payload bytes, file has "
-                                       f"{n - HEADER_SIZE}")
+            assert str(info.value) == (
+                f"cut.sfsite: length mismatch (truncated): header says "
+                f"{len(data) - HEADER_SIZE} payload bytes, file has "
+                f"{n - HEADER_SIZE}"
+            )
 
 
 def test_every_payload_byte_flip_is_a_crc_error(vector_site):
@@ -118,8 +133,9 @@ def test_every_payload_byte_flip_is_a_crc_error(vector_site):
         with pytest.raises(SiteFileError) as info:
             sitefile.decode_site_file(bytes(bad), "f.sfsite")
         assert info.value.kind == "crc"
-        assert str(info.value).startswith(f"f.sfsite: CRC-32 mismatch: header says 0x{crc:08x}, "
-                                          f"payload has 0x")
+        assert str(info.value).startswith(
+            f"f.sfsite: CRC-32 mismatch: header says 0x{crc:08x}, payload has 0x"
+        )
 
 
 def test_missing_file(tmp_path):
@@ -129,15 +145,22 @@ def test_missing_file(tmp_path):
     assert "nope.sfsite: cannot read site file" in str(info.value)
 
 
-@pytest.mark.parametrize("change,text", [
-    ({"entry_ap": [0, 0, 0, 1, 1, 3, 4]}, "entry 6: ap index 4 outside 0..3"),
-    ({"entry_count": [3, 4, 3, 2, 5, 1, 5]}, "entry 2: count 3 outside 1..2 (rp_scans of rp 3)"),
-    ({"floor_height_m": [0.0, -1.0, 2.0]},
-     "floor_height_m[1] = -1 not above floor_height_m[0] = 0 (heights must increase)"),
-    ({"rp_floor": [-2, 0, 0, 1, 1, 1]}, "rp 0: floor -2 outside -1..1"),
-    ({"entry_std_db": [1.25, float("nan"), 2.5, 3.0, 0.5, 0.0, 1.1]},
-     "entry 1: entry_std_db = nan, must be finite and >= 0"),
-])
+@pytest.mark.parametrize(
+    "change,text",
+    [
+        ({"entry_ap": [0, 0, 0, 1, 1, 3, 4]}, "entry 6: ap index 4 outside 0..3"),
+        ({"entry_count": [3, 4, 3, 2, 5, 1, 5]}, "entry 2: count 3 outside 1..2 (rp_scans of rp 3)"),
+        (
+            {"floor_height_m": [0.0, -1.0, 2.0]},
+            "floor_height_m[1] = -1 not above floor_height_m[0] = 0 (heights must increase)",
+        ),
+        ({"rp_floor": [-2, 0, 0, 1, 1, 1]}, "rp 0: floor -2 outside -1..1"),
+        (
+            {"entry_std_db": [1.25, float("nan"), 2.5, 3.0, 0.5, 0.0, 1.1]},
+            "entry 1: entry_std_db = nan, must be finite and >= 0",
+        ),
+    ],
+)
 def test_validate_names_the_field(vector_site, change, text):
     for name, value in change.items():
         setattr(vector_site, name, value)
