@@ -14,13 +14,13 @@ import sys
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
     "sim": "stridefix_sim.cli",
-    "analyze": "stridefix_analyzer.analyze",
-    "report": "stridefix_analyzer.report",
-    "bench": "stridefix_analyzer.bench",
-    "import": "stridefix_sim.importers.cli",
-    "realbench": "stridefix_analyzer.realbench",
-    "radiomap": "stridefix_analyzer.radiomap",
-    "crowd": "stridefix_analyzer.crowd",
+    "analyze": "stridefix_analyzer.scoring.analyze",
+    "report": "stridefix_analyzer.scoring.report",
+    "bench": "stridefix_analyzer.bench.sil_pdr",
+    "import": "stridefix_analyzer.datasets.cli",
+    "realbench": "stridefix_analyzer.realbench.pdr_distance",
+    "radiomap": "stridefix_analyzer.radiomap.build",
+    "crowd": "stridefix_analyzer.crowd.cli",
 }
 
 
@@ -54,7 +54,9 @@ def _unavailable(name: str, exc: ImportError):
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
-        from .realbench import with_default_bench  # `realbench --format ...` = `realbench fusion ...`
+        from stridefix_analyzer.realbench.pdr_distance import (
+            with_default_bench,  # `realbench --format ...` = `realbench fusion ...`
+        )
     except ImportError:
         pass
     else:

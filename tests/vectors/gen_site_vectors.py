@@ -31,7 +31,7 @@ if __name__ == "__main__":
         sys.path.insert(0, _d)
 
 from stridefix import site_t, truth_t  # noqa: E402
-from stridefix_analyzer import sitefile  # noqa: E402
+from stridefix_analyzer.io import sitefile  # noqa: E402
 
 _SCALAR_FIELDS = (
     "name",

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import wifi_scan_t
-from stridefix_analyzer.logread import LogReadError, LogTruncatedWarning, read_logs
+from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs
 
 
 def test_columns_and_sorting(msg, write_log):

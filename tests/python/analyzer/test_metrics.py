@@ -4,8 +4,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import pose_t
-from stridefix_analyzer.logread import Table, read_logs
-from stridefix_analyzer.metrics import MetricsInputError, error_stats, run_metrics, scheme_code, step_metrics
+from stridefix_analyzer.io.logread import Table, read_logs
+from stridefix_analyzer.scoring.metrics import (
+    MetricsInputError,
+    error_stats,
+    run_metrics,
+    scheme_code,
+    step_metrics,
+)
 
 STATS = ("mean", "median", "p75", "p90", "p95", "max", "rmse")
 

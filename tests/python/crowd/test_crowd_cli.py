@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from stridefix_analyzer.sitefile import read_site
+from stridefix_analyzer.io.sitefile import read_site
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-from stridefix_analyzer import crowd_model as cm
+from stridefix_analyzer.crowd import model as cm
 
 NAN = np.nan
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-from stridefix_analyzer import crowd_model as cm
-from stridefix_analyzer.crowd_solve import (
+from stridefix_analyzer.crowd import model as cm
+from stridefix_analyzer.crowd.solve import (
     Problem,
     build_problem,
     error_stats,
@@ -18,7 +18,7 @@ from stridefix_analyzer.crowd_solve import (
     solve,
     solve_scipy,
 )
-from stridefix_analyzer.crowd_walks import CrowdInputError, Walk, pool_scans
+from stridefix_analyzer.crowd.walks import CrowdInputError, Walk, pool_scans
 
 APS = np.array([[0.0, 0.0], [20.0, 0.0], [20.0, 10.0], [0.0, 10.0]])
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import baro_t, gnss_t, imu_t, truth_t, wifi_scan_t
-from stridefix_analyzer.logread import read_logs
-from stridefix_sim.importers import gsd
+from stridefix_analyzer.datasets import gsd
+from stridefix_analyzer.io.logread import read_logs
 
 
 def _import(path, tmp_path, **kw):
@@ -239,7 +239,7 @@ def _parse(*argv):
     """`stridefix import ...` parsed in-process (the console script costs seconds per start)."""
     import argparse
 
-    from stridefix_sim.importers import cli as import_cli
+    from stridefix_analyzer.datasets import cli as import_cli
 
     parser = argparse.ArgumentParser(prog="stridefix")
     import_cli.add_parser(parser.add_subparsers(dest="command"))
@@ -247,7 +247,7 @@ def _parse(*argv):
 
 
 def test_cli_output_file_takes_one_input(gsd_log, handmade_trace, tmp_path, capsys):
-    from stridefix_sim.importers import cli as import_cli
+    from stridefix_analyzer.datasets import cli as import_cli
 
     args = _parse("gsd", str(gsd_log), str(gsd_log), "-o", str(tmp_path / "x.lcmlog"))
     assert import_cli.run(args) == 2

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import imu_t, truth_t, wifi_scan_t
-from stridefix_analyzer.logread import read_logs
-from stridefix_sim.importers import msindoor
+from stridefix_analyzer.datasets import msindoor
+from stridefix_analyzer.io.logread import read_logs
 
 
 def _import(trace, tmp_path, **kw):

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer import realbench as rb
+from stridefix_analyzer.realbench import pdr_distance as rb
 
 # --- calibration and segments on synthetic data ---------------------------------------------------
 

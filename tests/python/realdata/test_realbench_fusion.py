@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import truth_t, wifi_scan_t
-from stridefix_analyzer import radiomap as rm
-from stridefix_analyzer import realbench as rb
-from stridefix_analyzer import realbench_fusion as rf
-from stridefix_analyzer.logread import LogTruncatedWarning, read_logs
-from stridefix_analyzer.sitefile import read_site
+from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
+from stridefix_analyzer.io.sitefile import read_site
+from stridefix_analyzer.radiomap import build as rm
+from stridefix_analyzer.realbench import fusion as rf
+from stridefix_analyzer.realbench import pdr_distance as rb
 
 SCHEMES = ("pdr_only", "wifi_only", "overwrite", "static", "adaptive", "kalman")
 
@@ -302,8 +302,8 @@ def test_mean_and_rmse_equal_evo_ape(realbench_fusion_small, tmp_path):
     computes (APE, translation part, no alignment) from our TUM exports."""
     evo_metrics = pytest.importorskip("evo.core.metrics")
     from evo.tools import file_interface
-    from stridefix_analyzer.analyze import run_analyze
-    from stridefix_analyzer.tum import write_tum
+    from stridefix_analyzer.io.tum import write_tum
+    from stridefix_analyzer.scoring.analyze import run_analyze
 
     r = realbench_fusion_small
     checked = 0

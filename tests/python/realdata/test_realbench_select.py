@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import fix_t, pose_t
-from stridefix_analyzer import realbench_select as rs
-from stridefix_analyzer.sitefile import read_site
+from stridefix_analyzer.io.sitefile import read_site
+from stridefix_analyzer.realbench import select as rs
 
 from .conftest import MSINDOOR
 

@@ -8,7 +8,9 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer import cli, radiomap, sitefile
+from stridefix_analyzer import cli
+from stridefix_analyzer.io import sitefile
+from stridefix_analyzer.radiomap import build as radiomap
 
 S = 1_000_000  # µs per s
 
@@ -230,4 +232,4 @@ def test_show_summary_and_png(survey_log, tmp_path, stridefix_main, capsys):
 
 
 def test_registered_in_cli():
-    assert cli.SUBCOMMANDS["radiomap"] == "stridefix_analyzer.radiomap"
+    assert cli.SUBCOMMANDS["radiomap"] == "stridefix_analyzer.radiomap.build"

@@ -10,8 +10,8 @@ import zlib
 
 import numpy as np
 import pytest
-from stridefix_analyzer import sitefile
-from stridefix_analyzer.sitefile import HEADER_SIZE, SiteFileError
+from stridefix_analyzer.io import sitefile
+from stridefix_analyzer.io.sitefile import HEADER_SIZE, SiteFileError
 
 
 def _f32(values):

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .lines import LineReader, MalformedLineWarning  # noqa: F401  (re-exported for callers)
+from stridefix_analyzer.datasets.lines import LineReader, MalformedLineWarning  # noqa: F401  (re-exported for callers)
 
 #: Bump when the log content for the same input changes (caches compare it).
 IMPORTER_VERSION = 1
@@ -459,7 +459,7 @@ def format_summary(s: dict) -> str:
 
 def add_parser(subparsers):
     """Declare ``stridefix import msindoor``."""
-    from .cli import add_output_arguments
+    from stridefix_analyzer.datasets.cli import add_output_arguments
 
     p = subparsers.add_parser(
         "msindoor",
@@ -491,7 +491,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Import every trace; exit 0, or 2 when a trace was missing/unreadable or output failed."""
-    from .cli import run_imports
+    from stridefix_analyzer.datasets.cli import run_imports
 
     return run_imports(
         args,

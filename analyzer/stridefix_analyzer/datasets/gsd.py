@@ -51,8 +51,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .lines import LineReader, MalformedLineWarning
-from .msindoor import DEFAULT_MAX_WIFI_AGE_S, _dedupe_sorted, bssid_to_int
+from stridefix_analyzer.datasets.lines import LineReader, MalformedLineWarning
+from stridefix_analyzer.datasets.msindoor import DEFAULT_MAX_WIFI_AGE_S, _dedupe_sorted, bssid_to_int
 
 __all__ = [
     "GsdLog",
@@ -656,7 +656,7 @@ def _origin_arg(text: str) -> tuple[float, float]:
 
 def add_parser(subparsers):
     """Declare ``stridefix import gsd``."""
-    from .cli import add_output_arguments
+    from stridefix_analyzer.datasets.cli import add_output_arguments
 
     p = subparsers.add_parser(
         "gsd",
@@ -691,7 +691,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     """Import every logfile; exit 0, or 2 when one was missing/unreadable or output failed."""
-    from .cli import run_imports
+    from stridefix_analyzer.datasets.cli import run_imports
 
     return run_imports(
         args,

@@ -16,8 +16,8 @@ from pathlib import Path
 
 # format name -> module providing add_parser() and run()
 FORMATS = {
-    "msindoor": "stridefix_sim.importers.msindoor",
-    "gsd": "stridefix_sim.importers.gsd",
+    "msindoor": "stridefix_analyzer.datasets.msindoor",
+    "gsd": "stridefix_analyzer.datasets.gsd",
 }
 
 
@@ -79,7 +79,7 @@ def run_imports(
     import time
     import warnings
 
-    from .msindoor import MalformedLineWarning
+    from stridefix_analyzer.datasets.msindoor import MalformedLineWarning
 
     outs = output_paths(inputs, args, prog)
     if outs is None:

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from stridefix_analyzer.analyze import run_analyze
-from stridefix_analyzer.bench import _run, _stridefix
-from stridefix_analyzer.metrics import SCHEME_NAMES
+from stridefix_analyzer.bench.sil_pdr import _run, _stridefix
+from stridefix_analyzer.scoring.analyze import run_analyze
+from stridefix_analyzer.scoring.metrics import SCHEME_NAMES
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
 SCHEME_ORDER = ["wifi_only", "overwrite", "static", "adaptive", "kalman", "pdr_only"]

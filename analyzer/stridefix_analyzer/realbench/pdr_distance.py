@@ -6,7 +6,7 @@ every fusion scheme, leave one walk out; see :mod:`stridefix_analyzer.realbench_
 ``pdr-distance``: how well step detection + Weinberg step length measure distance walked, on the
 Microsoft Indoor Location Competition 2.0 traces of one floor.
 
-For every trace of the floor: import it (``stridefix_sim.importers.msindoor``; the ``.lcmlog`` is
+For every trace of the floor: import it (``stridefix_analyzer.datasets.msindoor``; the ``.lcmlog`` is
 cached under ``OUT/cache``), replay it through ``stridefixd --input lcmlog:FILE``, read its ``STEP``
 messages (``accel_range_mps2`` = vertical acceleration amax − amin over the step) and the ``TRUTH``
 waypoints.
@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .analyze import _json_ready
-from .logread import LogReadError, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.scoring.analyze import _json_ready
 
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
@@ -107,14 +107,14 @@ def _cached_import(
 ) -> dict:
     """Import ``trace`` into ``cache_dir/<stem>.lcmlog`` unless an up-to-date copy is there.
 
-    ``importer``: the importer module (default ``stridefix_sim.importers.msindoor``); it provides
+    ``importer``: the importer module (default ``stridefix_analyzer.datasets.msindoor``); it provides
     ``import_trace(path, out_path[, max_wifi_age_s=], **import_kwargs)`` and ``IMPORTER_VERSION``.
     ``import_kwargs`` (JSON-able values) are part of the cache key.
     """
     import inspect
 
     if importer is None:
-        from stridefix_sim.importers import msindoor as importer
+        from stridefix_analyzer.datasets import msindoor as importer
 
     log = cache_dir / f"{trace.stem}.lcmlog"
     meta = cache_dir / f"{trace.stem}.import.json"
@@ -162,7 +162,7 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0, reimpo
         (w, 2), ``step_t_us`` (s,), ``step_range_mps2`` (s,), ``step_length_m`` (s,),
         ``health`` (last HEALTH fields), ``warnings``.
     """
-    from stridefix_sim.importers import msindoor
+    from stridefix_analyzer.datasets import msindoor
 
     trace, out_dir = Path(trace), Path(out_dir)
     walk = {"trace": str(trace), "walk": trace.stem, "import": None, "error": None, "warnings": []}
@@ -739,7 +739,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--out results.json",
     )
     sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
-    from .realbench_fusion import add_fusion_parser
+    from stridefix_analyzer.realbench.fusion import add_fusion_parser
 
     add_fusion_parser(sub)
     d = sub.add_parser(

@@ -47,10 +47,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import realbench as rb
-from . import realbench_select as rs
-from .logread import LogReadError, LogTruncatedWarning, read_logs, read_table
-from .radiomap import WalkStats
+from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
+from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.realbench import pdr_distance as rb
+from stridefix_analyzer.realbench import select as rs
 
 FORMATS = ("msindoor", "gsd")
 SCHEME_ORDER = ("pdr_only", "wifi_only", "overwrite", "static", "adaptive", "kalman")
@@ -91,15 +91,15 @@ class FusionBenchError(rb.RealbenchError):
 
 
 def importer_module(fmt: str):
-    """The importer of ``fmt`` (``stridefix_sim.importers.<fmt>``)."""
+    """The importer of ``fmt`` (``stridefix_analyzer.datasets.<fmt>``)."""
     if fmt not in FORMATS:
         raise FusionBenchError(f"unknown format {fmt!r}; known: {', '.join(FORMATS)}")
     import importlib
 
     try:
-        return importlib.import_module(f"stridefix_sim.importers.{fmt}")
+        return importlib.import_module(f"stridefix_analyzer.datasets.{fmt}")
     except ImportError as exc:
-        raise FusionBenchError(f"no importer for {fmt} (stridefix_sim.importers.{fmt}: {exc})") from None
+        raise FusionBenchError(f"no importer for {fmt} (stridefix_analyzer.datasets.{fmt}: {exc})") from None
 
 
 def find_groups(fmt: str, dirs) -> list[dict]:
@@ -345,7 +345,7 @@ def prepare(
         (:func:`rotation_stats`), ``floor_heights`` (:func:`floor_heights_of_walk`), ``floors``
         (truth floors), ``first_waypoint`` (t_us, x, y, floor) and ``import_log``.
     """
-    from .radiomap import RadioMapInputError, WalkStats, load_recordings
+    from stridefix_analyzer.radiomap.build import RadioMapInputError, WalkStats, load_recordings
 
     importer = importer_module(fmt)
     if max_wifi_age_s is None:
@@ -474,10 +474,10 @@ def _first_fix_floor(fw_log: Path) -> int | None:
 
 def run_fold(job: dict) -> dict:
     """Phase 3 of one walk: write its fold's site, replay it with ``--site``, score every scheme."""
-    from .analyze import run_analyze
-    from .metrics import MetricsInputError
-    from .radiomap import RadioMapInputError
-    from .sitefile import write_site
+    from stridefix_analyzer.io.sitefile import write_site
+    from stridefix_analyzer.radiomap.build import RadioMapInputError
+    from stridefix_analyzer.scoring.analyze import run_analyze
+    from stridefix_analyzer.scoring.metrics import MetricsInputError
 
     t0 = time.perf_counter()
     out = {"walk": job["walk"], "group": job["group"], "error": None, "fold": {}}
@@ -800,7 +800,7 @@ def run_fusion(
             selection stages use the same block pairs: each site is written once."""
             if str(path) in built:
                 return built[str(path)]
-            from .sitefile import write_site
+            from stridefix_analyzer.io.sitefile import write_site
 
             idx = [j for j, w in enumerate(sub) if any(w is o for o in others)]
             heights, _, lowest = fold_floors(others, [])
@@ -925,7 +925,7 @@ def run_fusion(
         "total": time.perf_counter() - t_start,
     }
     if report:
-        from .realbench_report import write_report
+        from stridefix_analyzer.realbench.report import write_report
 
         html = out_json.with_suffix(".html")
         write_report(doc, html)
@@ -953,7 +953,7 @@ def fold_floors(others: list[dict], own_floors) -> tuple[list[float], str, int]:
 
 def rb_default_height() -> float:
     """Storey height of a one-floor site [m] (the radio map's default; only its index matters)."""
-    from .radiomap import DEFAULT_FLOOR_HEIGHT_M
+    from stridefix_analyzer.radiomap.build import DEFAULT_FLOOR_HEIGHT_M
 
     return DEFAULT_FLOOR_HEIGHT_M
 

@@ -21,7 +21,7 @@ import dataclasses
 import numpy as np
 import stridefix
 
-from .logread import LogData, Table
+from stridefix_analyzer.io.logread import LogData, Table
 
 #: pose_t.scheme code → name used in reports and JSON keys
 SCHEME_NAMES = {

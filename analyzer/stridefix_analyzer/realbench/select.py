@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .logread import read_table
+from stridefix_analyzer.io.logread import read_table
 
 #: candidates, as stridefixd --set arguments; the first is the firmware default. Scans averaged
 #: (1 or 2) × WkNN representation (dBm, or "powed" with beta 2 or e — Torres-Sospedra 2015's choice)

@@ -28,10 +28,10 @@ import time
 
 import numpy as np
 
-from . import crowd_model as cm
-from .crowd_solve import RANGES, SOLVERS, build_problem, error_stats, make_points, solve
-from .crowd_walks import BANDS, DEFAULT_BAND, CrowdInputError, Walk, load_walks, pool_scans
-from .logread import LogReadError, Table
+from stridefix_analyzer.crowd import model as cm
+from stridefix_analyzer.crowd.solve import RANGES, SOLVERS, build_problem, error_stats, make_points, solve
+from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError, Walk, load_walks, pool_scans
+from stridefix_analyzer.io.logread import LogReadError, Table
 
 DEFAULT_OUT = os.path.join("out", "crowd")
 
@@ -99,7 +99,7 @@ def run_fit(args) -> dict:
     with open(path, "w") as f:
         json.dump(doc, f, indent=2)
         f.write("\n")
-    from .crowd_plots import plot_fit
+    from stridefix_analyzer.crowd.plots import plot_fit
 
     png = os.path.join(args.out, "model_fit.png")
     plot_fit(bins, model, png)
@@ -203,7 +203,7 @@ def run_solve(args) -> dict:
         json.dump(res, f, indent=2, default=float)
         f.write("\n")
     write_positions(os.path.join(args.out, "positions.csv"), xy, points, prob)
-    from .crowd_plots import plot_solution
+    from stridefix_analyzer.crowd.plots import plot_solution
 
     e = res["error"]
     plot_solution(
@@ -261,7 +261,7 @@ def write_positions(path: str, xy, points, prob) -> None:
 def crowd_recordings(walks: list[Walk], xy: np.ndarray | None, points):
     """radiomap Recordings of ``walks`` whose TRUTH is the solved position at each scan time
     (``xy`` None: the real truth at the scan times, for the comparison map)."""
-    from .radiomap import Recording
+    from stridefix_analyzer.radiomap.build import Recording
 
     recs = []
     for k, w in enumerate(walks):
@@ -309,8 +309,8 @@ def build_crowd_sites(
     map_rotation_deg: float = 0.0,
 ) -> dict:
     """Write the crowd-built site (and the truth-built one); return their summaries."""
-    from .radiomap import build_site
-    from .sitefile import write_site
+    from stridefix_analyzer.io.sitefile import write_site
+    from stridefix_analyzer.radiomap.build import build_site
 
     out = {}
     for path, pos, label in ((out_site, xy, "crowd"), (truth_site, None, "truth")):
@@ -478,7 +478,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     r.add_argument("--cell-size-m", type=float, default=2.0, help="walk-mode grid cell [m]")
     r.add_argument("--map-rotation-deg", type=float, default=0.0)
     e = sub.add_parser("experiment", help="the thesis's table: --sil or --msindoor DIR")
-    from .crowd_experiment import add_arguments
+    from stridefix_analyzer.crowd.experiment import add_arguments
 
     add_arguments(e)
     return p
@@ -494,7 +494,7 @@ def run(args: argparse.Namespace) -> int:
         elif args.crowd_command == "radiomap":
             run_radiomap(args)
         else:
-            from .crowd_experiment import run_experiment
+            from stridefix_analyzer.crowd.experiment import run_experiment
 
             return run_experiment(args)
     except (LogReadError, CrowdInputError) as exc:

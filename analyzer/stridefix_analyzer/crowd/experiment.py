@@ -9,7 +9,7 @@ from their truth; every scored walk (and a held-out walk) is replayed with each 
 ``wifi_only`` by ``stridefix analyze``.
 
 ``--msindoor DIR`` (a floor folder, or the msindoor root for every floor): each trace is imported
-(``stridefix_sim.importers.msindoor``, cached) and replayed through ``stridefixd``. The first
+(``stridefix_analyzer.datasets.msindoor``, cached) and replayed through ``stridefixd``. The first
 ``--limit`` traces (sorted by name) are scored; the model and stride scale come from the floor's other
 traces. Anchors: every other waypoint; error at the held-out waypoints. The floor's model is also fitted
 on all its traces and reported.
@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .crowd_walks import CrowdInputError, load_walks
+from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
 
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
@@ -104,8 +104,8 @@ def run_table(
     walks, model, anchors: str, solver: str, band: str, scale: float, progress=print
 ) -> tuple[list[dict], dict]:
     """Every row of :data:`ROWS` on ``walks``; returns (rows, positions of each row)."""
-    from .crowd import solve_walks
-    from .crowd_solve import error_stats
+    from stridefix_analyzer.crowd.cli import solve_walks
+    from stridefix_analyzer.crowd.solve import error_stats
 
     out, positions = [], {}
     for key, label, tm, ts, opts in ROWS:
@@ -215,7 +215,7 @@ def _sil_walk(scenario: str, seed: int, stridefixd: Path, out: Path, duration_s:
 
 
 def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
-    from .analyze import run_analyze
+    from stridefix_analyzer.scoring.analyze import run_analyze
 
     out.mkdir(parents=True, exist_ok=True)
     log = out / "stridefixd.lcmlog"
@@ -245,7 +245,7 @@ def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
 
 
 def run_sil(args, progress) -> dict:
-    from .crowd import build_crowd_sites, fit_walks, format_model
+    from stridefix_analyzer.crowd.cli import build_crowd_sites, fit_walks, format_model
 
     t0 = time.perf_counter()
     stridefixd = Path(args.stridefixd)
@@ -323,7 +323,7 @@ def format_fixes(fixes: list[dict]) -> str:
 def _ms_walk(trace: Path, cache: Path, stridefixd: Path) -> dict:
     import warnings
 
-    from stridefix_sim.importers import msindoor
+    from stridefix_analyzer.datasets import msindoor
 
     log, fw = cache / f"{trace.stem}.lcmlog", cache / f"{trace.stem}.fw.lcmlog"
     if not (log.is_file() and fw.is_file() and log.stat().st_mtime >= trace.stat().st_mtime):
@@ -351,7 +351,7 @@ def _usable(walks, min_truth: int = 3):
 
 
 def run_msindoor(args, progress) -> dict:
-    from .crowd import fit_walks, format_model
+    from stridefix_analyzer.crowd.cli import fit_walks, format_model
 
     t0 = time.perf_counter()
     stridefixd = Path(args.stridefixd)

@@ -26,8 +26,8 @@ import warnings
 
 import numpy as np
 
-from .crowd_model import fingerprint_matrix
-from .logread import LogTruncatedWarning, read_logs
+from stridefix_analyzer.crowd.model import fingerprint_matrix
+from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 
 SOURCE_SIMULATION, SOURCE_WAYPOINT = 1, 2
 BANDS = ("2.4", "all")

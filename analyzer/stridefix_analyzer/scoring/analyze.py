@@ -24,8 +24,14 @@ import warnings
 
 import numpy as np
 
-from .logread import KNOWN_CHANNELS, LogData, LogReadError, LogTruncatedWarning, read_logs
-from .metrics import Metrics, MetricsInputError, run_metrics, scheme_code
+from stridefix_analyzer.io.logread import (
+    KNOWN_CHANNELS,
+    LogData,
+    LogReadError,
+    LogTruncatedWarning,
+    read_logs,
+)
+from stridefix_analyzer.scoring.metrics import Metrics, MetricsInputError, run_metrics, scheme_code
 
 DEFAULT_OUT = os.path.join("out", "analyze")
 METRICS_FILE = "metrics.json"
@@ -212,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
     print(format_summary(summary))
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
-        from .tum import write_tum
+        from stridefix_analyzer.io.tum import write_tum
 
         paths = write_tum(metrics, args.tum)
         print(f"wrote {len(paths)} TUM trajectories into {args.tum}")

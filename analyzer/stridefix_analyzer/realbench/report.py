@@ -22,8 +22,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .metrics import scheme_code  # noqa: E402
-from .plots import to_png  # noqa: E402
+from stridefix_analyzer.scoring.metrics import scheme_code  # noqa: E402
+from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
 _COLORS = {

@@ -18,8 +18,8 @@ import sys
 
 import numpy as np
 
-from . import plots
-from .analyze import METRICS_FILE, SERIES_FILE
+from stridefix_analyzer.scoring import plots
+from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
 
 
 class ReportInputError(Exception):

@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from stridefix_analyzer.analyze import run_analyze
-from stridefix_analyzer.logread import read_logs
+from stridefix_analyzer.io.logread import read_logs
+from stridefix_analyzer.scoring.analyze import run_analyze
 
 CALIBRATION_SCENARIO = """# one lap of the floor-0 loop at normal pace, no pauses: the stride calibration walk
 [walk]
@@ -283,7 +283,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from stridefix_analyzer import bench_fusion
+    from stridefix_analyzer.bench import fusion as bench_fusion
 
     stridefixd = Path(args.stridefixd)
     if not stridefixd.is_file():

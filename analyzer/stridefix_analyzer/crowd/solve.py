@@ -42,8 +42,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import least_squares
 
-from .crowd_model import DEFAULT_TAU, DistanceModel, _block, _Prepared
-from .crowd_walks import DEFAULT_BORROW_S, CrowdInputError, ScanSet, Walk
+from stridefix_analyzer.crowd.model import DEFAULT_TAU, DistanceModel, _block, _Prepared
+from stridefix_analyzer.crowd.walks import DEFAULT_BORROW_S, CrowdInputError, ScanSet, Walk
 
 RANGES = ("pdr", "wifi", "both", "hybrid")
 DEFAULT_WEIGHTS = (1.0, 2.0)

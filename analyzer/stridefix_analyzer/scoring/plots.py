@@ -15,7 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
-from .metrics import scheme_name  # noqa: E402
+from stridefix_analyzer.scoring.metrics import scheme_name  # noqa: E402
 
 _TRUTH_STYLE = dict(color="black", linewidth=2.0, label="truth")
 _PERCENTILE_LINES = ((50, "p50", ":"), (75, "p75", "--"), (95, "p95", "-."))

@@ -22,7 +22,7 @@ import os
 
 import numpy as np
 
-from .metrics import Metrics
+from stridefix_analyzer.scoring.metrics import Metrics
 
 
 def yaw_quaternion(yaw_rad) -> np.ndarray:

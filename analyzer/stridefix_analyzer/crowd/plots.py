@@ -6,7 +6,7 @@ import os
 
 import numpy as np
 
-from .crowd_model import DistanceModel, PairBins
+from stridefix_analyzer.crowd.model import DistanceModel, PairBins
 
 
 def _plt():

@@ -45,8 +45,8 @@ import warnings
 import numpy as np
 from stridefix import site_t
 
-from .logread import LogData, LogReadError, LogTruncatedWarning, Table, read_logs
-from .sitefile import SiteFileError, new_site, read_site, write_site
+from stridefix_analyzer.io.logread import LogData, LogReadError, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.io.sitefile import SiteFileError, new_site, read_site, write_site
 
 MODES = ("auto", "survey", "walk")
 DEFAULT_CELL_SIZE_M = 2.0
