@@ -1,0 +1,199 @@
+"""The one way the analyzer runs the firmware: :class:`Firmware` wraps the ``stridefixd`` binary.
+
+Every replay of a recording (candump or raw-sensor LCM log) through the estimator goes through
+:meth:`Firmware.run`, so the command line is built in one place, failures raise one exception type
+naming the command and its stderr, and ``--set KEY=VALUE`` keys are checked once against the
+firmware's own parameter table (``stridefixd --print-config --json``; the INI text of
+``--print-config`` on a firmware built before the JSON export). Python never spells the list of
+parameter keys itself.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+import os
+import re
+import subprocess
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[2]
+DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
+
+
+class FirmwareError(RuntimeError):
+    """stridefixd is missing, refused its arguments or failed; the message names the command."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Param:
+    """One firmware parameter: ``key`` is ``section.name`` as ``--set`` and INI files spell it."""
+
+    key: str
+    default: str
+    unit: str = ""
+    min: float | None = None
+    max: float | None = None
+    help: str = ""
+
+
+def default_path() -> Path:
+    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary."""
+    return Path(os.environ.get("STRIDEFIXD") or DEFAULT_STRIDEFIXD)
+
+
+def set_args(sets: Iterable[str]) -> list[str]:
+    """``["--set", kv, ...]`` for KEY=VALUE strings."""
+    return [a for kv in sets for a in ("--set", kv)]
+
+
+_INI_HELP = re.compile(
+    r"^# (?P<help>.*?)(?: \[(?P<unit>[^\]]*)\])?(?:, range (?P<lo>\S+) \.\. (?P<hi>\S+))?$"
+)
+
+
+def _parse_ini(text: str) -> dict[str, Param]:
+    """The parameters of ``--print-config``'s INI text (section headers, ``# help [unit], range``)."""
+    params: dict[str, Param] = {}
+    section, comment = "", ""
+    for line in text.splitlines():
+        line = line.strip()
+        if line.startswith("[") and line.endswith("]"):
+            section = line[1:-1]
+        elif line.startswith("#"):
+            comment = line
+        elif "=" in line and section:
+            name, value = (s.strip() for s in line.split("=", 1))
+            m = _INI_HELP.match(comment)
+            lo = hi = None
+            if m and m["lo"] is not None:
+                lo, hi = float(m["lo"]), float(m["hi"])
+            params[f"{section}.{name}"] = Param(
+                key=f"{section}.{name}",
+                default=value,
+                unit=(m["unit"] or "") if m else "",
+                min=lo,
+                max=hi,
+                help=m["help"] if m else "",
+            )
+            comment = ""
+    return params
+
+
+class Firmware:
+    """A built ``stridefixd``. ``path`` defaults to :func:`default_path`."""
+
+    def __init__(self, path: str | os.PathLike[str] | None = None) -> None:
+        self.path = Path(path) if path is not None else default_path()
+
+    def __repr__(self) -> str:
+        return f"Firmware({str(self.path)!r})"
+
+    def check_executable(self) -> None:
+        """Raises :class:`FirmwareError` unless the binary exists and is executable."""
+        if not (self.path.is_file() and os.access(self.path, os.X_OK)):
+            raise FirmwareError(f"{self.path}: stridefixd not found or not executable (build it: make build)")
+
+    def _call(self, args: Sequence[str], timeout: float | None = None) -> subprocess.CompletedProcess[str]:
+        self.check_executable()
+        cmd = [str(self.path), *map(str, args)]
+        try:
+            return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired as exc:
+            raise FirmwareError(f"{' '.join(cmd)}: no answer within {timeout} s") from exc
+
+    @functools.cached_property
+    def params(self) -> dict[str, Param]:
+        """Every parameter of the firmware's table, by key (read once per instance)."""
+        proc = self._call(["--print-config", "--json"], timeout=30)
+        if proc.returncode == 0:
+            try:
+                doc = json.loads(proc.stdout)
+                rows = doc["params"] if isinstance(doc, dict) else doc
+                return {
+                    r["key"]: Param(
+                        key=r["key"],
+                        default=str(r.get("default", "")),
+                        unit=r.get("unit", ""),
+                        min=r.get("min"),
+                        max=r.get("max"),
+                        help=r.get("help", ""),
+                    )
+                    for r in rows
+                }
+            except (ValueError, KeyError, TypeError) as exc:
+                raise FirmwareError(f"{self.path} --print-config --json: unreadable ({exc})") from exc
+        proc = self._call(["--print-config"], timeout=30)
+        if proc.returncode != 0:
+            raise FirmwareError(f"{self.path} --print-config exited {proc.returncode}: {proc.stderr[-300:]}")
+        return _parse_ini(proc.stdout)
+
+    def check_sets(self, sets: Iterable[str]) -> list[str]:
+        """Validates KEY=VALUE overrides once: every key must be in :attr:`params` and stridefixd must
+        accept the values (range, syntax). Returns them as a list; raises :class:`FirmwareError`."""
+        sets = list(sets)
+        bad = [kv for kv in sets if "=" not in kv or kv.split("=", 1)[0].strip() not in self.params]
+        if bad:
+            raise FirmwareError(
+                f"--set: unknown key or not KEY=VALUE: {bad}; see `stridefixd --print-config`"
+            )
+        if sets:
+            proc = self._call(["--print-config", *set_args(sets)], timeout=30)
+            if proc.returncode != 0:
+                raise FirmwareError(f"--set: {proc.stderr.strip()[-300:]}")
+        return sets
+
+    def version(self) -> str:
+        """``stridefixd -V`` (or why it is unknown)."""
+        try:
+            return self._call(["-V"], timeout=10).stdout.strip()
+        except (OSError, FirmwareError) as exc:
+            return f"unknown ({exc})"
+
+    def command(
+        self,
+        *,
+        log: str | os.PathLike[str],
+        input: str | os.PathLike[str] | None = None,
+        replay: str | os.PathLike[str] | None = None,
+        site: str | os.PathLike[str] | None = None,
+        fusion: str | None = None,
+        sets: Iterable[str] = (),
+        quiet: bool = True,
+        extra: Sequence[str] = (),
+    ) -> list[str]:
+        """The stridefixd command line for one replay: exactly one of ``input`` (candump file or
+        ``lcmlog:FILE``) and ``replay`` (a raw-sensor LCM log)."""
+        if (input is None) == (replay is None):
+            raise FirmwareError("Firmware.run: give exactly one of input= and replay=")
+        cmd = [str(self.path)]
+        cmd += ["--input", str(input)] if input is not None else ["--replay", str(replay)]
+        cmd += ["--log", str(log)]
+        if site is not None:
+            cmd += ["--site", str(site)]
+        if fusion is not None:
+            cmd += ["--fusion", fusion]
+        if quiet:
+            cmd.append("-q")
+        return cmd + set_args(sets) + [str(a) for a in extra]
+
+    def run(
+        self, *, check: bool = True, timeout: float | None = None, **kw
+    ) -> subprocess.CompletedProcess[str]:
+        """Runs one replay (arguments as :meth:`command`). With ``check`` a non-zero exit raises
+        :class:`FirmwareError` with the command and the end of stderr; otherwise the caller reads
+        ``returncode``."""
+        self.check_executable()
+        cmd = self.command(**kw)
+        try:
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        except subprocess.TimeoutExpired as exc:
+            raise FirmwareError(f"{' '.join(cmd)}: still running after {timeout} s") from exc
+        if check and proc.returncode != 0:
+            raise FirmwareError(
+                f"stridefixd exit {proc.returncode}: {' '.join(cmd)}: {proc.stderr.strip()[-500:]}"
+            )
+        return proc

@@ -1,0 +1,76 @@
+"""The fusion schemes, from their one source: the ``SCHEME_*`` constants of ``pose_t.lcm``.
+
+Ids, names and report order come from the generated LCM binding (``stridefix.pose_t``); the only
+thing Python adds per scheme is its colour in plots and reports (one row in :data:`_COLOURS`). A
+scheme added to ``pose_t.lcm`` appears here by itself (with a fallback colour until it gets a row).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from stridefix import pose_t
+
+# Report colour per scheme name: matplotlib's tab10 in id order, so plots keep the colours they had.
+_COLOURS = {
+    "pdr_only": "#1f77b4",
+    "wifi_only": "#ff7f0e",
+    "overwrite": "#2ca02c",
+    "static": "#d62728",
+    "adaptive": "#9467bd",
+    "kalman": "#8c564b",
+}
+_FALLBACK_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
+
+
+class UnknownSchemeError(ValueError):
+    """A scheme name or id that ``pose_t.lcm`` does not define."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Scheme:
+    """One fusion scheme: ``id`` is ``pose_t.SCHEME_<NAME>``, ``name`` its lower-case name."""
+
+    id: int
+    name: str
+    colour: str
+
+
+def _from_lcm() -> tuple[Scheme, ...]:
+    consts = sorted(
+        (int(v), k[len("SCHEME_") :].lower()) for k, v in vars(pose_t).items() if k.startswith("SCHEME_")
+    )
+    extra = iter(_FALLBACK_COLOURS * (1 + len(consts)))
+    return tuple(Scheme(i, n, _COLOURS.get(n) or next(extra)) for i, n in consts)
+
+
+SCHEMES: tuple[Scheme, ...] = _from_lcm()
+"""Every scheme, in id order (the report order)."""
+NAMES: tuple[str, ...] = tuple(s.name for s in SCHEMES)
+_BY_ID = {s.id: s for s in SCHEMES}
+_BY_NAME = {s.name: s for s in SCHEMES}
+
+
+def scheme_name(code: int) -> str:
+    """The name of scheme id ``code`` (``scheme_<code>`` for an id the LCM type does not know)."""
+    s = _BY_ID.get(int(code))
+    return s.name if s else f"scheme_{int(code)}"
+
+
+def scheme_code(name: str | int) -> int:
+    """The id of a scheme given by name (``adaptive``) or number (``4``)."""
+    if isinstance(name, str) and name in _BY_NAME:
+        return _BY_NAME[name].id
+    try:
+        code = int(name)
+    except ValueError:
+        raise UnknownSchemeError(f"unknown scheme {name!r}; known: {list(NAMES)}") from None
+    if code not in _BY_ID:
+        raise UnknownSchemeError(f"unknown scheme {name!r}; known: {list(NAMES)}")
+    return code
+
+
+def scheme_colour(code: int) -> str:
+    """The report colour of scheme id ``code``."""
+    s = _BY_ID.get(int(code))
+    return s.colour if s else _FALLBACK_COLOURS[int(code) % len(_FALLBACK_COLOURS)]
