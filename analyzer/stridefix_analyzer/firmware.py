@@ -181,7 +181,7 @@ class Firmware:
         return cmd + set_args(sets) + [str(a) for a in extra]
 
     def run(
-        self, *, check: bool = True, timeout: float | None = None, **kw
+        self, *, check: bool = True, timeout: float | None = None, **kw: Any
     ) -> subprocess.CompletedProcess[str]:
         """Runs one replay (arguments as :meth:`command`). With ``check`` a non-zero exit raises
         :class:`FirmwareError` with the command and the end of stderr; otherwise the caller reads
