@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import pytest
 from stridefix import pose_t
-
 from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware, FirmwareError, _parse_ini
 
