@@ -47,6 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
+from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import pdr_distance as rb
@@ -932,7 +933,7 @@ def run_fusion(
         doc["report"] = str(html)
     doc["run_s"]["total"] = time.perf_counter() - t_start
     with open(out_json, "w", encoding="utf-8") as f:
-        json.dump(rb._json_ready(_strip_samples(doc)), f, indent=1, allow_nan=False)
+        json.dump(json_ready(_strip_samples(doc)), f, indent=1, allow_nan=False)
         f.write("\n")
     if quiet:
         stream.close()
@@ -1026,7 +1027,7 @@ def _spread(v) -> dict:
 
 def _strip_samples(doc: dict) -> dict:
     """The JSON keeps per-walk statistics; per-sample errors stay in each walk's analysis.npz."""
-    out = json.loads(json.dumps(rb._json_ready(doc)))
+    out = json.loads(json.dumps(json_ready(doc)))
     for g in out["groups"]:
         for row in g["walk_rows"]:
             for tag in ("fixes", "true_start"):

@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
+from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
-from stridefix_analyzer.scoring.analyze import _json_ready
 
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
@@ -147,7 +147,7 @@ def _cached_import(
     summary.setdefault("out", str(log))
     summary["warnings"] = [str(w.message) for w in caught]
     summary["cache_key"] = key
-    meta.write_text(json.dumps(_json_ready(summary), indent=1) + "\n", encoding="utf-8")
+    meta.write_text(json.dumps(json_ready(summary), indent=1) + "\n", encoding="utf-8")
     return summary
 
 
@@ -476,7 +476,7 @@ def run_pdr_distance(
     doc["out_dir"] = str(out_dir)
     doc["run_s"] = time.perf_counter() - t_start
     with open(out_dir / JSON_FILE, "w", encoding="utf-8") as f:
-        json.dump(_json_ready(doc), f, indent=1, allow_nan=False)
+        json.dump(json_ready(doc), f, indent=1, allow_nan=False)
         f.write("\n")
     if plot:
         (out_dir / PNG_FILE).write_bytes(plot_pdr_distance(seg, label))

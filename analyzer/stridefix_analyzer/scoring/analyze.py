@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import warnings
 
 import numpy as np
 
+from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,
     LogData,
@@ -95,21 +95,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def _json_ready(value):
-    """Recursively convert numpy scalars/arrays to Python, and non-finite floats to None."""
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_ready(value.tolist())
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> dict:
     """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
     doc = {"label": label, "inputs": data.inputs}
@@ -122,7 +107,7 @@ def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> 
         config={**data.versions, "params": data.config},
         warnings=data.warnings,
     )
-    return _json_ready(doc)
+    return json_ready(doc)
 
 
 def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, str]:

@@ -13,7 +13,9 @@ def test_schemes_come_from_the_lcm_constants():
     assert {s.name: s.id for s in schemes.SCHEMES} == consts
     assert [s.id for s in schemes.SCHEMES] == sorted(consts.values())
     assert schemes.scheme_code("kalman") == pose_t.SCHEME_KALMAN and schemes.scheme_code("4") == 4
-    assert schemes.scheme_name(pose_t.SCHEME_ADAPTIVE) == "adaptive" and schemes.scheme_name(99) == "scheme_99"
+    assert (
+        schemes.scheme_name(pose_t.SCHEME_ADAPTIVE) == "adaptive" and schemes.scheme_name(99) == "scheme_99"
+    )
     assert len({s.colour for s in schemes.SCHEMES}) == len(schemes.SCHEMES)
     with pytest.raises(schemes.UnknownSchemeError, match="known"):
         schemes.scheme_code("nope")
