@@ -1,46 +1,66 @@
 """``stridefix import FORMAT ...``: turn files of a public data set into raw-sensor LCM logs.
 
-Each format is a module of this package providing ``add_parser(subparsers)`` (its own sub-command and
-arguments) and ``run(args) -> int``; adding one is one entry in :data:`FORMATS`. Every format writes
-either one log per input into a directory (``--out DIR``: ``DIR/<input-stem>.lcmlog``) or, for a single
-input, one named file (``-o/--output FILE``): :func:`add_output_arguments`, :func:`output_paths`.
+One sub-command per registered data set (:mod:`stridefix_analyzer.datasets`: every module with a
+``DATASET``), built from its protocol (:class:`~.protocol.Dataset`): the inputs, the output arguments
+every format shares, then the set's own options (:meth:`~.protocol.Dataset.add_arguments`) and
+``--json``. Every format writes either one log per input into a directory (``--out DIR``:
+``DIR/<input-stem>.lcmlog``) or, for a single input, one named file (``-o/--output FILE``):
+:func:`add_output_arguments`, :func:`output_paths`.
 Exit status: 0 success, 1 the import failed, 2 bad usage or a missing/unreadable input.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
+import json
 import sys
+import time
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any, TextIO
 
-# format name -> module providing add_parser() and run()
-FORMATS = {
-    "msindoor": "stridefix_analyzer.datasets.msindoor",
-    "gsd": "stridefix_analyzer.datasets.gsd",
-}
+from stridefix_analyzer import datasets
+from stridefix_analyzer.datasets.lines import MalformedLineWarning
+from stridefix_analyzer.datasets.protocol import Dataset, DatasetReadError
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Declare ``stridefix import`` and one sub-command per format."""
-    p = subparsers.add_parser(
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Declare ``stridefix import`` and one sub-command per data set."""
+    names = datasets.names()
+    p: argparse.ArgumentParser = subparsers.add_parser(
         "import",
         help="import real data sets into raw-sensor LCM logs for stridefixd",
         description="Import files of a public data set into raw-sensor LCM event logs "
         "(IMU, MAG, BARO, WIFI, GNSS, TRUTH) that `stridefixd --input lcmlog:FILE` "
-        f"replays. Formats: {', '.join(FORMATS)}.",
+        f"replays. Formats: {', '.join(names)}.",
     )
     sub = p.add_subparsers(dest="format", metavar="FORMAT", required=True)
-    for module_name in FORMATS.values():
-        module = importlib.import_module(module_name)
-        fp = module.add_parser(sub)
-        fp.set_defaults(_import_run=module.run)
+    for name in names:
+        ds = datasets.get(name)
+        fp = sub.add_parser(name, help=ds.title, description=ds.description)
+        fp.add_argument("inputs", nargs="+", metavar=ds.input_metavar, help=ds.input_help)
+        add_output_arguments(fp)
+        ds.add_arguments(fp)
+        fp.add_argument("--json", metavar="FILE", help="also write the summaries as JSON to FILE")
+        fp.set_defaults(_dataset=ds)
     return p
 
 
-def run(args) -> int:
-    """Dispatch to the chosen format's ``run``."""
-    return int(args._import_run(args) or 0)
+def run(args: argparse.Namespace) -> int:
+    """Import every input of the chosen data set; exit 0, or 2 when an input was missing/unreadable
+    or its output failed."""
+    ds: Dataset = args._dataset
+    options = ds.options(args)
+    return run_imports(
+        args,
+        f"stridefix import {ds.name}",
+        args.inputs,
+        lambda item, out: ds.import_walk(item, out, **options),
+        ds.format_summary,
+        ds.summary_keys,
+        ds.input_noun,
+    )
 
 
 def add_output_arguments(p: argparse.ArgumentParser) -> None:
@@ -52,7 +72,7 @@ def add_output_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("-o", "--output", metavar="FILE", help="output log file (a single input only)")
 
 
-def output_paths(inputs: list, args, prog: str) -> list[Path] | None:
+def output_paths(inputs: Sequence[str], args: argparse.Namespace, prog: str) -> list[Path] | None:
     """The output log of each input, or None after printing a usage error (``-o`` with several)."""
     if args.output is not None:
         if len(inputs) != 1:
@@ -67,25 +87,32 @@ def output_paths(inputs: list, args, prog: str) -> list[Path] | None:
 
 
 def run_imports(
-    args, prog: str, inputs: list, do_import, read_error: type, format_summary, json_keys: tuple, noun: str
+    args: argparse.Namespace,
+    prog: str,
+    inputs: Sequence[str],
+    do_import: Callable[[str, Path], dict[str, Any]],
+    format_summary: Callable[[Mapping[str, Any]], str],
+    json_keys: Sequence[str],
+    noun: str,
 ) -> int:
-    """The import loop every format shares: one input at a time, malformed-line warnings on stderr,
-    a progress line and a JSON summary line per input, ``--json`` with all summaries.
+    """The import loop: one input at a time, malformed-line warnings on stderr, a progress line and a
+    JSON summary line per input, ``--json`` with all summaries.
 
-    ``do_import(input, out) -> summary dict``; ``read_error`` is the format's missing/unreadable-input
-    exception. Returns 0, or 2 when an input was missing/unreadable or its output failed.
+    ``do_import(input, out) -> summary dict``. Returns 0, or 2 when an input was missing/unreadable
+    (:class:`~.protocol.DatasetReadError`) or its output failed.
     """
-    import json
-    import time
-    import warnings
-
-    from stridefix_analyzer.datasets.msindoor import MalformedLineWarning
-
     outs = output_paths(inputs, args, prog)
     if outs is None:
         return 2
 
-    def show(message, category, filename, lineno, file=None, line=None):
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
         print(f"{prog}: warning: {message}", file=sys.stderr)
 
     status, summaries = 0, []
@@ -96,7 +123,7 @@ def run_imports(
                 warnings.simplefilter("always", MalformedLineWarning)
                 warnings.showwarning = show
                 s = do_import(item, out)
-        except read_error as exc:
+        except DatasetReadError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
             status = 2
             continue

@@ -1,0 +1,178 @@
+"""The one container every data set reads a walk into: :class:`RawWalk`, named numpy columns per sensor.
+
+A data set's ``read(path)`` (:mod:`.protocol`) returns a RawWalk and :func:`.lcmwrite.write_lcmlog`
+turns any RawWalk into a raw-sensor LCM log, so a new format never touches LCM. Every stream is an
+:class:`~stridefix_analyzer.io.logread.Table` sorted by ``t_us`` (int64 µs, the data set's common
+clock) with units in the column names; a stream the set does not have is an empty table.
+
+=======  ==========================================================================================
+stream   columns
+=======  ==========================================================================================
+imu      t_us (n,), accel_mps2 (n, 3), gyro_radps (n, 3)
+mag      t_us (m,), field_ut (m, 3)
+baro     t_us (b,), pressure_pa (b,)
+gnss     t_us (g,), lat_deg, lon_deg, alt_m, accuracy_m
+wifi     one row per access point of a scan: scan (scan index 0, 1, ..., non-decreasing), t_us (the
+         scan's time), bssid (int64), rssi_dbm (float32), freq_mhz (int32), age_ms (float64, NaN
+         when unknown)
+truth    t_us (w,), x_m, y_m (map metres), floor (int64): surveyed waypoints or reference positions
+=======  ==========================================================================================
+
+``meta`` holds what the set knows about the walk beyond samples (header fields, floor name, building
+ids, projection origin), ``stats`` the import's counts, ``skipped`` the malformed lines and ``notes``
+remarks for the summary; all JSON-ready.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+from stridefix_analyzer.io.logread import Table
+
+#: The columns of each stream (see the module docstring), in writing order.
+STREAMS: dict[str, tuple[str, ...]] = {
+    "imu": ("t_us", "accel_mps2", "gyro_radps"),
+    "mag": ("t_us", "field_ut"),
+    "baro": ("t_us", "pressure_pa"),
+    "gnss": ("t_us", "lat_deg", "lon_deg", "alt_m", "accuracy_m"),
+    "wifi": ("scan", "t_us", "bssid", "rssi_dbm", "freq_mhz", "age_ms"),
+    "truth": ("t_us", "x_m", "y_m", "floor"),
+}
+
+
+def empty(stream: str) -> Table:
+    """A stream with no rows (vector columns keep their width 3)."""
+    wide = {"accel_mps2", "gyro_radps", "field_ut"}
+    return Table(
+        {
+            c: np.zeros((0, 3)) if c in wide else np.zeros(0, np.int64 if c in ("t_us", "scan") else float)
+            for c in STREAMS[stream]
+        }
+    )
+
+
+@dataclasses.dataclass
+class RawWalk:
+    """One walk as read from a data set's files, before LCM (see the module docstring).
+
+    Raises
+    ------
+    ValueError
+        On construction, when a stream lacks a column of :data:`STREAMS`.
+    """
+
+    path: str
+    imu: Table = dataclasses.field(default_factory=lambda: empty("imu"))
+    mag: Table = dataclasses.field(default_factory=lambda: empty("mag"))
+    baro: Table = dataclasses.field(default_factory=lambda: empty("baro"))
+    gnss: Table = dataclasses.field(default_factory=lambda: empty("gnss"))
+    wifi: Table = dataclasses.field(default_factory=lambda: empty("wifi"))
+    truth: Table = dataclasses.field(default_factory=lambda: empty("truth"))
+    meta: dict[str, Any] = dataclasses.field(default_factory=dict)
+    stats: dict[str, Any] = dataclasses.field(default_factory=dict)
+    skipped: list[tuple[int, str]] = dataclasses.field(default_factory=list)
+    notes: list[str] = dataclasses.field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        for stream, cols in STREAMS.items():
+            missing = [c for c in cols if c not in getattr(self, stream)]
+            if missing:
+                raise ValueError(f"{self.path}: RawWalk.{stream} lacks column(s) {missing}")
+
+    @property
+    def n_scans(self) -> int:
+        """Number of Wi-Fi scans."""
+        scan = self.wifi["scan"]
+        return int(scan[-1]) + 1 if len(scan) else 0
+
+    def scan_bounds(self) -> np.ndarray:
+        """(n_scans + 1,) row offsets: scan i is rows ``bounds[i]:bounds[i + 1]`` of :attr:`wifi`."""
+        return np.searchsorted(self.wifi["scan"], np.arange(self.n_scans + 1))
+
+    def scan_t_us(self) -> np.ndarray:
+        """(n_scans,) time of each scan [µs]."""
+        return self.wifi["t_us"][self.scan_bounds()[:-1]].astype(np.int64)
+
+    def scan(self, i: int) -> Table:
+        """The access points of scan ``i``."""
+        b = self.scan_bounds()
+        return self.wifi.rows(slice(int(b[i]), int(b[i + 1])))
+
+    def time_span_us(self) -> tuple[int, int] | None:
+        """(first, last) time of any sample [µs], or None for a walk without samples."""
+        ts = [s["t_us"] for s in (self.imu, self.mag, self.baro, self.gnss, self.wifi, self.truth) if len(s)]
+        if not ts:
+            return None
+        return int(min(t.min() for t in ts)), int(max(t.max() for t in ts))
+
+
+# --- conversions the importers share ---------------------------------------------------------------
+
+
+def finite(values: list[str]) -> list[float]:
+    """The fields as floats. Raises ValueError on a field that is not a finite number."""
+    out = [float(x) for x in values]
+    if not all(math.isfinite(x) for x in out):
+        raise ValueError("non-finite value")
+    return out
+
+
+def dedupe_sorted(t: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Stable sort by time and keep the first sample of each time; returns (t, v, dropped)."""
+    order = np.argsort(t, kind="stable")
+    t, v = t[order], v[order]
+    keep = np.ones(len(t), dtype=bool)
+    keep[1:] = t[1:] != t[:-1]
+    return t[keep], v[keep], int((~keep).sum())
+
+
+def gyro_at(acc_t: np.ndarray, gyr_t: np.ndarray, gyr: np.ndarray) -> tuple[np.ndarray, int] | None:
+    """Gyroscope (k, 3) interpolated linearly to the accelerometer times ``acc_t`` (held at the end
+    values outside its span) and the number of accelerometer times so held; None without gyro data."""
+    if not len(gyr_t):
+        return None
+    gyro = np.column_stack([np.interp(acc_t, gyr_t, gyr[:, i]) for i in range(3)])
+    return gyro, int(((acc_t < gyr_t[0]) | (acc_t > gyr_t[-1])).sum())
+
+
+def freshest(
+    entries: list[tuple[int, float, int, float]], max_age_ms: float
+) -> tuple[list[tuple[int, float, int, float]], int, int]:
+    """One scan's (bssid, rssi_dbm, freq_mhz, age_ms) entries without cached results (age above
+    ``max_age_ms``) and with the freshest entry of a BSSID heard twice (the first one when ages are
+    unknown, NaN). Returns (entries sorted by BSSID, stale dropped, duplicates dropped)."""
+    best: dict[int, tuple[int, float, int, float]] = {}
+    stale = dup = 0
+    for bssid, rssi, freq, age in entries:
+        if age > max_age_ms:
+            stale += 1
+            continue
+        if bssid in best:
+            dup += 1
+            if not age < best[bssid][3]:
+                continue
+        best[bssid] = (bssid, rssi, freq, age)
+    return sorted(best.values()), stale, dup
+
+
+def wifi_table(scans: list[tuple[int, list[tuple[int, float, int, float]]]]) -> Table:
+    """The :attr:`RawWalk.wifi` stream of (t_us, entries) scans (entries as :func:`freshest` returns)."""
+    rows = [(i, t, *e) for i, (t, entries) in enumerate(scans) for e in entries]
+    cols = list(zip(*rows)) if rows else [[] for _ in STREAMS["wifi"]]
+    dtypes = (np.int64, np.int64, np.int64, np.float32, np.int32, np.float64)
+    return Table({n: np.asarray(c, dtype=d) for n, c, d in zip(STREAMS["wifi"], cols, dtypes)})
+
+
+def bssid_to_int(bssid: str) -> int:
+    """``aa:bb:cc:dd:ee:ff`` → 0xaabbccddeeff (48-bit int). Raises ValueError on another form."""
+    if not _BSSID_RE.match(bssid):
+        raise ValueError(f"BSSID {bssid!r} is not six hex pairs")
+    return int(bssid.replace(":", ""), 16)
+
+
+_BSSID_RE = re.compile(r"^[0-9A-Fa-f]{2}(:[0-9A-Fa-f]{2}){5}$")
