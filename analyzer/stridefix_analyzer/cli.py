@@ -18,7 +18,7 @@ SUBCOMMANDS = {
     "report": "stridefix_analyzer.scoring.report",
     "bench": "stridefix_analyzer.bench.sil_pdr",
     "import": "stridefix_analyzer.datasets.cli",
-    "realbench": "stridefix_analyzer.realbench.pdr_distance",
+    "realbench": "stridefix_analyzer.realbench.cli",
     "radiomap": "stridefix_analyzer.radiomap.build",
     "crowd": "stridefix_analyzer.crowd.cli",
 }
@@ -54,7 +54,7 @@ def _unavailable(name: str, exc: ImportError):
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     try:
-        from stridefix_analyzer.realbench.pdr_distance import (
+        from stridefix_analyzer.realbench.cli import (
             with_default_bench,  # `realbench --format ...` = `realbench fusion ...`
         )
     except ImportError:

@@ -323,13 +323,13 @@ def format_fixes(fixes: list[dict]) -> str:
 def _ms_walk(trace: Path, cache: Path, stridefixd: Path) -> dict:
     import warnings
 
-    from stridefix_analyzer.datasets import msindoor
+    from stridefix_analyzer import datasets
 
     log, fw = cache / f"{trace.stem}.lcmlog", cache / f"{trace.stem}.fw.lcmlog"
     if not (log.is_file() and fw.is_file() and log.stat().st_mtime >= trace.stat().st_mtime):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            msindoor.import_trace(trace, log)
+            datasets.get("msindoor").import_walk(trace, log)
         _run(
             [str(stridefixd), "--input", f"lcmlog:{log}", "--log", str(fw), "-q"], f"stridefixd {trace.name}"
         )

@@ -1,28 +1,16 @@
-"""``stridefix realbench``: benchmarks of the real firmware on real public data.
+"""``stridefix realbench pdr-distance``: how well step detection + Weinberg step length measure distance
+walked, on the Microsoft Indoor Location Competition 2.0 traces of one floor.
 
-``fusion`` (the default: ``stridefix realbench --format msindoor|gsd DIR... --out results.json``):
-every fusion scheme, leave one walk out; see :mod:`stridefix_analyzer.realbench_fusion`.
-
-``pdr-distance``: how well step detection + Weinberg step length measure distance walked, on the
-Microsoft Indoor Location Competition 2.0 traces of one floor.
-
-For every trace of the floor: import it (``stridefix_analyzer.datasets.msindoor``; the ``.lcmlog`` is
-cached under ``OUT/cache``), replay it through ``stridefixd --input lcmlog:FILE``, read its ``STEP``
-messages (``accel_range_mps2`` = vertical acceleration amax − amin over the step) and the ``TRUTH``
-waypoints.
-
-- Segment = two consecutive waypoints k, k+1 of a walk; true distance = the straight line between them
-  [m]; Weinberg sum W = Σ range^¼ over the steps with t_k < t_step ≤ t_{k+1}; n_steps = their count.
-- Calibration, leave one walk out (DESIGN.md evaluation protocol): K_i = Σ true / Σ W over the scored
-  segments of every *other* walk of the floor. PDR distance = K_i · W; error % = 100 |PDR − true| / true.
-- Baseline without step length model: fixed stride = median over the other walks' segments of
-  true / n_steps, times n_steps. Also reported: the firmware's own ``length_m`` sum as configured.
-- Segments are excluded (counted, with the reason) when shorter than ``min_segment_m``, of zero
-  duration, not covered by IMU data, or when the walk's import or firmware run failed. Nothing else
-  is dropped; segments whose implied walking speed is implausible are flagged, not excluded.
+For every trace of the floor: import it through the data-set protocol (the ``.lcmlog`` is cached under
+``OUT/cache``, :func:`.walks.cached_import`), replay it through ``stridefixd --input lcmlog:FILE``,
+read its ``STEP`` messages (``accel_range_mps2`` = vertical acceleration amax − amin over the step) and
+the ``TRUTH`` waypoints. Segments, Weinberg sums and the leave-one-walk-out calibrations are
+:mod:`.strides`: K_i from every *other* walk of the floor, PDR distance = K_i · W, error % =
+100 |PDR − true| / true; baseline: a fixed stride (median true / n_steps of the other walks) × n_steps;
+also reported: the firmware's own ``length_m`` sum as configured.
 
 Outputs in ``--out DIR``: ``realbench_pdr_distance.json`` (summary, per-walk and per-segment rows; non-
-finite numbers as null) and ``realbench_pdr_distance.png`` (PDR vs true distance, error CDF).
+finite numbers as null) and ``realbench_pdr_distance.png`` (:mod:`.pdr_plot`).
 Exit status: 0 done, 1 nothing could be scored, 2 bad usage or unreadable input (no traces, no
 stridefixd).
 
@@ -32,127 +20,56 @@ errors include the surveyor's path shape; K absorbs the floor-wide average of th
 
 from __future__ import annotations
 
-import argparse
 import concurrent.futures
 import json
 import math
 import os
-import subprocess
-import sys
 import time
 import warnings
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.datasets.protocol import DatasetReadError
+from stridefix_analyzer.firmware import Firmware, FirmwareError
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.realbench.pdr_plot import plot_pdr_distance
+from stridefix_analyzer.realbench.strides import (
+    DEFAULT_MIN_SEGMENT_M,
+    IMU_COVER_TOLERANCE_S,
+    SUSPECT_SLOW_MPS,
+    SUSPECT_SPEED_MPS,
+    WEINBERG_EXPONENT,
+    build_segments,
+    calibrate_lowo,
+    stride_lowo,
+)
+from stridefix_analyzer.realbench.strides import error_stats as error_stats
+from stridefix_analyzer.realbench.walks import cached_import, dataset, find_groups, firmware
 
-REPO = Path(__file__).resolve().parents[2]
-DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
+#: The data set whose floors this benchmark reads.
+DATASET = "msindoor"
 DEFAULT_OUT = os.path.join("out", "realbench")
 JSON_FILE = "realbench_pdr_distance.json"
 PNG_FILE = "realbench_pdr_distance.png"
-DEFAULT_MIN_SEGMENT_M = 3.0
+DEFAULT_MAX_WIFI_AGE_S = 3.0
 #: The target of the benchmark: median absolute segment distance error [%].
 TARGET_MEDIAN_ABS_ERROR_PCT = 5.0
-#: Waypoints this far outside the IMU data [s] still count as covered (sensor start-up jitter).
-IMU_COVER_TOLERANCE_S = 0.5
-#: Segments implying a walk faster / slower than these [m/s] are flagged as suspect (not excluded):
-#: too fast = waypoint times off; too slow = a stop, a detour or a turn-around between the waypoints,
-#: where the straight line underestimates the distance walked.
-SUSPECT_SPEED_MPS = 2.5
-SUSPECT_SLOW_MPS = 0.5
 #: Segment length bins of the error breakdown [m].
 LENGTH_BINS_M = (3.0, 5.0, 10.0, math.inf)
-WEINBERG_EXPONENT = 0.25
 
 
-class RealbenchError(RuntimeError):
-    """The benchmark cannot run (no traces, no firmware binary). The message says what is missing."""
-
-
-# --- inputs ----------------------------------------------------------------------------------------
-
-
-def find_traces(floor_dir) -> tuple[str, list[Path]]:
-    """The floor's label (``site1/F2``) and its trace files, sorted.
-
-    ``floor_dir`` is either the floor folder or its ``path_data_files`` folder.
-
-    Raises
-    ------
-    RealbenchError
-        The folder does not exist or holds no ``*.txt`` trace.
-    """
-    d = Path(floor_dir)
-    if not d.is_dir():
-        raise RealbenchError(f"{d}: no such directory")
-    if (d / "path_data_files").is_dir():
-        d = d / "path_data_files"
-    traces = sorted(d.glob("*.txt"))
-    if not traces:
-        raise RealbenchError(f"{d}: no *.txt trace files")
-    floor = d.parent if d.name == "path_data_files" else d
-    return f"{floor.parent.name}/{floor.name}", traces
-
-
-def _cached_import(
-    trace: Path,
-    cache_dir: Path,
-    max_wifi_age_s: float,
-    reimport: bool,
-    importer=None,
-    import_kwargs: dict | None = None,
-) -> dict:
-    """Import ``trace`` into ``cache_dir/<stem>.lcmlog`` unless an up-to-date copy is there.
-
-    ``importer``: the importer module (default ``stridefix_analyzer.datasets.msindoor``); it provides
-    ``import_trace(path, out_path[, max_wifi_age_s=], **import_kwargs)`` and ``IMPORTER_VERSION``.
-    ``import_kwargs`` (JSON-able values) are part of the cache key.
-    """
-    import inspect
-
-    if importer is None:
-        from stridefix_analyzer.datasets import msindoor as importer
-
-    log = cache_dir / f"{trace.stem}.lcmlog"
-    meta = cache_dir / f"{trace.stem}.import.json"
-    st = trace.stat()
-    key = {
-        "trace": str(trace.resolve()),
-        "size": st.st_size,
-        "mtime_ns": st.st_mtime_ns,
-        "importer_version": getattr(importer, "IMPORTER_VERSION", None),
-        "max_wifi_age_s": max_wifi_age_s,
-    }
-    if importer.__name__.rsplit(".", 1)[-1] != "msindoor":
-        key["importer"] = importer.__name__
-    if import_kwargs:
-        key["import_kwargs"] = json.loads(json.dumps(import_kwargs))
-    if not reimport and log.is_file() and meta.is_file():
-        try:
-            cached = json.loads(meta.read_text(encoding="utf-8"))
-            if cached.get("cache_key") == key:
-                return cached
-        except (OSError, ValueError):
-            pass
-    kwargs = dict(import_kwargs or {})
-    if "max_wifi_age_s" in inspect.signature(importer.import_trace).parameters:
-        kwargs["max_wifi_age_s"] = max_wifi_age_s
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", getattr(importer, "MalformedLineWarning", UserWarning))
-        summary = importer.import_trace(trace, log, **kwargs)
-    summary = dict(summary)
-    summary.setdefault("out", str(log))
-    summary["warnings"] = [str(w.message) for w in caught]
-    summary["cache_key"] = key
-    meta.write_text(json.dumps(json_ready(summary), indent=1) + "\n", encoding="utf-8")
-    return summary
-
-
-def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0, reimport: bool = False) -> dict:
-    """Import one trace (cached), replay it through ``stridefixd``, read STEP and TRUTH.
+def prepare_walk(
+    trace: str | Path,
+    out_dir: str | Path,
+    fw: Firmware,
+    max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
+    reimport: bool = False,
+) -> dict[str, Any]:
+    """Import one trace (cached), replay it through the firmware, read STEP and TRUTH.
 
     Returns
     -------
@@ -162,25 +79,30 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0, reimpo
         (w, 2), ``step_t_us`` (s,), ``step_range_mps2`` (s,), ``step_length_m`` (s,),
         ``health`` (last HEALTH fields), ``warnings``.
     """
-    from stridefix_analyzer.datasets import msindoor
-
     trace, out_dir = Path(trace), Path(out_dir)
-    walk = {"trace": str(trace), "walk": trace.stem, "import": None, "error": None, "warnings": []}
+    walk: dict[str, Any] = {
+        "trace": str(trace),
+        "walk": trace.stem,
+        "import": None,
+        "error": None,
+        "warnings": [],
+    }
     cache_dir, fw_dir = out_dir / "cache", out_dir / "stridefixd"
     cache_dir.mkdir(parents=True, exist_ok=True)
     fw_dir.mkdir(parents=True, exist_ok=True)
     try:
-        summary = _cached_import(trace, cache_dir, max_wifi_age_s, reimport)
-    except (msindoor.TraceReadError, OSError) as exc:
+        options = {"max_wifi_age_s": max_wifi_age_s}
+        summary = cached_import(dataset(DATASET), trace, cache_dir, options, reimport)
+    except (DatasetReadError, OSError) as exc:
         walk["error"] = f"import failed: {exc}"
         return walk
     walk["import"] = summary
     walk["warnings"] += summary.get("warnings", [])
     fw_log = fw_dir / f"{trace.stem}.lcmlog"
-    cmd = [str(stridefixd), "--input", f"lcmlog:{summary['out']}", "--log", str(fw_log), "-q"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        walk["error"] = f"stridefixd exit {proc.returncode}: {' '.join(cmd)}: {proc.stderr.strip()[-500:]}"
+    try:
+        fw.run(input=f"lcmlog:{summary['out']}", log=fw_log)
+    except FirmwareError as exc:
+        walk["error"] = str(exc)
         return walk
     try:
         with warnings.catch_warnings():
@@ -202,166 +124,6 @@ def prepare_walk(trace, out_dir, stridefixd, max_wifi_age_s: float = 3.0, reimpo
     walk["step_length_m"] = steps["length_m"] if steps is not None else empty
     walk["health"] = data.health
     return walk
-
-
-# --- segments, calibration, scores -----------------------------------------------------------------
-
-
-def build_segments(walks: list[dict], min_segment_m: float = DEFAULT_MIN_SEGMENT_M) -> Table:
-    """One row per pair of consecutive waypoints of every walk.
-
-    Returns
-    -------
-    Table
-        ``walk`` (index into ``walks``), ``k`` (first waypoint), ``t0_us``, ``t1_us``, ``true_m``,
-        ``weinberg`` (Σ range^¼ [(m/s²)^¼]), ``n_steps``, ``fw_length_m`` (Σ firmware length_m),
-        ``speed_mps`` (true / duration), ``bad_range`` (steps with a non-finite or negative range),
-        ``suspect`` (implied speed above :data:`SUSPECT_SPEED_MPS` or below
-        :data:`SUSPECT_SLOW_MPS`), ``excluded`` ('' when
-        scored, else the reason).
-    """
-    rows = []
-    for w, walk in enumerate(walks):
-        if walk.get("error") or "waypoint_t_us" not in walk:
-            n_wp = walk["import"]["waypoints"] if walk.get("import") else 0
-            for k in range(max(n_wp - 1, 0)):
-                rows.append((w, k, 0, 0, math.nan, math.nan, 0, math.nan, math.nan, 0, False, "walk failed"))
-            continue
-        t_wp, xy = walk["waypoint_t_us"], walk["waypoint_xy_m"]
-        t_st = walk["step_t_us"]
-        rng = walk["step_range_mps2"]
-        bad = ~np.isfinite(rng) | (rng < 0)
-        root = np.where(bad, 0.0, np.abs(rng)) ** WEINBERG_EXPONENT
-        imu0, imu1 = walk["import"].get("imu_t_first_us"), walk["import"].get("imu_t_last_us")
-        tol = IMU_COVER_TOLERANCE_S * 1e6
-        for k in range(len(t_wp) - 1):
-            t0, t1 = int(t_wp[k]), int(t_wp[k + 1])
-            true_m = float(np.hypot(*(xy[k + 1] - xy[k])))
-            # steps with t0 < t <= t1
-            i0, i1 = np.searchsorted(t_st, [t0, t1], side="right")
-            duration_s = (t1 - t0) / 1e6
-            speed = true_m / duration_s if duration_s > 0 else math.inf
-            if imu0 is None or t0 < imu0 - tol or t1 > imu1 + tol:
-                reason = "not covered by IMU data"
-            elif t1 <= t0:
-                reason = "zero duration"
-            elif true_m < min_segment_m:
-                reason = f"shorter than {min_segment_m:g} m"
-            else:
-                reason = ""
-            rows.append(
-                (
-                    w,
-                    k,
-                    t0,
-                    t1,
-                    true_m,
-                    float(root[i0:i1].sum()),
-                    int(i1 - i0),
-                    float(walk["step_length_m"][i0:i1].sum()),
-                    speed,
-                    int(bad[i0:i1].sum()),
-                    bool(speed > SUSPECT_SPEED_MPS or speed < SUSPECT_SLOW_MPS),
-                    reason,
-                )
-            )
-    names = [
-        "walk",
-        "k",
-        "t0_us",
-        "t1_us",
-        "true_m",
-        "weinberg",
-        "n_steps",
-        "fw_length_m",
-        "speed_mps",
-        "bad_range",
-        "suspect",
-        "excluded",
-    ]
-    cols = list(zip(*rows)) if rows else [[] for _ in names]
-    dtypes = [
-        np.int64,
-        np.int64,
-        np.int64,
-        np.int64,
-        float,
-        float,
-        np.int64,
-        float,
-        float,
-        np.int64,
-        bool,
-        object,
-    ]
-    return Table({n: np.asarray(c, dtype=t) for n, c, t in zip(names, cols, dtypes)})
-
-
-def calibrate_lowo(seg_walk, true_m, weinberg, walks=None) -> np.ndarray:
-    """Weinberg K per walk, leave one walk out.
-
-    Parameters
-    ----------
-    seg_walk : (n,) int
-        Walk of each (scored) segment.
-    true_m : (n,) float
-        True segment distances [m].
-    weinberg : (n,) float
-        Σ range^¼ of each segment's steps.
-    walks : (m,) int, optional
-        Walks to calibrate for (default: the distinct values of ``seg_walk``).
-
-    Returns
-    -------
-    (m,) float
-        K_i = Σ true / Σ weinberg over the segments of every walk except walk i [m/(m/s²)^¼];
-        NaN when the other walks have no Weinberg sum.
-    """
-    seg_walk = np.asarray(seg_walk)
-    true_m, weinberg = np.asarray(true_m, float), np.asarray(weinberg, float)
-    walks = np.unique(seg_walk) if walks is None else np.asarray(walks)
-    tot_true, tot_w = true_m.sum(), weinberg.sum()
-    k = np.full(len(walks), math.nan)
-    for j, w in enumerate(walks):
-        mine = seg_walk == w
-        den = tot_w - weinberg[mine].sum()
-        if den > 0:
-            k[j] = (tot_true - true_m[mine].sum()) / den
-    return k
-
-
-def stride_lowo(seg_walk, true_m, n_steps, walks=None) -> np.ndarray:
-    """Fixed stride per walk, leave one walk out: median of true / n_steps over the other walks'
-    segments with at least one step [m]; NaN when there is none."""
-    seg_walk, n_steps = np.asarray(seg_walk), np.asarray(n_steps)
-    true_m = np.asarray(true_m, float)
-    walks = np.unique(seg_walk) if walks is None else np.asarray(walks)
-    has = n_steps > 0
-    stride = np.where(has, true_m / np.maximum(n_steps, 1), math.nan)
-    out = np.full(len(walks), math.nan)
-    for j, w in enumerate(walks):
-        s = stride[has & (seg_walk != w)]
-        if len(s):
-            out[j] = float(np.median(s))
-    return out
-
-
-def error_stats(err_pct) -> dict:
-    """n, mean, median, p75, p90, p95, max of absolute errors [%] (NaN-free input expected)."""
-    e = np.abs(np.asarray(err_pct, float))
-    e = e[np.isfinite(e)]
-    if not len(e):
-        return {"n": 0, **{k: math.nan for k in ("mean", "median", "p75", "p90", "p95", "max")}}
-    p = np.percentile(e, [50, 75, 90, 95])
-    return {
-        "n": int(len(e)),
-        "mean": float(e.mean()),
-        "median": float(p[0]),
-        "p75": float(p[1]),
-        "p90": float(p[2]),
-        "p95": float(p[3]),
-        "max": float(e.max()),
-    }
 
 
 def score_segments(seg: Table, n_walks: int) -> tuple[Table, dict]:
@@ -414,30 +176,22 @@ def _spread(values: np.ndarray) -> dict:
     }
 
 
-def _firmware_version(stridefixd: Path) -> str:
-    try:
-        return subprocess.run(
-            [str(stridefixd), "-V"], capture_output=True, text=True, timeout=10
-        ).stdout.strip()
-    except (OSError, subprocess.SubprocessError) as exc:
-        return f"unknown ({exc})"
-
-
 def run_pdr_distance(
-    floor_dir,
-    stridefixd=DEFAULT_STRIDEFIXD,
-    out_dir=None,
-    limit=None,
+    floor_dir: str | Path,
+    stridefixd: str | Path | None = None,
+    out_dir: str | Path | None = None,
+    limit: int | None = None,
     min_segment_m: float = DEFAULT_MIN_SEGMENT_M,
-    max_wifi_age_s: float = 3.0,
+    max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
     jobs: int | None = None,
     reimport: bool = False,
-    progress=None,
+    progress: Callable[[str], None] | None = None,
     plot: bool = True,
-) -> dict:
+) -> dict[str, Any]:
     """Run the PDR distance benchmark on one floor; write JSON (+ PNG) into ``out_dir``.
 
-    Returns the JSON document (a dict; non-finite numbers still as NaN).
+    ``stridefixd`` None: :func:`stridefix_analyzer.firmware.default_path`. Returns the JSON document
+    (a dict; non-finite numbers still as NaN).
 
     Raises
     ------
@@ -445,41 +199,34 @@ def run_pdr_distance(
         No traces, or no executable ``stridefixd``.
     """
     t_start = time.perf_counter()
-    label, traces = find_traces(floor_dir)
-    if limit is not None:
-        traces = traces[: max(int(limit), 0)]
-    stridefixd = Path(stridefixd)
-    if not (stridefixd.is_file() and os.access(stridefixd, os.X_OK)):
-        raise RealbenchError(
-            f"{stridefixd}: stridefixd not found or not executable (build it: cmake --build build)"
-        )
-    out_dir = Path(out_dir or os.path.join(DEFAULT_OUT, label.replace("/", "-")))
-    out_dir.mkdir(parents=True, exist_ok=True)
-    progress = progress or (lambda msg: None)
-    jobs = max(1, jobs or os.cpu_count() or 1)
-    walks: list[dict | None] = [None] * len(traces)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs) as pool:
+    (group,) = find_groups(dataset(DATASET), [floor_dir], limit)
+    label, traces = group.label, group.walks
+    fw = firmware(stridefixd or Firmware().path)
+    out = Path(out_dir or os.path.join(DEFAULT_OUT, label.replace("/", "-")))
+    out.mkdir(parents=True, exist_ok=True)
+    say = progress or (lambda msg: None)
+    n_jobs = max(1, jobs or os.cpu_count() or 1)
+    walks: list[dict[str, Any]] = [{}] * len(traces)
+    with concurrent.futures.ProcessPoolExecutor(max_workers=n_jobs) as pool:
         futures = {
-            pool.submit(prepare_walk, t, out_dir, stridefixd, max_wifi_age_s, reimport): i
-            for i, t in enumerate(traces)
+            pool.submit(prepare_walk, t, out, fw, max_wifi_age_s, reimport): i for i, t in enumerate(traces)
         }
         for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             i = futures[fut]
-            walks[i] = fut.result()
-            w = walks[i]
+            walks[i] = w = fut.result()
             state = w["error"] or (f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints")
-            progress(f"walk {done}/{len(traces)} {w['walk']}: {state}")
+            say(f"walk {done}/{len(traces)} {w['walk']}: {state}")
 
     seg, fits = score_segments(build_segments(walks, min_segment_m), len(walks))
     doc = summarize(label, floor_dir, walks, seg, fits, min_segment_m, max_wifi_age_s, limit)
-    doc["stridefixd"] = {"path": str(stridefixd), "version": _firmware_version(stridefixd)}
-    doc["out_dir"] = str(out_dir)
+    doc["stridefixd"] = {"path": str(fw.path), "version": fw.version()}
+    doc["out_dir"] = str(out)
     doc["run_s"] = time.perf_counter() - t_start
-    with open(out_dir / JSON_FILE, "w", encoding="utf-8") as f:
+    with open(out / JSON_FILE, "w", encoding="utf-8") as f:
         json.dump(json_ready(doc), f, indent=1, allow_nan=False)
         f.write("\n")
     if plot:
-        (out_dir / PNG_FILE).write_bytes(plot_pdr_distance(seg, label))
+        (out / PNG_FILE).write_bytes(plot_pdr_distance(seg, label, TARGET_MEDIAN_ABS_ERROR_PCT))
     return doc
 
 
@@ -650,181 +397,3 @@ def format_table(doc: dict) -> str:
     for w in wk["failed"]:
         lines.append(f"  failed walk {w['walk']}: {w['error']}")
     return "\n".join(lines)
-
-
-# --- figure (no metrics computed here) -------------------------------------------------------------
-
-
-def plot_pdr_distance(seg: Table, title: str) -> bytes:
-    """PNG: PDR vs true segment distance (scatter, 1:1 and ±5 % lines) and the |error| CDFs."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    used = seg["excluded"] == ""
-    true = seg["true_m"][used]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5.2))
-    ax1.scatter(true, seg["baseline_m"][used], s=9, color="0.6", label="fixed stride × steps")
-    ax1.scatter(true, seg["pdr_m"][used], s=9, color="C0", label="Weinberg, K LOWO")
-    top = float(np.nanmax(np.r_[true, seg["pdr_m"][used], 1.0])) * 1.05
-    x = np.array([0, top])
-    ax1.plot(x, x, "k-", lw=1, label="1:1")
-    ax1.plot(x, 1.05 * x, "k:", lw=0.8, label="±5 %")
-    ax1.plot(x, 0.95 * x, "k:", lw=0.8)
-    ax1.set(
-        xlim=(0, top),
-        ylim=(0, top),
-        xlabel="true segment distance [m]",
-        ylabel="PDR distance [m]",
-        title=f"{title}: {int(used.sum())} segments",
-    )
-    ax1.set_aspect("equal")
-    ax1.legend(loc="upper left", fontsize=8)
-    for col, name, color in (
-        ("err_pct", "Weinberg, K LOWO", "C0"),
-        ("baseline_err_pct", "fixed stride × steps", "0.5"),
-        ("fw_err_pct", "firmware length_m", "C3"),
-    ):
-        e = np.sort(np.abs(seg[col][used]))
-        e = e[np.isfinite(e)]
-        if len(e):
-            ax2.step(
-                e,
-                np.arange(1, len(e) + 1) / len(e),
-                where="post",
-                color=color,
-                label=f"{name} (median {np.median(e):.1f} %)",
-            )
-    ax2.axvline(TARGET_MEDIAN_ABS_ERROR_PCT, color="k", ls=":", lw=0.8)
-    ax2.axhline(0.5, color="k", ls=":", lw=0.8)
-    ax2.set(
-        xlim=(0, 50),
-        ylim=(0, 1),
-        xlabel="|distance error| [%]",
-        ylabel="fraction of segments",
-        title="error CDF",
-    )
-    ax2.grid(alpha=0.3)
-    ax2.legend(loc="lower right", fontsize=8)
-    import io
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
-
-
-# --- CLI -------------------------------------------------------------------------------------------
-
-BENCHES = ("fusion", "pdr-distance")
-
-
-def with_default_bench(argv: list[str]) -> list[str]:
-    """``stridefix realbench --format ...`` means ``stridefix realbench fusion --format ...``:
-    insert the default benchmark when the word after ``realbench`` names none (and is no help)."""
-    argv = list(argv)
-    if argv and argv[0] == "realbench" and (len(argv) == 1 or argv[1] not in (*BENCHES, "-h", "--help")):
-        argv.insert(1, "fusion")
-    return argv
-
-
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Declare ``stridefix realbench`` and its benchmarks (``fusion`` is the default)."""
-    p = subparsers.add_parser(
-        "realbench",
-        help="benchmarks of stridefixd on real public data (msindoor, gsd)",
-        description="Benchmarks of the real firmware on real data sets. Without a benchmark name "
-        "the fusion benchmark runs: stridefix realbench --format msindoor DIR [DIR...] "
-        "--out results.json",
-    )
-    sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
-    from stridefix_analyzer.realbench.fusion import add_fusion_parser
-
-    add_fusion_parser(sub)
-    d = sub.add_parser(
-        "pdr-distance",
-        help="segment distance from steps + Weinberg length, K leave-one-walk-out",
-        description="For every trace of a floor: import, replay through stridefixd, and compare "
-        "the Weinberg distance (K calibrated leave-one-walk-out) between consecutive "
-        "waypoints with the true straight-line distance. Writes "
-        f"DIR/{JSON_FILE} and DIR/{PNG_FILE}.",
-    )
-    d.add_argument(
-        "--floor",
-        required=True,
-        metavar="DIR",
-        help="floor folder, e.g. ../shared/data/msindoor/site1/F2[/path_data_files]",
-    )
-    d.add_argument(
-        "--stridefixd",
-        default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
-        metavar="PATH",
-        help="firmware binary (default: $STRIDEFIXD or build/firmware/stridefixd)",
-    )
-    d.add_argument(
-        "--out",
-        default=None,
-        metavar="DIR",
-        help=f"output and cache directory (default: {DEFAULT_OUT}/<site>-<floor>)",
-    )
-    d.add_argument(
-        "--limit", type=int, default=None, metavar="N", help="only the first N traces (sorted by name)"
-    )
-    d.add_argument(
-        "--min-segment-m",
-        type=float,
-        default=DEFAULT_MIN_SEGMENT_M,
-        metavar="M",
-        help=f"exclude shorter segments (default {DEFAULT_MIN_SEGMENT_M:g})",
-    )
-    d.add_argument(
-        "--max-wifi-age-s",
-        type=float,
-        default=3.0,
-        metavar="S",
-        help="importer: drop cached Wi-Fi entries older than S (default 3)",
-    )
-    d.add_argument(
-        "--jobs",
-        "-j",
-        type=int,
-        default=None,
-        metavar="N",
-        help="walks prepared in parallel (default: CPU count)",
-    )
-    d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
-    d.set_defaults(_bench=_run_pdr_distance_cli)
-    return p
-
-
-def _run_pdr_distance_cli(args) -> int:
-    def progress(msg):
-        print(f"realbench: {msg}", file=sys.stderr, flush=True)
-
-    try:
-        doc = run_pdr_distance(
-            args.floor,
-            args.stridefixd,
-            args.out,
-            args.limit,
-            args.min_segment_m,
-            args.max_wifi_age_s,
-            args.jobs,
-            args.reimport,
-            progress,
-        )
-    except RealbenchError as exc:
-        print(f"stridefix realbench: error: {exc}", file=sys.stderr)
-        return 2
-    print(format_table(doc))
-    print(
-        f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
-        f"({doc['run_s']:.1f} s)"
-    )
-    return 0 if doc["segments"]["scored"] else 1
-
-
-def run(args) -> int:
-    """Entry point of ``stridefix realbench``."""
-    return int(args._bench(args) or 0)

@@ -3,16 +3,16 @@
 Per group (floor or building): the learned constants, the scheme table, the error CDF of every
 scheme, a box plot per scheme (errors at the ground-truth times, all walks pooled), and the worst
 walks' trajectories — truth against that walk's best and worst scheme — over the floor plan
-(msindoor: ``floor_image.png`` stretched over 0..width × 0..height m of ``floor_info.json``, origin at
-the bottom-left; gsd: plain axes). No metric is computed here: everything comes from the document of
-:func:`stridefix_analyzer.realbench_fusion.run_fusion` and each walk's ``analysis.npz``.
+(the data set's :meth:`~stridefix_analyzer.datasets.protocol.Dataset.floor_plan`: msindoor's
+``floor_image.png`` stretched over 0..width × 0..height m of ``floor_info.json``, origin at the
+bottom-left; plain axes where the set has none). No metric is computed here: everything comes from the document of
+:func:`stridefix_analyzer.realbench.fusion.run_fusion` and each walk's ``analysis.npz``.
 """
 
 from __future__ import annotations
 
 import base64
 import html
-import json
 import math
 from pathlib import Path
 
@@ -22,18 +22,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from stridefix_analyzer.scoring.metrics import scheme_code  # noqa: E402
+from stridefix_analyzer import datasets  # noqa: E402
+from stridefix_analyzer.datasets.protocol import DatasetError  # noqa: E402
+from stridefix_analyzer.schemes import UnknownSchemeError, scheme_code, scheme_colour  # noqa: E402
 from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
-_COLORS = {
-    "pdr_only": "C7",
-    "wifi_only": "C0",
-    "overwrite": "C1",
-    "static": "C2",
-    "adaptive": "C3",
-    "kalman": "C4",
-}
 
 
 def _f(v, d=2) -> str:
@@ -44,18 +38,28 @@ def _img(png: bytes, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{base64.b64encode(png).decode()}"/>'
 
 
-def floor_plan(floor_dir) -> tuple[np.ndarray, tuple[float, float, float, float]] | None:
-    """(image, extent) of an msindoor floor: extent (0, width, 0, height) [m]; None when absent."""
+def _colour(name: str) -> str:
+    """A scheme's report colour (:mod:`stridefix_analyzer.schemes`); black for an unknown name."""
+    try:
+        return scheme_colour(scheme_code(name))
+    except UnknownSchemeError:
+        return "k"
+
+
+def floor_plan(fmt: str, floor_dir) -> tuple[np.ndarray, tuple[float, float, float, float]] | None:
+    """(image, extent) of a group's floor plan from its data set: extent (0, width, 0, height) [m];
+    None when the set has none there."""
     if not floor_dir:
         return None
-    d = Path(floor_dir)
-    img, info = d / "floor_image.png", d / "floor_info.json"
-    if not (img.is_file() and info.is_file()):
+    try:
+        plan = datasets.get(fmt).floor_plan(floor_dir)
+    except DatasetError:
+        return None
+    if plan is None or plan.image is None:
         return None
     try:
-        mi = json.loads(info.read_text(encoding="utf-8"))["map_info"]
-        return plt.imread(str(img)), (0.0, float(mi["width"]), 0.0, float(mi["height"]))
-    except (OSError, ValueError, KeyError):
+        return plt.imread(str(plan.image)), (0.0, plan.width_m, 0.0, plan.height_m)
+    except (OSError, ValueError):
         return None
 
 
@@ -76,7 +80,7 @@ def plot_cdf(pooled: dict[str, np.ndarray], title: str):
                 e,
                 np.arange(1, len(e) + 1) / len(e),
                 where="post",
-                color=_COLORS.get(name),
+                color=_colour(name),
                 label=f"{name} (mean {e.mean():.1f} m, n {len(e)})",
             )
     ax.axvline(15.0, color="k", ls=":", lw=0.8)
@@ -98,7 +102,7 @@ def plot_box(pooled: dict[str, np.ndarray], title: str):
     data = [pooled[n][np.isfinite(pooled[n])] for n in names]
     bp = ax.boxplot(data, tick_labels=names, showmeans=True, whis=(5, 95), flierprops={"ms": 2})
     for patch, n in zip(bp["boxes"], names):
-        patch.set_color(_COLORS.get(n, "k"))
+        patch.set_color(_colour(n))
     ax.set(ylabel="position error [m]", title=f"{title} (whiskers p5–p95, triangle = mean)")
     ax.grid(alpha=0.3, axis="y")
     return fig
@@ -120,14 +124,14 @@ def plot_walk(series, walk: str, schemes: list[str], plan, title: str):
         if c not in codes:
             continue
         px, py = series[f"s{c}_pose_x_m"], series[f"s{c}_pose_y_m"]
-        ax.plot(px, py, "-", color=_COLORS.get(name), lw=1.2, label=name, zorder=2)
+        ax.plot(px, py, "-", color=_colour(name), lw=1.2, label=name, zorder=2)
         err_x = series[f"s{c}_error_m"]
         ok = np.isfinite(err_x)
         # the matched estimate at each truth time, joined to its truth point
         m = series.get(f"m{c}_xy")
         if m is not None:
             for (x0, y0), (x1, y1) in zip(np.column_stack([tx, ty])[ok], m[ok]):
-                ax.plot([x0, x1], [y0, y1], ":", color=_COLORS.get(name), lw=0.8, zorder=2)
+                ax.plot([x0, x1], [y0, y1], ":", color=_colour(name), lw=0.8, zorder=2)
     if plan is not None:
         ax.set_xlim(plan[1][0], plan[1][1])
         ax.set_ylim(plan[1][2], plan[1][3])
@@ -207,7 +211,7 @@ def render(doc: dict) -> str:
         "before them (causal).</p>",
     ]
     for g in doc["groups"]:
-        plan = floor_plan(g.get("floor_dir"))
+        plan = floor_plan(doc["format"], g.get("floor_dir"))
         c = g["constants"]
         parts.append(f"<h2>{html.escape(g['label'])}</h2>")
         parts.append(

@@ -19,7 +19,8 @@ A second stage does the same for the adaptive scheme's Wi-Fi accuracy-factor sca
 matcher, on the adaptive scheme's POSE error at the waypoints): the AADR 2015 table is on the AP
 count, which says little when every scan hears ~100 APs.
 
-So the held-out walk's data never enter its own choice. Cost: n_blocks·(n_blocks − 1) maps and
+So the held-out walk's data never enter its own choice. The candidates and the order of the stages
+are rows of :mod:`.tuning` (:data:`~.tuning.AXES`); this module only measures them. Cost: n_blocks·(n_blocks − 1) maps and
 (n_blocks − 1) replays of every walk per candidate.
 """
 
@@ -27,53 +28,18 @@ from __future__ import annotations
 
 import concurrent.futures
 import math
-import subprocess
 from pathlib import Path
 
 import numpy as np
 
+from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
 
-#: candidates, as stridefixd --set arguments; the first is the firmware default. Scans averaged
-#: (1 or 2) × WkNN representation (dBm, or "powed" with beta 2 or e — Torres-Sospedra 2015's choice)
-_AVERAGE = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
-_REPRESENTATION = {
-    "dBm": [],
-    "powed 2": ["fingerprint.powed_beta=2"],
-    "powed e": ["fingerprint.powed_beta=2.718281828"],
-}
-MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items() for r, sr in _REPRESENTATION.items()}
-#: the adaptive scheme's Wi-Fi accuracy factors (a table on the AP count, AADR 2015) times a scale:
-#: chosen second, with the block's matcher, on the adaptive POSE error at the waypoints
-ADAPTIVE_VARIANTS = {
-    "table x 1": [],
-    "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
-    "table x 0.25": ["fusion.acc_wifi_scale=0.25"],
-}
 #: what each stage replays (--fusion) and scores
 STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
 DEFAULT_BLOCKS = 4
 #: fewest walks in a group for a choice (fewer: the firmware default)
 MIN_WALKS = 6
-
-
-def variants_unless_given(param_sets, table: dict[str, list[str]]) -> dict[str, list[str]]:
-    """The candidates of ``table`` ({name: ["key=value", ...]}), or only ``{"given": []}`` when the
-    user's ``--set`` list already sets one of the keys they vary (the user's choice wins)."""
-    keys = {kv.split("=", 1)[0] for sets in table.values() for kv in sets}
-    if any(kv.split("=", 1)[0].strip() in keys for kv in param_sets or []):
-        return {"given": []}
-    return dict(table)
-
-
-def matcher_variants(param_sets) -> dict[str, list[str]]:
-    """The matcher candidates, or only the user's own choice when ``--set`` gives one of their keys."""
-    return variants_unless_given(param_sets, MATCHER_VARIANTS)
-
-
-def adaptive_variants(param_sets) -> dict[str, list[str]]:
-    """The adaptive scheme's candidates, or the user's own ``fusion.acc_wifi_scale``."""
-    return variants_unless_given(param_sets, ADAPTIVE_VARIANTS)
 
 
 def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
@@ -107,20 +73,14 @@ def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
 
 
 def _replay(job: dict) -> dict:
-    cmd = [
-        job["stridefixd"],
-        "--input",
-        f"lcmlog:{job['import_log']}",
-        "--site",
-        job["site"],
-        "--fusion",
-        STAGES[job["stage"]],
-        "--log",
-        job["log"],
-        "-q",
-    ]
-    cmd += [a for kv in job["sets"] for a in ("--set", kv)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = Firmware(job["stridefixd"]).run(
+        input=f"lcmlog:{job['import_log']}",
+        site=job["site"],
+        fusion=STAGES[job["stage"]],
+        log=job["log"],
+        sets=job["sets"],
+        check=False,
+    )
     if proc.returncode != 0:
         return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
     score = fix_errors_m if job["stage"] == "matcher" else pose_errors_m

@@ -1,0 +1,245 @@
+"""``stridefix realbench``: the command line of the real-data benchmarks (it only declares arguments and
+calls the benchmark modules).
+
+``fusion`` (the default: ``stridefix realbench --format NAME DIR... --out results.json``): every fusion
+scheme, leave one walk out (:mod:`.fusion`); ``--format`` is any registered data set.
+``pdr-distance``: step detection + Weinberg length against the distance walked (:mod:`.pdr_distance`).
+Exit status: 0 done, 1 nothing could be scored, 2 bad usage or unreadable input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from stridefix_analyzer import datasets
+from stridefix_analyzer.firmware import default_path
+from stridefix_analyzer.realbench import tuning
+from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT
+from stridefix_analyzer.realbench.fusion import DEFAULT_CELL_SIZE_M, FusionConfig, run_fusion
+from stridefix_analyzer.realbench.pdr_distance import (
+    DEFAULT_MAX_WIFI_AGE_S,
+    DEFAULT_OUT,
+    JSON_FILE,
+    PNG_FILE,
+    format_table,
+    run_pdr_distance,
+)
+from stridefix_analyzer.realbench.strides import DEFAULT_MIN_SEGMENT_M
+from stridefix_analyzer.realbench.summary import format_tables
+from stridefix_analyzer.realbench.walks import RealbenchError
+
+BENCHES = ("fusion", "pdr-distance")
+
+
+def with_default_bench(argv: list[str]) -> list[str]:
+    """``stridefix realbench --format ...`` means ``stridefix realbench fusion --format ...``:
+    insert the default benchmark when the word after ``realbench`` names none (and is no help)."""
+    argv = list(argv)
+    if argv and argv[0] == "realbench" and (len(argv) == 1 or argv[1] not in (*BENCHES, "-h", "--help")):
+        argv.insert(1, "fusion")
+    return argv
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    """Declare ``stridefix realbench`` and its benchmarks (``fusion`` is the default)."""
+    p: argparse.ArgumentParser = subparsers.add_parser(
+        "realbench",
+        help="benchmarks of stridefixd on real public data (msindoor, gsd)",
+        description="Benchmarks of the real firmware on real data sets. Without a benchmark name "
+        "the fusion benchmark runs: stridefix realbench --format msindoor DIR [DIR...] "
+        "--out results.json",
+    )
+    sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+    add_fusion_parser(sub)
+    d = sub.add_parser(
+        "pdr-distance",
+        help="segment distance from steps + Weinberg length, K leave-one-walk-out",
+        description="For every trace of a floor: import, replay through stridefixd, and compare "
+        "the Weinberg distance (K calibrated leave-one-walk-out) between consecutive "
+        "waypoints with the true straight-line distance. Writes "
+        f"DIR/{JSON_FILE} and DIR/{PNG_FILE}.",
+    )
+    d.add_argument(
+        "--floor",
+        required=True,
+        metavar="DIR",
+        help="floor folder, e.g. ../shared/data/msindoor/site1/F2[/path_data_files]",
+    )
+    d.add_argument(
+        "--stridefixd",
+        default=str(default_path()),
+        metavar="PATH",
+        help="firmware binary (default: $STRIDEFIXD or build/firmware/stridefixd)",
+    )
+    d.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help=f"output and cache directory (default: {DEFAULT_OUT}/<site>-<floor>)",
+    )
+    d.add_argument(
+        "--limit", type=int, default=None, metavar="N", help="only the first N traces (sorted by name)"
+    )
+    d.add_argument(
+        "--min-segment-m",
+        type=float,
+        default=DEFAULT_MIN_SEGMENT_M,
+        metavar="M",
+        help=f"exclude shorter segments (default {DEFAULT_MIN_SEGMENT_M:g})",
+    )
+    d.add_argument(
+        "--max-wifi-age-s",
+        type=float,
+        default=DEFAULT_MAX_WIFI_AGE_S,
+        metavar="S",
+        help=f"importer: drop cached Wi-Fi entries older than S (default {DEFAULT_MAX_WIFI_AGE_S:g})",
+    )
+    d.add_argument(
+        "--jobs",
+        "-j",
+        type=int,
+        default=None,
+        metavar="N",
+        help="walks prepared in parallel (default: CPU count)",
+    )
+    d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
+    d.set_defaults(_bench=_run_pdr_distance_cli)
+    return p
+
+
+def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
+    def progress(msg: str) -> None:
+        print(f"realbench: {msg}", file=sys.stderr, flush=True)
+
+    try:
+        doc = run_pdr_distance(
+            args.floor,
+            args.stridefixd,
+            args.out,
+            args.limit,
+            args.min_segment_m,
+            args.max_wifi_age_s,
+            args.jobs,
+            args.reimport,
+            progress,
+        )
+    except RealbenchError as exc:
+        print(f"stridefix realbench: error: {exc}", file=sys.stderr)
+        return 2
+    print(format_table(doc))
+    print(
+        f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
+        f"({doc['run_s']:.1f} s)"
+    )
+    return 0 if doc["segments"]["scored"] else 1
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``stridefix realbench``."""
+    return int(args._bench(args) or 0)
+
+
+def add_fusion_parser(sub: Any) -> None:
+    """Declare ``stridefix realbench [fusion]``."""
+    d = sub.add_parser(
+        "fusion",
+        help="all fusion schemes on real walks, leave one walk out (default benchmark)",
+        description="Leave one walk out per floor (msindoor) or building (gsd): build the site "
+        "(walk-mode radio map, floors, map rotation) and Weinberg K from the other "
+        "walks, replay the held-out walk through stridefixd --site and score all six "
+        "schemes at its ground-truth times. Writes results.json, an HTML report next "
+        "to it, and per-walk work files under its folder.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    d.add_argument(
+        "dirs",
+        nargs="+",
+        metavar="DIR",
+        help="msindoor: floor folders (site1/F2 or its path_data_files); gsd: folders "
+        "of GetSensorData logs (or log files)",
+    )
+    d.add_argument("--format", required=True, choices=datasets.names(), help="data set format")
+    d.add_argument("--out", required=True, metavar="results.json", help="JSON results file")
+    d.add_argument(
+        "--stridefixd",
+        default=str(default_path()),
+        metavar="PATH",
+        help="firmware binary ($STRIDEFIXD or build/firmware/stridefixd)",
+    )
+    d.add_argument(
+        "--limit",
+        type=int,
+        default=None,
+        metavar="N",
+        help="only the first N walks of each group (sorted by name)",
+    )
+    d.add_argument("--jobs", "-j", type=int, default=2, metavar="N", help="parallel workers")
+    d.add_argument(
+        "--true-start", action="store_true", help="also run every walk truth-initialised (labelled as such)"
+    )
+    d.add_argument("--cell-size-m", type=float, default=DEFAULT_CELL_SIZE_M, help="radio-map grid cell [m]")
+    d.add_argument(
+        "--min-count",
+        type=int,
+        default=DEFAULT_MIN_COUNT,
+        help="radio map: drop (cell, AP) entries heard in fewer scans",
+    )
+    d.add_argument(
+        "--max-wifi-age-s",
+        type=float,
+        default=None,
+        help="importer: drop cached Wi-Fi entries older than this [s] (default: the importer's)",
+    )
+    d.add_argument(
+        "--set",
+        dest="param_sets",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="firmware parameter for every replay (stridefixd --set; repeatable): what-if "
+        "runs; recorded in results.json",
+    )
+    d.add_argument(
+        "--cache", default=None, metavar="DIR", help="import cache (default: <folder of results.json>/cache)"
+    )
+    d.add_argument("--reimport", action="store_true", help="ignore the cached imports")
+    d.add_argument("--no-report", action="store_true", help="skip the HTML report")
+    d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+    d.set_defaults(_bench=_run_fusion_cli)
+
+
+def _run_fusion_cli(args: argparse.Namespace) -> int:
+    try:
+        cfg = FusionConfig(
+            fmt=args.format,
+            dirs=args.dirs,
+            out_json=Path(args.out),
+            stridefixd=args.stridefixd,
+            limit=args.limit,
+            jobs=args.jobs,
+            reimport=args.reimport,
+            true_start=args.true_start,
+            max_wifi_age_s=args.max_wifi_age_s,
+            cell_size_m=args.cell_size_m,
+            min_count=args.min_count,
+            cache_dir=args.cache,
+            report=not args.no_report,
+            quiet=args.quiet,
+            param_sets=args.param_sets,
+        )
+        doc = run_fusion(cfg)
+    except RealbenchError as exc:
+        print(f"stridefix realbench: error: {exc}", file=sys.stderr)
+        return 2
+    print(format_tables(doc, tuning.axes(args.param_sets)))
+    extra = f" and {doc['report']}" if doc.get("report") else ""
+    print(
+        f"wrote {args.out}{extra} ({doc['run_s']['total']:.1f} s: prepare "
+        f"{doc['run_s']['prepare']:.1f} s, folds {doc['run_s']['folds']:.1f} s)"
+    )
+    scored = sum(g["summary"]["schemes"].get("kalman", {}).get("n", 0) for g in doc["groups"])
+    return 0 if scored else 1

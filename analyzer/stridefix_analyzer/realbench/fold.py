@@ -1,0 +1,209 @@
+"""Phase 3 of ``realbench fusion``, one fold: the held-out walk replayed on a site learned from the
+other walks of its group, every scheme scored at the walk's ground-truth times.
+
+The fold's site is the walk-mode radio map of ``total − held`` (sufficient statistics, so no map is
+rebuilt from scratch) with the fold's map rotation and floors; the replay adds
+``--set stride.weinberg_k=K`` and the tuning axes' chosen settings (:mod:`.tuning`). The firmware
+starts on ``init.floor``, so on a multi-floor site a first pass gives the first fix's floor for the
+scored pass (the start still comes from the fixes, never from the truth). Everything a worker needs
+comes in its :class:`FoldJob`: no state outside it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.logread import LogReadError, read_table
+from stridefix_analyzer.radiomap.build import WalkStats
+
+#: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
+#: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
+DEFAULT_MIN_COUNT = 1
+#: IPIN competition score: p75 of (2-D error + this × |floor error|) [m per floor]
+IPIN_FLOOR_PENALTY_M = 15.0
+STATS_KEYS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
+
+
+@dataclasses.dataclass(frozen=True)
+class FoldJob:
+    """One fold: the held-out walk, what was learned without it, and the statistics to subtract."""
+
+    index: int  # the walk's index among all prepared walks
+    walk: str
+    group: str
+    dir: Path
+    import_log: str
+    firmware: Firmware
+    K: float
+    rotation_deg: float
+    rotation_learned: bool
+    floor_heights_m: Sequence[float]
+    floor_heights_source: str
+    lowest_floor: int
+    min_count: int
+    true_start: bool
+    #: the user's --set, then every axis's chosen settings
+    param_sets: Sequence[str]
+    #: axis name -> chosen candidate; then further per-fold records of the choosers
+    variants: Mapping[str, str]
+    extra: Mapping[str, Any]
+    first_waypoint: tuple[int, float, float, int]
+    total: WalkStats
+    held: WalkStats
+
+
+def fold_site(
+    total: WalkStats,
+    held: WalkStats,
+    *,
+    name: str,
+    rotation_deg: float,
+    floor_heights_m: Sequence[float],
+    lowest_floor: int,
+    min_count: int = DEFAULT_MIN_COUNT,
+) -> tuple[Any, dict[str, Any]]:
+    """The fold's site: radio map of ``total − held`` (sufficient statistics) with the given
+    rotation and floors; returns (site, summary)."""
+    stats = total - held
+    return stats.to_site(
+        min_count=min_count,
+        name=name,
+        map_rotation_deg=rotation_deg,
+        floor_heights_m=floor_heights_m,
+        lowest_floor=lowest_floor,
+        source=f"stridefix realbench: leave-one-walk-out fold without {name}",
+    )
+
+
+def _first_fix_floor(fw_log: Path) -> int | None:
+    fix = read_table(fw_log, "FIX")
+    if fix is None or not len(fix):
+        return None
+    ok = fix["n_ap_used"] > 0
+    return int(fix["floor"][ok][0]) if ok.any() else None
+
+
+def run_fold(job: FoldJob) -> dict[str, Any]:
+    """Phase 3 of one walk: write its fold's site, replay it with ``--site``, score every scheme."""
+    from stridefix_analyzer.io.sitefile import write_site
+    from stridefix_analyzer.radiomap.build import RadioMapInputError
+    from stridefix_analyzer.scoring.analyze import run_analyze
+    from stridefix_analyzer.scoring.metrics import MetricsInputError
+
+    t0 = time.perf_counter()
+    out: dict[str, Any] = {"walk": job.walk, "group": job.group, "error": None, "fold": {}}
+    job.dir.mkdir(parents=True, exist_ok=True)
+    try:
+        site, summ = fold_site(
+            job.total,
+            job.held,
+            name=job.walk,
+            rotation_deg=job.rotation_deg,
+            floor_heights_m=job.floor_heights_m,
+            lowest_floor=job.lowest_floor,
+            min_count=job.min_count,
+        )
+    except RadioMapInputError as exc:
+        out["error"] = f"no site for this fold: {exc}"
+        return out
+    site_path = job.dir / "site.sfsite"
+    write_site(site_path, site)
+    out["fold"] = {
+        "K": job.K,
+        "rotation_deg": job.rotation_deg,
+        **{f"{axis}_variant": v for axis, v in job.variants.items()},
+        **job.extra,
+        "n_rp": site.n_rp,
+        "n_ap": site.n_ap,
+        "n_entries": site.n_entries,
+        "n_floors": site.n_floors,
+        "lowest_floor": site.lowest_floor,
+        "floor_heights_m": [float(h) for h in site.floor_height_m],
+        "floor_heights_source": job.floor_heights_source,
+        "scans_used": summ["scans"].get("used"),
+    }
+    sets = list(job.param_sets)
+    if math.isfinite(job.K):
+        sets.append(f"stride.weinberg_k={job.K:.6f}")
+    runs: list[tuple[str, list[str]]] = [("fixes", [])]
+    if job.true_start:
+        _, x, y, f = job.first_waypoint
+        runs.append(
+            (
+                "true_start",
+                ["init.use_config_pose=1", f"init.x_m={x:.3f}", f"init.y_m={y:.3f}", f"init.floor={f}"],
+            )
+        )
+    for tag, extra in runs:
+        fw_log = job.dir / ("stridefixd.lcmlog" if tag == "fixes" else f"stridefixd_{tag}.lcmlog")
+        replay: dict[str, Any] = {
+            "input": f"lcmlog:{job.import_log}",
+            "site": site_path,
+            "log": fw_log,
+            "check": False,
+        }
+        run_sets = sets + extra
+        if tag == "fixes" and site.n_floors > 1:
+            # the firmware starts on init.floor: take the first fix's floor from a first pass
+            proc = job.firmware.run(**replay, sets=run_sets)
+            f0 = _first_fix_floor(fw_log) if proc.returncode == 0 else None
+            if f0 is not None:
+                run_sets = run_sets + [f"init.floor={f0}"]
+                out["fold"]["init_floor_from_first_fix"] = f0
+        proc = job.firmware.run(**replay, sets=run_sets)
+        if proc.returncode != 0:
+            out["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
+            return out
+        adir = job.dir if tag == "fixes" else job.dir / tag
+        label = f"{job.walk}: leave-one-walk-out, " + (
+            "every scheme from its first fix" if tag == "fixes" else "truth-initialised"
+        )
+        logs = [str(fw_log), job.import_log]
+        try:
+            try:
+                _, metrics = run_analyze(logs, str(adir), label=label, truth_source="waypoint")
+            except MetricsInputError as exc:
+                if "source" not in str(exc):
+                    raise
+                _, metrics = run_analyze(logs, str(adir), label=label)
+        except (LogReadError, MetricsInputError) as exc:
+            out["error"] = f"cannot score: {exc}"
+            return out
+        out[tag] = score_walk(metrics)
+    out["run_s"] = time.perf_counter() - t0
+    return out
+
+
+def score_walk(metrics: Any) -> dict[str, dict[str, Any]]:
+    """Per scheme of one walk: stats, floor hit rate, IPIN score and the raw per-sample errors."""
+    res = {}
+    for s in metrics.schemes.values():
+        m = s.match
+        sc = m["scored"]
+        err = m["error_m"][sc]
+        ferr = np.abs(m["pose_floor"][sc] - m["truth_floor"][sc]).astype(float)
+        res[s.name] = {
+            **{k: s.summary["position_error_m"][k] for k in STATS_KEYS},
+            "unscored": s.summary["unscored"],
+            "floor_hit_rate": s.summary["floor_hit_rate"],
+            "ipin_score": ipin_score(err, ferr),
+            "errors_m": err.astype(float).tolist(),
+            "floor_errors": ferr.astype(int).tolist(),
+        }
+    return res
+
+
+def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:
+    """IPIN score [m]: 75th percentile of 2-D error + :data:`IPIN_FLOOR_PENALTY_M` × |floor error|."""
+    e = np.asarray(error_m, float) + IPIN_FLOOR_PENALTY_M * np.abs(np.asarray(floor_error, float))
+    e = e[np.isfinite(e)]
+    return float(np.percentile(e, 75)) if len(e) else math.nan

@@ -1,0 +1,217 @@
+"""The results of ``realbench fusion``: per group and scheme the pooled error statistics, the learned
+constants and the tuning choices of every fold, the JSON document and the console tables.
+
+Per walk and per group, per scheme: n, mean, median, p75, p90, p95, max, RMSE, floor hit rate, IPIN
+score = p75 of 2-D error + 15 m·|floor error|; the share of walks whose mean error exceeds
+:data:`ROBUST_MEAN_M`. Scheme names and their order come from :mod:`stridefix_analyzer.schemes`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from stridefix_analyzer import schemes
+from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.realbench.fold import IPIN_FLOOR_PENALTY_M, STATS_KEYS, FoldJob, ipin_score
+from stridefix_analyzer.realbench.tuning import Axis
+
+#: a walk whose mean error exceeds this is a failure for the robustness share [m]
+ROBUST_MEAN_M = 15.0
+
+
+def stats_of(errors: ArrayLike) -> dict[str, Any]:
+    """n, mean, median, p75, p90, p95, max, RMSE of the finite errors [m]."""
+    e = np.asarray(errors, float)
+    e = e[np.isfinite(e)]
+    if not len(e):
+        return {"n": 0, **{k: math.nan for k in STATS_KEYS[1:]}}
+    p = np.percentile(e, [50, 75, 90, 95])
+    return {
+        "n": int(len(e)),
+        "mean": float(e.mean()),
+        "median": float(p[0]),
+        "p75": float(p[1]),
+        "p90": float(p[2]),
+        "p95": float(p[3]),
+        "max": float(e.max()),
+        "rmse": float(np.sqrt(np.mean(e**2))),
+    }
+
+
+def summarize_group(results: Sequence[Mapping[str, Any]], tag: str = "fixes") -> dict[str, Any]:
+    """Per scheme over a group's walks: pooled sample stats, IPIN score, floor hit rate, the
+    per-walk mean spread and the share of walks whose mean error exceeds :data:`ROBUST_MEAN_M`."""
+    table = {}
+    names = [n for n in schemes.NAMES if any(n in r.get(tag, {}) for r in results)]
+    for name in names:
+        rows = [r[tag][name] for r in results if name in r.get(tag, {})]
+        err = np.concatenate([np.asarray(r["errors_m"], float) for r in rows]) if rows else []
+        ferr = np.concatenate([np.asarray(r["floor_errors"], float) for r in rows]) if rows else []
+        means = np.array([r["mean"] for r in rows], float)
+        finite = means[np.isfinite(means)]
+        table[name] = {
+            **stats_of(err),
+            "ipin_score": ipin_score(err, ferr),
+            "floor_hit_rate": float(np.mean(ferr == 0)) if len(ferr) else math.nan,
+            "walks": len(rows),
+            "walks_mean_over_15m": int(np.sum(finite > ROBUST_MEAN_M)),
+            "share_walks_mean_over_15m": (
+                float(np.mean(finite > ROBUST_MEAN_M)) if len(finite) else math.nan
+            ),
+            "walk_mean_median": float(np.median(finite)) if len(finite) else math.nan,
+        }
+    w, a = table.get("wifi_only", {}).get("mean"), table.get("adaptive", {}).get("mean")
+    red = 100.0 * (w - a) / w if w and a is not None and math.isfinite(w) and w > 0 else math.nan
+    return {"schemes": table, "adaptive_vs_wifi_only_reduction_pct": red}
+
+
+def build_doc(
+    fmt: str,
+    dirs: Sequence[Any],
+    labels: Sequence[str],
+    group_info: Mapping[str, dict[str, Any]],
+    walks: Sequence[Mapping[str, Any]],
+    results: Sequence[Mapping[str, Any]],
+    job_of: Mapping[str, FoldJob],
+    axes: Sequence[Axis],
+    true_start: bool,
+) -> dict[str, Any]:
+    """The JSON document: per group its info, scheme summaries, fold constants and walk rows."""
+    per_group = []
+    for label in labels:
+        info = group_info[label]
+        rs = [r for r in results if r["group"] == label]
+        entry = {**info, "summary": summarize_group([r for r in rs if not r["error"]], "fixes")}
+        if true_start:
+            entry["summary_true_start"] = summarize_group([r for r in rs if not r["error"]], "true_start")
+        entry["fold_errors"] = [{"walk": r["walk"], "error": r["error"]} for r in rs if r["error"]]
+        folds = [r["fold"] for r in rs if r.get("fold")]
+        entry["constants"] = {
+            "K": _spread([f["K"] for f in folds]),
+            "rotation_deg": _spread([f["rotation_deg"] for f in folds]),
+            "n_rp": _spread([f["n_rp"] for f in folds]),
+            "n_ap": _spread([f["n_ap"] for f in folds]),
+            **{
+                key: {
+                    v: sum(1 for f in folds if f.get(key) == v)
+                    for v in sorted({f.get(key) for f in folds} - {None})
+                }
+                for key in (f"{a.name}_variant" for a in axes)
+            },
+        }
+        entry["walk_rows"] = []
+        for r in rs:
+            j = job_of[r["walk"]]
+            w = walks[j.index]
+            row = {
+                "walk": r["walk"],
+                "error": r["error"],
+                "fold": r.get("fold"),
+                "rotation_learned": j.rotation_learned,
+                "waypoints": len(w["waypoint_t_us"]),
+                "steps_nosite": len(w["step_t_us"]),
+                "duration_s": (w["import"] or {}).get("duration_s"),
+                "floors": w["floors"],
+                "dir": str(j.dir),
+            }
+            for tag in ("fixes", "true_start"):
+                if tag in r:
+                    row[tag] = r[tag]
+            entry["walk_rows"].append(row)
+        per_group.append(entry)
+    return {
+        "benchmark": "realbench fusion (leave one walk out)",
+        "format": fmt,
+        "inputs": [str(d) for d in dirs],
+        "true_start": true_start,
+        "groups": per_group,
+    }
+
+
+def _spread(v: Iterable[float | None]) -> dict[str, Any]:
+    v = np.asarray([x for x in v if x is not None], float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return {"n": 0, "mean": math.nan, "min": math.nan, "max": math.nan, "std": math.nan}
+    return {
+        "n": int(len(v)),
+        "mean": float(v.mean()),
+        "min": float(v.min()),
+        "max": float(v.max()),
+        "std": float(v.std()),
+    }
+
+
+def strip_samples(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """The JSON keeps per-walk statistics; per-sample errors stay in each walk's analysis.npz."""
+    out = json.loads(json.dumps(json_ready(doc)))
+    for g in out["groups"]:
+        for row in g["walk_rows"]:
+            for tag in ("fixes", "true_start"):
+                for s in (row.get(tag) or {}).values():
+                    s.pop("errors_m", None)
+                    s.pop("floor_errors", None)
+    return out
+
+
+# --- console ---------------------------------------------------------------------------------------
+
+
+def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
+    """Per group: scheme × n, mean, median, p75, p90, max, RMSE, IPIN, floor %, walks > 15 m."""
+
+    def f(v: Any, d: int = 2) -> str:
+        return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
+
+    lines = []
+    for g in doc["groups"]:
+        c = g["constants"]
+        lines.append(
+            f"{g['label']}: {g['walks']} walks ({g['ran']} ran, "
+            f"{len(g['walk_rows']) - len(g['fold_errors'])} scored), leave one walk out; "
+            f"K {f(c['K']['mean'], 3)} ({f(c['K']['min'], 3)}..{f(c['K']['max'], 3)}), "
+            f"rotation {f(c['rotation_deg']['mean'], 1)} deg "
+            f"({f(c['rotation_deg']['min'], 1)}..{f(c['rotation_deg']['max'], 1)}), "
+            + "".join(
+                f"{a.label} "
+                + ", ".join(f"{v} in {n} folds" for v, n in c.get(f"{a.name}_variant", {}).items())
+                + ", "
+                for a in axes
+            )
+            + f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs"
+        )
+        for key, title in (
+            ("summary", "every scheme from its first fix"),
+            ("summary_true_start", "TRUTH-INITIALISED start"),
+        ):
+            if key not in g:
+                continue
+            s = g[key]
+            lines.append(f"  [{title}]  errors in m at the ground-truth times")
+            lines.append(
+                f"  {'scheme':<10}{'n':>6}{'mean':>8}{'median':>8}{'p75':>8}{'p90':>8}"
+                f"{'max':>8}{'rmse':>8}{'ipin':>8}{'floor%':>8}{'>15m':>10}"
+            )
+            for name, r in s["schemes"].items():
+                share = r["share_walks_mean_over_15m"]
+                lines.append(
+                    f"  {name:<10}{r['n']:>6}{f(r['mean']):>8}{f(r['median']):>8}"
+                    f"{f(r['p75']):>8}{f(r['p90']):>8}{f(r['max']):>8}{f(r['rmse']):>8}"
+                    f"{f(r['ipin_score']):>8}{f(100 * r['floor_hit_rate'], 1):>8}"
+                    f"{(f(100 * share, 1) + '%') if share == share else '-':>10}"
+                )
+            lines.append(
+                f"  adaptive vs wifi_only: mean error reduced by "
+                f"{f(s['adaptive_vs_wifi_only_reduction_pct'], 1)} %  (>15m = share of walks "
+                f"whose mean error exceeds {ROBUST_MEAN_M:g} m; ipin = p75 of 2-D error + "
+                f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|)"
+            )
+        for e in g["failed"] + g["fold_errors"]:
+            lines.append(f"  failed {e['walk']}: {e['error']}")
+    return "\n".join(lines)

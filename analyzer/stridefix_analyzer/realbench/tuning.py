@@ -1,0 +1,189 @@
+"""Tuning as data: every choice ``realbench fusion`` makes per fold is one row — an :class:`Axis` of
+(name, candidates, chooser) in :data:`AXES` — and :func:`choose` runs the rows in order.
+
+Candidates are ``stridefixd --set KEY=VALUE`` lists (the first is the firmware default). A chooser
+sees the prepared walks of one group and returns the candidate of every walk's fold, chosen from the
+*other* walks only (DESIGN.md, evaluation protocol):
+
+* ``heading`` (:class:`TruthAgreement`): gait-learned or fixed mounting offset × normal or wide
+  magnetometer gate; the one whose STEP headings agree best with the other walks' truth directions
+  (:func:`.heading.choose_heading_variant`). A hand-held phone is not a body-worn board.
+* ``matcher`` (:class:`InnerCV`, :mod:`.select`): scans averaged (1 or 2) × WkNN representation (dBm
+  or "powed"), by cross-validation inside the training walks on the Wi-Fi fix error.
+* ``adaptive`` (:class:`InnerCV`): the adaptive scheme's Wi-Fi accuracy-factor scale, the same way on
+  the adaptive POSE error, with each block's matcher (settings chosen by earlier inner-CV rows carry
+  over per block).
+
+A user's ``--set`` of any key an axis varies replaces that axis's candidates by ``{"given": []}``
+(:func:`axes`). A new tuning idea is one more row, not a new stage in ``run_fusion``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any, Protocol, TextIO
+
+from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.realbench import select as rs
+from stridefix_analyzer.realbench.heading import (
+    HEADING_VARIANTS,
+    RotationSums,
+    choose_heading_variant,
+    learn_heading,
+)
+from stridefix_analyzer.realbench.progress import Progress
+
+#: the matcher's candidates: scans averaged (1 or 2) × WkNN representation (dBm, or "powed" with beta
+#: 2 or e — Torres-Sospedra 2015's choice)
+_AVERAGE = {"1 scan": [], "2 scans": ["fingerprint.average_scans=2"]}
+_REPRESENTATION = {
+    "dBm": [],
+    "powed 2": ["fingerprint.powed_beta=2"],
+    "powed e": ["fingerprint.powed_beta=2.718281828"],
+}
+MATCHER_VARIANTS = {f"{a}, {r}": sa + sr for a, sa in _AVERAGE.items() for r, sr in _REPRESENTATION.items()}
+#: the adaptive scheme's Wi-Fi accuracy factors (a table on the AP count, AADR 2015) times a scale: the
+#: table says little when every scan hears ~100 APs
+ADAPTIVE_VARIANTS = {
+    "table x 1": [],
+    "table x 0.5": ["fusion.acc_wifi_scale=0.5"],
+    "table x 0.25": ["fusion.acc_wifi_scale=0.25"],
+}
+
+Candidates = Mapping[str, Sequence[str]]
+
+
+@dataclasses.dataclass(frozen=True)
+class Group:
+    """What a chooser sees of one group: its prepared walks (phase 1) and how to replay them."""
+
+    walks: Sequence[Mapping[str, Any]]
+    rotation: Sequence[Mapping[str, RotationSums]]  # per walk, per heading candidate
+    #: ``sites(removed, others, name, path)`` writes a selection site and returns its settings
+    sites: Callable[[Any, list[Mapping[str, Any]], str, Path], list[str]]
+    firmware: Firmware
+    work_dir: Path
+    base_sets: Sequence[str]
+    jobs: int
+    stream: TextIO
+
+
+@dataclasses.dataclass(frozen=True)
+class Choice:
+    """One axis's outcome in one group."""
+
+    per_walk: list[str]  # the candidate of each walk's fold
+    info: dict[str, Any]  # the group's record of how it was chosen (results.json)
+    extra: list[dict[str, Any]]  # per walk, further fold fields (results.json)
+    #: settings chosen per inner-CV block, for the inner-CV rows after this one
+    block_sets: dict[int, list[str]] = dataclasses.field(default_factory=dict)
+
+
+class Chooser(Protocol):
+    def __call__(self, axis: Axis, group: Group, block_sets: Mapping[int, Sequence[str]]) -> Choice: ...
+
+
+@dataclasses.dataclass(frozen=True)
+class TruthAgreement:
+    """Per fold, the candidate whose STEP headings agree best with the truth directions of the other
+    walks (every walk was replayed with every candidate in phase 1)."""
+
+    def __call__(self, axis: Axis, group: Group, block_sets: Mapping[int, Sequence[str]]) -> Choice:
+        variant, score, rotation = learn_heading(group.rotation)
+        per_walk, extra = [], []
+        for j in range(len(group.walks)):
+            v, s = choose_heading_variant(group.rotation, exclude=j)
+            per_walk.append(v)
+            extra.append({f"{axis.name}_resultant": s})
+        info = {
+            f"{axis.name}_variant_all_walks": variant,
+            f"{axis.name}_resultant_all_walks": score,
+            "rotation_all_walks_deg": rotation,
+        }
+        return Choice(per_walk, info, extra)
+
+
+@dataclasses.dataclass(frozen=True)
+class InnerCV:
+    """Cross-validation inside the training walks (:func:`.select.select`); ``stage`` says what is
+    replayed and scored (:data:`.select.STAGES`)."""
+
+    stage: str
+
+    def __call__(self, axis: Axis, group: Group, block_sets: Mapping[int, Sequence[str]]) -> Choice:
+        prog = Progress(
+            f"choose {axis.name}", rs.n_tasks(len(group.walks), len(axis.candidates)), group.stream
+        )
+        per_walk, report = rs.select(
+            list(group.walks),
+            group.sites,
+            stridefixd=group.firmware.path,
+            work_dir=group.work_dir,
+            base_sets=list(group.base_sets),
+            candidates={k: list(v) for k, v in axis.candidates.items()},
+            jobs=group.jobs,
+            progress=prog.step,
+            stage=self.stage,
+            block_sets={a: list(s) for a, s in block_sets.items()},
+        )
+        chosen = report.get("choice_of_block", {})
+        sets = {a: list(axis.candidates[n]) for a, n in chosen.items()}
+        return Choice(per_walk, {f"{axis.name}_selection": report}, [{} for _ in per_walk], sets)
+
+
+@dataclasses.dataclass(frozen=True)
+class Axis:
+    """One tuning row: ``name`` (fold field ``<name>_variant``), ``label`` (console), the candidates
+    (name → --set list) and the chooser."""
+
+    name: str
+    label: str
+    candidates: Candidates
+    chooser: Chooser
+
+
+AXES: tuple[Axis, ...] = (
+    Axis("heading", "heading variant", HEADING_VARIANTS, TruthAgreement()),
+    Axis("matcher", "matcher", MATCHER_VARIANTS, InnerCV("matcher")),
+    Axis("adaptive", "adaptive", ADAPTIVE_VARIANTS, InnerCV("adaptive")),
+)
+
+
+def variants_unless_given(param_sets: Sequence[str] | None, table: Candidates) -> dict[str, list[str]]:
+    """The candidates of ``table`` ({name: ["key=value", ...]}), or only ``{"given": []}`` when the
+    user's ``--set`` list already sets one of the keys they vary (the user's choice wins)."""
+    keys = {kv.split("=", 1)[0] for sets in table.values() for kv in sets}
+    if any(kv.split("=", 1)[0].strip() in keys for kv in param_sets or []):
+        return {"given": []}
+    return {k: list(v) for k, v in table.items()}
+
+
+def axes(param_sets: Sequence[str] | None, rows: Sequence[Axis] = AXES) -> tuple[Axis, ...]:
+    """The rows with the user's ``--set`` applied (see :func:`variants_unless_given`)."""
+    return tuple(
+        dataclasses.replace(a, candidates=variants_unless_given(param_sets, a.candidates)) for a in rows
+    )
+
+
+def candidates(name: str, param_sets: Sequence[str] | None = None) -> dict[str, list[str]]:
+    """The candidates of axis ``name`` given the user's ``--set`` list."""
+    (axis,) = [a for a in axes(param_sets) if a.name == name]
+    return {k: list(v) for k, v in axis.candidates.items()}
+
+
+def choose(rows: Sequence[Axis], group: Group) -> dict[str, Choice]:
+    """Run every row's chooser in order on one group; returns axis name → choice."""
+    choices: dict[str, Choice] = {}
+    block_sets: dict[int, list[str]] = {}
+    for axis in rows:
+        choices[axis.name] = c = axis.chooser(axis, group, block_sets)
+        for a, sets in c.block_sets.items():
+            block_sets[a] = block_sets.get(a, []) + sets
+    return choices
+
+
+def settings(rows: Sequence[Axis], variants: Mapping[str, str]) -> list[str]:
+    """The --set list of the chosen candidate of every row, in row order."""
+    return [kv for a in rows for kv in a.candidates[variants[a.name]]]
