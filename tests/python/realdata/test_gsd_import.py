@@ -11,15 +11,16 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import baro_t, gnss_t, imu_t, truth_t, wifi_scan_t
-from stridefix_analyzer.datasets import gsd
+from stridefix_analyzer.datasets import gsd, gsd_convert, gsd_parse
+from stridefix_analyzer.datasets.lines import MalformedLineWarning
 from stridefix_analyzer.io.logread import read_logs
 
 
 def _import(path, tmp_path, **kw):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        summary = gsd.import_log(path, tmp_path / "out.lcmlog", **kw)
-    return summary, [str(w.message) for w in caught if w.category is gsd.MalformedLineWarning]
+        summary = gsd.DATASET.import_walk(path, tmp_path / "out.lcmlog", **kw)
+    return summary, [str(w.message) for w in caught if w.category is MalformedLineWarning]
 
 
 def _events(tmp_path, channel, decoder):
@@ -113,9 +114,9 @@ def test_handmade_wifi_grouped_cached_dropped(gsd_log, tmp_path):
 
 @pytest.mark.parametrize("max_age_s, n_first_scan", [(2.0, 2), (3.0, 3), (0.015, 1)])
 def test_wifi_age_limit_is_a_parameter(gsd_log, max_age_s, n_first_scan):
-    with pytest.warns(gsd.MalformedLineWarning, match="3 in all"):
-        log = gsd.read_log(gsd_log, max_wifi_age_s=max_age_s, max_line_warnings=0)
-    assert len(log.scans[0].bssid) == n_first_scan
+    with pytest.warns(MalformedLineWarning, match="3 in all"):
+        log = gsd.DATASET.read(gsd_log, max_wifi_age_s=max_age_s, max_line_warnings=0)
+    assert len(log.scan(0)["bssid"]) == n_first_scan
 
 
 def test_handmade_posi_to_local_metres(gsd_log, tmp_path):
@@ -153,12 +154,12 @@ def test_origin_option_shifts_the_frame(gsd_log, tmp_path):
 
 
 def test_project_and_parse_origin():
-    x, y = gsd.project([49.46, 49.4601], [11.11, 11.11], 49.46, 11.11)
+    x, y = gsd_convert.project([49.46, 49.4601], [11.11, 11.11], 49.46, 11.11)
     assert_allclose(y, [0.0, 11.1219], atol=1e-4) and x.tolist() == [0.0, 0.0]
-    assert gsd.parse_origin("49.46, 11.11") == (49.46, 11.11)
+    assert gsd_convert.parse_origin("49.46, 11.11") == (49.46, 11.11)
     for bad in ("49.46", "91,0", "a,b"):
         with pytest.raises(ValueError):
-            gsd.parse_origin(bad)
+            gsd_convert.parse_origin(bad)
 
 
 @pytest.mark.parametrize("unit, pa", [("hPa", 101325.0), ("kPa", 1013250.0), ("Pa", 1013.25)])
@@ -169,7 +170,7 @@ def test_pressure_unit_from_header(tmp_path, unit, pa):
         "PRES;1.0;5.0;1013.25;3\n",
         encoding="utf-8",
     )
-    assert gsd.read_log(path).baro_pa.tolist() == pytest.approx([pa])
+    assert gsd.DATASET.read(path).baro["pressure_pa"].tolist() == pytest.approx([pa])
 
 
 def test_unknown_pressure_unit_raises_naming_file_and_line(tmp_path):
@@ -177,19 +178,20 @@ def test_unknown_pressure_unit_raises_naming_file_and_line(tmp_path):
     path.write_text(
         "% x\n% Pressure data: 'PRES;AppTimestamp(s);SensorTimestamp(s);Pres(psi);A'\n", encoding="utf-8"
     )
-    with pytest.raises(gsd.LogHeaderError, match=r"psi.txt: line 2: pressure unit 'psi'"):
-        gsd.read_log(path)
+    with pytest.raises(gsd_parse.LogHeaderError, match=r"psi.txt: line 2: pressure unit 'psi'"):
+        gsd.DATASET.read(path)
 
 
-def test_import_trace_alias_takes_the_msindoor_arguments(gsd_log, tmp_path):
-    with pytest.warns(gsd.MalformedLineWarning):
-        s = gsd.import_trace(gsd_log, tmp_path / "a.lcmlog", max_wifi_age_s=3.0)
+def test_import_walk_takes_the_protocol_options(gsd_log, tmp_path):
+    # the options every data set reads (was the import_trace alias of msindoor's signature)
+    with pytest.warns(MalformedLineWarning):
+        s = gsd.DATASET.import_walk(gsd_log, tmp_path / "a.lcmlog", max_wifi_age_s=3.0)
     assert s["wifi_aps_written"] == 5 and s["max_wifi_age_s"] == 3.0
 
 
 def test_missing_file_raises_naming_it(tmp_path):
-    with pytest.raises(gsd.LogReadError, match="nope.txt: no such file"):
-        gsd.read_log(tmp_path / "nope.txt")
+    with pytest.raises(gsd_parse.LogReadError, match="nope.txt: no such file"):
+        gsd.DATASET.read(tmp_path / "nope.txt")
 
 
 def test_many_malformed_lines_are_summed_up(tmp_path):
@@ -197,9 +199,9 @@ def test_many_malformed_lines_are_summed_up(tmp_path):
     path.write_text("ACCE;1;2;x;y;z;3\n" * 50, encoding="utf-8")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        log = gsd.read_log(path)
+        log = gsd.DATASET.read(path)
     assert len(log.skipped) == 50
-    assert len(caught) == gsd.MAX_LINE_WARNINGS + 1
+    assert len(caught) == gsd_parse.MAX_LINE_WARNINGS + 1
     assert "30 more malformed line(s)" in str(caught[-1].message)
 
 

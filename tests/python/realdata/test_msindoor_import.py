@@ -10,15 +10,17 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import imu_t, truth_t, wifi_scan_t
-from stridefix_analyzer.datasets import msindoor
+from stridefix_analyzer.datasets import msindoor, msindoor_parse
+from stridefix_analyzer.datasets.lines import MalformedLineWarning
+from stridefix_analyzer.datasets.rawwalk import bssid_to_int
 from stridefix_analyzer.io.logread import read_logs
 
 
 def _import(trace, tmp_path, **kw):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        summary = msindoor.import_trace(trace, tmp_path / "out.lcmlog", **kw)
-    return summary, [str(w.message) for w in caught if w.category is msindoor.MalformedLineWarning]
+        summary = msindoor.DATASET.import_walk(trace, tmp_path / "out.lcmlog", **kw)
+    return summary, [str(w.message) for w in caught if w.category is MalformedLineWarning]
 
 
 def test_handmade_counts_and_summary(handmade_trace, tmp_path):
@@ -77,9 +79,9 @@ def test_handmade_wifi_scans_grouped_cached_dropped(handmade_trace, tmp_path):
 
 @pytest.mark.parametrize("max_age_s, n_first_scan", [(3.0, 2), (4.0, 3), (0.05, 1)])
 def test_wifi_age_limit_is_a_parameter(handmade_trace, tmp_path, max_age_s, n_first_scan):
-    with pytest.warns(msindoor.MalformedLineWarning, match="4 in all"):
-        trace = msindoor.read_trace(handmade_trace, max_wifi_age_s=max_age_s, max_line_warnings=0)
-    assert len(trace.scans[0].bssid) == n_first_scan
+    with pytest.warns(MalformedLineWarning, match="4 in all"):
+        trace = msindoor.DATASET.read(handmade_trace, max_wifi_age_s=max_age_s, max_line_warnings=0)
+    assert len(trace.scan(0)["bssid"]) == n_first_scan
 
 
 def test_handmade_waypoints_become_truth_in_time_order(handmade_trace, tmp_path):
@@ -107,33 +109,34 @@ def test_handmade_waypoints_become_truth_in_time_order(handmade_trace, tmp_path)
     [("F1", 0), ("F2", 1), ("F10", 9), ("B1", -1), ("B2", -2), ("1F", 0), ("2B", -2), ("L3", 2), ("G", 0)],
 )
 def test_floor_index(name, index):
-    assert msindoor.floor_index(name) == index
+    assert msindoor_parse.floor_index(name) == index
 
 
 @pytest.mark.parametrize("name", ["", "F0", "roof", "F1.5"])
 def test_floor_index_rejects(name):
     with pytest.raises(ValueError):
-        msindoor.floor_index(name)
+        msindoor_parse.floor_index(name)
 
 
 def test_bssid_to_int():
-    assert msindoor.bssid_to_int("a8:0c:ca:05:9f:74") == 0xA80CCA059F74
+    assert bssid_to_int("a8:0c:ca:05:9f:74") == 0xA80CCA059F74
     with pytest.raises(ValueError):
-        msindoor.bssid_to_int("a8:0c:ca:05:9f")
+        bssid_to_int("a8:0c:ca:05:9f")
 
 
 def test_missing_file_raises_naming_it(tmp_path):
     missing = tmp_path / "nope.txt"
-    with pytest.raises(msindoor.TraceReadError, match="nope.txt: no such file"):
-        msindoor.read_trace(missing)
+    with pytest.raises(msindoor_parse.TraceReadError, match="nope.txt: no such file"):
+        msindoor.DATASET.read(missing)
 
 
 def test_unknown_floor_name_raises_unless_given(tmp_path):
     path = tmp_path / "roof.txt"
     path.write_text("#\tFloorName:Roof\n1000\tTYPE_WAYPOINT\t1\t2\n", encoding="utf-8")
-    with pytest.raises(msindoor.TraceHeaderError, match="roof.txt"):
-        msindoor.read_trace(path)
-    assert msindoor.read_trace(path, floor=7).floor == 7
+    with pytest.raises(msindoor_parse.TraceHeaderError, match="roof.txt"):
+        msindoor.DATASET.read(path)
+    walk = msindoor.DATASET.read(path, floor=7)
+    assert walk.meta["floor"] == 7 and walk.truth["floor"].tolist() == [7]
 
 
 def test_many_malformed_lines_are_summed_up(tmp_path):
@@ -141,9 +144,9 @@ def test_many_malformed_lines_are_summed_up(tmp_path):
     path.write_text("#\tFloorName:F1\n" + "1000\tTYPE_GYROSCOPE\tx\n" * 50, encoding="utf-8")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        trace = msindoor.read_trace(path)
+        trace = msindoor.DATASET.read(path)
     assert len(trace.skipped) == 50
-    assert len(caught) == msindoor.MAX_LINE_WARNINGS + 1
+    assert len(caught) == msindoor_parse.MAX_LINE_WARNINGS + 1
     assert "30 more malformed line(s)" in str(caught[-1].message)
 
 
@@ -189,7 +192,7 @@ def test_real_trace(real_trace, tmp_path):
 
 def test_default_wifi_age_limit_is_2_s(tmp_path):
     # issue 5: an entry last seen more than ~2 s before its scan is cached and dropped (was 3 s)
-    assert msindoor.DEFAULT_MAX_WIFI_AGE_S == 2.0
+    assert msindoor.DATASET.defaults.max_wifi_age_s == 2.0
     path = tmp_path / "ages.txt"
     path.write_text(
         "#\tFloorName:F1\n"
@@ -197,6 +200,6 @@ def test_default_wifi_age_limit_is_2_s(tmp_path):
         "5000\tTYPE_WIFI\tb\taa:bb:cc:dd:ee:02\t-60\t2412\t2500\n",  # 2.5 s: cached
         encoding="utf-8",
     )
-    trace = msindoor.read_trace(path)
-    assert trace.scans[0].bssid.tolist() == [0xAABBCCDDEE01]
+    trace = msindoor.DATASET.read(path)
+    assert trace.scan(0)["bssid"].tolist() == [0xAABBCCDDEE01]
     assert trace.stats["wifi_aps_stale_dropped"] == 1

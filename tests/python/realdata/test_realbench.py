@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix_analyzer.realbench import pdr_distance as rb
+from stridefix_analyzer.realbench import strides
 
 # --- calibration and segments on synthetic data ---------------------------------------------------
 
@@ -24,23 +25,23 @@ def three_walks():
 
 def test_lowo_k_uses_only_the_other_walks(three_walks):
     walk, true_m, weinberg = three_walks
-    k = rb.calibrate_lowo(walk, true_m, weinberg)
+    k = strides.calibrate_lowo(walk, true_m, weinberg)
     # K_0 from walks 1, 2: (0.4·40 + 0.5·40) / 80 = 0.45; K_1: (0.3·30 + 0.5·40) / 70; K_2: ...
     assert_allclose(k, [0.45, (9 + 20) / 70, (9 + 16) / 70], rtol=1e-12)
 
 
 def test_lowo_k_is_blind_to_the_scored_walk(three_walks):
     walk, true_m, weinberg = three_walks
-    k = rb.calibrate_lowo(walk, true_m, weinberg)
+    k = strides.calibrate_lowo(walk, true_m, weinberg)
     changed = true_m.copy()
     changed[walk == 0] *= 5.0
-    k2 = rb.calibrate_lowo(walk, changed, weinberg)
+    k2 = strides.calibrate_lowo(walk, changed, weinberg)
     assert k2[0] == k[0]
     assert k2[1] != k[1] and k2[2] != k[2]
 
 
 def test_lowo_single_walk_has_no_k():
-    assert math.isnan(rb.calibrate_lowo([0, 0], [3.0, 4.0], [8.0, 9.0])[0])
+    assert math.isnan(strides.calibrate_lowo([0, 0], [3.0, 4.0], [8.0, 9.0])[0])
 
 
 def test_lowo_stride_is_median_of_other_walks():
@@ -48,7 +49,7 @@ def test_lowo_stride_is_median_of_other_walks():
     true_m = np.array([100.0, 6.0, 7.0, 8.0, 9.0])
     n_steps = np.array([1, 10, 10, 10, 10])
     # strides: walk 0: 100; walk 1: 0.6, 0.7, 0.8; walk 2: 0.9
-    assert_allclose(rb.stride_lowo(walk, true_m, n_steps), [0.75, (100 + 0.9) / 2, 0.75])
+    assert_allclose(strides.stride_lowo(walk, true_m, n_steps), [0.75, (100 + 0.9) / 2, 0.75])
 
 
 def _walk(waypoints, step_t_s, ranges, imu_s=(0.0, 100.0)):
@@ -76,7 +77,7 @@ def test_segments_take_steps_after_start_up_to_end():
     walk = _walk(
         [(0, 0, 0), (10, 6, 8), (12, 7, 8), (200, 7, 20)], [0.0, 5.0, 10.0, 11.0], [16.0, 81.0, 1.0, 16.0]
     )
-    seg = rb.build_segments([walk], min_segment_m=3.0)
+    seg = strides.build_segments([walk], min_segment_m=3.0)
     assert seg["true_m"].tolist() == pytest.approx([10.0, 1.0, 12.0])
     # t0 < t <= t1: the step at 0 s is not in segment 0, the one at 10 s is
     assert seg["n_steps"].tolist() == [2, 1, 0]
@@ -90,7 +91,7 @@ def test_score_segments_end_to_end_synthetic():
         _walk([(0, 0, 0), (10, 10, 0)], np.arange(1, 11), np.full(10, 16.0)),
         _walk([(0, 0, 0), (10, 0, 5)], np.arange(1, 6), np.full(5, 16.0)),
     ]
-    seg, fits = rb.score_segments(rb.build_segments(walks), 2)
+    seg, fits = rb.score_segments(strides.build_segments(walks), 2)
     assert_allclose(fits["K"], [0.5, 0.5])
     assert_allclose(seg["err_pct"], [0.0, 0.0], atol=1e-9)
     assert_allclose(seg["stride_m"], [1.0, 1.0])

@@ -16,13 +16,15 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import truth_t, wifi_scan_t
+from stridefix_analyzer import schemes
 from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
-from stridefix_analyzer.realbench import fusion as rf
-from stridefix_analyzer.realbench import pdr_distance as rb
+from stridefix_analyzer.realbench import cli as rbcli
+from stridefix_analyzer.realbench import floors, heading
+from stridefix_analyzer.realbench import fold as rfold
 
-SCHEMES = ("pdr_only", "wifi_only", "overwrite", "static", "adaptive", "kalman")
+SCHEMES = schemes.NAMES
 
 
 # --- synthetic walks with WIFI + TRUTH -------------------------------------------------------------
@@ -135,7 +137,7 @@ def test_held_out_walk_never_contributes_to_its_own_site(synthetic_walks):
     stats = [rm.WalkStats.from_recordings([r]) for r in synthetic_walks]
     total = rm.WalkStats.total(stats)
     sites = [
-        rf.fold_site(
+        rfold.fold_site(
             total, stats[i], name=f"w{i}", rotation_deg=0.0, floor_heights_m=[0.0, 4.0], lowest_floor=0
         )[0]
         for i in range(5)
@@ -180,41 +182,41 @@ def synthetic_rotation_walk(rot_deg: float, seed: int, noise_deg: float = 8.0):
 
 @pytest.mark.parametrize("rot_deg", [-31.0, 0.0, 97.5, 179.0])
 def test_rotation_learning_recovers_a_known_rotation(rot_deg):
-    stats = [rf.rotation_stats(*synthetic_rotation_walk(rot_deg, seed)) for seed in range(6)]
+    stats = [heading.rotation_stats(*synthetic_rotation_walk(rot_deg, seed)) for seed in range(6)]
     assert all(s["n_segments"] >= 1 for s in stats)
     for held in (None, 0, 5):
-        got = rf.learn_rotation_deg(stats, exclude=held)
+        got = heading.learn_rotation_deg(stats, exclude=held)
         assert abs(math.remainder(got - rot_deg, 360.0)) < 2.0
 
 
 def test_rotation_of_a_fold_ignores_the_held_out_walk():
-    stats = [rf.rotation_stats(*synthetic_rotation_walk(10.0, s)) for s in range(3)]
-    stats.append(rf.rotation_stats(*synthetic_rotation_walk(120.0, 9)))  # an outlier walk
-    assert abs(rf.learn_rotation_deg(stats, exclude=3) - 10.0) < 2.0
-    assert abs(rf.learn_rotation_deg(stats) - 10.0) > 5.0
-    assert math.isnan(rf.learn_rotation_deg(stats[:1], exclude=0))
+    stats = [heading.rotation_stats(*synthetic_rotation_walk(10.0, s)) for s in range(3)]
+    stats.append(heading.rotation_stats(*synthetic_rotation_walk(120.0, 9)))  # an outlier walk
+    assert abs(heading.learn_rotation_deg(stats, exclude=3) - 10.0) < 2.0
+    assert abs(heading.learn_rotation_deg(stats) - 10.0) > 5.0
+    assert math.isnan(heading.learn_rotation_deg(stats[:1], exclude=0))
 
 
 def test_floor_heights_from_barometer_and_default():
     # walk A: floors 0, -1, -2 at 0, -5, -9.5 m (+ weather offset 40 m); walk B: floors 0, -1
     a = {0: 40.0, -1: 35.0, -2: 30.5}
     b = {0: -7.0, -1: -12.0}
-    h, src = rf.learn_floor_heights([a, b, {0: 3.0}], [-2, -1, 0])
+    h, src = floors.learn_floor_heights([a, b, {0: 3.0}], [-2, -1, 0])
     assert src == "barometer"
     assert_allclose(np.diff(h), [4.5, 5.0], atol=1e-9)
-    h, src = rf.learn_floor_heights([b], [-2, -1, 0], storey_m=4.0)
+    h, src = floors.learn_floor_heights([b], [-2, -1, 0], storey_m=4.0)
     assert src == "barometer+default"
     assert_allclose(np.diff(h), [4.0, 5.0], atol=1e-9)
-    h, src = rf.learn_floor_heights([{0: 1.0}], [-2, -1, 0], storey_m=4.0)
+    h, src = floors.learn_floor_heights([{0: 1.0}], [-2, -1, 0], storey_m=4.0)
     assert src == "default"
     assert_allclose(h, [-8.0, -4.0, 0.0])
 
 
 def test_default_benchmark_is_fusion():
-    assert rb.with_default_bench(["realbench", "--format", "gsd", "d"])[:2] == ["realbench", "fusion"]
-    assert rb.with_default_bench(["realbench", "pdr-distance", "--floor", "x"])[1] == "pdr-distance"
-    assert rb.with_default_bench(["realbench", "--help"])[1] == "--help"
-    assert rb.with_default_bench(["analyze", "x"]) == ["analyze", "x"]
+    assert rbcli.with_default_bench(["realbench", "--format", "gsd", "d"])[:2] == ["realbench", "fusion"]
+    assert rbcli.with_default_bench(["realbench", "pdr-distance", "--floor", "x"])[1] == "pdr-distance"
+    assert rbcli.with_default_bench(["realbench", "--help"])[1] == "--help"
+    assert rbcli.with_default_bench(["analyze", "x"]) == ["analyze", "x"]
 
 
 # --- a small real run ------------------------------------------------------------------------------

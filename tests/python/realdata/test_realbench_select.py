@@ -1,5 +1,5 @@
 """realbench's per-fold matcher choice by cross-validation inside the training walks
-(``stridefix_analyzer.realbench_select``): the fix-error arithmetic, the user's override, and a real
+(``stridefix_analyzer.realbench.select``, the rows of ``realbench.tuning``): the fix-error arithmetic, the user's override, and a real
 run on 8 msindoor walks checked for the choice rule and for leakage of the held-out block."""
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from numpy.testing import assert_allclose
 from stridefix import fix_t, pose_t
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.realbench import select as rs
+from stridefix_analyzer.realbench import tuning
 
 from .conftest import MSINDOOR
 
@@ -56,20 +57,21 @@ def test_pose_errors_are_causal_at_the_waypoints(tmp_path):
 
 
 def test_a_user_setting_replaces_the_candidates():
-    assert rs.matcher_variants([]) == rs.MATCHER_VARIANTS
-    assert rs.matcher_variants(["fingerprint.average_scans=3"]) == {"given": []}
-    assert rs.matcher_variants(["fingerprint.powed_beta=3"]) == {"given": []}
-    assert rs.matcher_variants(["fusion.gate_sigma=4"]) == rs.MATCHER_VARIANTS
-    assert rs.adaptive_variants(["fusion.acc_wifi_scale=0.3"]) == {"given": []}
-    assert rs.adaptive_variants([]) == rs.ADAPTIVE_VARIANTS
+    assert tuning.candidates("matcher", []) == tuning.MATCHER_VARIANTS
+    assert tuning.candidates("matcher", ["fingerprint.average_scans=3"]) == {"given": []}
+    assert tuning.candidates("matcher", ["fingerprint.powed_beta=3"]) == {"given": []}
+    assert tuning.candidates("matcher", ["fusion.gate_sigma=4"]) == tuning.MATCHER_VARIANTS
+    assert tuning.candidates("adaptive", ["fusion.acc_wifi_scale=0.3"]) == {"given": []}
+    assert tuning.candidates("adaptive", []) == tuning.ADAPTIVE_VARIANTS
+    assert tuning.candidates("heading", ["heading.learn_offset=1"]) == {"given": []}
 
 
 def test_too_few_walks_keep_the_firmware_default():
     walks = [{"walk": str(i)} for i in range(rs.MIN_WALKS - 1)]
     choice, report = rs.select(
-        walks, None, stridefixd="x", work_dir="unused", base_sets=[], candidates=rs.MATCHER_VARIANTS
+        walks, None, stridefixd="x", work_dir="unused", base_sets=[], candidates=tuning.MATCHER_VARIANTS
     )
-    assert choice == [next(iter(rs.MATCHER_VARIANTS))] * len(walks)
+    assert choice == [next(iter(tuning.MATCHER_VARIANTS))] * len(walks)
     assert report["chosen_by"].startswith("default")
     assert rs.n_tasks(rs.MIN_WALKS - 1, 2) == 0
     assert rs.n_tasks(8, 2) == 3 * 8 * 2
@@ -102,12 +104,12 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
         stridefixd="x",
         work_dir=tmp_path,
         base_sets=["k=v"],
-        candidates=rs.MATCHER_VARIANTS,
+        candidates=tuning.MATCHER_VARIANTS,
         jobs=1,
         replay=replay,
     )
     assert choice == ["2 scans, dBm" if i % 4 == 1 else "1 scan, dBm" for i in range(10)]
-    assert len(replays) == rs.n_tasks(10, len(rs.MATCHER_VARIANTS)) == 3 * 10 * 6
+    assert len(replays) == rs.n_tasks(10, len(tuning.MATCHER_VARIANTS)) == 3 * 10 * 6
     for t in replays:
         removed, others = sites[t["site"]]
         a = t["a"]
@@ -156,7 +158,7 @@ def test_each_block_takes_the_candidate_with_the_lowest_pooled_error(realbench_e
     assert set(sel["blocks"]) == {"0", "1", "2", "3"}
     for b in sel["blocks"].values():
         c = b["candidates"]
-        assert set(c) == set(rs.MATCHER_VARIANTS)
+        assert set(c) == set(tuning.MATCHER_VARIANTS)
         for v in c.values():
             assert v["fixes"] > 20 and 0.5 < v["mean_m"] < 50.0  # real fixes, plausible errors
         assert b["chosen"] == min(c, key=lambda n: c[n]["mean_m"])
@@ -164,7 +166,7 @@ def test_each_block_takes_the_candidate_with_the_lowest_pooled_error(realbench_e
     ad = g["adaptive_selection"]
     for b in ad["blocks"].values():
         c = b["candidates"]
-        assert set(c) == set(rs.ADAPTIVE_VARIANTS)
+        assert set(c) == set(tuning.ADAPTIVE_VARIANTS)
         assert b["chosen"] == min(c, key=lambda n: c[n]["mean_m"])
     for i, row in enumerate(g["walk_rows"]):
         assert row["fold"]["matcher_variant"] == sel["blocks"][str(i % 4)]["chosen"]
