@@ -84,7 +84,7 @@ def _inertial(
         if len(a):
             start = a[a[:, 0] <= a[:, 0].min() + CLOCK_ALIGN_S]
             per_type[k] = float(np.median(start[:, 0] - start[:, 1]))
-    base = [k for k in ("ACCE", "GYRO") if k in per_type] or list(per_type)
+    base: list[str] = [k for k in ("ACCE", "GYRO") if k in per_type] or list(per_type)
     if base:
         a = np.concatenate([arrays[k] for k in base])
         start = a[a[:, 0] <= a[:, 0].min() + CLOCK_ALIGN_S]

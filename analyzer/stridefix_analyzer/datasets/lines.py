@@ -22,7 +22,7 @@ class LineReader:
     """Reads ``path`` line by line for one importer; ``error`` is the importer's read error class,
     built as ``error(path, reason)`` (missing file, not a file, unreadable)."""
 
-    def __init__(self, path, error: type[Exception], max_line_warnings: int):
+    def __init__(self, path: str | os.PathLike[str], error: type[Exception], max_line_warnings: int):
         self.path = os.fspath(path)
         self.error = error
         self.max_line_warnings = max_line_warnings

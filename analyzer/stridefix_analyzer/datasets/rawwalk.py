@@ -28,6 +28,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -96,7 +97,8 @@ class RawWalk:
 
     def scan_t_us(self) -> np.ndarray:
         """(n_scans,) time of each scan [µs]."""
-        return self.wifi["t_us"][self.scan_bounds()[:-1]].astype(np.int64)
+        t: np.ndarray = self.wifi["t_us"][self.scan_bounds()[:-1]]
+        return t.astype(np.int64)
 
     def scan(self, i: int) -> Table:
         """The access points of scan ``i``."""
@@ -163,7 +165,7 @@ def freshest(
 def wifi_table(scans: list[tuple[int, list[tuple[int, float, int, float]]]]) -> Table:
     """The :attr:`RawWalk.wifi` stream of (t_us, entries) scans (entries as :func:`freshest` returns)."""
     rows = [(i, t, *e) for i, (t, entries) in enumerate(scans) for e in entries]
-    cols = list(zip(*rows)) if rows else [[] for _ in STREAMS["wifi"]]
+    cols: list[Sequence[object]] = list(zip(*rows)) if rows else [[] for _ in STREAMS["wifi"]]
     dtypes = (np.int64, np.int64, np.int64, np.float32, np.int32, np.float64)
     return Table({n: np.asarray(c, dtype=d) for n, c, d in zip(STREAMS["wifi"], cols, dtypes)})
 

@@ -68,10 +68,12 @@ def learn_floor_heights(
             for f, h in w.items():
                 r = np.zeros(nf + nw)
                 r[idx[f]], r[nf + j] = 1.0, 1.0
-                rows.append(r), rhs.append(h)
+                rows.append(r)
+                rhs.append(h)
         r = np.zeros(nf + nw)
         r[0] = 1.0
-        rows.append(r), rhs.append(0.0)
+        rows.append(r)
+        rhs.append(0.0)
         sol = np.linalg.lstsq(np.array(rows), np.array(rhs), rcond=None)[0]
         # only floors connected to floor fl[0] through multi-floor walks are meaningful; with one
         # or two multi-floor walks sharing floors that holds; check monotony below anyway

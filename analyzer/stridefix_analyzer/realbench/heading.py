@@ -105,7 +105,7 @@ def choose_heading_variant(
         n = sum(w[name]["n_steps"] for j, w in enumerate(per_walk) if j != exclude)
         score[name] = math.hypot(c, s_) / n if n else math.nan
     finite = {k: v for k, v in score.items() if math.isfinite(v)}
-    best = max(finite, key=finite.get) if finite else next(iter(score))
+    best = max(finite, key=lambda k: finite[k]) if finite else next(iter(score))
     return best, score
 
 

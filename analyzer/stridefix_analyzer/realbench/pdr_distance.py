@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stridefix_analyzer.datasets.protocol import DatasetReadError
 from stridefix_analyzer.firmware import Firmware, FirmwareError
@@ -230,7 +231,16 @@ def run_pdr_distance(
     return doc
 
 
-def summarize(label, floor_dir, walks, seg: Table, fits: dict, min_segment_m, max_wifi_age_s, limit) -> dict:
+def summarize(
+    label: str,
+    floor_dir: str | Path,
+    walks: list[dict[str, Any]],
+    seg: Table,
+    fits: dict[str, Any],
+    min_segment_m: float,
+    max_wifi_age_s: float,
+    limit: int | None,
+) -> dict[str, Any]:
     """The JSON document of one run (see the module docstring)."""
     used = seg["excluded"] == ""
     excluded: dict[str, int] = {}
@@ -334,8 +344,8 @@ def _row(t: Table, i: int) -> dict:
     return {n: t[n][i].item() if hasattr(t[n][i], "item") else t[n][i] for n in t.names}
 
 
-def _median(x) -> float:
-    x = np.asarray(x, float)
+def _median(values: ArrayLike) -> float:
+    x = np.asarray(values, float)
     x = x[np.isfinite(x)]
     return float(np.median(x)) if len(x) else math.nan
 
@@ -343,7 +353,7 @@ def _median(x) -> float:
 def format_table(doc: dict) -> str:
     """A readable plain-text table of one floor's results."""
 
-    def f(v, d=2):
+    def f(v: Any, d: int = 2) -> str:
         return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
 
     seg, wk = doc["segments"], doc["walks"]

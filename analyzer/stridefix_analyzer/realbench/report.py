@@ -14,13 +14,16 @@ from __future__ import annotations
 import base64
 import html
 import math
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 from stridefix_analyzer import datasets  # noqa: E402
 from stridefix_analyzer.datasets.protocol import DatasetError  # noqa: E402
@@ -28,9 +31,11 @@ from stridefix_analyzer.schemes import UnknownSchemeError, scheme_code, scheme_c
 from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
+#: a floor plan as drawn: the image and its extent (0, width, 0, height) [m]
+Plan = tuple[np.ndarray, tuple[float, float, float, float]]
 
 
-def _f(v, d=2) -> str:
+def _f(v: Any, d: int = 2) -> str:
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
 
 
@@ -46,7 +51,7 @@ def _colour(name: str) -> str:
         return "k"
 
 
-def floor_plan(fmt: str, floor_dir) -> tuple[np.ndarray, tuple[float, float, float, float]] | None:
+def floor_plan(fmt: str, floor_dir: str | Path | None) -> Plan | None:
     """(image, extent) of a group's floor plan from its data set: extent (0, width, 0, height) [m];
     None when the set has none there."""
     if not floor_dir:
@@ -71,7 +76,7 @@ def _pooled(group: dict, tag: str = "fixes") -> dict[str, np.ndarray]:
     return {k: np.concatenate(v) for k, v in out.items()}
 
 
-def plot_cdf(pooled: dict[str, np.ndarray], title: str):
+def plot_cdf(pooled: dict[str, np.ndarray], title: str) -> Figure:
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for name, e in pooled.items():
         e = np.sort(e[np.isfinite(e)])
@@ -96,7 +101,7 @@ def plot_cdf(pooled: dict[str, np.ndarray], title: str):
     return fig
 
 
-def plot_box(pooled: dict[str, np.ndarray], title: str):
+def plot_box(pooled: dict[str, np.ndarray], title: str) -> Figure:
     names = list(pooled)
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
     data = [pooled[n][np.isfinite(pooled[n])] for n in names]
@@ -108,7 +113,9 @@ def plot_box(pooled: dict[str, np.ndarray], title: str):
     return fig
 
 
-def plot_walk(series, walk: str, schemes: list[str], plan, title: str):
+def plot_walk(
+    series: Mapping[str, np.ndarray], walk: str, schemes: list[str], plan: Plan | None, title: str
+) -> Figure:
     """Truth (waypoints joined) and the POSE tracks of ``schemes`` of one walk, over the plan."""
     fig, ax = plt.subplots(figsize=(7.5, 6.0))
     if plan is not None:
@@ -142,7 +149,7 @@ def plot_walk(series, walk: str, schemes: list[str], plan, title: str):
     return fig
 
 
-def _matched(series) -> dict:
+def _matched(series: Mapping[str, np.ndarray]) -> dict[str, Any]:
     """Add m<c>_xy: the POSE matched causally to each truth time (as the metrics do)."""
     out = dict(series)
     for c in series["scheme_codes"]:
@@ -196,7 +203,7 @@ def _scheme_table(summary: dict) -> str:
     return _table(head, rows)
 
 
-def _table(head, rows) -> str:
+def _table(head: Sequence[object], rows: Iterable[Sequence[object]]) -> str:
     th = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
     body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
     return f"<table><tr>{th}</tr>{body}</table>"
@@ -235,7 +242,7 @@ def render(doc: dict) -> str:
         # worst walks, ranked by the mean error of the group's best scheme
         sch = g["summary"]["schemes"]
         finite = {n: s["mean"] for n, s in sch.items() if s["mean"] is not None and math.isfinite(s["mean"])}
-        best_overall = min(finite, key=finite.get) if finite else None
+        best_overall = min(finite, key=lambda n: finite[n]) if finite else None
         rows = [r for r in g["walk_rows"] if r.get("fixes") and best_overall in r["fixes"]]
         rows.sort(key=lambda r: -(r["fixes"][best_overall]["mean"] or 0))
         if rows:
@@ -248,7 +255,7 @@ def render(doc: dict) -> str:
             }
             if not means:
                 continue
-            best, worst = min(means, key=means.get), max(means, key=means.get)
+            best, worst = min(means, key=lambda n: means[n]), max(means, key=lambda n: means[n])
             npz = Path(r["dir"]) / "analysis.npz"
             if not npz.is_file():
                 continue
@@ -281,7 +288,7 @@ def render(doc: dict) -> str:
     )
 
 
-def write_report(doc: dict, path) -> str:
+def write_report(doc: dict[str, Any], path: str | Path) -> str:
     """Render ``doc`` (with per-sample errors, before they are stripped) to ``path``."""
     Path(path).write_text(render(doc), encoding="utf-8")
     return str(path)

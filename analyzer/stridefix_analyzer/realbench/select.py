@@ -28,12 +28,18 @@ from __future__ import annotations
 
 import concurrent.futures
 import math
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
+from typing import Any, TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 #: what each stage replays (--fusion) and scores
 STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
@@ -42,7 +48,7 @@ DEFAULT_BLOCKS = 4
 MIN_WALKS = 6
 
 
-def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
+def fix_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
     """2-D error [m] of every Wi-Fi fix of a stridefixd log (one per scan) against the truth
     interpolated linearly between waypoints; fixes outside the truth span are left out."""
     fix = read_table(fw_log, "FIX")
@@ -58,7 +64,7 @@ def fix_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
     return np.hypot(fix["x_m"][first] - x, fix["y_m"][first] - y)
 
 
-def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
+def pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
     """2-D error [m] at each waypoint of the latest POSE at or before it (causal, as realbench scores;
     the log holds one scheme); waypoints before the first pose are left out."""
     pose = read_table(fw_log, "POSE")
@@ -72,7 +78,7 @@ def pose_errors_m(fw_log, wp_t_us, wp_xy_m) -> np.ndarray:
     return np.hypot(pose["x_m"][k[ok]] - wp[ok, 0], pose["y_m"][k[ok]] - wp[ok, 1])
 
 
-def _replay(job: dict) -> dict:
+def _replay(job: dict[str, Any]) -> dict[str, Any]:
     proc = Firmware(job["stridefixd"]).run(
         input=f"lcmlog:{job['import_log']}",
         site=job["site"],
@@ -90,20 +96,20 @@ def _replay(job: dict) -> dict:
 
 
 def select(
-    sub: list[dict],
-    build_site,
+    sub: list[dict[str, Any]],
+    build_site: Callable[[Any, list[dict[str, Any]], str, Path], list[str] | None] | None,
     *,
-    stridefixd,
-    work_dir,
+    stridefixd: str | Path,
+    work_dir: str | Path,
     base_sets: list[str],
     candidates: dict[str, list[str]],
     jobs: int = 2,
     n_blocks: int = DEFAULT_BLOCKS,
-    progress=None,
-    replay=None,
+    progress: Callable[[], None] | None = None,
+    replay: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
     stage: str = "matcher",
-    block_sets: dict[int, list[str]] | None = None,
-) -> tuple[list[str], dict]:
+    block_sets: Mapping[int, Sequence[str]] | None = None,
+) -> tuple[list[str], dict[str, Any]]:
     """Choose a candidate for every walk of ``sub`` (the prepared walks of one group).
 
     ``build_site(stats_removed, others, name, path)`` writes to ``path`` the site whose radio map is
@@ -132,10 +138,11 @@ def select(
             removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
             others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
             site_path = work_dir / f"site_{a}_{b}.sfsite"
+            assert build_site is not None  # only None when no choice is made (tests)
             site_sets = build_site(removed, others, f"select {a}/{b}", site_path) or []
             for i in (i for i in range(len(sub)) if block[i] == b):
                 for name in names:
-                    sets = base_sets + site_sets + (block_sets or {}).get(a, []) + candidates[name]
+                    sets = [*base_sets, *site_sets, *(block_sets or {}).get(a, []), *candidates[name]]
                     tasks.append(
                         {
                             "a": a,
@@ -151,7 +158,7 @@ def select(
                             "wp_xy_m": sub[i]["waypoint_xy_m"],
                         }
                     )
-    pooled = {a: {n: [] for n in names} for a in range(n_blocks)}
+    pooled: dict[int, dict[str, list[np.ndarray]]] = {a: {n: [] for n in names} for a in range(n_blocks)}
     failures = []
     with (
         concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) if jobs > 1 else _InProcess() as pool
@@ -164,7 +171,7 @@ def select(
             if progress:
                 progress()
     what = "mean Wi-Fi fix error" if stage == "matcher" else f"mean {STAGES[stage]} error at waypoints"
-    report = {
+    report: dict[str, Any] = {
         "chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, {what})",
         "blocks": {},
         "failures": failures[:10],
@@ -177,7 +184,7 @@ def select(
             e = np.concatenate(pooled[a][n]) if pooled[a][n] else np.zeros(0)
             means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, "fixes": int(len(e))}
         finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
-        choice_of_block[a] = min(finite, key=finite.get) if finite else names[0]
+        choice_of_block[a] = min(finite, key=lambda n: finite[n]) if finite else names[0]
         report["blocks"][str(a)] = {"candidates": means, "chosen": choice_of_block[a]}
     report["choice_of_block"] = choice_of_block
     return [choice_of_block[block[i]] for i in range(len(sub))], report
@@ -186,14 +193,14 @@ def select(
 class _InProcess:
     """The part of an executor :func:`select` uses, without processes (jobs ≤ 1, tests)."""
 
-    def __enter__(self):
+    def __enter__(self) -> _InProcess:
         return self
 
-    def __exit__(self, *exc):
-        return False
+    def __exit__(self, *exc: object) -> None:
+        return None
 
     @staticmethod
-    def map(fn, items, chunksize=1):
+    def map(fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1) -> Iterator[R]:
         return map(fn, items)
 
 

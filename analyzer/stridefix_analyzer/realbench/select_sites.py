@@ -37,9 +37,7 @@ class SelectionSites:
     min_count: int
     built: dict[str, list[str]] = dataclasses.field(default_factory=dict)
 
-    def __call__(
-        self, removed: WalkStats, others: list[Mapping[str, Any]], name: str, path: Path
-    ) -> list[str]:
+    def __call__(self, removed: WalkStats, others: list[dict[str, Any]], name: str, path: Path) -> list[str]:
         """Write to ``path`` the site of ``total − removed`` learned from ``others``; returns the
         settings learned with it (heading candidate, stride K) for the replays on that site."""
         if str(path) in self.built:

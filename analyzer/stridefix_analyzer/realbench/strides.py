@@ -103,7 +103,7 @@ def build_segments(walks: Sequence[dict[str, Any]], min_segment_m: float = DEFAU
         "suspect",
         "excluded",
     ]
-    cols = list(zip(*rows)) if rows else [[] for _ in names]
+    cols: list[Sequence[Any]] = list(zip(*rows)) if rows else [[] for _ in names]
     dtypes = [
         np.int64,
         np.int64,

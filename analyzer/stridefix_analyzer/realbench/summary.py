@@ -51,8 +51,8 @@ def summarize_group(results: Sequence[Mapping[str, Any]], tag: str = "fixes") ->
     names = [n for n in schemes.NAMES if any(n in r.get(tag, {}) for r in results)]
     for name in names:
         rows = [r[tag][name] for r in results if name in r.get(tag, {})]
-        err = np.concatenate([np.asarray(r["errors_m"], float) for r in rows]) if rows else []
-        ferr = np.concatenate([np.asarray(r["floor_errors"], float) for r in rows]) if rows else []
+        err = np.concatenate([np.asarray(r["errors_m"], float) for r in rows]) if rows else np.zeros(0)
+        ferr = np.concatenate([np.asarray(r["floor_errors"], float) for r in rows]) if rows else np.zeros(0)
         means = np.array([r["mean"] for r in rows], float)
         finite = means[np.isfinite(means)]
         table[name] = {
@@ -134,8 +134,8 @@ def build_doc(
     }
 
 
-def _spread(v: Iterable[float | None]) -> dict[str, Any]:
-    v = np.asarray([x for x in v if x is not None], float)
+def _spread(values: Iterable[float | None]) -> dict[str, Any]:
+    v = np.asarray([x for x in values if x is not None], float)
     v = v[np.isfinite(v)]
     if not len(v):
         return {"n": 0, "mean": math.nan, "min": math.nan, "max": math.nan, "std": math.nan}

@@ -59,10 +59,10 @@ Candidates = Mapping[str, Sequence[str]]
 class Group:
     """What a chooser sees of one group: its prepared walks (phase 1) and how to replay them."""
 
-    walks: Sequence[Mapping[str, Any]]
+    walks: list[dict[str, Any]]  # the same dict objects the sites callable sees (identity matters)
     rotation: Sequence[Mapping[str, RotationSums]]  # per walk, per heading candidate
     #: ``sites(removed, others, name, path)`` writes a selection site and returns its settings
-    sites: Callable[[Any, list[Mapping[str, Any]], str, Path], list[str]]
+    sites: Callable[[Any, list[dict[str, Any]], str, Path], list[str]]
     firmware: Firmware
     work_dir: Path
     base_sets: Sequence[str]
@@ -117,7 +117,7 @@ class InnerCV:
             f"choose {axis.name}", rs.n_tasks(len(group.walks), len(axis.candidates)), group.stream
         )
         per_walk, report = rs.select(
-            list(group.walks),
+            group.walks,
             group.sites,
             stridefixd=group.firmware.path,
             work_dir=group.work_dir,
