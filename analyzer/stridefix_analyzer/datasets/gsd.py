@@ -191,10 +191,7 @@ class Gsd(Dataset):
             "imu_max_gap_ms": float(dt.max()) / 1e3 if len(dt) else None,
             "mag_rate_hz": rate(raw.mag["t_us"]),
             "baro_rate_hz": rate(raw.baro["t_us"]),
-            "skipped_lines": len(raw.skipped),
-            "skipped": [{"line": n, "reason": r} for n, r in raw.skipped[:100]],
-            **raw.stats,
-            "notes": list(raw.notes),
+            **raw.books(),
         }
 
     def format_summary(self, summary: Mapping[str, Any]) -> str:

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from stridefix_analyzer.datasets.gsd_parse import INERTIAL, GsdRecords
-from stridefix_analyzer.datasets.rawwalk import RawWalk, dedupe_sorted, freshest, gyro_at, wifi_table
+from stridefix_analyzer.datasets.rawwalk import RawWalk, dedupe_sorted, gyro_at, wifi_scans
 from stridefix_analyzer.io.logread import Table
 
 #: WIFI records whose AppTimestamps lie within this of a scan's first record belong to that scan [s].
@@ -109,13 +109,7 @@ def _inertial(
         return dedupe_sorted(np.round((a[:, 1] + offsets[k]) * 1e6).astype(np.int64), a[:, 2:5])
 
     (acc_t, acc, dup_a), (gyr_t, gyr, dup_g), (mag_t, mag, dup_m) = map(sensor_times, INERTIAL)
-    at = gyro_at(acc_t, gyr_t, gyr)
-    if at is None:
-        gyro, held = np.zeros_like(acc), len(acc_t)
-        if len(acc_t):
-            notes.append("no GYRO record: gyro written as 0")
-    else:
-        gyro, held = at
+    gyro, held = gyro_at(acc_t, gyr_t, gyr, notes, "GYRO record")
     if not len(acc_t):
         notes.append("no ACCE record: no IMU message")
     stats["imu_gyro_held"] = held
@@ -171,30 +165,17 @@ def _wifi(
             wifi_offset = None
     elif wifi:
         notes.append("no inertial record to align the WIFI SensorTimestamps: no cached-entry check")
-    scans, stale, dup_ap, empty = [], 0, 0, 0
+    scans = []
     for rows in groups:
         t_scan = rows[0][0]
         entries = [
             (bssid, rssi, freq, math.nan if wifi_offset is None else (t_scan - (sensor + wifi_offset)) * 1e3)
             for _app, sensor, bssid, rssi, freq in rows
         ]
-        kept, n_stale, n_dup = freshest(entries, max_wifi_age_s * 1e3)
-        stale, dup_ap = stale + n_stale, dup_ap + n_dup
-        if kept:
-            scans.append((int(round(t_scan * 1e6)), kept))
-        else:
-            empty += 1
-    stats.update(
-        wifi_lines=len(wifi),
-        wifi_scans_in_file=len(groups),
-        wifi_aps_written=sum(len(e) for _, e in scans),
-        wifi_aps_stale_dropped=stale,
-        wifi_aps_duplicate_dropped=dup_ap,
-        wifi_scans_empty=empty,
-        max_wifi_age_s=max_wifi_age_s,
-        wifi_group_s=WIFI_GROUP_S,
-    )
-    return wifi_table(scans)
+        scans.append((int(round(t_scan * 1e6)), entries))
+    table = wifi_scans(scans, max_wifi_age_s, stats)
+    stats["wifi_group_s"] = WIFI_GROUP_S
+    return table
 
 
 def to_rawwalk(rec: GsdRecords, origin: tuple[float, float] | None, max_wifi_age_s: float) -> RawWalk:

@@ -122,10 +122,7 @@ class MsIndoor(Dataset):
             "imu_t_last_us": int(imu_t_ms[-1]) * 1000 if len(imu_t_ms) else None,
             "imu_rate_hz": float(1e3 / np.median(dt)) if len(dt) else None,
             "imu_max_gap_ms": int(dt.max()) if len(dt) else None,
-            "skipped_lines": len(raw.skipped),
-            "skipped": [{"line": n, "reason": r} for n, r in raw.skipped[:100]],
-            **raw.stats,
-            "notes": list(raw.notes),
+            **raw.books(),
         }
 
     def format_summary(self, summary: Mapping[str, Any]) -> str:

@@ -30,9 +30,8 @@ from stridefix_analyzer.datasets.rawwalk import (
     bssid_to_int,
     dedupe_sorted,
     finite,
-    freshest,
     gyro_at,
-    wifi_table,
+    wifi_scans,
 )
 from stridefix_analyzer.io.logread import Table
 
@@ -180,34 +179,12 @@ def read_trace(
     gyr_t, gyr, dup_g = dedupe_sorted(*_columns(samples["gyro"], 3))
     mag_t, mag, dup_m = dedupe_sorted(*_columns(samples["mag"], 3))
     stats["duplicate_times_dropped"] = {"accel": dup_a, "gyro": dup_g, "mag": dup_m}
-    at = gyro_at(acc_t, gyr_t, gyr)
-    if at is None:
-        gyro, held = np.zeros_like(acc), len(acc_t)
-        if len(acc_t):
-            notes.append("no TYPE_GYROSCOPE line: gyro written as 0")
-    else:
-        gyro, held = at
+    gyro, held = gyro_at(acc_t, gyr_t, gyr, notes, "TYPE_GYROSCOPE line")
     stats["imu_gyro_held"] = held
     if not len(acc_t):
         notes.append("no TYPE_ACCELEROMETER line: no IMU message")
 
-    scans, stale, dup_ap, empty = [], 0, 0, 0
-    for t_ms in sorted(wifi):
-        entries, n_stale, n_dup = freshest(wifi[t_ms], max_wifi_age_s * 1e3)
-        stale, dup_ap = stale + n_stale, dup_ap + n_dup
-        if entries:
-            scans.append((t_ms * 1000, entries))
-        else:
-            empty += 1
-    stats.update(
-        wifi_lines=sum(len(v) for v in wifi.values()),
-        wifi_scans_in_file=len(wifi),
-        wifi_aps_written=sum(len(e) for _, e in scans),
-        wifi_aps_stale_dropped=stale,
-        wifi_aps_duplicate_dropped=dup_ap,
-        wifi_scans_empty=empty,
-        max_wifi_age_s=max_wifi_age_s,
-    )
+    scans = wifi_scans([(t_ms * 1000, wifi[t_ms]) for t_ms in sorted(wifi)], max_wifi_age_s, stats)
 
     waypoints.sort(key=lambda w: w[0])
     wp_t = np.array([w[0] for w in waypoints], dtype=np.int64)
@@ -216,7 +193,7 @@ def read_trace(
         path=name,
         imu=Table({"t_us": acc_t * 1000, "accel_mps2": acc, "gyro_radps": gyro}),
         mag=Table({"t_us": mag_t * 1000, "field_ut": mag}),
-        wifi=wifi_table(scans),
+        wifi=scans,
         truth=Table(
             {
                 "t_us": wp_t * 1000,

@@ -105,6 +105,16 @@ class RawWalk:
         b = self.scan_bounds()
         return self.wifi.rows(slice(int(b[i]), int(b[i + 1])))
 
+    def books(self) -> dict[str, Any]:
+        """The import's books, the end of every summary: ``skipped_lines``, ``skipped`` (the first 100
+        as line and reason), the :attr:`stats` and the ``notes``."""
+        return {
+            "skipped_lines": len(self.skipped),
+            "skipped": [{"line": n, "reason": r} for n, r in self.skipped[:100]],
+            **self.stats,
+            "notes": list(self.notes),
+        }
+
     def time_span_us(self) -> tuple[int, int] | None:
         """(first, last) time of any sample [µs], or None for a walk without samples."""
         ts = [s["t_us"] for s in (self.imu, self.mag, self.baro, self.gnss, self.wifi, self.truth) if len(s)]
@@ -133,11 +143,16 @@ def dedupe_sorted(t: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return t[keep], v[keep], int((~keep).sum())
 
 
-def gyro_at(acc_t: np.ndarray, gyr_t: np.ndarray, gyr: np.ndarray) -> tuple[np.ndarray, int] | None:
+def gyro_at(
+    acc_t: np.ndarray, gyr_t: np.ndarray, gyr: np.ndarray, notes: list[str], missing: str
+) -> tuple[np.ndarray, int]:
     """Gyroscope (k, 3) interpolated linearly to the accelerometer times ``acc_t`` (held at the end
-    values outside its span) and the number of accelerometer times so held; None without gyro data."""
+    values outside its span) and the number of accelerometer times so held. Without gyro data: zeros,
+    all held, and the note "no ``missing``: gyro written as 0" when there are accelerometer samples."""
     if not len(gyr_t):
-        return None
+        if len(acc_t):
+            notes.append(f"no {missing}: gyro written as 0")
+        return np.zeros((len(acc_t), 3)), len(acc_t)
     gyro = np.column_stack([np.interp(acc_t, gyr_t, gyr[:, i]) for i in range(3)])
     return gyro, int(((acc_t < gyr_t[0]) | (acc_t > gyr_t[-1])).sum())
 
@@ -168,6 +183,33 @@ def wifi_table(scans: list[tuple[int, list[tuple[int, float, int, float]]]]) -> 
     cols: list[Sequence[object]] = list(zip(*rows)) if rows else [[] for _ in STREAMS["wifi"]]
     dtypes = (np.int64, np.int64, np.int64, np.float32, np.int32, np.float64)
     return Table({n: np.asarray(c, dtype=d) for n, c, d in zip(STREAMS["wifi"], cols, dtypes)})
+
+
+def wifi_scans(
+    scans: list[tuple[int, list[tuple[int, float, int, float]]]], max_wifi_age_s: float, stats: dict[str, Any]
+) -> Table:
+    """The :attr:`RawWalk.wifi` stream of the file's scans, (t_us, entries) in time order: each scan
+    :func:`freshest` (cached entries older than ``max_wifi_age_s`` [s] dropped), scans left empty left
+    out. The counts go into ``stats`` (``wifi_lines``, ``wifi_scans_in_file``, ``wifi_aps_written``,
+    ``wifi_aps_stale_dropped``, ``wifi_aps_duplicate_dropped``, ``wifi_scans_empty``, ``max_wifi_age_s``)."""
+    kept, stale, dup, empty = [], 0, 0, 0
+    for t_us, entries in scans:
+        fresh, n_stale, n_dup = freshest(entries, max_wifi_age_s * 1e3)
+        stale, dup = stale + n_stale, dup + n_dup
+        if fresh:
+            kept.append((t_us, fresh))
+        else:
+            empty += 1
+    stats.update(
+        wifi_lines=sum(len(e) for _, e in scans),
+        wifi_scans_in_file=len(scans),
+        wifi_aps_written=sum(len(e) for _, e in kept),
+        wifi_aps_stale_dropped=stale,
+        wifi_aps_duplicate_dropped=dup,
+        wifi_scans_empty=empty,
+        max_wifi_age_s=max_wifi_age_s,
+    )
+    return wifi_table(kept)
 
 
 def bssid_to_int(bssid: str) -> int:

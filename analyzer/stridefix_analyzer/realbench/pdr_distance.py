@@ -49,7 +49,7 @@ from stridefix_analyzer.realbench.strides import (
     stride_lowo,
 )
 from stridefix_analyzer.realbench.strides import error_stats as error_stats
-from stridefix_analyzer.realbench.walks import cached_import, dataset, find_groups, firmware
+from stridefix_analyzer.realbench.walks import cached_import, dataset, find_groups, firmware, new_walk
 
 #: The data set whose floors this benchmark reads.
 DATASET = "msindoor"
@@ -81,13 +81,7 @@ def prepare_walk(
         ``health`` (last HEALTH fields), ``warnings``.
     """
     trace, out_dir = Path(trace), Path(out_dir)
-    walk: dict[str, Any] = {
-        "trace": str(trace),
-        "walk": trace.stem,
-        "import": None,
-        "error": None,
-        "warnings": [],
-    }
+    walk = new_walk(trace)
     cache_dir, fw_dir = out_dir / "cache", out_dir / "stridefixd"
     cache_dir.mkdir(parents=True, exist_ok=True)
     fw_dir.mkdir(parents=True, exist_ok=True)

@@ -22,7 +22,7 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 from stridefix_analyzer.realbench.floors import floor_heights_of_walk
 from stridefix_analyzer.realbench.heading import rotation_stats
-from stridefix_analyzer.realbench.walks import cached_import
+from stridefix_analyzer.realbench.walks import cached_import, new_walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,13 +58,7 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
     from stridefix_analyzer.radiomap.build import RadioMapInputError, WalkStats, load_recordings
 
     trace = job.trace
-    walk: dict[str, Any] = {
-        "trace": str(trace),
-        "walk": trace.stem,
-        "import": None,
-        "error": None,
-        "warnings": [],
-    }
+    walk = new_walk(trace)
     fw_dir = job.work_dir / "nosite"
     job.cache_dir.mkdir(parents=True, exist_ok=True)
     fw_dir.mkdir(parents=True, exist_ok=True)

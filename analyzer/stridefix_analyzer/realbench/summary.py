@@ -18,7 +18,8 @@ from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.io.jsonio import json_ready
-from stridefix_analyzer.realbench.fold import IPIN_FLOOR_PENALTY_M, STATS_KEYS, FoldJob, ipin_score
+from stridefix_analyzer.realbench.fold import IPIN_FLOOR_PENALTY_M, FoldJob, ipin_score
+from stridefix_analyzer.realbench.strides import error_stats
 from stridefix_analyzer.realbench.tuning import Axis
 
 #: a walk whose mean error exceeds this is a failure for the robustness share [m]
@@ -26,22 +27,11 @@ ROBUST_MEAN_M = 15.0
 
 
 def stats_of(errors: ArrayLike) -> dict[str, Any]:
-    """n, mean, median, p75, p90, p95, max, RMSE of the finite errors [m]."""
+    """n, mean, median, p75, p90, p95, max (:func:`.strides.error_stats`) and RMSE of the finite
+    position errors [m] (distances, so never negative)."""
     e = np.asarray(errors, float)
     e = e[np.isfinite(e)]
-    if not len(e):
-        return {"n": 0, **{k: math.nan for k in STATS_KEYS[1:]}}
-    p = np.percentile(e, [50, 75, 90, 95])
-    return {
-        "n": int(len(e)),
-        "mean": float(e.mean()),
-        "median": float(p[0]),
-        "p75": float(p[1]),
-        "p90": float(p[2]),
-        "p95": float(p[3]),
-        "max": float(e.max()),
-        "rmse": float(np.sqrt(np.mean(e**2))),
-    }
+    return {**error_stats(e), "rmse": float(np.sqrt(np.mean(e**2))) if len(e) else math.nan}
 
 
 def summarize_group(results: Sequence[Mapping[str, Any]], tag: str = "fixes") -> dict[str, Any]:

@@ -25,6 +25,12 @@ class RealbenchError(RuntimeError):
     """The benchmark cannot run (no walks, no firmware binary, a bad --set). The message says what."""
 
 
+def new_walk(trace: Path) -> dict[str, Any]:
+    """The record of one walk before anything ran: ``trace``, ``walk`` (its stem), ``import``,
+    ``error`` (None or why the walk could not be run), ``warnings``."""
+    return {"trace": str(trace), "walk": trace.stem, "import": None, "error": None, "warnings": []}
+
+
 def dataset(name: str) -> Dataset:
     """The registered data set ``name``; raises :class:`RealbenchError`."""
     try:
