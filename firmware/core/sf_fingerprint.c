@@ -170,6 +170,8 @@ typedef struct {
     int32_t age; /* 0 = newest scan */
     float rssi_dbm;
 } reading_t;
+_Static_assert(sizeof(reading_t) * SF_FINGERPRINT_QUERY_APS <= 16 * 1024,
+               "sf_fingerprint.h promises at most 16 KiB of stack");
 
 static int reading_cmp(const void *const a, const void *const b)
 {

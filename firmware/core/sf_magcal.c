@@ -10,7 +10,6 @@
 #define JACOBI_SWEEPS 16        /* bound on the eigen-decomposition (3×3 converges in ~5) */
 #define PIVOT_REL 1e-12         /* pivot below this × the largest diagonal entry: singular */
 
-_Static_assert(sizeof(sf_magcal_t) <= 512, "sf_magcal.h promises sizeof(sf_magcal_t) < 512 bytes");
 
 static double dot3(const double a[3], const double b[3])
 {
