@@ -9,7 +9,8 @@ PY := $(VENV)/bin/python
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build test test-c test-python demo bench clean help change-indication
+.PHONY: all deps build test test-c test-python demo bench clean help change-indication \
+	gates check-static check-clang check-asan
 
 all: build
 
@@ -20,14 +21,21 @@ help:
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
-	@echo "make clean  - remove $(BUILD)/ and out/"
+	@echo "make gates  - the C/C++ quality gates below, one after the other"
+	@echo "make check-static - cppcheck on firmware/ (suppressions: tools/cppcheck.supp); fails on a finding"
+	@echo "make check-clang  - the whole tree with clang/clang++ (warnings are errors) into build-clang/, ctest"
+	@echo "make check-asan   - firmware + C tests with ASan+UBSan and SF_ASSERT on into build-asan/, ctest"
+	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/ and out/"
 
 deps:
 	@BUILD=$(BUILD) VENV=$(VENV) tools/deps.sh
 
+# $(call configure,DIR,EXTRA_CMAKE_ARGS): CMake into DIR, its output kept in DIR/cmake.log (shown on failure).
+configure = mkdir -p $(1) && cmake -S . -B $(1) -DSTRIDEFIX_PYTHON=$(abspath $(PY)) $(2) > $(1)/cmake.log 2>&1 \
+	|| { cat $(1)/cmake.log; exit 1; }
+
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DSTRIDEFIX_PYTHON=$(abspath $(PY)) > $(BUILD).cmake.log 2>&1 \
-		|| { cat $(BUILD).cmake.log; exit 1; }
+	@$(call configure,$(BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE))
 	@cmake --build $(BUILD) -j $(JOBS)
 
 test: build
@@ -58,5 +66,26 @@ bench: build
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
 	done
 
+# Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
+# so it needs the build; the other two are separate build trees with their own compiler and flags.
+gates: check-static check-clang check-asan
+
+check-static: build
+	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
+		--inline-suppr --suppressions-list=tools/cppcheck.supp \
+		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/lcmtypes/c \
+		firmware/core firmware/board firmware/app
+
+check-clang: deps
+	@$(call configure,build-clang,-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++)
+	@cmake --build build-clang -j $(JOBS)
+	cd build-clang && ctest --output-on-failure
+
+# Debug: no NDEBUG, so SF_ASSERT is live. No native module (a sanitized one cannot load into Python).
+check-asan: deps
+	@$(call configure,build-asan,-DCMAKE_BUILD_TYPE=Debug -DSF_SANITIZE=ON -DSF_NATIVE=OFF)
+	@cmake --build build-asan -j $(JOBS)
+	cd build-asan && ctest --output-on-failure
+
 clean:
-	rm -rf $(BUILD) $(BUILD).cmake.log out
+	rm -rf $(BUILD) build-clang build-asan out
