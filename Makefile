@@ -9,14 +9,15 @@ PY := $(VENV)/bin/python
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build test test-c test-python demo bench clean help change-indication \
+.PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
 	gates check-static check-clang check-asan
 
 all: build
 
 help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
-	@echo "make test   - install what is missing, build, run every test (C, Python, end to end)"
+	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
+	@echo "make lint   - ruff (lint + format check) on all Python"
 	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
@@ -38,8 +39,13 @@ build: deps
 	@$(call configure,$(BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE))
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# Everything CI checks: the C and Python tests, the Python lint/type gates and the C/C++ gates.
 test: build
-	@$(MAKE) --no-print-directory test-c test-python
+	@$(MAKE) --no-print-directory test-c test-python lint gates
+
+lint: deps
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 test-c:
 	cd $(BUILD) && ctest --output-on-failure
