@@ -8,7 +8,7 @@
  * are counted in sf_rx_counters_t and skipped: the return code says which counter moved, so the
  * caller can print a message naming the line.
  *
- * Memory: sizeof(sf_board_rx_t) ≈ 5 KiB (one scan in progress); no heap. */
+ * Memory: sizeof(sf_board_rx_t) = 4560 B on x86-64 (one scan in progress; asserted ≤ 4.5 KiB); no heap. */
 #ifndef SF_BOARD_RX_H
 #define SF_BOARD_RX_H
 
@@ -67,6 +67,8 @@ typedef struct {
     float gnss_accuracy_m;
     sf_rx_counters_t counters;
 } sf_board_rx_t;
+
+_Static_assert(sizeof(sf_board_rx_t) <= 4608, "sf_board_rx.h promises at most 4.5 KiB");
 
 void sf_board_rx_init(sf_board_rx_t *rx);
 

@@ -19,6 +19,8 @@ struct sf_input {
     char name[256];
 };
 
+_Static_assert(sizeof(struct sf_input) <= 6 * 1024, "sf_input.h promises at most 6 KiB per input");
+
 int sf_input_open(sf_input_t **const result, const char *const spec, char *const err, const size_t err_size)
 {
     *result = NULL;

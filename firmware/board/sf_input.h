@@ -9,8 +9,9 @@
  *
  * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
- * sf_input_next: see below. Memory: one heap block per open input (≈ 10 KiB: the decoder's scan in
- * progress plus the candump line buffer), allocated by sf_input_open, freed by sf_input_close. */
+ * sf_input_next: see below. Memory: one heap block per open input (≈ 5.5 KiB on x86-64, asserted
+ * ≤ 6 KiB: the decoder with its scan in progress, the candump line buffer), allocated by
+ * sf_input_open, freed by sf_input_close; sf_input_item_t is ≈ 4 KiB (the caller's). */
 #ifndef SF_INPUT_H
 #define SF_INPUT_H
 

@@ -94,12 +94,17 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
     SF_LCM_WRITE(out, "HEALTH", log_t_us, stridefix_health_t, &msg);
 }
 
+#define CONFIG_KEY_BYTES 64
+#define CONFIG_VALUE_BYTES 32
+_Static_assert(SF_PARAM_COUNT * (CONFIG_KEY_BYTES + CONFIG_VALUE_BYTES + 2 * sizeof(char *)) <= 16 * 1024,
+               "sf_publish.h promises CONFIG's text within 16 KiB of stack");
+
 void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
                        const sf_params_t *const params, const char *const version, const char *const dbc_sha256)
 {
     enum { n = SF_PARAM_COUNT };
-    char keys[n][64];
-    char values[n][32];
+    char keys[n][CONFIG_KEY_BYTES];
+    char values[n][CONFIG_VALUE_BYTES];
     char *key_ptrs[n];
     char *value_ptrs[n];
     for (size_t i = 0; i < sf_param_count; i++) {

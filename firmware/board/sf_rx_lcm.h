@@ -5,7 +5,7 @@
  * One row per SF_RX_KINDS entry (sf_rx_event.h) with its channel, decode and encode, generated from
  * that list: a kind without both functions does not compile, so the CAN path, the replay and the log
  * always carry the same kinds. Cost: one generated LCM encode or decode per call; the encode buffer
- * is on the stack (≤ 4.1 KiB, a full scan). */
+ * is on the stack (at most 4109 B: a full scan of SF_WIFI_MAX_AP access points). */
 #ifndef SF_RX_LCM_H
 #define SF_RX_LCM_H
 

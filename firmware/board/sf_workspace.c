@@ -6,6 +6,8 @@
 
 #include "sf_error.h"
 
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 32, "sf_workspace.h promises 32 bytes per reference point");
+
 int sf_workspace_alloc(const sf_radiomap_t *const map, sf_fingerprint_workspace_t *const ws, void **const memory)
 {
     const size_t n = (size_t)(map->n_rp > 0 ? map->n_rp : 1);
