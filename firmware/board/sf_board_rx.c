@@ -80,7 +80,6 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
             out->gyro_radps[i] = gyr->xyz[i] * DEG_TO_RAD;
         }
         ev->kind = sf_rx_imu;
-        rx->counters.imu++;
         return 1;
     }
     if (other->valid) { /* the other half waits for a sample we will never complete */
@@ -108,7 +107,6 @@ static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_
     }
     ev->kind = sf_rx_wifi;
     ev->u.wifi = rx->scan;
-    rx->counters.wifi++;
     return 1;
 }
 
@@ -216,7 +214,6 @@ static int on_mag(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_
     out->field_ut[1] = board_mag_mag_y_decode(m.mag_y);
     out->field_ut[2] = board_mag_mag_z_decode(m.mag_z);
     ev->kind = sf_rx_mag;
-    rx->counters.mag++;
     return 1;
 }
 
@@ -236,7 +233,6 @@ static int on_baro(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx
     out->pressure_pa = board_baro_pressure_decode(m.pressure);
     out->temperature_degc = board_baro_temperature_decode(m.temperature);
     ev->kind = sf_rx_baro;
-    rx->counters.baro++;
     return 1;
 }
 
@@ -297,7 +293,6 @@ static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const
     out->alt_m = rx->gnss_alt_m;
     out->accuracy_m = rx->gnss_accuracy_m;
     ev->kind = sf_rx_gnss;
-    rx->counters.gnss++;
     return 1;
 }
 
@@ -376,5 +371,20 @@ int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
     if (rc >= 0) {
         rx->counters.frames_ok++;
     }
+    if (rc == 1) {
+        sf_rx_count_sample(&rx->counters, ev->kind);
+    }
     return rc;
+}
+
+void sf_rx_count_sample(sf_rx_counters_t *const c, const sf_rx_kind_t kind)
+{
+    switch (kind) { /* no default: a new kind needs its counter (-Wswitch) */
+    case sf_rx_imu: c->imu++; break;
+    case sf_rx_mag: c->mag++; break;
+    case sf_rx_baro: c->baro++; break;
+    case sf_rx_wifi: c->wifi++; break;
+    case sf_rx_gnss: c->gnss++; break;
+    case sf_rx_none: break;
+    }
 }

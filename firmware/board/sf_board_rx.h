@@ -78,6 +78,10 @@ void sf_board_rx_init(sf_board_rx_t *rx);
  * SF_ENOTSYNC (no board time yet), SF_EDUPLICATE. */
 int sf_board_rx_frame(sf_board_rx_t *rx, const sf_can_frame_t *frame, sf_rx_event_t *event);
 
+/* Counts one sample of a kind in its counter (imu .. gnss; sf_rx_none counts nothing): the one place
+ * for both input paths (sf_board_rx_frame, and the LCM replay in sf_input). */
+void sf_rx_count_sample(sf_rx_counters_t *counters, sf_rx_kind_t kind);
+
 /* The length board.dbc declares for a standard frame id [bytes]; 0 for an id not in board.dbc. */
 unsigned sf_board_rx_dbc_length(uint32_t id);
 

@@ -61,14 +61,7 @@ static int next_lcm(sf_input_t *const in, sf_input_item_t *const item)
         return SF_ESYNTAX;
     }
     c->frames_ok++;
-    switch (item->event.kind) {
-    case sf_rx_imu: c->imu++; break;
-    case sf_rx_mag: c->mag++; break;
-    case sf_rx_baro: c->baro++; break;
-    case sf_rx_wifi: c->wifi++; break;
-    case sf_rx_gnss: c->gnss++; break;
-    case sf_rx_none: break;
-    }
+    sf_rx_count_sample(c, item->event.kind);
     item->status = SF_OK;
     return 1;
 }
