@@ -12,8 +12,6 @@
 #include "sf_fusion.h"
 #include "sf_input.h"
 
-#define EXIT_USAGE 2
-
 /* The scheme names of pose_t.SCHEME_*, as "a, b, ... or z". */
 static void scheme_list(FILE *const f, const char *const last_sep)
 {
@@ -76,13 +74,13 @@ static int effective_params(const sf_options_t *const o, sf_params_t *const para
     for (int i = 0; i < o->n_configs; i++) {
         if (sf_config_load(o->config_paths[i], params, err, sizeof err) != SF_OK) {
             fprintf(stderr, "stridefixd: %s\n", err);
-            return EXIT_USAGE;
+            return SF_EXIT_USAGE;
         }
     }
     for (int i = 0; i < o->n_sets; i++) {
         if (sf_config_set(o->sets[i], params, err, sizeof err) != SF_OK) {
             fprintf(stderr, "stridefixd: %s\n", err);
-            return EXIT_USAGE;
+            return SF_EXIT_USAGE;
         }
     }
     if (o->fusion != NULL) {
@@ -91,7 +89,7 @@ static int effective_params(const sf_options_t *const o, sf_params_t *const para
             fprintf(stderr, "stridefixd: --fusion %s: expected all, ", o->fusion);
             scheme_list(stderr, " or ");
             fprintf(stderr, "\n");
-            return EXIT_USAGE;
+            return SF_EXIT_USAGE;
         }
         params->output_scheme = code;
     }
@@ -134,14 +132,14 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         case 'c':
             if (o->n_configs == SF_OPTIONS_MAX_SETS) {
                 fprintf(stderr, "stridefixd: at most %d --config options\n", SF_OPTIONS_MAX_SETS);
-                return EXIT_USAGE;
+                return SF_EXIT_USAGE;
             }
             o->config_paths[o->n_configs++] = optarg;
             break;
         case 's':
             if (o->n_sets == SF_OPTIONS_MAX_SETS) {
                 fprintf(stderr, "stridefixd: at most %d --set options\n", SF_OPTIONS_MAX_SETS);
-                return EXIT_USAGE;
+                return SF_EXIT_USAGE;
             }
             o->sets[o->n_sets++] = optarg;
             break;
@@ -151,16 +149,16 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         case opt_max_messages: o->max_messages = strtol(optarg, NULL, 10); break;
         case 'h': usage(stdout); exit(0);
         case 'V': printf("stridefixd %s (board.dbc sha256 %s)\n", version, dbc_sha256); exit(0);
-        default: usage(stderr); return EXIT_USAGE;
+        default: usage(stderr); return SF_EXIT_USAGE;
         }
     }
     if (optind < argc) {
         fprintf(stderr, "stridefixd: unexpected argument '%s' (see --help)\n", argv[optind]);
-        return EXIT_USAGE;
+        return SF_EXIT_USAGE;
     }
     if (want_json && !want_print_config) {
         fprintf(stderr, "stridefixd: --json goes with --print-config (see --help)\n");
-        return EXIT_USAGE;
+        return SF_EXIT_USAGE;
     }
     const int prc = effective_params(o, params);
     if (prc != 0) {
@@ -172,7 +170,7 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
     }
     if (o->input == NULL) {
         fprintf(stderr, "stridefixd: --input is required (see --help)\n");
-        return EXIT_USAGE;
+        return SF_EXIT_USAGE;
     }
     return 0;
 }

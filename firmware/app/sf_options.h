@@ -9,6 +9,7 @@
 #include "sf_params.h"
 
 #define SF_OPTIONS_MAX_SETS 64
+#define SF_EXIT_USAGE 2 /* bad usage, or an input or config that cannot be read */
 
 typedef struct {
     const char *input;
@@ -27,7 +28,7 @@ typedef struct {
     long max_messages;
 } sf_options_t;
 
-/* 0 to run, or the exit status (2: bad usage or config, with a message on stderr). */
+/* 0 to run, or the exit status (SF_EXIT_USAGE, with a message on stderr). */
 int sf_options_parse(int argc, char **argv, const char *version, const char *dbc_sha256, sf_options_t *o,
                      sf_params_t *params);
 

@@ -31,7 +31,6 @@
 #define SF_DBC_SHA256 "unknown"
 #endif
 
-#define EXIT_USAGE 2
 #define LOG_QUEUE_MESSAGES 8192
 
 typedef struct {
@@ -280,7 +279,7 @@ static int serve(daemon_t *const d)
     char err[512];
     if (sf_input_open(&d->in, d->opt.input, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
-        return EXIT_USAGE;
+        return SF_EXIT_USAGE;
     }
     default_log_path(d);
     /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
@@ -290,14 +289,14 @@ static int serve(daemon_t *const d)
         return 1;
     }
     if (d->opt.site_path != NULL && load_site(d) != 0) {
-        return EXIT_USAGE;
+        return SF_EXIT_USAGE;
     }
     sf_estimator_init(&d->est, &d->params);
     if (d->opt.site_path != NULL) {
         const int rc = sf_estimator_attach_site(&d->est, &d->params, &d->site, &d->ws);
         if (rc != SF_OK) {
             fprintf(stderr, "stridefixd: %s: the site cannot be used: %s\n", d->opt.site_path, sf_strerror(rc));
-            return EXIT_USAGE;
+            return SF_EXIT_USAGE;
         }
     }
     d->last_pose_t_us = INT64_MIN / 2;
