@@ -84,7 +84,10 @@ static void json_number(FILE *const f, const sf_param_kind_t kind, const double 
     } else if (kind == sf_param_int32) {
         fprintf(f, "%.0f", v);
     } else {
-        fprintf(f, "%.17g", v);
+        char text[32];
+        snprintf(text, sizeof text, "%.17g", v);
+        /* a double stays a JSON float ("0.0", not "0"), so readers keep the type */
+        fprintf(f, "%s%s", text, strpbrk(text, ".e") == NULL ? ".0" : "");
     }
 }
 

@@ -70,8 +70,8 @@ def test_json_lists_every_key_of_the_ini(stridefixd, config_json):
         assert p["type"] in ("double", "int32")
         assert p["min"] <= p["default"] <= p["max"], p["key"]
         assert float(ini[p["key"]]) == pytest.approx(p["value"], rel=1e-8, abs=1e-12)
-        if p["type"] == "int32":
-            assert isinstance(p["default"], int)
+        want = int if p["type"] == "int32" else float
+        assert all(isinstance(p[f], want) for f in ("default", "value", "min", "max")), p["key"]
 
 
 def test_json_value_follows_set_and_default_does_not(stridefixd):
