@@ -1,4 +1,5 @@
-/* sf_fusion.h — PDR + absolute-fix fusion: six schemes run side by side on the same inputs.
+/* sf_fusion.h — PDR + absolute-fix fusion: every scheme of pose_t.SCHEME_* (six today), side by side
+ * on the same inputs.
  *
  * Ownership. One sf_fusion_t is one scheme. The estimator owns an array
  *     sf_fusion_t fusion[sf_scheme_count];   sf_fusion_init(&fusion[s], (int8_t)s) for each s,
