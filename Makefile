@@ -79,7 +79,7 @@ gates: check-static check-clang check-asan
 check-static: build
 	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
 		--inline-suppr --suppressions-list=tools/cppcheck.supp \
-		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/lcmtypes/c \
+		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/gen/schemes -I$(BUILD)/lcmtypes/c \
 		firmware/core firmware/board firmware/app
 
 check-clang: deps

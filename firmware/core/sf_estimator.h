@@ -125,4 +125,19 @@ int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_s
 /* The pose of one scheme; false while that scheme has no position yet (waiting for its first fix). */
 bool sf_estimator_scheme_pose(const sf_estimator_t *est, const sf_params_t *p, int scheme, sf_pose_t *pose);
 
+/* What the board layer publishes about the estimator (HEALTH, POSE timing) without reading its
+ * internals. */
+typedef struct {
+    int64_t t_us;          /* newest input time */
+    int32_t step_count;    /* steps credited since start */
+    int16_t floor;         /* the barometric floor (sf_floor) */
+    bool has_site;         /* a site is attached: Wi-Fi fixes and every scheme; else only pdr_only */
+    uint32_t mag_rejected; /* magnetometer samples the attitude refused (disturbed field) */
+    uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
+    uint32_t stride_calibrations;
+} sf_estimator_status_t;
+
+/* Fills *status; cannot fail. */
+void sf_estimator_status(const sf_estimator_t *est, sf_estimator_status_t *status);
+
 #endif

@@ -1,9 +1,13 @@
-/* sf_fusion.h — PDR + absolute-fix fusion: six schemes run side by side on the same inputs.
+/* sf_fusion.h — PDR + absolute-fix fusion: every scheme of pose_t.SCHEME_* (six today), side by side
+ * on the same inputs.
  *
  * Ownership. One sf_fusion_t is one scheme. The estimator owns an array
  *     sf_fusion_t fusion[sf_scheme_count];   sf_fusion_init(&fusion[s], (int8_t)s) for each s,
  * and feeds every scheme the same steps and fixes, so one log compares all of them (DESIGN.md,
  * evaluation protocol). A scheme never looks at another; there is no shared state.
+ * Scheme ids and names come from pose_t.SCHEME_* (generated sf_schemes.h); what each scheme does is
+ * one row of the registry in sf_fusion.c (mode: dead reckoning, follow the fixes, or blend with a gain
+ * law), so adding a scheme is the pose_t.lcm constant plus one row (and its law, if new).
  *
  * Frame and units: map frame x, y [m], floors as int16 indices, times int64 µs carried by the inputs
  * (no clock). Position uncertainty is isotropic: `var_m2` is the variance of each axis [m²], the fix's
@@ -182,5 +186,12 @@ void sf_fusion_audit_refused(const sf_fusion_t *f, const sf_fix_t *fix, int8_t r
 
 /* Short English text for a reason (fix_t.reason_text); never NULL. */
 const char *sf_fix_reason_text(int reason);
+
+/* The scheme registry (one row per pose_t.SCHEME_*, ids and names from sf_schemes.h): the lower-case
+ * name of a scheme ("pdr_only", ...; NULL outside [0, sf_scheme_count)); the id of a name, or
+ * SF_EINVAL; and whether a scheme has a complete row (for tests: a scheme without one cannot run). */
+const char *sf_fusion_scheme_name(int scheme);
+int sf_fusion_scheme_from_name(const char *name);
+bool sf_fusion_scheme_is_registered(int scheme);
 
 #endif

@@ -82,6 +82,22 @@ def test_every_scheme_judges_every_scan(walk):
         )
 
 
+def test_adaptive_fix_records_carry_accuracy_factor_and_drift(walk):
+    """FIX.accuracy_factor and FIX.drift: the adaptive law's two terms where it blended a fix
+    (α = clamp(sum, 0, 1)), 0 everywhere else."""
+    fixes = [fix_t.decode(e.data) for e in walk["events"] if e.channel == "FIX"]
+    blended = [f for f in fixes if f.scheme == pose_t.SCHEME_ADAPTIVE and f.reason == fix_t.REASON_ACCEPTED]
+    assert len(blended) > 5
+    for f in blended:
+        assert f.accuracy_factor > 0.0 and f.drift >= 0.0
+        assert f.alpha == pytest.approx(min(max(f.accuracy_factor + f.drift, 0.0), 1.0), abs=1e-6)
+    assert any(f.drift > 0.0 for f in blended)
+    others = [
+        f for f in fixes if not (f.scheme == pose_t.SCHEME_ADAPTIVE and f.reason == fix_t.REASON_ACCEPTED)
+    ]
+    assert all(f.accuracy_factor == 0.0 and f.drift == 0.0 for f in others)
+
+
 def test_every_scheme_publishes_pose_after_its_first_fix(walk):
     first_scan_t = min(wifi_scan_t.decode(e.data).t_us for e in walk["events"] if e.channel == "WIFI")
     poses = [pose_t.decode(e.data) for e in walk["events"] if e.channel == "POSE"]
