@@ -19,7 +19,7 @@ SUBCOMMANDS = {
     "bench": "stridefix_analyzer.bench.sil_pdr",
     "import": "stridefix_analyzer.datasets.cli",
     "realbench": "stridefix_analyzer.realbench.pdr_distance",
-    "radiomap": "stridefix_analyzer.radiomap.build",
+    "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
 }
 
