@@ -19,19 +19,11 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import stridefix
 
+from stridefix_analyzer import schemes
 from stridefix_analyzer.io.logread import LogData, Table
+from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 
-#: pose_t.scheme code → name used in reports and JSON keys
-SCHEME_NAMES = {
-    stridefix.pose_t.SCHEME_PDR_ONLY: "pdr_only",
-    stridefix.pose_t.SCHEME_WIFI_ONLY: "wifi_only",
-    stridefix.pose_t.SCHEME_OVERWRITE: "overwrite",
-    stridefix.pose_t.SCHEME_STATIC: "static",
-    stridefix.pose_t.SCHEME_ADAPTIVE: "adaptive",
-    stridefix.pose_t.SCHEME_KALMAN: "kalman",
-}
 #: preference when several schemes have equally many POSE messages (first wins)
 _PRIMARY_PREFERENCE = ["adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
 
@@ -43,22 +35,20 @@ class MetricsInputError(ValueError):
     """The logs lack what scoring needs (no TRUTH, no POSE, unknown scheme); the message says what."""
 
 
-def scheme_name(code: int) -> str:
-    """Name of a pose_t.scheme code; unknown codes become ``scheme_<code>``."""
-    return SCHEME_NAMES.get(int(code), f"scheme_{int(code)}")
-
-
-def scheme_code(name: str) -> int:
-    """Inverse of :func:`scheme_name`; accepts a name (``adaptive``) or a number (``4``)."""
-    for code, known in SCHEME_NAMES.items():
-        if name.lower() == known:
-            return code
-    if name.lower().startswith("scheme_"):
-        name = name[len("scheme_") :]
+def scheme_code(name: str | int) -> int:
+    """The id of a scheme given by name (``adaptive``, any case), number (``4``) or ``scheme_<id>``
+    (the name :func:`~stridefix_analyzer.schemes.scheme_name` gives an id the LCM type does not
+    know: such an id is returned as it is, and scoring then reports it absent from the POSE stream).
+    Raises :class:`MetricsInputError` for anything else."""
+    text = str(name).lower()
+    text = text[len("scheme_") :] if text.startswith("scheme_") else text
     try:
-        return int(name)
-    except ValueError:
-        raise MetricsInputError(f"unknown scheme {name!r}; known: {list(SCHEME_NAMES.values())}") from None
+        return schemes.scheme_code(text)
+    except UnknownSchemeError:
+        try:
+            return int(text)
+        except ValueError:
+            raise MetricsInputError(f"unknown scheme {name!r}; known: {list(schemes.NAMES)}") from None
 
 
 # --- the causal match ----------------------------------------------------------------------------
