@@ -63,7 +63,8 @@ from .gait import (
     Person,
     make_person,
 )
-from .route import Route, make_route, survey_route
+from .route import Route, make_route
+from .survey_route import survey_route
 from .survey_stops import plan_stop
 from .world import World, survey_points
 
