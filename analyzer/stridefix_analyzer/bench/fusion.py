@@ -202,7 +202,7 @@ def run_office(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[s
         for k, v in errors.items():
             pooled.setdefault(k, []).append(v)
     table = pooled_table(pooled)
-    k = table.get("kalman", {})
+    kalman = table.get("kalman", {})
     doc = {
         "bench": "office_wifi",
         "seeds": seeds,
@@ -211,7 +211,10 @@ def run_office(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[s
         "table": table,
         "runs": runs,
         "targets": {"kalman_mean_m_max": 2.0, "kalman_p95_m_max": 4.5},
-        "targets_met": {"kalman_mean": k.get("mean_m", 1e9) <= 2.0, "kalman_p95": k.get("p95_m", 1e9) <= 4.5},
+        "targets_met": {
+            "kalman_mean": kalman.get("mean_m", 1e9) <= 2.0,
+            "kalman_p95": kalman.get("p95_m", 1e9) <= 4.5,
+        },
         "run_s": time.perf_counter() - t0,
     }
     (out / "office_wifi.json").write_text(json.dumps(doc, indent=2) + "\n")

@@ -26,6 +26,7 @@ import os
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -40,7 +41,7 @@ from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 DEFAULT_OUT = os.path.join("out", "crowd", "experiment")
 
 # (key, label, thesis mean, thesis std, solve options)
-ROWS = [
+ROWS: list[tuple[str, str, float | None, float | None, dict[str, Any]]] = [
     (
         "pdr",
         "PDR only, no weights/filtering",

@@ -8,6 +8,8 @@ with no entry tells a matcher nothing). Floors: ``lowest_floor`` .. highest RP f
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from stridefix import site_t
 
@@ -116,7 +118,7 @@ def site_summary(site: site_t) -> dict:
         f = site.lowest_floor + i
         sel = rp_floor == f
         entry_sel = sel[np.asarray(site.entry_rp, dtype=np.int64)] if site.n_entries else np.zeros(0, bool)
-        info = {
+        info: dict[str, Any] = {
             "height_m": float(site.floor_height_m[i]),
             "rps": int(sel.sum()),
             "aps": int(len(set(np.asarray(site.entry_ap)[entry_sel].tolist()))),

@@ -86,11 +86,15 @@ def collect_scans(recordings: list[Recording], scan_duration_ms: float, static_t
         p = place_scans(rec, int(round(scan_duration_ms * 1000)), static_tol_m)
         for i, reason in enumerate(SKIP_REASONS):
             skipped[reason] += int(np.sum(p["skip"] == i + 1))
-        xs.append(p["x_m"]), ys.append(p["y_m"]), fs.append(p["floor"]), st.append(p["static"])
+        xs.append(p["x_m"])
+        ys.append(p["y_m"])
+        fs.append(p["floor"])
+        st.append(p["static"])
         scan_ok.append(p["skip"] == 0)
         recs.append(np.full(len(rec.wifi), r, dtype=np.int64))
         ap_scan.append(rec.wifi_ap["scan_row"] + base)
-        ap_bssid.append(rec.wifi_ap["bssid"]), ap_rssi.append(rec.wifi_ap["rssi_dbm"])
+        ap_bssid.append(rec.wifi_ap["bssid"])
+        ap_rssi.append(rec.wifi_ap["rssi_dbm"])
         base += len(rec.wifi)
         n_total += len(rec.wifi)
 

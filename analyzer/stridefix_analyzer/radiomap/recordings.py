@@ -44,15 +44,15 @@ def _merge(files: list[str], datas: list[LogData]) -> Recording:
         )
     wifi_parts, ap_parts, truth_parts, offset = [], [], [], 0
     for d in datas:
-        if d.table("WIFI"):
-            w, ap = d.table("WIFI"), d.table("WIFI_AP")
+        w, truth = d.table("WIFI"), d.table("TRUTH")
+        if w:
             wifi_parts.append(w.to_dict())
-            cols = ap.to_dict()
+            cols = d.tables["WIFI_AP"].to_dict()
             cols["scan_row"] = cols["scan_row"] + offset
             ap_parts.append(cols)
             offset += len(w)
-        if d.table("TRUTH"):
-            truth_parts.append(d.table("TRUTH").to_dict())
+        if truth:
+            truth_parts.append(truth.to_dict())
 
     def cat(parts):
         return Table({k: np.concatenate([p[k] for p in parts]) for k in parts[0]})

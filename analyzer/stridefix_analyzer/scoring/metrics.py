@@ -20,7 +20,7 @@ import dataclasses
 
 import numpy as np
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import schemes as registry
 from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 
@@ -43,12 +43,12 @@ def scheme_code(name: str | int) -> int:
     text = str(name).lower()
     text = text[len("scheme_") :] if text.startswith("scheme_") else text
     try:
-        return schemes.scheme_code(text)
+        return registry.scheme_code(text)
     except UnknownSchemeError:
         try:
             return int(text)
         except ValueError:
-            raise MetricsInputError(f"unknown scheme {name!r}; known: {list(schemes.NAMES)}") from None
+            raise MetricsInputError(f"unknown scheme {name!r}; known: {list(registry.NAMES)}") from None
 
 
 # --- the causal match ----------------------------------------------------------------------------
@@ -140,7 +140,7 @@ def error_stats(error_m: np.ndarray) -> dict:
     """
     error_m = np.asarray(error_m, dtype=np.float64)
     finite = error_m[np.isfinite(error_m)]
-    stats = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
+    stats: dict[str, float] = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
     if finite.size == 0:
         stats.update(dict.fromkeys(["mean", "median", "p75", "p90", "p95", "max", "rmse"], float("nan")))
         return stats
@@ -187,7 +187,7 @@ def step_metrics(pose: Table, truth: Table, n_step_messages: int) -> dict:
     """
     detected = int(pose["step_count"][-1]) if len(pose) else int(n_step_messages)
     known = truth["step_count"][truth["step_count"] >= 0] if len(truth) else np.array([])
-    out = {
+    out: dict[str, float | None] = {
         "detected": detected,
         "step_messages": int(n_step_messages),
         "truth": None,
@@ -372,13 +372,13 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     MetricsInputError
         No TRUTH or no POSE messages (both listed when both are missing), or ``scheme`` absent.
     """
-    missing = [ch for ch in ("TRUTH", "POSE") if data.table(ch) is None or not len(data.table(ch))]
-    if missing:
+    truth, pose = data.table("TRUTH"), data.table("POSE")
+    missing = [ch for ch, t in (("TRUTH", truth), ("POSE", pose)) if t is None or not len(t)]
+    if truth is None or pose is None or missing:
         raise MetricsInputError(
             f"no {' and no '.join(missing)} messages in "
             f"{', '.join(i['path'] for i in data.inputs) or 'the input'}"
         )
-    truth, pose = data.table("TRUTH"), data.table("POSE")
     if truth_source is not None:
         if truth_source not in TRUTH_SOURCES:
             raise MetricsInputError(f"unknown truth source {truth_source!r}; known: {list(TRUTH_SOURCES)}")

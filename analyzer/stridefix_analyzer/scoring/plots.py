@@ -8,6 +8,7 @@ Every function takes the arrays of ``analysis.npz`` (see
 from __future__ import annotations
 
 import io
+from typing import Any
 
 import matplotlib
 
@@ -17,7 +18,7 @@ import numpy as np  # noqa: E402
 
 from stridefix_analyzer.schemes import scheme_colour, scheme_name  # noqa: E402
 
-_TRUTH_STYLE = dict(color="black", linewidth=2.0, label="truth")
+_TRUTH_STYLE: dict[str, Any] = dict(color="black", linewidth=2.0, label="truth")
 _PERCENTILE_LINES = ((50, "p50", ":"), (75, "p75", "--"), (95, "p95", "-."))
 
 
