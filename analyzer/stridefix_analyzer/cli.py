@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from collections.abc import Callable
 
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
@@ -53,8 +54,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _unavailable(name: str, exc: ImportError):
-    def run(_args) -> int:
+def _unavailable(name: str, exc: ImportError) -> Callable[[argparse.Namespace], int]:
+    def run(_args: argparse.Namespace) -> int:
         print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
         return 1
 
