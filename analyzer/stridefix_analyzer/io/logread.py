@@ -17,7 +17,7 @@ WIFI_AP   scan_row (row in WIFI), bssid, rssi_dbm, freq_mhz
 GNSS      t_us, lat_deg, lon_deg, alt_m, accuracy_m
 STEP      t_us, index, length_m, accel_range_mps2, period_s, heading_rad, activity, floor
 FIX       t_us, method, scheme, x_m, y_m, floor, accuracy_m, n_ap_used, innovation_{x,y}_m,
-          innovation_var_m2, test_ratio, alpha, accepted, reason, reason_text
+          innovation_var_m2, test_ratio, accuracy_factor, drift, alpha, accepted, reason, reason_text
 POSE      t_us, x_m, y_m, floor, heading_rad, sigma_m, step_count, scheme
 TRUTH     t_us, x_m, y_m, floor, heading_rad, step_count, source
 HEALTH    every health_t field (counters over time); the last report is also in ``LogData.health``
