@@ -9,29 +9,43 @@ PY := $(VENV)/bin/python
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build test test-c test-python demo bench clean help change-indication
+.PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
+	gates check-static check-clang check-asan
 
 all: build
 
 help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
-	@echo "make test   - install what is missing, build, run every test (C, Python, end to end)"
+	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
+	@echo "make lint   - ruff (lint + format check) on all Python"
 	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
-	@echo "make clean  - remove $(BUILD)/ and out/"
+	@echo "make gates  - the C/C++ quality gates below, one after the other"
+	@echo "make check-static - cppcheck on firmware/ (suppressions: tools/cppcheck.supp); fails on a finding"
+	@echo "make check-clang  - the whole tree with clang/clang++ (warnings are errors) into build-clang/, ctest"
+	@echo "make check-asan   - firmware + C tests with ASan+UBSan and SF_ASSERT on into build-asan/, ctest"
+	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/ and out/"
 
 deps:
 	@BUILD=$(BUILD) VENV=$(VENV) tools/deps.sh
 
+# $(call configure,DIR,EXTRA_CMAKE_ARGS): CMake into DIR, its output kept in DIR/cmake.log (shown on failure).
+configure = mkdir -p $(1) && cmake -S . -B $(1) -DSTRIDEFIX_PYTHON=$(abspath $(PY)) $(2) > $(1)/cmake.log 2>&1 \
+	|| { cat $(1)/cmake.log; exit 1; }
+
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DSTRIDEFIX_PYTHON=$(abspath $(PY)) > $(BUILD).cmake.log 2>&1 \
-		|| { cat $(BUILD).cmake.log; exit 1; }
+	@$(call configure,$(BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE))
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# Everything CI checks: the C and Python tests, the Python lint/type gates and the C/C++ gates.
 test: build
-	@$(MAKE) --no-print-directory test-c test-python
+	@$(MAKE) --no-print-directory test-c test-python lint gates
+
+lint: deps
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 test-c:
 	cd $(BUILD) && ctest --output-on-failure
@@ -46,17 +60,42 @@ demo: build
 	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
 
 MSINDOOR ?= ../shared/data/msindoor
+# Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
-	$(PY) -m stridefix_analyzer.cli bench sil-pdr --stridefixd $(STRIDEFIXD) --out out/bench
-	$(PY) -m stridefix_analyzer.cli bench aadr2015 --stridefixd $(STRIDEFIXD) --out out/bench
-	$(PY) -m stridefix_analyzer.cli bench office-wifi --stridefixd $(STRIDEFIXD) --out out/bench
-	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json
-	@for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
+	@status=0; \
+	for b in sil-pdr aadr2015 office-wifi; do \
+		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
+	done; \
+	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \
+	for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
 		if [ -d "$$floor" ]; then \
 			$(PY) -m stridefix_analyzer.cli realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
-				--out out/bench/realbench/$$(basename $$(dirname $$floor))-$$(basename $$floor) || exit 1; \
+				--out out/bench/realbench/$$(basename $$(dirname $$floor))-$$(basename $$floor) || status=1; \
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
-	done
+	done; \
+	if [ $$status -ne 0 ]; then echo "bench: FAILED: a target was missed or a bench failed (TARGET MISSED lines above)"; fi; \
+	exit $$status
+
+# Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
+# so it needs the build; the other two are separate build trees with their own compiler and flags.
+gates: check-static check-clang check-asan
+
+check-static: build
+	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
+		--inline-suppr --suppressions-list=tools/cppcheck.supp \
+		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/gen/schemes -I$(BUILD)/lcmtypes/c \
+		firmware/core firmware/board firmware/app
+
+check-clang: deps
+	@$(call configure,build-clang,-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++)
+	@cmake --build build-clang -j $(JOBS)
+	cd build-clang && ctest --output-on-failure
+
+# Debug: no NDEBUG, so SF_ASSERT is live. No native module (a sanitized one cannot load into Python).
+check-asan: deps
+	@$(call configure,build-asan,-DCMAKE_BUILD_TYPE=Debug -DSF_SANITIZE=ON -DSF_NATIVE=OFF)
+	@cmake --build build-asan -j $(JOBS)
+	cd build-asan && ctest --output-on-failure
 
 clean:
-	rm -rf $(BUILD) $(BUILD).cmake.log out
+	rm -rf $(BUILD) build-clang build-asan out

@@ -9,7 +9,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
 BUILD=${BUILD:-build}
-DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev python3-dev cmake g++ gcc make pkg-config)
+# clang and cppcheck: the quality gates (make check-clang, make check-static).
+DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev python3-dev cmake g++ gcc make pkg-config
+      clang cppcheck)
 
 missing=()
 for p in "${DEBS[@]}"; do

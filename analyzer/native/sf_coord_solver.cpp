@@ -184,14 +184,14 @@ void sf_coord_validate(const coord_problem_t& pr, const std::vector<double>& ini
   if (bad_pair > 0) problems.push_back(std::to_string(bad_pair) + " pair index(es) outside 0..n_points-1");
   if (self_pair > 0) problems.push_back(std::to_string(self_pair) + " pair(s) join a point to itself");
   size_t bad_range = 0;
-  for (const double b : pr.range_m) bad_range += (std::isfinite(b) && b >= 0.0) ? 0 : 1;
+  for (const double b : pr.range_m) bad_range += (std::isfinite(b) && b >= 0.0) ? size_t{0} : size_t{1};
   if (bad_range > 0) problems.push_back(std::to_string(bad_range) + " range(s) negative or non-finite");
   if (pr.weight_per_m.size() != m) {
     problems.push_back("weights has " + std::to_string(pr.weight_per_m.size()) + " entries, ranges_m " +
                        std::to_string(m));
   }
   size_t bad_weight = 0;
-  for (const double w : pr.weight_per_m) bad_weight += (std::isfinite(w) && w > 0.0) ? 0 : 1;
+  for (const double w : pr.weight_per_m) bad_weight += (std::isfinite(w) && w > 0.0) ? size_t{0} : size_t{1};
   if (bad_weight > 0) problems.push_back(std::to_string(bad_weight) + " weight(s) non-positive or non-finite");
 
   if (!init_xy_m.empty()) {

@@ -2,6 +2,10 @@
 
 Each sub-command lives in the module that does the work and contributes two functions:
 ``add_parser(subparsers)`` (declares its arguments and help) and ``run(args) -> int`` (the exit status).
+A sub-command may also rewrite its own argument list before parsing (e.g. to supply a default
+sub-sub-command): :data:`ARGV_REWRITES` names that hook as ``"module:function"``, ``function(argv) ->
+argv``, applied only when that sub-command is the one given. This module registers and dispatches
+and nothing else; nothing imports from it.
 Exit status: 0 success, 1 the work failed, 2 bad usage or unreadable input.
 """
 
@@ -10,17 +14,24 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from collections.abc import Callable
 
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
     "sim": "stridefix_sim.cli",
     "analyze": "stridefix_analyzer.scoring.analyze",
     "report": "stridefix_analyzer.scoring.report",
-    "bench": "stridefix_analyzer.bench.sil_pdr",
+    "bench": "stridefix_analyzer.bench.cli",
     "import": "stridefix_analyzer.datasets.cli",
     "realbench": "stridefix_analyzer.realbench.cli",
-    "radiomap": "stridefix_analyzer.radiomap.build",
+    "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
+}
+
+# sub-command name -> "module:function" rewriting argv before parsing
+ARGV_REWRITES = {
+    # `realbench --format ...` = `realbench fusion ...`
+    "realbench": "stridefix_analyzer.realbench.cli:with_default_bench",
 }
 
 
@@ -43,24 +54,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _unavailable(name: str, exc: ImportError):
-    def run(_args) -> int:
+def _unavailable(name: str, exc: ImportError) -> Callable[[argparse.Namespace], int]:
+    def run(_args: argparse.Namespace) -> int:
         print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
         return 1
 
     return run
 
 
-def main(argv: list[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
+def rewrite_argv(argv: list[str]) -> list[str]:
+    """``argv`` after the :data:`ARGV_REWRITES` hook of its sub-command (unchanged without one, or
+    when the hook's module does not import: the sub-command then reports itself)."""
+    ref = ARGV_REWRITES.get(argv[0]) if argv else None
+    if ref is None:
+        return argv
+    module_name, function = ref.split(":")
     try:
-        from stridefix_analyzer.realbench.cli import (
-            with_default_bench,  # `realbench --format ...` = `realbench fusion ...`
-        )
+        module = importlib.import_module(module_name)
     except ImportError:
-        pass
-    else:
-        argv = with_default_bench(argv)
+        return argv
+    return list(getattr(module, function)(argv))
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = rewrite_argv(sys.argv[1:] if argv is None else list(argv))
     args = build_parser().parse_args(argv)
     return int(args._run(args) or 0)
 

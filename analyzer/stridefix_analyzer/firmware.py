@@ -3,9 +3,8 @@
 Every replay of a recording (candump or raw-sensor LCM log) through the estimator goes through
 :meth:`Firmware.run`, so the command line is built in one place, failures raise one exception type
 naming the command and its stderr, and ``--set KEY=VALUE`` keys are checked once against the
-firmware's own parameter table (``stridefixd --print-config --json``; the INI text of
-``--print-config`` on a firmware built before the JSON export). Python never spells the list of
-parameter keys itself.
+firmware's own parameter table (``stridefixd --print-config --json``, generated from the X-macro
+of ``firmware/core/sf_params.h``). Python never spells the list of parameter keys itself.
 """
 
 from __future__ import annotations
@@ -14,7 +13,6 @@ import dataclasses
 import functools
 import json
 import os
-import re
 import subprocess
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -50,39 +48,6 @@ def set_args(sets: Iterable[str]) -> list[str]:
     return [a for kv in sets for a in ("--set", kv)]
 
 
-_INI_HELP = re.compile(
-    r"^# (?P<help>.*?)(?: \[(?P<unit>[^\]]*)\])?(?:, range (?P<lo>\S+) \.\. (?P<hi>\S+))?$"
-)
-
-
-def _parse_ini(text: str) -> dict[str, Param]:
-    """The parameters of ``--print-config``'s INI text (section headers, ``# help [unit], range``)."""
-    params: dict[str, Param] = {}
-    section, comment = "", ""
-    for line in text.splitlines():
-        line = line.strip()
-        if line.startswith("[") and line.endswith("]"):
-            section = line[1:-1]
-        elif line.startswith("#"):
-            comment = line
-        elif "=" in line and section:
-            name, value = (s.strip() for s in line.split("=", 1))
-            m = _INI_HELP.match(comment)
-            lo = hi = None
-            if m and m["lo"] is not None:
-                lo, hi = float(m["lo"]), float(m["hi"])
-            params[f"{section}.{name}"] = Param(
-                key=f"{section}.{name}",
-                default=value,
-                unit=(m["unit"] or "") if m else "",
-                min=lo,
-                max=hi,
-                help=m["help"] if m else "",
-            )
-            comment = ""
-    return params
-
-
 class Firmware:
     """A built ``stridefixd``. ``path`` defaults to :func:`default_path`."""
 
@@ -107,29 +72,26 @@ class Firmware:
 
     @functools.cached_property
     def params(self) -> dict[str, Param]:
-        """Every parameter of the firmware's table, by key (read once per instance)."""
+        """Every parameter of the firmware's table (``--print-config --json``), by key; read once."""
         proc = self._call(["--print-config", "--json"], timeout=30)
-        if proc.returncode == 0:
-            try:
-                doc = json.loads(proc.stdout)
-                rows = doc["params"] if isinstance(doc, dict) else doc
-                return {
-                    r["key"]: Param(
-                        key=r["key"],
-                        default=str(r.get("default", "")),
-                        unit=r.get("unit", ""),
-                        min=r.get("min"),
-                        max=r.get("max"),
-                        help=r.get("help", ""),
-                    )
-                    for r in rows
-                }
-            except (ValueError, KeyError, TypeError) as exc:
-                raise FirmwareError(f"{self.path} --print-config --json: unreadable ({exc})") from exc
-        proc = self._call(["--print-config"], timeout=30)
         if proc.returncode != 0:
-            raise FirmwareError(f"{self.path} --print-config exited {proc.returncode}: {proc.stderr[-300:]}")
-        return _parse_ini(proc.stdout)
+            raise FirmwareError(
+                f"{self.path} --print-config --json exited {proc.returncode}: {proc.stderr[-300:]}"
+            )
+        try:
+            return {
+                r["key"]: Param(
+                    key=r["key"],
+                    default=str(r["default"]),
+                    unit=r.get("unit", ""),
+                    min=r.get("min"),
+                    max=r.get("max"),
+                    help=r.get("help", ""),
+                )
+                for r in json.loads(proc.stdout)["params"]
+            }
+        except (ValueError, KeyError, TypeError) as exc:
+            raise FirmwareError(f"{self.path} --print-config --json: unreadable ({exc})") from exc
 
     def check_sets(self, sets: Iterable[str]) -> list[str]:
         """Validates KEY=VALUE overrides once: every key must be in :attr:`params` and stridefixd must

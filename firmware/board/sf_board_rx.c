@@ -80,7 +80,6 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
             out->gyro_radps[i] = gyr->xyz[i] * DEG_TO_RAD;
         }
         ev->kind = sf_rx_imu;
-        rx->counters.imu++;
         return 1;
     }
     if (other->valid) { /* the other half waits for a sample we will never complete */
@@ -108,7 +107,6 @@ static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_
     }
     ev->kind = sf_rx_wifi;
     ev->u.wifi = rx->scan;
-    rx->counters.wifi++;
     return 1;
 }
 
@@ -167,166 +165,226 @@ static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end
     return close_scan(rx, rx->scan.n_ap == (int32_t)m->n_ap, ev);
 }
 
-static int decode(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+/* ---- one handler per board.dbc frame ------------------------------------------------------------ */
+
+static int on_board_time(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
-    switch (f->id) {
-    case BOARD_BOARD_TIME_FRAME_ID: {
-        struct board_board_time_t m;
-        (void)board_board_time_unpack(&m, f->data, f->dlc);
-        const uint32_t restarts = rx->clock.restarts;
-        sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id);
-        if (rx->clock.restarts != restarts) {
-            rx->counters.board_restarts++;
-            rx->accel.valid = rx->gyro.valid = false;
-        }
-        return 0;
+    (void)ev;
+    struct board_board_time_t m;
+    (void)board_board_time_unpack(&m, f->data, f->dlc);
+    const uint32_t restarts = rx->clock.restarts;
+    sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id);
+    if (rx->clock.restarts != restarts) {
+        rx->counters.board_restarts++;
+        rx->accel.valid = rx->gyro.valid = false;
     }
-    case BOARD_IMU_ACCEL_FRAME_ID: {
-        struct board_imu_accel_t m;
-        (void)board_imu_accel_unpack(&m, f->data, f->dlc);
-        const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
-                                 {board_imu_accel_accel_x_decode(m.accel_x), board_imu_accel_accel_y_decode(m.accel_y),
-                                  board_imu_accel_accel_z_decode(m.accel_z)}};
-        return on_imu_half(rx, true, &h, ev);
-    }
-    case BOARD_IMU_GYRO_FRAME_ID: {
-        struct board_imu_gyro_t m;
-        (void)board_imu_gyro_unpack(&m, f->data, f->dlc);
-        const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
-                                 {board_imu_gyro_gyro_x_decode(m.gyro_x), board_imu_gyro_gyro_y_decode(m.gyro_y),
-                                  board_imu_gyro_gyro_z_decode(m.gyro_z)}};
-        return on_imu_half(rx, false, &h, ev);
-    }
-    case BOARD_MAG_FRAME_ID: {
-        struct board_mag_t m;
-        (void)board_mag_unpack(&m, f->data, f->dlc);
-        sf_rx_mag_t *const out = &ev->u.mag;
-        const int rc = resolve(rx, &rx->mag_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
-        if (rc != SF_OK) {
-            return rc;
-        }
-        out->field_ut[0] = board_mag_mag_x_decode(m.mag_x);
-        out->field_ut[1] = board_mag_mag_y_decode(m.mag_y);
-        out->field_ut[2] = board_mag_mag_z_decode(m.mag_z);
-        ev->kind = sf_rx_mag;
-        rx->counters.mag++;
-        return 1;
-    }
-    case BOARD_BARO_FRAME_ID: {
-        struct board_baro_t m;
-        (void)board_baro_unpack(&m, f->data, f->dlc);
-        if (!board_baro_pressure_is_in_range(m.pressure)) {
-            rx->counters.decode_errors++;
-            return SF_ERANGE;
-        }
-        sf_rx_baro_t *const out = &ev->u.baro;
-        const int rc = resolve(rx, &rx->baro_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
-        if (rc != SF_OK) {
-            return rc;
-        }
-        out->pressure_pa = board_baro_pressure_decode(m.pressure);
-        out->temperature_degc = board_baro_temperature_decode(m.temperature);
-        ev->kind = sf_rx_baro;
-        rx->counters.baro++;
-        return 1;
-    }
-    case BOARD_WIFI_SCAN_BEGIN_FRAME_ID: {
-        struct board_wifi_scan_begin_t m;
-        (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
-        return on_scan_begin(rx, &m, ev);
-    }
-    case BOARD_WIFI_AP_FRAME_ID: {
-        struct board_wifi_ap_t m;
-        (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
-        return on_scan_ap(rx, &m);
-    }
-    case BOARD_WIFI_SCAN_END_FRAME_ID: {
-        struct board_wifi_scan_end_t m;
-        (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
-        return on_scan_end(rx, &m, ev);
-    }
-    case BOARD_GNSS_INFO_FRAME_ID: {
-        struct board_gnss_info_t m;
-        (void)board_gnss_info_unpack(&m, f->data, f->dlc);
-        int64_t t_ms;
-        if (sf_board_clock_unwrap(&rx->clock, m.time_ms, &t_ms) != SF_OK) {
-            rx->counters.unsynced++;
-            return SF_ENOTSYNC;
-        }
-        rx->gnss_info_valid = true;
-        rx->gnss_t_ms = t_ms;
-        rx->gnss_alt_m = board_gnss_info_altitude_decode(m.altitude);
-        rx->gnss_accuracy_m = (float)board_gnss_info_accuracy_decode(m.accuracy);
-        return 0;
-    }
-    case BOARD_GNSS_POSITION_FRAME_ID: {
-        struct board_gnss_position_t m;
-        (void)board_gnss_position_unpack(&m, f->data, f->dlc);
-        if (!rx->gnss_info_valid || !board_gnss_position_latitude_is_in_range(m.latitude) ||
-            !board_gnss_position_longitude_is_in_range(m.longitude)) {
-            rx->gnss_info_valid = false;
-            rx->counters.decode_errors++;
-            return SF_ERANGE;
-        }
-        rx->gnss_info_valid = false;
-        sf_rx_gnss_t *const out = &ev->u.gnss;
-        out->t_us = rx->gnss_t_ms * 1000;
-        out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
-        out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
-        out->alt_m = rx->gnss_alt_m;
-        out->accuracy_m = rx->gnss_accuracy_m;
-        ev->kind = sf_rx_gnss;
-        rx->counters.gnss++;
-        return 1;
-    }
-    case BOARD_BOARD_STATUS_FRAME_ID: {
-        struct board_board_status_t m;
-        (void)board_board_status_unpack(&m, f->data, f->dlc);
-        rx->counters.board_status++;
-        rx->counters.board_tx_overflows = m.tx_overflows;
-        return 0;
-    }
-    default:
-        rx->counters.unknown_id++;
-        return SF_EUNKNOWN_ID;
-    }
+    return 0;
 }
 
-/* The DBC length of a known id, or 0 for an unknown one. */
-static unsigned dbc_length(const uint32_t id)
+static int on_imu_accel(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
-    switch (id) {
-    case BOARD_BOARD_TIME_FRAME_ID: return BOARD_BOARD_TIME_LENGTH;
-    case BOARD_IMU_ACCEL_FRAME_ID: return BOARD_IMU_ACCEL_LENGTH;
-    case BOARD_IMU_GYRO_FRAME_ID: return BOARD_IMU_GYRO_LENGTH;
-    case BOARD_MAG_FRAME_ID: return BOARD_MAG_LENGTH;
-    case BOARD_BARO_FRAME_ID: return BOARD_BARO_LENGTH;
-    case BOARD_WIFI_SCAN_BEGIN_FRAME_ID: return BOARD_WIFI_SCAN_BEGIN_LENGTH;
-    case BOARD_WIFI_AP_FRAME_ID: return BOARD_WIFI_AP_LENGTH;
-    case BOARD_WIFI_SCAN_END_FRAME_ID: return BOARD_WIFI_SCAN_END_LENGTH;
-    case BOARD_GNSS_POSITION_FRAME_ID: return BOARD_GNSS_POSITION_LENGTH;
-    case BOARD_GNSS_INFO_FRAME_ID: return BOARD_GNSS_INFO_LENGTH;
-    case BOARD_BOARD_STATUS_FRAME_ID: return BOARD_BOARD_STATUS_LENGTH;
-    default: return 0;
+    struct board_imu_accel_t m;
+    (void)board_imu_accel_unpack(&m, f->data, f->dlc);
+    const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
+                             {board_imu_accel_accel_x_decode(m.accel_x), board_imu_accel_accel_y_decode(m.accel_y),
+                              board_imu_accel_accel_z_decode(m.accel_z)}};
+    return on_imu_half(rx, true, &h, ev);
+}
+
+static int on_imu_gyro(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_imu_gyro_t m;
+    (void)board_imu_gyro_unpack(&m, f->data, f->dlc);
+    const sf_imu_half_t h = {true, m.seq, m.t_lo_ms,
+                             {board_imu_gyro_gyro_x_decode(m.gyro_x), board_imu_gyro_gyro_y_decode(m.gyro_y),
+                              board_imu_gyro_gyro_z_decode(m.gyro_z)}};
+    return on_imu_half(rx, false, &h, ev);
+}
+
+static int on_mag(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_mag_t m;
+    (void)board_mag_unpack(&m, f->data, f->dlc);
+    sf_rx_mag_t *const out = &ev->u.mag;
+    const int rc = resolve(rx, &rx->mag_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
+    if (rc != SF_OK) {
+        return rc;
     }
+    out->field_ut[0] = board_mag_mag_x_decode(m.mag_x);
+    out->field_ut[1] = board_mag_mag_y_decode(m.mag_y);
+    out->field_ut[2] = board_mag_mag_z_decode(m.mag_z);
+    ev->kind = sf_rx_mag;
+    return 1;
+}
+
+static int on_baro(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_baro_t m;
+    (void)board_baro_unpack(&m, f->data, f->dlc);
+    if (!board_baro_pressure_is_in_range(m.pressure)) {
+        rx->counters.decode_errors++;
+        return SF_ERANGE;
+    }
+    sf_rx_baro_t *const out = &ev->u.baro;
+    const int rc = resolve(rx, &rx->baro_time, m.seq, m.t_lo_ms, &out->t_us, &out->seq);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    out->pressure_pa = board_baro_pressure_decode(m.pressure);
+    out->temperature_degc = board_baro_temperature_decode(m.temperature);
+    ev->kind = sf_rx_baro;
+    return 1;
+}
+
+static int on_wifi_scan_begin(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_wifi_scan_begin_t m;
+    (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
+    return on_scan_begin(rx, &m, ev);
+}
+
+static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    (void)ev;
+    struct board_wifi_ap_t m;
+    (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
+    return on_scan_ap(rx, &m);
+}
+
+static int on_wifi_scan_end(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_wifi_scan_end_t m;
+    (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
+    return on_scan_end(rx, &m, ev);
+}
+
+static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    (void)ev;
+    struct board_gnss_info_t m;
+    (void)board_gnss_info_unpack(&m, f->data, f->dlc);
+    int64_t t_ms;
+    if (sf_board_clock_unwrap(&rx->clock, m.time_ms, &t_ms) != SF_OK) {
+        rx->counters.unsynced++;
+        return SF_ENOTSYNC;
+    }
+    rx->gnss_info_valid = true;
+    rx->gnss_t_ms = t_ms;
+    rx->gnss_alt_m = board_gnss_info_altitude_decode(m.altitude);
+    rx->gnss_accuracy_m = (float)board_gnss_info_accuracy_decode(m.accuracy);
+    return 0;
+}
+
+static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_gnss_position_t m;
+    (void)board_gnss_position_unpack(&m, f->data, f->dlc);
+    if (!rx->gnss_info_valid || !board_gnss_position_latitude_is_in_range(m.latitude) ||
+        !board_gnss_position_longitude_is_in_range(m.longitude)) {
+        rx->gnss_info_valid = false;
+        rx->counters.decode_errors++;
+        return SF_ERANGE;
+    }
+    rx->gnss_info_valid = false;
+    sf_rx_gnss_t *const out = &ev->u.gnss;
+    out->t_us = rx->gnss_t_ms * 1000;
+    out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
+    out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
+    out->alt_m = rx->gnss_alt_m;
+    out->accuracy_m = rx->gnss_accuracy_m;
+    ev->kind = sf_rx_gnss;
+    return 1;
+}
+
+static int on_board_status(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    (void)ev;
+    struct board_board_status_t m;
+    (void)board_board_status_unpack(&m, f->data, f->dlc);
+    rx->counters.board_status++;
+    rx->counters.board_tx_overflows = m.tx_overflows;
+    return 0;
+}
+
+/* ---- the frame table: id, DBC length, handler ------------------------------------------------------
+ * Adding a frame: its BO_ in board.dbc (cantools generates board_<name>_unpack and the constants) and
+ * one row here with its handler; a frame that carries a new kind of sample also adds that kind to
+ * SF_RX_KINDS (sf_rx_event.h), which the LCM replay and the daemon then cannot miss. */
+
+typedef int (*frame_handler_t)(sf_board_rx_t *rx, const sf_can_frame_t *f, sf_rx_event_t *ev);
+
+typedef struct {
+    uint32_t id;
+    unsigned length; /* bytes the DBC declares */
+    frame_handler_t on_frame;
+} frame_row_t;
+
+static const frame_row_t frame_rows[] = {
+    {BOARD_BOARD_TIME_FRAME_ID, BOARD_BOARD_TIME_LENGTH, on_board_time},
+    {BOARD_IMU_ACCEL_FRAME_ID, BOARD_IMU_ACCEL_LENGTH, on_imu_accel},
+    {BOARD_IMU_GYRO_FRAME_ID, BOARD_IMU_GYRO_LENGTH, on_imu_gyro},
+    {BOARD_MAG_FRAME_ID, BOARD_MAG_LENGTH, on_mag},
+    {BOARD_BARO_FRAME_ID, BOARD_BARO_LENGTH, on_baro},
+    {BOARD_WIFI_SCAN_BEGIN_FRAME_ID, BOARD_WIFI_SCAN_BEGIN_LENGTH, on_wifi_scan_begin},
+    {BOARD_WIFI_AP_FRAME_ID, BOARD_WIFI_AP_LENGTH, on_wifi_ap},
+    {BOARD_WIFI_SCAN_END_FRAME_ID, BOARD_WIFI_SCAN_END_LENGTH, on_wifi_scan_end},
+    {BOARD_GNSS_POSITION_FRAME_ID, BOARD_GNSS_POSITION_LENGTH, on_gnss_position},
+    {BOARD_GNSS_INFO_FRAME_ID, BOARD_GNSS_INFO_LENGTH, on_gnss_info},
+    {BOARD_BOARD_STATUS_FRAME_ID, BOARD_BOARD_STATUS_LENGTH, on_board_status},
+};
+
+/* The row of a standard data frame's id, or NULL. */
+static const frame_row_t *find_row(const sf_can_frame_t *const f)
+{
+    if (f->extended || f->remote) {
+        return NULL;
+    }
+    for (size_t i = 0; i < sizeof frame_rows / sizeof frame_rows[0]; i++) {
+        if (frame_rows[i].id == f->id) {
+            return &frame_rows[i];
+        }
+    }
+    return NULL;
+}
+
+unsigned sf_board_rx_dbc_length(const uint32_t id)
+{
+    const sf_can_frame_t f = {.id = id};
+    const frame_row_t *const row = find_row(&f);
+    return row != NULL ? row->length : 0u;
 }
 
 int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
     rx->counters.frames++;
     ev->kind = sf_rx_none;
-    const unsigned len = f->extended || f->remote ? 0u : dbc_length(f->id);
-    if (len == 0) {
+    const frame_row_t *const row = find_row(f);
+    if (row == NULL) {
         rx->counters.unknown_id++;
         return SF_EUNKNOWN_ID;
     }
-    if (f->dlc < len) {
+    if (f->dlc < row->length) {
         rx->counters.bad_length++;
         return SF_ELENGTH;
     }
-    const int rc = decode(rx, f, ev);
+    const int rc = row->on_frame(rx, f, ev);
     if (rc >= 0) {
         rx->counters.frames_ok++;
     }
+    if (rc == 1) {
+        sf_rx_count_sample(&rx->counters, ev->kind);
+    }
     return rc;
+}
+
+void sf_rx_count_sample(sf_rx_counters_t *const c, const sf_rx_kind_t kind)
+{
+    switch (kind) { /* no default: a new kind needs its counter (-Wswitch) */
+    case sf_rx_imu: c->imu++; break;
+    case sf_rx_mag: c->mag++; break;
+    case sf_rx_baro: c->baro++; break;
+    case sf_rx_wifi: c->wifi++; break;
+    case sf_rx_gnss: c->gnss++; break;
+    case sf_rx_none: break;
+    }
 }

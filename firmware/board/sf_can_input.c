@@ -162,7 +162,9 @@ void sf_can_input_close(sf_can_input_t *const in)
         fclose(in->file);
     }
     in->file = NULL;
-    if (in->fd >= 0) {
+    /* Only a socket this input opened: a zeroed, never-opened input has fd 0, which is stdin (the
+     * --replay bug that closed a CAN input it never opened). */
+    if (in->kind == sf_can_input_socketcan && in->fd >= 0) {
         close(in->fd);
     }
     in->fd = -1;

@@ -31,6 +31,8 @@ int sf_can_input_open(sf_can_input_t *in, const char *spec, char *err_text, size
  * line is skipped; in->line_no and in->line name it), SF_EIO a read error. */
 int sf_can_input_next(sf_can_input_t *in, sf_can_frame_t *frame);
 
+/* Closes the file or socket that sf_can_input_open opened (never stdin, never a descriptor of a
+ * zeroed input that was not opened); safe to call twice. */
 void sf_can_input_close(sf_can_input_t *in);
 
 #endif

@@ -97,9 +97,9 @@ int sf_candump_parse(const char *line, sf_can_frame_t *const frame)
         p++;
     } else {
         int n = 0;
-        int hi, lo;
+        int hi;
         while ((hi = hex_value(p[0])) >= 0) {
-            lo = hex_value(p[1]);
+            const int lo = hex_value(p[1]);
             if (lo < 0 || n >= 8) {
                 return SF_ESYNTAX;
             }

@@ -2,7 +2,7 @@
  * path for real data sets that the analyzer's importers convert (DESIGN.md data flow).
  *
  * Each event is decoded with the generated stridefix types into the same sf_rx_event_t that the CAN
- * path produces, so the estimator cannot tell the two apart. Other channels (TRUTH, POSE, ...) are
+ * path produces (through the kind table of sf_rx_lcm.h), so the estimator cannot tell the two apart. Other channels (TRUTH, POSE, ...) are
  * skipped and counted. The reader stops at the end of the log, or at its last whole event if the
  * log is truncated. */
 #ifndef SF_LCM_INPUT_H
@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "sf_board_rx.h"
+#include "sf_rx_event.h"
 
 typedef struct sf_lcm_input sf_lcm_input_t;
 

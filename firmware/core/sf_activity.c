@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
+
 void sf_activity_init(sf_activity_t *const a, const sf_params_t *const p)
 {
     (void)p;
@@ -113,6 +115,7 @@ static void credit(sf_activity_t *const a, const int64_t t_us)
 
 int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
 {
+    SF_ASSERT(a != NULL && p != NULL && ev != NULL);
     if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4 ||
         fabs(a->vspeed_mps) > 2.0 * p->activity_elevator_vspeed_mps) {
         a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */

@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
+
 #define PI 3.14159265358979323846
 #define G_MPS2 9.80665
 #define MAG_DT_MAX_S 0.2     /* clamp of the mag blend interval (header: "clamped to [0, 0.2] s") */
@@ -167,6 +169,7 @@ void sf_attitude_init(sf_attitude_t *const att)
 void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
                             const double accel_mps2[3], const double gyro_radps[3])
 {
+    SF_ASSERT(att != NULL && p != NULL && accel_mps2 != NULL && gyro_radps != NULL);
     if (!finite3(accel_mps2) || !finite3(gyro_radps)) {
         att->imu_invalid++;
         return;
@@ -288,6 +291,7 @@ static void reject(sf_attitude_t *const att, const sf_mag_verdict_t v)
 void sf_attitude_update_mag(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
                             const double field_ut[3])
 {
+    SF_ASSERT(att != NULL && p != NULL && field_ut != NULL);
     if (!att->tilt_initialised && finite3(field_ut)) {
         if (att->mag_pending) {
             reject(att, sf_mag_no_tilt); /* the held sample is replaced by a newer one */

@@ -237,3 +237,14 @@ bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *
     sf_estimator_pose(e, pose);
     return sf_fusion_pose(&e->fusion[scheme], p, e->t_us, sf_floor_current(&e->floor), pose);
 }
+
+void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *const status)
+{
+    *status = (sf_estimator_status_t){.t_us = e->t_us,
+                                      .step_count = e->step_count,
+                                      .floor = sf_floor_current(&e->floor),
+                                      .has_site = e->site != NULL,
+                                      .mag_rejected = e->attitude.mag_rejected,
+                                      .steps_refused = e->steps_refused,
+                                      .stride_calibrations = e->stride_calibrations};
+}

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 
 #define HALF_LOG_2PI 0.91893853320467274178
@@ -169,6 +170,8 @@ typedef struct {
     int32_t age; /* 0 = newest scan */
     float rssi_dbm;
 } reading_t;
+_Static_assert(sizeof(reading_t) * SF_FINGERPRINT_QUERY_APS <= 16 * 1024,
+               "sf_fingerprint.h promises at most 16 KiB of stack");
 
 static int reading_cmp(const void *const a, const void *const b)
 {
@@ -183,6 +186,7 @@ static int reading_cmp(const void *const a, const void *const b)
 /* Builds fp->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
 static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map)
 {
+    SF_ASSERT(fp->count > 0); /* store_scan has just run */
     reading_t readings[SF_FINGERPRINT_QUERY_APS]; /* 16 kB of stack */
     int32_t n = 0;
     int32_t n_scans = 0;
@@ -199,11 +203,13 @@ static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, 
         if (age > 0 && t_now - slot->t_us > max_age_us) {
             break;
         }
+        SF_ASSERT(slot->n >= 0 && slot->n <= SF_FINGERPRINT_SCAN_APS); /* so n stays < QUERY_APS */
         for (int32_t j = 0; j < slot->n; j++) {
             readings[n++] = (reading_t){slot->bssid[j], age, slot->rssi_dbm[j]};
         }
         n_scans++;
     }
+    /* cppcheck-suppress uninitvar ; qsort reads only the n readings written above (none when n = 0) */
     qsort(readings, (size_t)n, sizeof readings[0], reading_cmp);
     fp->n_query = 0;
     fp->audit.n_scans_averaged = n_scans;
@@ -234,6 +240,7 @@ static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, 
 /* Adds term to RP r's partial sum, registering r on first touch. */
 static void touch(sf_fingerprint_workspace_t *const ws, int32_t *const n_touched, const int32_t r, const double term)
 {
+    SF_ASSERT(r >= 0 && r < ws->map_n_rp);
     if (ws->n_common[r] == 0) {
         ws->touched[(*n_touched)++] = r;
         ws->acc[r] = 0.0;
@@ -249,6 +256,7 @@ typedef struct {
 
 static void insert_best(ranked_t *const best, int32_t *const n_best, const int32_t k, const double key, const int32_t rp)
 {
+    SF_ASSERT(k >= 1 && k <= SF_FINGERPRINT_K_MAX && *n_best >= 0 && *n_best <= k);
     int32_t pos = *n_best;
     while (pos > 0 && (key < best[pos - 1].key || (key == best[pos - 1].key && rp < best[pos - 1].rp))) {
         pos--;

@@ -63,8 +63,9 @@
  * candidates on its floor with their posterior (naive Bayes: the posterior's own spread, so a split
  * posterior reads as poor accuracy even when the k best agree). It feeds the fusion's α and gate.
  *
- * Memory. sf_fingerprint_t ≈ 24 kB (ring of 4 × 255 readings, the last query of up to 1020 APs, audit);
- * 16 kB of stack while the query is built.
+ * Memory. sizeof(sf_fingerprint_t) = 24 992 B on x86-64 and i686, at most 25 KiB (checked): the ring of
+ * 4 × 255 readings, the last query of up to 1020 APs, the audit; 16 320 B of stack (at most 16 KiB,
+ * checked in sf_fingerprint.c) while the query is built.
  * Workspace: caller-owned arrays of n_rp each, SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
  * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
  * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
@@ -99,6 +100,7 @@
 _Static_assert(SF_FINGERPRINT_RING_SCANS >= 3, "SmartLocator averages 3 scans");
 _Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used is int16");
 _Static_assert(SF_FINGERPRINT_K_MAX >= 3, "the papers use k = 3");
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 32, "the model above promises 32 bytes per RP");
 
 /* Why the last match gave no fix. */
 enum { sf_fp_ok = 0, sf_fp_too_few_aps = 1, sf_fp_no_candidate = 2 };
@@ -161,6 +163,7 @@ typedef struct {
     uint32_t scans, fixes, rejected_too_few_aps, rejected_no_candidate;
     uint32_t readings_bad, readings_weak, readings_truncated, readings_unknown, backwards;
 } sf_fingerprint_t;
+_Static_assert(sizeof(sf_fingerprint_t) <= 25 * 1024, "sf_fingerprint.h promises at most 25 KiB");
 
 /* Empty ring, zero counters. */
 void sf_fingerprint_init(sf_fingerprint_t *fp);

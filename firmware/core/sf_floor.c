@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 
 double sf_floor_pressure_to_height_m(const double pressure_pa)
@@ -24,6 +25,7 @@ static int32_t index_of(const sf_floor_t *const f, const int16_t floor)
 
 static double floor_height(const sf_floor_t *const f, const int16_t floor)
 {
+    SF_ASSERT(index_of(f, floor) >= 0 && index_of(f, floor) < f->n_floors);
     return f->height_m[index_of(f, floor)];
 }
 
@@ -125,6 +127,7 @@ static void control(sf_floor_t *const f, const sf_params_t *const p, const int64
 
 void sf_floor_update(sf_floor_t *const f, const sf_params_t *const p, const int64_t t_us, const double pressure_pa)
 {
+    SF_ASSERT(f != NULL && p != NULL);
     if (!isfinite(pressure_pa) || pressure_pa < SF_FLOOR_MIN_PA || pressure_pa > SF_FLOOR_MAX_PA) {
         f->bad++;
         return;

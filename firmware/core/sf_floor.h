@@ -35,7 +35,7 @@
  * [1, SF_FLOOR_CAPACITY], a height not finite or not strictly above the one below, or a table that
  * would leave int16 floor numbers). Everything else cannot fail.
  * Cost: one pow() and two exp() per sample, O(n_floors) for the nearest floor. Memory:
- * sizeof(sf_floor_t) ≈ 0.6 kB. No heap, no I/O, no clock. */
+ * sizeof(sf_floor_t) = 592 B on x86-64 and i686 (at most 640 B, checked). No heap, no I/O, no clock. */
 #ifndef SF_FLOOR_H
 #define SF_FLOOR_H
 
@@ -71,6 +71,7 @@ typedef struct {
     /* counters, never decrease */
     uint32_t changes, rereferences, gaps, backwards, bad;
 } sf_floor_t;
+_Static_assert(sizeof(sf_floor_t) <= 640, "sf_floor.h promises at most 640 B");
 
 /* Default uniform table from floor_height_m around init_floor; current floor = init_floor. */
 void sf_floor_init(sf_floor_t *f, const sf_params_t *p);

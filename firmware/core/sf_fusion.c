@@ -5,10 +5,10 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "sf_error.h"
 
-_Static_assert(sf_scheme_count == 6, "sf_fusion handles exactly the six schemes of sf_types.h");
 _Static_assert(sf_fix_reason_count == 9, "reasons mirror fix_t.REASON_*");
 
 static double clamp(const double v, const double lo, const double hi)
@@ -26,19 +26,90 @@ static int16_t to_floor(const int32_t v)
     return (int16_t)(v < INT16_MIN ? INT16_MIN : (v > INT16_MAX ? INT16_MAX : v));
 }
 
+/* ---- the scheme registry: one row per pose_t.SCHEME_* ------------------------------------------- */
+
+/* How a scheme uses steps and fixes (sf_fusion.h): dead reckoning only (fixes initialise, then are
+ * ignored), following the fixes (no prediction, no gate), or predicting and blending gated fixes with
+ * the row's gain law. */
+typedef enum { mode_dead_reckoning = 1, mode_follow_fixes, mode_blend } scheme_mode_t;
+
+typedef double (*alpha_law_t)(const sf_fusion_t *f, const sf_params_t *p, const sf_fix_t *fix, double r_m2,
+                              sf_fix_audit_t *audit);
+
+typedef struct {
+    scheme_mode_t mode;
+    alpha_law_t alpha;    /* mode_blend: α of an accepted fix */
+    bool kalman_variance; /* var ← (1 − α)·var instead of the Joseph form */
+} scheme_row_t;
+
+static double alpha_one(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                        const double r_m2, sf_fix_audit_t *const audit)
+{
+    (void)f, (void)p, (void)fix, (void)r_m2, (void)audit;
+    return 1.0;
+}
+
+static double alpha_static(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const double r_m2, sf_fix_audit_t *const audit)
+{
+    (void)f, (void)fix, (void)r_m2, (void)audit;
+    return p->fusion_static_alpha;
+}
+
+/* Records the adaptive terms in the audit (FIX.accuracy_factor, FIX.drift). */
+static double alpha_adaptive(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                             const double r_m2, sf_fix_audit_t *const audit)
+{
+    (void)r_m2;
+    const double dt_s = us_to_s(fix->t_us - f->last_fix_t_us);
+    audit->accuracy_factor = sf_fusion_accuracy_factor(p, fix);
+    audit->drift = sf_fusion_drift(p, dt_s);
+    return clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
+}
+
+static double alpha_kalman(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const double r_m2, sf_fix_audit_t *const audit)
+{
+    (void)p, (void)fix, (void)audit;
+    return f->var_m2 / (f->var_m2 + r_m2);
+}
+
+/* Adding a scheme: its SCHEME_* constant in pose_t.lcm (which makes sf_scheme_<name>) and one row. */
+static const scheme_row_t scheme_rows[] = {
+    [sf_scheme_pdr_only] = {mode_dead_reckoning, NULL, false},
+    [sf_scheme_wifi_only] = {mode_follow_fixes, NULL, false},
+    [sf_scheme_overwrite] = {mode_blend, alpha_one, false},
+    [sf_scheme_static] = {mode_blend, alpha_static, false},
+    [sf_scheme_adaptive] = {mode_blend, alpha_adaptive, false},
+    [sf_scheme_kalman] = {mode_blend, alpha_kalman, true},
+};
+_Static_assert(sizeof scheme_rows / sizeof scheme_rows[0] == sf_scheme_count,
+               "one scheme_rows entry per pose_t.SCHEME_* (sf_schemes.h)");
+
+static const char *const scheme_names[] = {
+#define SF_SCHEME_NAME(name, id) [id] = #name,
+    SF_SCHEMES(SF_SCHEME_NAME)
+#undef SF_SCHEME_NAME
+};
+
+static const scheme_row_t *row_of(const sf_fusion_t *const f)
+{
+    return &scheme_rows[f->scheme];
+}
+
 static bool blends(const sf_fusion_t *const f)
 {
-    return f->scheme != sf_scheme_pdr_only && f->scheme != sf_scheme_wifi_only;
+    return row_of(f)->mode == mode_blend;
 }
 
 static bool predicts(const sf_fusion_t *const f)
 {
-    return f->scheme != sf_scheme_wifi_only;
+    return row_of(f)->mode != mode_follow_fixes;
 }
 
 static int16_t scheme_floor(const sf_fusion_t *const f, const int16_t baro_floor)
 {
-    if (f->scheme == sf_scheme_wifi_only) {
+    if (row_of(f)->mode == mode_follow_fixes) {
         return to_floor(f->floor_offset);
     }
     return to_floor((int32_t)baro_floor + f->floor_offset);
@@ -74,24 +145,11 @@ static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const i
     f->t_us = t_us;
 }
 
-/* The scheme's blend weight for an accepted fix; records the adaptive terms. */
+/* The scheme's blend weight for an accepted fix (its row's gain law). */
 static double scheme_alpha(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                            const double r_m2, sf_fix_audit_t *const audit)
 {
-    switch (f->scheme) {
-    case sf_scheme_static:
-        return p->fusion_static_alpha;
-    case sf_scheme_adaptive: {
-        const double dt_s = us_to_s(fix->t_us - f->last_fix_t_us);
-        audit->accuracy_factor = sf_fusion_accuracy_factor(p, fix);
-        audit->drift = sf_fusion_drift(p, dt_s);
-        return clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
-    }
-    case sf_scheme_kalman:
-        return f->var_m2 / (f->var_m2 + r_m2);
-    default: /* overwrite (pdr_only and wifi_only never blend) */
-        return 1.0;
-    }
+    return row_of(f)->alpha(f, p, fix, r_m2, audit);
 }
 
 /* position ← position + α·ν; variance of the blend (Kalman form for kalman, Joseph form otherwise). */
@@ -101,7 +159,8 @@ static void blend(sf_fusion_t *const f, const sf_params_t *const p, const double
     f->x_m += alpha * nu_x;
     f->y_m += alpha * nu_y;
     const double keep = 1.0 - alpha;
-    const double var = f->scheme == sf_scheme_kalman ? keep * f->var_m2 : keep * keep * f->var_m2 + alpha * alpha * r_m2;
+    const double var =
+        row_of(f)->kalman_variance ? keep * f->var_m2 : keep * keep * f->var_m2 + alpha * alpha * r_m2;
     f->var_m2 = fmax(var, p->fusion_var_min_m2);
 }
 
@@ -113,7 +172,7 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     f->x_m = fix->x_m;
     f->y_m = fix->y_m;
     f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
-    f->floor_offset = f->scheme == sf_scheme_wifi_only ? (int32_t)fix->floor : (int32_t)fix->floor - baro_floor;
+    f->floor_offset = predicts(f) ? (int32_t)fix->floor - baro_floor : (int32_t)fix->floor;
 }
 
 /* ---- control: which fixes to fuse ---------------------------------------------------------------- */
@@ -122,10 +181,10 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
 static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                     const double test_ratio, const int16_t baro_floor)
 {
-    if (f->scheme == sf_scheme_pdr_only) {
+    if (row_of(f)->mode == mode_dead_reckoning) {
         return sf_fix_reason_scheme_ignores;
     }
-    if (f->scheme == sf_scheme_wifi_only) {
+    if (row_of(f)->mode == mode_follow_fixes) {
         return sf_fix_reason_accepted; /* no gate: the scheme is the fixes */
     }
     const bool floor_ok = fix->floor == scheme_floor(f, baro_floor);
@@ -184,7 +243,7 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
     f->x_m = x_m;
     f->y_m = y_m;
     f->var_m2 = fmax(sigma_m * sigma_m, p->fusion_var_min_m2);
-    f->floor_offset = f->scheme == sf_scheme_wifi_only ? (int32_t)floor : (int32_t)floor - baro_floor;
+    f->floor_offset = predicts(f) ? (int32_t)floor - baro_floor : (int32_t)floor;
     f->t_us = t_us;
     f->last_fix_t_us = t_us;
     f->rejections = 0;
@@ -363,4 +422,25 @@ const char *sf_fix_reason_text(const int reason)
         [sf_fix_reason_scheme_ignores] = "ignored: the scheme does not use fixes",
     };
     return reason >= 0 && reason < sf_fix_reason_count ? text[reason] : "unknown reason";
+}
+
+const char *sf_fusion_scheme_name(const int scheme)
+{
+    return scheme >= 0 && scheme < sf_scheme_count ? scheme_names[scheme] : NULL;
+}
+
+int sf_fusion_scheme_from_name(const char *const name)
+{
+    for (int s = 0; name != NULL && s < sf_scheme_count; s++) {
+        if (strcmp(name, scheme_names[s]) == 0) {
+            return s;
+        }
+    }
+    return SF_EINVAL;
+}
+
+bool sf_fusion_scheme_is_registered(const int scheme)
+{
+    return scheme >= 0 && scheme < sf_scheme_count && scheme_rows[scheme].mode != 0 &&
+           (scheme_rows[scheme].mode != mode_blend || scheme_rows[scheme].alpha != NULL);
 }

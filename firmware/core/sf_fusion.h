@@ -1,9 +1,13 @@
-/* sf_fusion.h — PDR + absolute-fix fusion: six schemes run side by side on the same inputs.
+/* sf_fusion.h — PDR + absolute-fix fusion: every scheme of pose_t.SCHEME_* (six today), side by side
+ * on the same inputs.
  *
  * Ownership. One sf_fusion_t is one scheme. The estimator owns an array
  *     sf_fusion_t fusion[sf_scheme_count];   sf_fusion_init(&fusion[s], (int8_t)s) for each s,
  * and feeds every scheme the same steps and fixes, so one log compares all of them (DESIGN.md,
  * evaluation protocol). A scheme never looks at another; there is no shared state.
+ * Scheme ids and names come from pose_t.SCHEME_* (generated sf_schemes.h); what each scheme does is
+ * one row of the registry in sf_fusion.c (mode: dead reckoning, follow the fixes, or blend with a gain
+ * law), so adding a scheme is the pose_t.lcm constant plus one row (and its law, if new).
  *
  * Frame and units: map frame x, y [m], floors as int16 indices, times int64 µs carried by the inputs
  * (no clock). Position uncertainty is isotropic: `var_m2` is the variance of each axis [m²], the fix's
@@ -77,9 +81,9 @@
  * Errors: sf_fusion_init returns SF_OK or SF_EINVAL (NULL, scheme outside [0, sf_scheme_count));
  * sf_fusion_init_at SF_OK or SF_EINVAL (non-finite x, y or sigma, negative sigma; state unchanged);
  * sf_fusion_fix SF_OK or SF_ERANGE (bad fix, see above). Everything else cannot fail.
- * Cost: O(1), a few tens of flops and one sqrt per call. Memory: sizeof(sf_fusion_t) = 104 B per
- * scheme on x86-64 (sf_fix_audit_t 120 B). No heap, no I/O, no clock, no hidden state: the same inputs
- * give bit-identical outputs. */
+ * Cost: O(1), a few tens of flops and one sqrt per call. Memory: sizeof(sf_fusion_t) = 104 B per scheme on
+ * x86-64, 92 B on i686 (sf_fix_audit_t 120 B, 104 B); at most 128 B and 160 B (checked). No heap, no I/O, no
+ * clock, no hidden state: the same inputs give bit-identical outputs. */
 #ifndef SF_FUSION_H
 #define SF_FUSION_H
 
@@ -128,6 +132,7 @@ typedef struct {
     double accuracy_factor;
     double drift;
 } sf_fix_audit_t;
+_Static_assert(sizeof(sf_fix_audit_t) <= 160, "sf_fusion.h promises at most 160 B");
 
 typedef struct {
     int8_t scheme; /* sf_scheme_* */
@@ -143,6 +148,7 @@ typedef struct {
     uint32_t steps, bad_steps, fixes, accepted, rejected_gate, rejected_floor, recoveries,
         initialisations, bad_fixes, backwards;
 } sf_fusion_t;
+_Static_assert(sizeof(sf_fusion_t) <= 128, "sf_fusion.h promises at most 128 B per scheme");
 
 /* An uninitialised scheme. SF_OK, or SF_EINVAL for NULL or an unknown scheme. */
 int sf_fusion_init(sf_fusion_t *f, int8_t scheme);
@@ -180,5 +186,12 @@ void sf_fusion_audit_refused(const sf_fusion_t *f, const sf_fix_t *fix, int8_t r
 
 /* Short English text for a reason (fix_t.reason_text); never NULL. */
 const char *sf_fix_reason_text(int reason);
+
+/* The scheme registry (one row per pose_t.SCHEME_*, ids and names from sf_schemes.h): the lower-case
+ * name of a scheme ("pdr_only", ...; NULL outside [0, sf_scheme_count)); the id of a name, or
+ * SF_EINVAL; and whether a scheme has a complete row (for tests: a scheme without one cannot run). */
+const char *sf_fusion_scheme_name(int scheme);
+int sf_fusion_scheme_from_name(const char *name);
+bool sf_fusion_scheme_is_registered(int scheme);
 
 #endif

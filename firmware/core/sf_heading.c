@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
+
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
 #define MAX_GAP_US 500000
@@ -31,6 +33,7 @@ void sf_heading_init(sf_heading_t *const h, const sf_params_t *const p)
 void sf_heading_update(sf_heading_t *const h, const sf_params_t *const p, const int64_t t_us,
                        const double accel_nav_mps2[3], const double device_yaw_rad)
 {
+    SF_ASSERT(h != NULL && p != NULL && accel_nav_mps2 != NULL);
     if (!isfinite(accel_nav_mps2[0]) || !isfinite(accel_nav_mps2[1]) || !isfinite(accel_nav_mps2[2]) ||
         !isfinite(device_yaw_rad)) {
         h->invalid++;

@@ -3,12 +3,13 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
+
 #define MIN_SAMPLES 20.0        /* W needed before a solve (header: "≥ 20 samples in memory") */
 #define LOCK_SPREAD_UT 1000.0   /* ridge along unobserved directions (header: "4W·(1000 µT)²") */
 #define JACOBI_SWEEPS 16        /* bound on the eigen-decomposition (3×3 converges in ~5) */
 #define PIVOT_REL 1e-12         /* pivot below this × the largest diagonal entry: singular */
 
-_Static_assert(sizeof(sf_magcal_t) <= 512, "sf_magcal.h promises sizeof(sf_magcal_t) < 512 bytes");
 
 static double dot3(const double a[3], const double b[3])
 {
@@ -249,6 +250,7 @@ static sf_magcal_solve_verdict_t solve(const sf_magcal_t *const cal, const sf_pa
 void sf_magcal_update(sf_magcal_t *const cal, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
+    SF_ASSERT(cal != NULL && p != NULL && field_ut != NULL);
     if (p->magcal_enable == 0) {
         return;
     }

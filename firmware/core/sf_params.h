@@ -11,6 +11,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "sf_schemes.h"
+
 /* Rows are grouped by concern, one macro per core module, so each module's parameters sit together.
  *        section   name                 type     default  min      max      unit     meaning */
 #define SF_PARAMS_INIT(X)                                                                              \
@@ -111,7 +113,7 @@
     X(floor,  max_gap_ms,          int32_t, 5000,    100,     600000,  "ms",    "baro gap beyond which the filters restart")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
-    X(output, scheme,              int32_t, -1,      -1,      5,       "",      "fusion scheme published in POSE and FIX: -1 = all six side by side, else pose_t.SCHEME_*") \
+    X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
 

@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
+
 #define PI 3.14159265358979323846
 
 /* Exact first-order low-pass gain for a step dt: k = 1 − exp(−dt/τ), τ = 1/(2π f_c). */
@@ -37,6 +39,7 @@ static void restart(sf_steps_t *const s, const int64_t t_us, const double a)
 
 static void push_event(sf_steps_t *const s, const sf_step_event_t *const ev)
 {
+    SF_ASSERT(s->queue_count >= 0 && s->queue_count <= SF_STEPS_QUEUE);
     if (s->queue_count == SF_STEPS_QUEUE) {
         s->dropped++;
         return;
@@ -168,6 +171,7 @@ static void grid_point(sf_steps_t *const s, const sf_params_t *const p, const in
 bool sf_steps_update(sf_steps_t *const s, const sf_params_t *const p, const int64_t t_us, const double accel_v_mps2,
                      sf_step_event_t *const ev)
 {
+    SF_ASSERT(s != NULL && p != NULL && ev != NULL);
     if (!isfinite(accel_v_mps2)) {
         s->bad++;
     } else if (!s->started) {

@@ -44,11 +44,14 @@
  *      steps_tp_max_interval_ms after the trough, rises at least steps_tp_min_rise_mps2 above it,
  *      and is at least steps_refractory_ms after the previous step. A step uses up its trough.
  *
- * Thresholds. steps_pt_threshold = 0.5 is y ≈ 0.22 m/s², i.e. a smoothed slope of ≈ 5.6 m/s³: about
- * a quarter of a slow (1.4 Hz) walk's heel strike; with 0.1 m/s² rms noise, extra steps appear below
- * ≈ 0.2 (20 Hz input) and slow-walk heel strikes are lost above ≈ 2 on the synthetic gait of
- * tests/c/test_steps.c. steps_tp_min_rise_mps2 = 1 m/s²
- * and steps_tp_max_interval_ms = 0.8 s are the thesis's values (person dependent, it says).
+ * Thresholds. steps_pt_threshold (0.15) is only the floor of the adaptive θ: z = 0.15 is y ≈ 0.072 m/s²,
+ * a smoothed slope of ≈ 1.8 m/s³, about a twelfth of a slow (1.4 Hz) walk's heel strike; above it the
+ * NPK terms (steps_pt_noise_factor 2, steps_pt_adaptive 0.1) keep sensor noise out. As a fixed
+ * threshold (steps_pt_adaptive = 0, steps_pt_noise_factor = 0; the default was 0.5, y ≈ 0.22 m/s²,
+ * ≈ 5.6 m/s³, before the threshold adapted), with 0.1 m/s² rms noise extra steps appeared below ≈ 0.2
+ * (20 Hz input) and slow-walk heel strikes were lost above ≈ 2 on the synthetic gait of
+ * tests/c/test_steps.c. steps_tp_min_rise_mps2 = 1 m/s² and steps_tp_max_interval_ms = 0.8 s are the
+ * thesis's values (person dependent, it says).
  * Tested at 20 Hz ±30 % jitter, 50 Hz ±30 %, 100 Hz and 200 Hz: the same counts. Below 25 Hz a heel
  * strike shorter than the sample spacing can fall between samples; counts held in the tests, timing
  * then wanders by up to 0.25 s.
@@ -65,8 +68,8 @@
  * step's time is kept, so the period rule above still applies).
  *
  * Cost: O(1) per grid point and per sample, a few dozen flops plus two exp() per sample; the grid loop
- * runs at most steps_max_gap_ms / 20 ms times in one call. Memory: sizeof(sf_steps_t) ≈ 2.4 kB (the
- * amax/amin ring is most of it).
+ * runs at most steps_max_gap_ms / 20 ms times in one call. Memory: sizeof(sf_steps_t) = 2 416 B on
+ * x86-64 (2 400 B on i686; at most 2.5 KiB, checked), the amax/amin ring most of it.
  * No heap, no I/O, no clock. Deterministic: the same inputs give bit-identical events. */
 #ifndef SF_STEPS_H
 #define SF_STEPS_H
@@ -132,6 +135,7 @@ typedef struct {
     uint32_t dropped;   /* events lost because the queue was full (should stay 0) */
     uint32_t bad;       /* non-finite a_v, ignored */
 } sf_steps_t;
+_Static_assert(sizeof(sf_steps_t) <= 2560, "sf_steps.h promises at most 2.5 KiB");
 
 /* Clears the state. */
 void sf_steps_init(sf_steps_t *s, const sf_params_t *p);

@@ -18,8 +18,9 @@
  * never leaves [k_min, k_max]. The caller chooses D: the straight distance between fixes is right only
  * for a straight walk; a path length from the map is better.
  *
- * Errors: sf_stride_calibrate returns SF_OK (K updated, possibly clamped) or SF_ERANGE (input outside
- * the documented range: skipped). Cost: O(1), one pow() per step. Memory: sizeof(sf_stride_t). */
+ * Errors: sf_stride_calibrate returns SF_OK (K updated, possibly clamped) or SF_ERANGE (input outside the
+ * documented range: skipped). Cost: O(1), one pow() per step. Memory: sizeof(sf_stride_t) = 24 B on x86-64
+ * (20 B on i686; at most 32 B, checked). */
 #ifndef SF_STRIDE_H
 #define SF_STRIDE_H
 
@@ -34,6 +35,7 @@ typedef struct {
     uint32_t clamped;      /* updates limited by k_max_change or [k_min, k_max] */
     uint32_t skipped;      /* calibrations refused (too short, bad numbers) */
 } sf_stride_t;
+_Static_assert(sizeof(sf_stride_t) <= 32, "sf_stride.h promises at most 32 B");
 
 /* K = stride_weinberg_k, clamped to [k_min, k_max]; counters 0. */
 void sf_stride_init(sf_stride_t *st, const sf_params_t *p);

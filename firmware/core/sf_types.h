@@ -9,6 +9,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_schemes.h"
+
 /* One accelerometer + gyroscope sample. */
 typedef struct {
     int64_t t_us;
@@ -26,15 +28,13 @@ enum {
     sf_activity_elevator = 5
 };
 
-/* Pose schemes, identical to pose_t.SCHEME_* in lcmtypes/stridefix/pose_t.lcm. */
+/* Pose schemes: sf_scheme_<name> = pose_t.SCHEME_<NAME>, generated from lcmtypes/stridefix/pose_t.lcm
+ * (sf_schemes.h), so the ids have one home. What each scheme does: sf_fusion.h. */
 enum {
-    sf_scheme_pdr_only = 0,
-    sf_scheme_wifi_only = 1,
-    sf_scheme_overwrite = 2,
-    sf_scheme_static = 3,
-    sf_scheme_adaptive = 4,
-    sf_scheme_kalman = 5,
-    sf_scheme_count = 6
+#define SF_SCHEME_ENUM(name, id) sf_scheme_##name = (id),
+    SF_SCHEMES(SF_SCHEME_ENUM)
+#undef SF_SCHEME_ENUM
+    sf_scheme_count = SF_SCHEME_COUNT
 };
 
 /* One Wi-Fi scan as the core sees it (views into the caller's arrays). */

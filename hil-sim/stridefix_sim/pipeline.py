@@ -25,10 +25,11 @@ from typing import TextIO
 import numpy as np
 
 from .board import IMU_PERIOD_MS, BoardOutput, emulate_board
+from .gait import make_person
 from .radio import Scan, simulate_scans
 from .scenario import Scenario
 from .sensors import IMU_RATE_HZ, SensorData, simulate_sensors
-from .walker import ACTIVITIES, Walk, make_person, simulate_walk
+from .walker import ACTIVITIES, Walk, simulate_walk
 from .world import World, load_world
 
 TRUTH_DECIMATION = 10  # 10 Hz truth from 100 Hz walker samples

@@ -17,11 +17,8 @@ Routes built here (from the world's geometry):
   partial lap of floor 0 (leg 2);
 * ``track``: the world's track (``World.track_m``, e.g. the aadr2015 foyer), one leg; its surveyed
   reference points (``World.reference_points_m``, on straight stretches) become ``Route.marks``;
-* ``survey``: the surveyor's walk over calibration points (``survey_route``): one leg from each point to
-  the next along the shortest path over the grid (moves between neighbouring points that cross no
-  wall), points in greedy nearest-next order (ties: the row-by-row serpentine order); a ``SurveyStop``
-  at every point (the walker stands there, turns through the orientations and scans: ``walker.py``);
-  between floors the surveyor walks into the elevator cab and rides (a ``LegBreak("elevator")``).
+* ``survey``: the surveyor's walk over calibration points (``survey_route.py``), a ``SurveyStop`` at
+  every point.
 """
 
 from __future__ import annotations
@@ -38,7 +35,8 @@ HEIGHT_GRID_M = 0.01  # height profile table resolution
 STAIRWELL_RADIUS_M = 0.6
 
 
-def _wrap(a: float) -> float:
+def wrap_angle(a: float) -> float:
+    """``a`` wrapped to (−π, π] [rad]."""
     return math.atan2(math.sin(a), math.cos(a))
 
 
@@ -66,7 +64,7 @@ class Polyline:
         tan_d = np.zeros(n)
         rad = np.zeros(n)
         for i in range(1, n - 1):
-            turn[i] = _wrap(ang[i] - ang[i - 1])
+            turn[i] = wrap_angle(ang[i] - ang[i - 1])
             if abs(turn[i]) < 1e-9:
                 turn[i] = 0.0
             elif abs(abs(turn[i]) - math.pi) < 1e-9:
@@ -353,153 +351,6 @@ def track_route(world: World, radius_m: float) -> Route:
     if any(b[0] <= a[0] for a, b in zip(marks, marks[1:])):
         raise ValueError("reference points must be listed in walking order")
     return Route(name="track", legs=[leg], breaks=[], radius_m=radius_m, marks=marks)
-
-
-def _segment_crosses(a, b, walls: np.ndarray) -> bool:
-    """Does the segment a-b cross or touch a wall segment?"""
-    if len(walls) == 0:
-        return False
-    x0, y0, x1, y1 = walls.T
-
-    def orient(ox, oy, px, py, qx, qy):
-        return (px - ox) * (qy - oy) - (py - oy) * (qx - ox)
-
-    d1 = orient(x0, y0, x1, y1, a[0], a[1])
-    d2 = orient(x0, y0, x1, y1, b[0], b[1])
-    d3 = orient(a[0], a[1], b[0], b[1], x0, y0)
-    d4 = orient(a[0], a[1], b[0], b[1], x1, y1)
-    return bool(np.any((d1 * d2 <= 0) & (d3 * d4 <= 0)))
-
-
-def _grid_paths(xy: np.ndarray, spacing_m: float, walls: np.ndarray):
-    """Shortest paths over the graph of neighbouring points (≤ 1.01 × spacing apart, no wall between)."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import shortest_path
-
-    n = len(xy)
-    d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
-    rows, cols, vals = [], [], []
-    for i in range(n):
-        for j in np.flatnonzero((d[i] > 1e-9) & (d[i] <= 1.01 * spacing_m)).tolist():
-            if j > i and not _segment_crosses(xy[i], xy[j], walls):
-                rows += [i, j]
-                cols += [j, i]
-                vals += [d[i, j], d[i, j]]
-    graph = csr_matrix((vals, (rows, cols)), shape=(n, n))
-    dist, pred = shortest_path(graph, directed=False, return_predecessors=True)
-    return dist, pred
-
-
-def _path_nodes(pred: np.ndarray, i: int, j: int) -> list[int]:
-    out = [j]
-    while out[-1] != i:
-        out.append(int(pred[i, out[-1]]))
-    return out[::-1]
-
-
-def _clean(points: list) -> list:
-    """Drop repeated waypoints and waypoints where the path would reverse (a U-turn is not a corner)."""
-    pts = []
-    for p in points:
-        if not pts or math.hypot(p[0] - pts[-1][0], p[1] - pts[-1][1]) > 1e-9:
-            pts.append((float(p[0]), float(p[1])))
-    changed = True
-    while changed and len(pts) > 2:
-        changed = False
-        for k in range(1, len(pts) - 1):
-            a = math.atan2(pts[k][1] - pts[k - 1][1], pts[k][0] - pts[k - 1][0])
-            b = math.atan2(pts[k + 1][1] - pts[k][1], pts[k + 1][0] - pts[k][0])
-            if abs(abs(_wrap(b - a)) - math.pi) < 1e-6:
-                del pts[k]
-                changed = True
-                break
-    return pts
-
-
-def survey_route(world: World, points: np.ndarray, spacing_m: float, radius_m: float) -> Route:
-    """The surveyor's walk over ``points`` (n, 3: x, y, floor), floor by floor (see the module docstring)."""
-    if len(points) < 2:
-        raise ValueError("a survey needs at least two calibration points")
-    floors = sorted({int(f) for f in points[:, 2]})
-    if len(floors) > 1 and world.elevator is None:
-        raise ValueError(f"world {world.name!r} has no elevator to survey several floors")
-    order: list[int] = []
-    legs: list[Leg] = []
-    breaks: list[LegBreak] = []
-    paths_per_floor = {}
-    entry = np.asarray(world.start_xy_m, float)
-    if world.elevator is not None:
-        el = world.elevator
-        x_door = float(world.loop_corners_m[0][0])  # the corridor centre line in front of the cab door
-        door, cab = (x_door, el.door_y_m), (el.x_m, el.door_y_m)
-    for fi, f in enumerate(floors):
-        idx = np.flatnonzero(points[:, 2] == f)
-        xy = points[idx, :2]
-        dist, pred = _grid_paths(xy, spacing_m, world.walls_m)
-        # serpentine rank: rows by y, x ascending on even rows, descending on odd rows
-        ys = np.unique(np.round(xy[:, 1], 6))
-        row = np.searchsorted(ys, np.round(xy[:, 1], 6))
-        rank = np.lexsort((np.where(row % 2 == 0, xy[:, 0], -xy[:, 0]), row))
-        rank_of = np.empty(len(xy), int)
-        rank_of[rank] = np.arange(len(xy))
-        ref = entry if fi == 0 else np.asarray(door)
-        cur = int(np.lexsort((rank_of, np.round(np.hypot(*(xy - ref).T), 6)))[0])
-        seq = [cur]
-        left = set(range(len(xy))) - {cur}
-        while left:
-            cand = sorted(left, key=lambda j: (round(float(dist[cur, j]), 6), rank_of[j]))
-            nxt = cand[0]
-            if not np.isfinite(dist[cur, nxt]):
-                raise ValueError(
-                    f"calibration points of floor {f} are not connected at {spacing_m} m spacing"
-                )
-            seq.append(nxt)
-            left.remove(nxt)
-            cur = nxt
-        paths_per_floor[f] = (idx, xy, pred, seq)
-    z = {f: f * world.storey_m for f in floors}
-    stop_of = {}
-    for f in floors:
-        idx, xy, pred, seq = paths_per_floor[f]
-        for j in seq:
-            stop_of[(f, j)] = SurveyStop(index=len(order), x_m=float(xy[j, 0]), y_m=float(xy[j, 1]), floor=f)
-            order.append(int(idx[j]))
-    pending_exit = None  # waypoints from the cab out to the corridor, after an elevator ride
-    for fi, f in enumerate(floors):
-        idx, xy, pred, seq = paths_per_floor[f]
-        if pending_exit is not None:
-            first = xy[seq[0]]
-            near = int(np.argmin(np.hypot(*(xy - np.asarray(door)).T)))
-            way = (
-                pending_exit + [tuple(xy[k]) for k in _path_nodes(pred, near, seq[0])]
-                if near != seq[0]
-                else pending_exit + [tuple(first)]
-            )
-            legs.append(Leg(path=Polyline(_clean(way), radius_m), z0_m=z[f]))
-            breaks.append(LegBreak("survey", stop=stop_of[(f, seq[0])]))
-        for a, b in zip(seq[:-1], seq[1:]):
-            way = [tuple(xy[k]) for k in _path_nodes(pred, a, b)]
-            legs.append(Leg(path=Polyline(_clean(way), radius_m), z0_m=z[f]))
-            breaks.append(LegBreak("survey", stop=stop_of[(f, b)]))
-        if fi + 1 < len(floors):
-            near = int(np.argmin(np.hypot(*(xy - np.asarray(door)).T)))
-            last = seq[-1]
-            way = [tuple(xy[k]) for k in _path_nodes(pred, last, near)] if near != last else [tuple(xy[last])]
-            legs.append(Leg(path=Polyline(_clean(way + [door, cab]), radius_m), z0_m=z[f]))
-            breaks.append(LegBreak("elevator", dz_m=z[floors[fi + 1]] - z[f]))
-            pending_exit = [cab, door]
-    end_stop = breaks[-1].stop
-    breaks = breaks[:-1]  # the last stop comes after the last leg
-    f0, (_, _, _, seq0) = floors[0], paths_per_floor[floors[0]]
-    return Route(
-        name="survey",
-        legs=legs,
-        breaks=breaks,
-        radius_m=radius_m,
-        start_stop=stop_of[(f0, seq0[0])],
-        end_stop=end_stop,
-        survey_points=points[order],
-    )
 
 
 def make_route(world: World, route: str, laps: float, radius_m: float) -> Route:

@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .walker import G_MPS2, Walk
+from .gait import G_MPS2
+from .walker import Walk
 from .world import World
 
 IMU_RATE_HZ = 100

@@ -1,10 +1,7 @@
 """Gait model: a person walking a route (``route.py``) at a pace, sampled at the IMU rate.
 
-Person (seeded by its own random stream, so the same seed is the same person whatever the pace):
-stride scale ~ N(1, 0.06) and cadence scale ~ N(1, 0.04) (clipped to ±12 % / ±8 %), Weinberg constant
-K = 0.5 × stride scale × (1 ± 3 %) within 0.45..0.55 (K, like the stride, grows with leg length, so
-people of one pace bounce alike). Pace (``walk.pace``): slow 1.5 Hz / 0.55 m, normal 1.8 Hz / 0.70 m, fast 2.1 Hz /
-0.85 m, times the person's scales. Around a staircase the person slows down (0.9 × cadence, 0.85 ×
+The person and the unit gait shape are in ``gait.py``; survey stops (turn and scan at calibration
+points) in ``survey_stops.py``. Around a staircase the person slows down (0.9 × cadence, 0.85 ×
 stride); on a flight each step climbs one stair: stride = the tread (0.28 m), cadence
 ``stairs.cadence_hz`` × the person's scale (1.5 Hz: 0.26 m/s vertical).
 
@@ -54,93 +51,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .route import Route, SurveyStop, make_route, survey_route
+from .gait import (
+    G_MPS2,
+    GAIT_DZ,
+    GAIT_F,
+    GAIT_U,
+    GAIT_U_PEAK,
+    GAIT_Z,
+    GAIT_Z_MEAN,
+    TURN_RATE_DPS,
+    Person,
+    make_person,
+)
+from .route import Route, make_route
+from .survey_route import survey_route
+from .survey_stops import plan_stop
 from .world import World, survey_points
 
-G_MPS2 = 9.80665
-PACES = {"slow": (1.5, 0.55), "normal": (1.8, 0.70), "fast": (2.1, 0.85)}  # cadence Hz, stride m
 ACTIVITIES = ("still", "walking", "stairs", "elevator")
 ACT_STILL, ACT_WALK, ACT_STAIRS, ACT_ELEVATOR = range(4)
 MODE_WALK, MODE_SLOW, MODE_STAIRS = 0, 1, 2
 STAIRS_PENDULUM_FACTOR = 1.0 / 7.0
 SLOW_CADENCE, SLOW_STRIDE = 0.9, 0.85  # around a staircase
 TAIL_M = 5.0  # the last metres of a bout absorb the distance correction
-TURN_RATE_DPS = 90.0  # mean turn rate in place
-SURVEY_TURN_LEAD_S = 0.2  # survey: standing before a turn in place starts
-SURVEY_TURN_MIN_S = 0.8  # survey: shortest turn in place
-SURVEY_AFTER_SCAN_S = 0.2  # survey: standing after the last scan's results before turning on
-
-
-def _gait_shape(n: int = 2048):
-    """Tables of the unit gait shape over one step (u in [0, 1], n + 1 points): F (a_z), Z' (v_z), Z (z)."""
-    u = np.arange(n) / n
-
-    def bump(mu, sig):
-        return sum(np.exp(-0.5 * ((u - mu + j) / sig) ** 2) for j in (-1, 0, 1))
-
-    # stance/swing (minimum at mid-stance u = 0) + heel-strike transient + a small push-off shoulder
-    f = -0.5 * np.cos(2 * math.pi * u) + 0.55 * bump(0.52, 0.035) + 0.08 * bump(0.40, 0.05)
-    f -= f.mean()
-    spec = np.fft.rfft(f)
-    w = 2 * math.pi * np.arange(len(spec))
-    zs = np.zeros_like(spec)
-    zs[1:] = -spec[1:] / w[1:] ** 2
-    z = np.fft.irfft(zs, n)
-    dz = np.fft.irfft(1j * w * zs, n)
-    i0 = int(np.argmax(z))  # start the step at mid-stance (highest point, v_z = 0)
-    f, z, dz = (np.roll(a, -i0) for a in (f, z, dz))
-    z = z - z[0]
-    p2p = f.max() - f.min()
-    f, z, dz = f / p2p, z / p2p, dz / p2p
-
-    def close(a):
-        return np.append(a, a[0])
-
-    return (
-        np.linspace(0.0, 1.0, n + 1),
-        close(f),
-        close(dz),
-        close(z),
-        float(np.argmax(f)) / n,
-        float(z.mean()),
-    )
-
-
-GAIT_U, GAIT_F, GAIT_DZ, GAIT_Z, GAIT_U_PEAK, GAIT_Z_MEAN = _gait_shape()
-
-
-@dataclass(frozen=True)
-class Person:
-    pace: str
-    cadence_hz: float  # walking cadence at this pace
-    stride_m: float  # walking step length at this pace
-    weinberg_k: float
-    stride_scale: float
-    cadence_scale: float
-
-    def as_dict(self) -> dict:
-        return {k: (round(v, 6) if isinstance(v, float) else v) for k, v in self.__dict__.items()}
-
-
-def make_person(sc: dict, rng: np.random.Generator) -> Person:
-    """The walker's body: drawn from ``rng`` (always the same three draws), scenario values override."""
-    p, w = sc["person"], sc["walk"]
-    n_stride, n_cadence, n_k = rng.standard_normal(3)  # always three draws: same seed, same person
-    stride_scale = p["stride_scale"] or float(np.clip(1.0 + 0.06 * n_stride, 0.88, 1.12))
-    cadence_scale = p["cadence_scale"] or float(np.clip(1.0 + 0.04 * n_cadence, 0.92, 1.08))
-    # Weinberg's K grows with leg length, as the stride does: 0.5 x stride scale, ±3 %, within 0.45..0.55
-    k = p["weinberg_k"] or float(np.clip(0.5 * stride_scale * math.exp(0.03 * n_k), 0.45, 0.55))
-    c0, l0 = PACES[w["pace"]]
-    cadence = w["cadence_hz"] or c0 * cadence_scale
-    stride = w["speed_mps"] / cadence if w["speed_mps"] > 0 else (w["stride_m"] or l0 * stride_scale)
-    return Person(
-        pace=w["pace"],
-        cadence_hz=cadence,
-        stride_m=stride,
-        weinberg_k=k,
-        stride_scale=stride_scale,
-        cadence_scale=cadence_scale,
-    )
 
 
 @dataclass
@@ -271,7 +204,7 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     steps = {k: [] for k in ("t0", "T", "v", "mode", "bout", "Lplan", "first", "last")}
     switches, turns, rides, stops, scan_plan = [], [], [], [], []
     if route.start_stop is not None:
-        t = _plan_stop(sc, route.start_stop, None, hd_start[0], t, 0, turns, stops, scan_plan, t_arrive=0.0)
+        t = plan_stop(sc, route.start_stop, None, hd_start[0], t, 0, turns, stops, scan_plan, t_arrive=0.0)
     for b, (s0, s1) in enumerate(zip(bounds[:-1], bounds[1:])):
         d = s1 - s0
         if d > 0.3 * person.stride_m:
@@ -304,7 +237,7 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
                 continue
             i = arg
             if route.breaks[i].kind == "survey":
-                t = _plan_stop(
+                t = plan_stop(
                     sc, route.breaks[i].stop, hd_end[i], hd_start[i + 1], t, i, turns, stops, scan_plan
                 )
                 switches.append(t)
@@ -325,7 +258,7 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
                 t = t_free
             switches.append(t)
     if route.end_stop is not None:
-        t = _plan_stop(sc, route.end_stop, hd_end[-1], None, t, len(route.legs) - 1, turns, stops, scan_plan)
+        t = plan_stop(sc, route.end_stop, hd_end[-1], None, t, len(route.legs) - 1, turns, stops, scan_plan)
         stops[-1]["t_leave"] = math.inf
     cat = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in steps.items()}
     cat["mode"] = cat["mode"].astype(int)
@@ -367,78 +300,6 @@ def _fsum_exact(values) -> float:
     for v in values:
         out = v if out is None else out + v
     return 0.0 if out is None else out
-
-
-def _plan_stop(
-    sc: dict,
-    stop: SurveyStop,
-    arrive: float | None,
-    depart: float | None,
-    t: float,
-    leg: int,
-    turns: list,
-    stops: list,
-    scan_plan: list,
-    t_arrive: float | None = None,
-) -> float:
-    """A survey stop from time ``t`` (standing at the point, facing ``arrive``; None = the start): turn in
-    place to each of the ``survey.orientations`` headings k·360°/n (map frame; first the one nearest the
-    arrival heading, then round in the direction that ends nearest the next leg's heading), take
-    ``scans_per_orientation`` scans in each (``settle_s`` after the turn, then every ``scan_interval_s``),
-    finally turn to ``depart`` (None = the end). Appends turns (t0, duration, dpsi, leg), the stop and its
-    scans; returns the time the surveyor walks on."""
-    sv = sc["survey"]
-    n = int(sv["orientations"])
-    o = [2.0 * math.pi * k / n for k in range(n)]
-
-    def wrap(a):
-        a = math.atan2(math.sin(a), math.cos(a))
-        return math.pi if abs(abs(a) - math.pi) < 1e-9 else a
-
-    def nearest(h):
-        return min(range(n), key=lambda k: (round(abs(wrap(o[k] - h)), 9), k))
-
-    if arrive is None:
-        i0, step = (nearest(depart) + 1) % n, 1  # round CCW, ending at the departure heading
-    else:
-        i0 = nearest(arrive)
-        step = 1
-        if depart is not None and n > 2:
-            ccw, cw = o[(i0 - 1) % n], o[(i0 + 1) % n]
-            step = -1 if abs(wrap(depart - cw)) < abs(wrap(depart - ccw)) - 1e-9 else 1
-    seq = [o[(i0 + step * k) % n] for k in range(n)]
-    cur = seq[0] if arrive is None else arrive
-    t_arr = t if t_arrive is None else t_arrive
-
-    def turn(dpsi: float, t: float) -> float:
-        if abs(dpsi) < 1e-9:
-            return t
-        dur = max(SURVEY_TURN_MIN_S, math.degrees(abs(dpsi)) / TURN_RATE_DPS)
-        turns.append((t + SURVEY_TURN_LEAD_S, dur, dpsi, leg))
-        return t + SURVEY_TURN_LEAD_S + dur
-
-    scan_s = sc["radio"]["scan_duration_ms"] / 1000.0
-    for h in seq:
-        t = turn(wrap(h - cur), t)
-        cur = h
-        for k in range(int(sv["scans_per_orientation"])):
-            t_ms = int(math.ceil((t + sv["settle_s"] + k * sv["scan_interval_s"]) * 1000.0 - 1e-6))
-            scan_plan.append((t_ms, stop.index, round(math.degrees(h) % 360.0, 6), k))
-        t = t_ms / 1000.0 + scan_s + SURVEY_AFTER_SCAN_S
-    if depart is not None:
-        t = turn(wrap(depart - cur), t)
-    stops.append(
-        {
-            "index": stop.index,
-            "x_m": stop.x_m,
-            "y_m": stop.y_m,
-            "floor": stop.floor,
-            "t_arrive": t_arr,
-            "t_leave": t,
-            "orientations_deg": [round(math.degrees(h) % 360.0, 6) for h in seq],
-        }
-    )
-    return t
 
 
 def simulate_walk(

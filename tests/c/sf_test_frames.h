@@ -13,7 +13,8 @@
 
 #include <math.h>
 
-/* The raw value of signal sig of message msg nearest to the physical value v. */
+/* The raw value of signal sig of message msg nearest to the physical value v (a long long: callers
+ * cast it to the signal's field type, explicitly, for -Wconversion). */
 #define TF_RAW(msg, sig, v)                                                                                 \
     llround(((v) - board_##msg##_##sig##_decode(0)) /                                                      \
             (board_##msg##_##sig##_decode(1) - board_##msg##_##sig##_decode(0)))
@@ -40,9 +41,9 @@ static inline sf_can_frame_t tf_accel(const uint8_t seq, const uint8_t t_lo_ms, 
                                       const double z)
 {
     sf_can_frame_t f = tf_frame(BOARD_IMU_ACCEL_FRAME_ID);
-    const struct board_imu_accel_t m = {.accel_x = TF_RAW(imu_accel, accel_x, x),
-                                        .accel_y = TF_RAW(imu_accel, accel_y, y),
-                                        .accel_z = TF_RAW(imu_accel, accel_z, z),
+    const struct board_imu_accel_t m = {.accel_x = (int16_t)TF_RAW(imu_accel, accel_x, x),
+                                        .accel_y = (int16_t)TF_RAW(imu_accel, accel_y, y),
+                                        .accel_z = (int16_t)TF_RAW(imu_accel, accel_z, z),
                                         .seq = seq,
                                         .t_lo_ms = t_lo_ms};
     (void)board_imu_accel_pack(f.data, &m, sizeof f.data);
@@ -53,9 +54,9 @@ static inline sf_can_frame_t tf_gyro(const uint8_t seq, const uint8_t t_lo_ms, c
                                      const double y_dps, const double z_dps)
 {
     sf_can_frame_t f = tf_frame(BOARD_IMU_GYRO_FRAME_ID);
-    const struct board_imu_gyro_t m = {.gyro_x = TF_RAW(imu_gyro, gyro_x, x_dps),
-                                       .gyro_y = TF_RAW(imu_gyro, gyro_y, y_dps),
-                                       .gyro_z = TF_RAW(imu_gyro, gyro_z, z_dps),
+    const struct board_imu_gyro_t m = {.gyro_x = (int16_t)TF_RAW(imu_gyro, gyro_x, x_dps),
+                                       .gyro_y = (int16_t)TF_RAW(imu_gyro, gyro_y, y_dps),
+                                       .gyro_z = (int16_t)TF_RAW(imu_gyro, gyro_z, z_dps),
                                        .seq = seq,
                                        .t_lo_ms = t_lo_ms};
     (void)board_imu_gyro_pack(f.data, &m, sizeof f.data);
@@ -66,9 +67,9 @@ static inline sf_can_frame_t tf_mag(const uint8_t seq, const uint8_t t_lo_ms, co
                                     const double z)
 {
     sf_can_frame_t f = tf_frame(BOARD_MAG_FRAME_ID);
-    const struct board_mag_t m = {.mag_x = TF_RAW(mag, mag_x, x),
-                                  .mag_y = TF_RAW(mag, mag_y, y),
-                                  .mag_z = TF_RAW(mag, mag_z, z),
+    const struct board_mag_t m = {.mag_x = (int16_t)TF_RAW(mag, mag_x, x),
+                                  .mag_y = (int16_t)TF_RAW(mag, mag_y, y),
+                                  .mag_z = (int16_t)TF_RAW(mag, mag_z, z),
                                   .seq = seq,
                                   .t_lo_ms = t_lo_ms};
     (void)board_mag_pack(f.data, &m, sizeof f.data);
@@ -103,8 +104,8 @@ static inline sf_can_frame_t tf_gnss_info(const uint32_t time_ms, const double a
 {
     sf_can_frame_t f = tf_frame(BOARD_GNSS_INFO_FRAME_ID);
     const struct board_gnss_info_t m = {.time_ms = time_ms,
-                                        .altitude = TF_RAW(gnss_info, altitude, alt_m),
-                                        .accuracy = TF_RAW(gnss_info, accuracy, accuracy_m)};
+                                        .altitude = (int32_t)TF_RAW(gnss_info, altitude, alt_m),
+                                        .accuracy = (uint16_t)TF_RAW(gnss_info, accuracy, accuracy_m)};
     (void)board_gnss_info_pack(f.data, &m, sizeof f.data);
     return f;
 }
@@ -112,8 +113,8 @@ static inline sf_can_frame_t tf_gnss_info(const uint32_t time_ms, const double a
 static inline sf_can_frame_t tf_gnss_position(const double lat_deg, const double lon_deg)
 {
     sf_can_frame_t f = tf_frame(BOARD_GNSS_POSITION_FRAME_ID);
-    const struct board_gnss_position_t m = {.latitude = TF_RAW(gnss_position, latitude, lat_deg),
-                                            .longitude = TF_RAW(gnss_position, longitude, lon_deg)};
+    const struct board_gnss_position_t m = {.latitude = (int32_t)TF_RAW(gnss_position, latitude, lat_deg),
+                                            .longitude = (int32_t)TF_RAW(gnss_position, longitude, lon_deg)};
     (void)board_gnss_position_pack(f.data, &m, sizeof f.data);
     return f;
 }

@@ -155,7 +155,7 @@ static void test_format_parse_round_trip(void **state)
         f.remote = (i % 7) == 0;
         f.id = f.extended ? (uint32_t)rand() & 0x1FFFFFFFu : (uint32_t)rand() & 0x7FFu;
         f.host_t_us = (int64_t)rand() * 1000 + i;
-        f.dlc = f.remote ? 0 : (uint8_t)(i % 9);
+        f.dlc = (uint8_t)(f.remote ? 0 : i % 9);
         for (int k = 0; k < f.dlc; k++) {
             f.data[k] = (uint8_t)rand();
         }

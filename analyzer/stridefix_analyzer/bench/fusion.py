@@ -21,53 +21,57 @@ from __future__ import annotations
 import json
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer.bench.sil_pdr import _run, _stridefix
+from stridefix_analyzer.bench.sil_pdr import BenchError
+from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.schemes import NAMES, scheme_name
 from stridefix_analyzer.scoring.analyze import run_analyze
-from stridefix_analyzer.scoring.metrics import SCHEME_NAMES
+from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
-SCHEME_ORDER = ["wifi_only", "overwrite", "static", "adaptive", "kalman", "pdr_only"]
+# table order: the schemes in id order, the PDR-only baseline last
+SCHEME_ORDER = [n for n in NAMES if n != "pdr_only"] + ["pdr_only"]
 SURVEY_SEED = 1000  # the survey is its own recording, never one of the scored walks
 
 
 def simulate_and_log(
-    scenario: str, seed: int, stridefixd: Path, out: Path, site: Path | None, sets: list[str] = ()
-) -> dict:
+    scenario: str, seed: int, firmware: Firmware, out: Path, site: Path | None, sets: Sequence[str] = ()
+) -> dict[str, Any]:
     """sim → candump → stridefixd (with the site, if any) → out/stridefixd.lcmlog; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
-    _run(
-        [_stridefix(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)],
+    run_stage(
+        [stridefix_exe(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)],
         f"sim {scenario} seed {seed}",
+        BenchError,
     )
-    summary = json.loads((out / "sim_summary.json").read_text())
-    cmd = [
-        str(stridefixd),
-        "--input",
-        str(out / "board.candump"),
-        "--log",
-        str(out / "stridefixd.lcmlog"),
-        "-q",
-    ]
-    if site is not None:
-        cmd += ["--site", str(site)]
-    else:  # a survey replay: only the WIFI scans matter; the start pose is irrelevant
-        cmd += ["--set", f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}"]
-    for kv in sets:
-        cmd += ["--set", kv]
-    _run(cmd, f"stridefixd {scenario} seed {seed}")
+    summary: dict[str, Any] = json.loads((out / "sim_summary.json").read_text())
+    # a survey replay (no site): only the WIFI scans matter; the start pose is irrelevant
+    survey_sets = (
+        [] if site is not None else [f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}"]
+    )
+    replay(
+        firmware,
+        f"stridefixd {scenario} seed {seed}",
+        BenchError,
+        input=out / "board.candump",
+        log=out / "stridefixd.lcmlog",
+        site=site,
+        sets=[*survey_sets, *sets],
+    )
     return summary
 
 
-def build_site(survey_scenario: str, stridefixd: Path, out: Path) -> Path:
+def build_site(survey_scenario: str, firmware: Firmware, out: Path) -> Path:
     """Survey → firmware log → radio map → site file."""
-    summary = simulate_and_log(survey_scenario, SURVEY_SEED, stridefixd, out, None)
+    summary = simulate_and_log(survey_scenario, SURVEY_SEED, firmware, out, None)
     site = out / "site.sfsite"
     cmd = [
-        _stridefix(),
+        stridefix_exe(),
         "radiomap",
         "build",
         str(out / "stridefixd.lcmlog"),
@@ -83,7 +87,7 @@ def build_site(survey_scenario: str, stridefixd: Path, out: Path) -> Path:
     ]
     if "floor_height_m" in summary:
         cmd += ["--floor-height-m", str(summary["floor_height_m"])]
-    _run(cmd, f"radiomap build {survey_scenario}")
+    run_stage(cmd, f"radiomap build {survey_scenario}", BenchError)
     return site
 
 
@@ -96,14 +100,14 @@ def score(out: Path, truth_source: str | None, label: str) -> dict[str, np.ndarr
         truth_source=truth_source,
     )
     series = np.load(out / "analysis.npz")
-    errors = {}
+    errors: dict[str, np.ndarray] = {}
     for code in series["scheme_codes"]:
         e = series[f"s{int(code)}_error_m"]
-        errors[SCHEME_NAMES[int(code)]] = e[np.isfinite(e)]
+        errors[scheme_name(int(code))] = e[np.isfinite(e)]
     return errors
 
 
-def pooled_table(pooled: dict[str, list[np.ndarray]]) -> dict[str, dict]:
+def pooled_table(pooled: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
     table = {}
     for name in SCHEME_ORDER:
         if name not in pooled:
@@ -119,7 +123,7 @@ def pooled_table(pooled: dict[str, list[np.ndarray]]) -> dict[str, dict]:
     return table
 
 
-def format_table(table: dict[str, dict], paper: bool) -> str:
+def format_table(table: dict[str, dict[str, Any]], paper: bool) -> str:
     head = f"{'scheme':<11}{'n':>6}{'mean m':>9}{'p75 m':>8}{'p95 m':>8}{'max m':>8}"
     if paper:
         head += f"{'paper mean':>12}{'paper p75':>11}"
@@ -135,10 +139,12 @@ def format_table(table: dict[str, dict], paper: bool) -> str:
     return "\n".join(lines)
 
 
-def run_aadr2015(seeds: list[int], paces: list[str], stridefixd: Path, out: Path, sets: list[str]) -> dict:
+def run_aadr2015(
+    seeds: list[int], paces: list[str], firmware: Firmware, out: Path, sets: Sequence[str]
+) -> dict[str, Any]:
     t0 = time.perf_counter()
     print("bench aadr2015: survey and radio map", file=sys.stderr, flush=True)
-    site = build_site("aadr2015_survey", stridefixd, out / "survey")
+    site = build_site("aadr2015_survey", firmware, out / "survey")
     pooled: dict[str, list[np.ndarray]] = {}
     runs = []
     n = len(seeds) * len(paces)
@@ -146,7 +152,7 @@ def run_aadr2015(seeds: list[int], paces: list[str], stridefixd: Path, out: Path
         scenario = "aadr2015" if pace == "normal" else f"aadr2015_{pace}"
         print(f"bench aadr2015: [{i + 1}/{n}] {scenario} seed {seed}", file=sys.stderr, flush=True)
         walk = out / f"{scenario}-s{seed}"
-        simulate_and_log(scenario, seed, stridefixd, walk, site, sets)
+        simulate_and_log(scenario, seed, firmware, walk, site, sets)
         errors = score(walk, "waypoint", f"{scenario} seed {seed}, error at the reference points")
         runs.append(
             {
@@ -181,22 +187,22 @@ def run_aadr2015(seeds: list[int], paces: list[str], stridefixd: Path, out: Path
     return doc
 
 
-def run_office(seeds: list[int], stridefixd: Path, out: Path, sets: list[str]) -> dict:
+def run_office(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[str]) -> dict[str, Any]:
     t0 = time.perf_counter()
     print("bench office-wifi: survey of both floors and radio map", file=sys.stderr, flush=True)
-    site = build_site("office_survey", stridefixd, out / "survey")
+    site = build_site("office_survey", firmware, out / "survey")
     pooled: dict[str, list[np.ndarray]] = {}
     runs = []
     for i, seed in enumerate(seeds):
         print(f"bench office-wifi: [{i + 1}/{len(seeds)}] default seed {seed}", file=sys.stderr, flush=True)
         walk = out / f"default-s{seed}"
-        simulate_and_log("default", seed, stridefixd, walk, site, sets)
+        simulate_and_log("default", seed, firmware, walk, site, sets)
         errors = score(walk, None, f"default seed {seed}, every scheme from its first fix")
         runs.append({"seed": seed, "mean_m": {k: float(np.mean(v)) for k, v in errors.items() if v.size}})
         for k, v in errors.items():
             pooled.setdefault(k, []).append(v)
     table = pooled_table(pooled)
-    k = table.get("kalman", {})
+    kalman = table.get("kalman", {})
     doc = {
         "bench": "office_wifi",
         "seeds": seeds,
@@ -205,8 +211,46 @@ def run_office(seeds: list[int], stridefixd: Path, out: Path, sets: list[str]) -
         "table": table,
         "runs": runs,
         "targets": {"kalman_mean_m_max": 2.0, "kalman_p95_m_max": 4.5},
-        "targets_met": {"kalman_mean": k.get("mean_m", 1e9) <= 2.0, "kalman_p95": k.get("p95_m", 1e9) <= 4.5},
+        "targets_met": {
+            "kalman_mean": kalman.get("mean_m", 1e9) <= 2.0,
+            "kalman_p95": kalman.get("p95_m", 1e9) <= 4.5,
+        },
         "run_s": time.perf_counter() - t0,
     }
     (out / "office_wifi.json").write_text(json.dumps(doc, indent=2) + "\n")
     return doc
+
+
+def _num(value: float | None, unit: str) -> str:
+    return "n/a" if value is None else f"{value:.2f} {unit}"
+
+
+def missed_targets_aadr2015(doc: dict[str, Any]) -> list[str]:
+    """One line per target missed in an ``aadr2015.json`` document (empty when all are met)."""
+    met, targets, table = doc["targets_met"], doc["targets"], doc["table"]
+    mean = {k: table.get(k, {}).get("mean_m") for k in ("adaptive", "kalman")}
+    lines = []
+    if not met["adaptive_reduction"]:
+        lines.append(
+            f"aadr2015: adaptive's mean error reduction vs wifi_only = {_num(doc['adaptive_reduction_pct'], '%')} "
+            f"(target >= {targets['adaptive_reduction_pct_min']} %)"
+        )
+    if not met["kalman_vs_adaptive"]:
+        lines.append(
+            f"aadr2015: kalman mean error = {_num(mean['kalman'], 'm')} "
+            f"(target <= adaptive's {_num(mean['adaptive'], 'm')})"
+        )
+    return lines
+
+
+def missed_targets_office(doc: dict[str, Any]) -> list[str]:
+    """One line per target missed in an ``office_wifi.json`` document (empty when all are met)."""
+    kalman, targets = doc["table"].get("kalman", {}), doc["targets"]
+    lines = []
+    for key, field, figure, target in (
+        ("kalman_mean", "mean_m", "kalman mean error", targets["kalman_mean_m_max"]),
+        ("kalman_p95", "p95_m", "kalman p95 error", targets["kalman_p95_m_max"]),
+    ):
+        if not doc["targets_met"][key]:
+            lines.append(f"office-wifi: {figure} = {_num(kalman.get(field), 'm')} (target <= {target} m)")
+    return lines

@@ -23,21 +23,25 @@ from __future__ import annotations
 import concurrent.futures
 import json
 import os
-import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.crowd.fit import fit_walks, format_model
+from stridefix_analyzer.crowd.positions import solve_walks
+from stridefix_analyzer.crowd.sites import build_crowd_sites
+from stridefix_analyzer.crowd.solve import error_stats
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
+from stridefix_analyzer.firmware import Firmware, default_path
+from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
-REPO = Path(__file__).resolve().parents[2]
-DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
 DEFAULT_OUT = os.path.join("out", "crowd", "experiment")
 
 # (key, label, thesis mean, thesis std, solve options)
-ROWS = [
+ROWS: list[tuple[str, str, float | None, float | None, dict[str, Any]]] = [
     (
         "pdr",
         "PDR only, no weights/filtering",
@@ -74,18 +78,6 @@ ROWS = [
 ]
 
 
-def _run(cmd: list[str], what: str) -> None:
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise CrowdInputError(
-            f"{what} failed (exit {proc.returncode}): {' '.join(cmd)}\n{proc.stderr[-1500:]}"
-        )
-
-
-def _stridefix() -> str:
-    return str(Path(sys.executable).with_name("stridefix"))
-
-
 def stride_scale(walks) -> float:
     """Σ truth chord / Σ DR chord over consecutive truth points of ``walks`` (module docstring)."""
     num = den = 0.0
@@ -104,9 +96,6 @@ def run_table(
     walks, model, anchors: str, solver: str, band: str, scale: float, progress=print
 ) -> tuple[list[dict], dict]:
     """Every row of :data:`ROWS` on ``walks``; returns (rows, positions of each row)."""
-    from stridefix_analyzer.crowd.cli import solve_walks
-    from stridefix_analyzer.crowd.solve import error_stats
-
     out, positions = [], {}
     for key, label, tm, ts, opts in ROWS:
         opts = dict(opts)
@@ -184,27 +173,21 @@ def format_table(rows: list[dict]) -> str:
 # --- SIL ---------------------------------------------------------------------------------------------
 
 
-def _sil_walk(scenario: str, seed: int, stridefixd: Path, out: Path, duration_s: float | None) -> dict:
+def _sil_walk(scenario: str, seed: int, firmware: Firmware, out: Path, duration_s: float | None) -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    sim = [_stridefix(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)]
+    sim = [stridefix_exe(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)]
     if duration_s:
         sim += ["--duration-s", str(duration_s)]
-    _run(sim, f"sim {scenario} seed {seed}")
+    run_stage(sim, f"sim {scenario} seed {seed}", CrowdInputError, tail=1500)
     summary = json.loads((out / "sim_summary.json").read_text())
-    _run(
-        [
-            str(stridefixd),
-            "--input",
-            str(out / "board.candump"),
-            "--log",
-            str(out / "stridefixd.lcmlog"),
-            "-q",
-            "--config",
-            str(out / "init_truth.ini"),
-            "--set",
-            f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}",
-        ],
+    replay(
+        firmware,
         f"stridefixd seed {seed}",
+        CrowdInputError,
+        input=out / "board.candump",
+        log=out / "stridefixd.lcmlog",
+        sets=[f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}"],
+        extra=["--config", str(out / "init_truth.ini")],
     )
     return {
         "seed": seed,
@@ -214,25 +197,19 @@ def _sil_walk(scenario: str, seed: int, stridefixd: Path, out: Path, duration_s:
     }
 
 
-def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
+def _replay_score(walk: dict, site: Path, firmware: Firmware, out: Path) -> dict:
     from stridefix_analyzer.scoring.analyze import run_analyze
 
     out.mkdir(parents=True, exist_ok=True)
     log = out / "stridefixd.lcmlog"
-    _run(
-        [
-            str(stridefixd),
-            "--input",
-            str(walk["dir"] / "board.candump"),
-            "--log",
-            str(log),
-            "-q",
-            "--site",
-            str(site),
-            "--fusion",
-            "wifi_only",
-        ],
+    replay(
+        firmware,
         f"stridefixd --site {site}",
+        CrowdInputError,
+        input=walk["dir"] / "board.candump",
+        log=log,
+        site=site,
+        fusion="wifi_only",
     )
     summary, _ = run_analyze(
         [str(log), str(walk["dir"] / "truth.lcmlog")],
@@ -245,10 +222,8 @@ def _replay_score(walk: dict, site: Path, stridefixd: Path, out: Path) -> dict:
 
 
 def run_sil(args, progress) -> dict:
-    from stridefix_analyzer.crowd.cli import build_crowd_sites, fit_walks, format_model
-
     t0 = time.perf_counter()
-    stridefixd = Path(args.stridefixd)
+    firmware = Firmware(args.stridefixd)
     out = Path(args.out) / "sil"
     seeds = [int(s) for s in args.seeds.split(",") if s]
     fit_seeds = [int(s) for s in args.fit_seeds.split(",") if s]
@@ -261,7 +236,7 @@ def run_sil(args, progress) -> dict:
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futs = {
             (s, kind): pool.submit(
-                _sil_walk, args.scenario, s, stridefixd, out / f"{kind}-s{s}", args.duration_s
+                _sil_walk, args.scenario, s, firmware, out / f"{kind}-s{s}", args.duration_s
             )
             for s, kind in jobs
         }
@@ -289,7 +264,7 @@ def run_sil(args, progress) -> dict:
                 row[label] = _replay_score(
                     runs[(s, kind)],
                     Path(sites[label]["path"]),
-                    stridefixd,
+                    firmware,
                     out / "replay" / f"{kind}-s{s}-{label}",
                 )
             fixes.append(row)
@@ -320,7 +295,7 @@ def format_fixes(fixes: list[dict]) -> str:
 # --- msindoor ----------------------------------------------------------------------------------------
 
 
-def _ms_walk(trace: Path, cache: Path, stridefixd: Path) -> dict:
+def _ms_walk(trace: Path, cache: Path, firmware: Firmware) -> dict:
     import warnings
 
     from stridefix_analyzer import datasets
@@ -330,9 +305,7 @@ def _ms_walk(trace: Path, cache: Path, stridefixd: Path) -> dict:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             datasets.get("msindoor").import_walk(trace, log)
-        _run(
-            [str(stridefixd), "--input", f"lcmlog:{log}", "--log", str(fw), "-q"], f"stridefixd {trace.name}"
-        )
+        replay(firmware, f"stridefixd {trace.name}", CrowdInputError, input=f"lcmlog:{log}", log=fw)
     return {"trace": trace.name, "spec": f"{fw},{log}"}
 
 
@@ -351,10 +324,8 @@ def _usable(walks, min_truth: int = 3):
 
 
 def run_msindoor(args, progress) -> dict:
-    from stridefix_analyzer.crowd.cli import fit_walks, format_model
-
     t0 = time.perf_counter()
-    stridefixd = Path(args.stridefixd)
+    firmware = Firmware(args.stridefixd)
     docs = []
     for floor in _floors(Path(args.msindoor)):
         label = f"{floor.parent.name}/{floor.name}"
@@ -364,7 +335,7 @@ def run_msindoor(args, progress) -> dict:
         progress(f"crowd experiment --msindoor {label}: importing and replaying {len(traces)} traces")
         t1 = time.perf_counter()
         with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces), [stridefixd] * len(traces)))
+            prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces), [firmware] * len(traces)))
         prep_s = time.perf_counter() - t1
         all_walks = load_walks([p["spec"] for p in prepared])
         for w, p in zip(all_walks, prepared):
@@ -411,7 +382,7 @@ def add_arguments(p) -> None:
     )
     p.add_argument(
         "--stridefixd",
-        default=os.environ.get("STRIDEFIXD", str(DEFAULT_STRIDEFIXD)),
+        default=str(default_path()),
         help="firmware binary (default $STRIDEFIXD or build/firmware/stridefixd)",
     )
     p.add_argument("--scenario", default="pace_normal", help="SIL scenario (default pace_normal)")

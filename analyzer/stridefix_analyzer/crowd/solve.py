@@ -210,7 +210,8 @@ def build_problem(
         is_anchor[tp[::K]] = True
     a_idx = np.flatnonzero(is_anchor)
     # PDR pairs within each walk
-    pi, pj = [], []
+    pi_parts: list[np.ndarray] = []
+    pj_parts: list[np.ndarray] = []
     if ranges != "wifi":
         for k, w in enumerate(walks):
             if len(w.step_t_us) == 0:
@@ -222,9 +223,10 @@ def build_problem(
             m = len(ids)
             span = m - 1 if pdr_span <= 0 else min(pdr_span, m - 1)
             for s in range(1, span + 1):
-                pi.append(ids[:-s]), pj.append(ids[s:])
-    pi = np.concatenate(pi) if pi else np.zeros(0, np.int64)
-    pj = np.concatenate(pj) if pj else np.zeros(0, np.int64)
+                pi_parts.append(ids[:-s])
+                pj_parts.append(ids[s:])
+    pi = np.concatenate(pi_parts) if pi_parts else np.zeros(0, np.int64)
+    pj = np.concatenate(pj_parts) if pj_parts else np.zeros(0, np.int64)
     if pdr_metric == "chord":
         b_pdr = np.hypot(*(points.dr_xy_m[pj] - points.dr_xy_m[pi]).T)
     else:
@@ -233,6 +235,7 @@ def build_problem(
     wi = wj = np.zeros(0, np.int64)
     bw = np.zeros(0)
     if ranges != "pdr":
+        assert model is not None  # checked on entry: Wi-Fi ranges need a model
         use_tau = tau if ranges in ("wifi", "both") else None
         wi, wj, bw, thr, n_cand, n_nc = _wifi_pairs(points, scans, model, use_tau, collect=ranges != "hybrid")
         info.update(wifi_candidate_pairs=n_cand, wifi_pairs_no_common_ap=n_nc, wifi_threshold_m=thr)
@@ -256,8 +259,8 @@ def build_problem(
     j = np.concatenate([pj, wj]).astype(np.int64)
     b = np.concatenate([b_pdr, bw]).astype(float)
     kind = np.concatenate([np.zeros(len(pi), np.int8), np.ones(len(wi), np.int8)])
-    w = 1.0 / (weights[0] * b + weights[1]) if weights else np.ones(len(b))
-    if weights and np.any(~np.isfinite(w) | (w <= 0)):
+    weight = 1.0 / (weights[0] * b + weights[1]) if weights else np.ones(len(b))
+    if weights and np.any(~np.isfinite(weight) | (weight <= 0)):
         raise CrowdInputError(
             f"weights 1/(m·b + c) with m, c = {weights} are not positive for every range (need c > −m·min b)"
         )
@@ -271,7 +274,7 @@ def build_problem(
         pair_i=i,
         pair_j=j,
         range_m=b,
-        weight=w,
+        weight=weight,
         row_kind=kind,
         x0=x0,
         info=info,

@@ -34,6 +34,7 @@ import os
 import struct
 import tempfile
 import zlib
+from typing import Any
 
 from stridefix import site_t
 
@@ -80,7 +81,7 @@ def _finite(value: float) -> bool:
     return math.isfinite(value)
 
 
-def _check_len(site, count_name: str, *arrays: str) -> int:
+def _check_len(site: site_t, count_name: str, *arrays: str) -> int:
     n = getattr(site, count_name)
     if n < 0:
         raise SiteValidationError(f"{count_name} = {n} is negative")
@@ -88,7 +89,7 @@ def _check_len(site, count_name: str, *arrays: str) -> int:
         got = len(getattr(site, name))
         if got != n:
             raise SiteValidationError(f"{name} has {got} values but {count_name} = {n}")
-    return n
+    return int(n)
 
 
 def validate_site(site: site_t) -> None:
@@ -176,7 +177,7 @@ def validate_site(site: site_t) -> None:
 def encode_site_file(site: site_t) -> bytes:
     """Header + payload bytes of ``site`` (validated first; raises SiteValidationError)."""
     validate_site(site)
-    payload = site.encode()
+    payload: bytes = site.encode()
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise SiteValidationError(
             f"encoded site is {len(payload)} bytes, more than the {MAX_PAYLOAD_BYTES} a reader accepts"
@@ -184,7 +185,7 @@ def encode_site_file(site: site_t) -> bytes:
     return HEADER.pack(MAGIC, FORMAT_VERSION, len(payload), zlib.crc32(payload), 0) + payload
 
 
-def write_site(path: str | os.PathLike, site: site_t) -> int:
+def write_site(path: str | os.PathLike[str], site: site_t) -> int:
     """Validate ``site`` and write it to ``path`` atomically (temporary file + rename).
 
     Returns the file size [bytes]. Raises :class:`SiteFileError` (kind ``field``) when the site
@@ -280,7 +281,7 @@ def decode_site_file(data: bytes, path: str = "<site>") -> site_t:
     return site
 
 
-def read_site(path: str | os.PathLike) -> site_t:
+def read_site(path: str | os.PathLike[str]) -> site_t:
     """Read and fully check a site file (see the module docstring); return the ``site_t``.
 
     Raises
@@ -299,7 +300,7 @@ def read_site(path: str | os.PathLike) -> site_t:
     return decode_site_file(data, path)
 
 
-def new_site(**fields) -> site_t:
+def new_site(**fields: Any) -> site_t:
     """A ``site_t`` with empty tables and one floor at 0 m, then ``fields`` applied; counts are
     set from the array lengths (``n_floors`` from ``floor_height_m``, and so on)."""
     s = site_t()

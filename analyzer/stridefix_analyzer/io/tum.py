@@ -19,13 +19,16 @@ with 17 significant digits so reading them back gives the same float64 values.
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
-from stridefix_analyzer.scoring.metrics import Metrics
+if TYPE_CHECKING:  # only the annotation: io does not depend on scoring at run time
+    from stridefix_analyzer.scoring.metrics import Metrics
 
 
-def yaw_quaternion(yaw_rad) -> np.ndarray:
+def yaw_quaternion(yaw_rad: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """(n, 4) quaternions qx, qy, qz, qw of rotations by ``yaw_rad`` about +z; NaN yaw → identity."""
     yaw = np.asarray(yaw_rad, float).reshape(-1)
     yaw = np.where(np.isfinite(yaw), yaw, 0.0)
@@ -34,7 +37,7 @@ def yaw_quaternion(yaw_rad) -> np.ndarray:
     return q
 
 
-def format_tum(t_us, x_m, y_m, yaw_rad) -> str:
+def format_tum(t_us: npt.ArrayLike, x_m: npt.ArrayLike, y_m: npt.ArrayLike, yaw_rad: npt.ArrayLike) -> str:
     """TUM lines of the given samples (timestamp = t_us / 1e6 [s])."""
     q = yaw_quaternion(yaw_rad)
     lines = []
@@ -48,7 +51,7 @@ def format_tum(t_us, x_m, y_m, yaw_rad) -> str:
     return "\n".join(lines) + ("\n" if lines else "")
 
 
-def write_tum(metrics: Metrics, out_dir) -> dict[str, str]:
+def write_tum(metrics: Metrics, out_dir: str | os.PathLike[str]) -> dict[str, str]:
     """Write ``truth.tum`` and one ``<scheme>.tum`` per scheme of ``metrics``; returns name → path.
 
     Only scored samples are written (a truth sample before the scheme's first POSE has no match).
@@ -56,7 +59,7 @@ def write_tum(metrics: Metrics, out_dir) -> dict[str, str]:
     otherwise ``truth_<scheme>.tum`` is written per scheme (and ``truth.tum`` for the primary).
     """
     os.makedirs(out_dir, exist_ok=True)
-    paths = {}
+    paths: dict[str, str] = {}
     scored_sets = {code: s.match["scored"] for code, s in metrics.schemes.items()}
     same = len({m.tobytes() for m in scored_sets.values()}) <= 1
     for code, s in metrics.schemes.items():

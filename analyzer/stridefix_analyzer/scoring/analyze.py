@@ -20,6 +20,7 @@ import json
 import os
 import sys
 import warnings
+from typing import Any
 
 import numpy as np
 
@@ -97,7 +98,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> dict:
     """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
-    doc = {"label": label, "inputs": data.inputs}
+    doc: dict[str, Any] = {"label": label, "inputs": data.inputs}
     doc.update(metrics.summary())
     doc.update(
         messages=dict(sorted(data.messages.items())),
@@ -118,7 +119,8 @@ def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, s
     with open(json_path, "w", encoding="utf-8") as f:
         json.dump(summary, f, indent=2, allow_nan=False)
         f.write("\n")
-    np.savez_compressed(npz_path, **metrics.series())
+    series: dict[str, Any] = metrics.series()
+    np.savez_compressed(npz_path, **series)
     return json_path, npz_path
 
 

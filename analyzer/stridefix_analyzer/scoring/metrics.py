@@ -19,19 +19,11 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import stridefix
 
+from stridefix_analyzer import schemes as registry
 from stridefix_analyzer.io.logread import LogData, Table
+from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 
-#: pose_t.scheme code → name used in reports and JSON keys
-SCHEME_NAMES = {
-    stridefix.pose_t.SCHEME_PDR_ONLY: "pdr_only",
-    stridefix.pose_t.SCHEME_WIFI_ONLY: "wifi_only",
-    stridefix.pose_t.SCHEME_OVERWRITE: "overwrite",
-    stridefix.pose_t.SCHEME_STATIC: "static",
-    stridefix.pose_t.SCHEME_ADAPTIVE: "adaptive",
-    stridefix.pose_t.SCHEME_KALMAN: "kalman",
-}
 #: preference when several schemes have equally many POSE messages (first wins)
 _PRIMARY_PREFERENCE = ["adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
 
@@ -43,22 +35,20 @@ class MetricsInputError(ValueError):
     """The logs lack what scoring needs (no TRUTH, no POSE, unknown scheme); the message says what."""
 
 
-def scheme_name(code: int) -> str:
-    """Name of a pose_t.scheme code; unknown codes become ``scheme_<code>``."""
-    return SCHEME_NAMES.get(int(code), f"scheme_{int(code)}")
-
-
-def scheme_code(name: str) -> int:
-    """Inverse of :func:`scheme_name`; accepts a name (``adaptive``) or a number (``4``)."""
-    for code, known in SCHEME_NAMES.items():
-        if name.lower() == known:
-            return code
-    if name.lower().startswith("scheme_"):
-        name = name[len("scheme_") :]
+def scheme_code(name: str | int) -> int:
+    """The id of a scheme given by name (``adaptive``, any case), number (``4``) or ``scheme_<id>``
+    (the name :func:`~stridefix_analyzer.schemes.scheme_name` gives an id the LCM type does not
+    know: such an id is returned as it is, and scoring then reports it absent from the POSE stream).
+    Raises :class:`MetricsInputError` for anything else."""
+    text = str(name).lower()
+    text = text[len("scheme_") :] if text.startswith("scheme_") else text
     try:
-        return int(name)
-    except ValueError:
-        raise MetricsInputError(f"unknown scheme {name!r}; known: {list(SCHEME_NAMES.values())}") from None
+        return registry.scheme_code(text)
+    except UnknownSchemeError:
+        try:
+            return int(text)
+        except ValueError:
+            raise MetricsInputError(f"unknown scheme {name!r}; known: {list(registry.NAMES)}") from None
 
 
 # --- the causal match ----------------------------------------------------------------------------
@@ -150,7 +140,7 @@ def error_stats(error_m: np.ndarray) -> dict:
     """
     error_m = np.asarray(error_m, dtype=np.float64)
     finite = error_m[np.isfinite(error_m)]
-    stats = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
+    stats: dict[str, float] = {"n": int(finite.size), "nonfinite": int(error_m.size - finite.size)}
     if finite.size == 0:
         stats.update(dict.fromkeys(["mean", "median", "p75", "p90", "p95", "max", "rmse"], float("nan")))
         return stats
@@ -197,7 +187,7 @@ def step_metrics(pose: Table, truth: Table, n_step_messages: int) -> dict:
     """
     detected = int(pose["step_count"][-1]) if len(pose) else int(n_step_messages)
     known = truth["step_count"][truth["step_count"] >= 0] if len(truth) else np.array([])
-    out = {
+    out: dict[str, float | None] = {
         "detected": detected,
         "step_messages": int(n_step_messages),
         "truth": None,
@@ -382,13 +372,13 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     MetricsInputError
         No TRUTH or no POSE messages (both listed when both are missing), or ``scheme`` absent.
     """
-    missing = [ch for ch in ("TRUTH", "POSE") if data.table(ch) is None or not len(data.table(ch))]
-    if missing:
+    truth, pose = data.table("TRUTH"), data.table("POSE")
+    missing = [ch for ch, t in (("TRUTH", truth), ("POSE", pose)) if t is None or not len(t)]
+    if truth is None or pose is None or missing:
         raise MetricsInputError(
             f"no {' and no '.join(missing)} messages in "
             f"{', '.join(i['path'] for i in data.inputs) or 'the input'}"
         )
-    truth, pose = data.table("TRUTH"), data.table("POSE")
     if truth_source is not None:
         if truth_source not in TRUTH_SOURCES:
             raise MetricsInputError(f"unknown truth source {truth_source!r}; known: {list(TRUTH_SOURCES)}")

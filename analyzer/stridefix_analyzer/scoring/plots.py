@@ -8,6 +8,7 @@ Every function takes the arrays of ``analysis.npz`` (see
 from __future__ import annotations
 
 import io
+from typing import Any
 
 import matplotlib
 
@@ -15,9 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
-from stridefix_analyzer.scoring.metrics import scheme_name  # noqa: E402
+from stridefix_analyzer.schemes import scheme_colour, scheme_name  # noqa: E402
 
-_TRUTH_STYLE = dict(color="black", linewidth=2.0, label="truth")
+_TRUTH_STYLE: dict[str, Any] = dict(color="black", linewidth=2.0, label="truth")
 _PERCENTILE_LINES = ((50, "p50", ":"), (75, "p75", "--"), (95, "p95", "-."))
 
 
@@ -26,8 +27,8 @@ def _scheme_codes(series: dict) -> list[int]:
 
 
 def _colors(codes: list[int]) -> dict[int, str]:
-    cycle = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    return {c: cycle[i % len(cycle)] for i, c in enumerate(codes)}
+    """Each scheme's own colour (the same in every plot and report, whichever schemes a log holds)."""
+    return {c: scheme_colour(c) for c in codes}
 
 
 def _t0_us(series: dict) -> int:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from stridefix import pose_t
 from stridefix_analyzer import schemes
-from stridefix_analyzer.firmware import Firmware, FirmwareError, _parse_ini
+from stridefix_analyzer.firmware import Firmware, FirmwareError
 
 
 def test_schemes_come_from_the_lcm_constants():
@@ -21,16 +21,10 @@ def test_schemes_come_from_the_lcm_constants():
         schemes.scheme_code("nope")
 
 
-def test_ini_text_parses_into_params():
-    text = "[init]\n# start floor index [], range -20 .. 200\nfloor = 0\n# a flag\nflag = 1\n"
-    p = _parse_ini(text)
-    assert p["init.floor"].default == "0" and (p["init.floor"].min, p["init.floor"].max) == (-20.0, 200.0)
-    assert p["init.flag"].help == "a flag" and p["init.flag"].min is None
-
-
 def test_firmware_params_and_set_checks(stridefixd):
     fw = Firmware(stridefixd)
     assert "init.floor" in fw.params and "output.scheme" in fw.params
+    assert (fw.params["init.floor"].min, fw.params["init.floor"].max) == (-20, 200)
     assert fw.check_sets(["init.floor=1"]) == ["init.floor=1"]
     with pytest.raises(FirmwareError, match="unknown key"):
         fw.check_sets(["init.flor=1"])

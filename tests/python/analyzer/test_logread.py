@@ -170,3 +170,51 @@ def test_several_corrupt_regions_lose_no_whole_record(write_log, tmp_path, msg):
     assert_array_equal(d.table("POSE")["t_us"], np.arange(8))
     info = d.inputs[0]
     assert info["skipped_bytes"] == sum(map(len, junk[:-1])) and info["truncated_bytes"] == 20
+
+
+def _fix(t_us, scheme, accepted):
+    from stridefix import fix_t
+
+    m = fix_t()
+    m.t_us, m.method, m.scheme, m.x_m, m.y_m, m.floor = t_us, fix_t.METHOD_WIFI, scheme, 1.5, -2.0, 1
+    m.accuracy_m, m.n_ap_used, m.innovation_m = 3.0, 7, [0.25, -0.5]
+    m.innovation_var_m2, m.test_ratio, m.alpha, m.accepted = 4.0, 0.5, 0.75 if accepted else 0.0, accepted
+    m.reason = fix_t.REASON_ACCEPTED if accepted else fix_t.REASON_GATE
+    m.reason_text = "accepted" if accepted else "gate"
+    return m
+
+
+def test_fix_keeps_the_scheme_of_each_audit_record(write_log):
+    # Regression: the FIX table dropped the audit record's `scheme`, so every scheme's verdicts on one
+    # Wi-Fi fix were indistinguishable. Every scheme judges every fix: two records per scan here.
+    from stridefix import pose_t
+
+    path = write_log(
+        "fix.lcmlog",
+        [
+            ("FIX", _fix(1_000, pose_t.SCHEME_KALMAN, True)),
+            ("FIX", _fix(1_000, pose_t.SCHEME_WIFI_ONLY, False)),
+        ],
+    )
+    fix = read_logs([path]).table("FIX")
+    assert_array_equal(fix["scheme"], [pose_t.SCHEME_KALMAN, pose_t.SCHEME_WIFI_ONLY])
+    assert fix["scheme"].dtype == np.int64
+    assert_array_equal(fix["accepted"], [True, False])
+    assert_allclose(fix["innovation_x_m"], [0.25, 0.25])
+    assert_allclose(fix["innovation_y_m"], [-0.5, -0.5])
+    assert list(fix["reason_text"]) == ["accepted", "gate"]
+
+
+def test_fix_columns_are_the_fields_of_fix_t():
+    # New fix_t fields (e.g. accuracy_factor, drift) must appear without an edit to the reader.
+    from stridefix import fix_t
+    from stridefix_analyzer.io.channels import CHANNELS
+
+    expected = []
+    for field in fix_t.__slots__:
+        if field == "innovation_m":
+            expected += ["innovation_x_m", "innovation_y_m"]
+        else:
+            expected.append(field)
+    assert CHANNELS["FIX"].names == expected
+    assert {"t_us", "method", "scheme", "x_m", "accepted", "reason", "reason_text"} <= set(expected)

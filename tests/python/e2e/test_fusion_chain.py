@@ -17,6 +17,9 @@ import lcm
 import numpy as np
 import pytest
 from stridefix import fix_t, pose_t, wifi_scan_t
+from stridefix_analyzer.schemes import SCHEMES
+
+SCHEME_IDS = [s.id for s in SCHEMES]  # every scheme of pose_t.lcm
 
 
 def run_fw(stridefixd: Path, walk: Path, log: Path, *extra: str) -> subprocess.CompletedProcess:
@@ -67,10 +70,10 @@ def test_every_scheme_judges_every_scan(walk):
     scans = [e for e in walk["events"] if e.channel == "WIFI"]
     fixes = [fix_t.decode(e.data) for e in walk["events"] if e.channel == "FIX"]
     assert len(scans) > 10
-    assert len(fixes) == 6 * len(scans)
+    assert len(fixes) == len(SCHEMES) * len(scans)
     per_scheme = Counter(f.scheme for f in fixes)
-    assert sorted(per_scheme) == [0, 1, 2, 3, 4, 5] and set(per_scheme.values()) == {len(scans)}
-    for scheme in range(6):
+    assert sorted(per_scheme) == SCHEME_IDS and set(per_scheme.values()) == {len(scans)}
+    for scheme in SCHEME_IDS:
         first = next(f for f in fixes if f.scheme == scheme)
         assert first.reason == fix_t.REASON_INITIALISED and first.accepted and first.alpha == 1.0
     for f in fixes:
@@ -82,10 +85,26 @@ def test_every_scheme_judges_every_scan(walk):
         )
 
 
+def test_adaptive_fix_records_carry_accuracy_factor_and_drift(walk):
+    """FIX.accuracy_factor and FIX.drift: the adaptive law's two terms where it blended a fix
+    (α = clamp(sum, 0, 1)), 0 everywhere else."""
+    fixes = [fix_t.decode(e.data) for e in walk["events"] if e.channel == "FIX"]
+    blended = [f for f in fixes if f.scheme == pose_t.SCHEME_ADAPTIVE and f.reason == fix_t.REASON_ACCEPTED]
+    assert len(blended) > 5
+    for f in blended:
+        assert f.accuracy_factor > 0.0 and f.drift >= 0.0
+        assert f.alpha == pytest.approx(min(max(f.accuracy_factor + f.drift, 0.0), 1.0), abs=1e-6)
+    assert any(f.drift > 0.0 for f in blended)
+    others = [
+        f for f in fixes if not (f.scheme == pose_t.SCHEME_ADAPTIVE and f.reason == fix_t.REASON_ACCEPTED)
+    ]
+    assert all(f.accuracy_factor == 0.0 and f.drift == 0.0 for f in others)
+
+
 def test_every_scheme_publishes_pose_after_its_first_fix(walk):
     first_scan_t = min(wifi_scan_t.decode(e.data).t_us for e in walk["events"] if e.channel == "WIFI")
     poses = [pose_t.decode(e.data) for e in walk["events"] if e.channel == "POSE"]
-    assert sorted({p.scheme for p in poses}) == [0, 1, 2, 3, 4, 5]
+    assert sorted({p.scheme for p in poses}) == SCHEME_IDS
     assert min(p.t_us for p in poses) >= first_scan_t  # nobody has a position before the first fix
 
 

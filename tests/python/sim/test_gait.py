@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from stridefix_sim.gait import make_person
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.scenario import builtin_scenario
-from stridefix_sim.walker import ACT_WALK, MODE_WALK, make_person
+from stridefix_sim.walker import ACT_WALK, MODE_WALK
 
 PACES = ("slow", "normal", "fast")
 # pace: (cadence range Hz, stride range m), the nominal values ± the person's scale

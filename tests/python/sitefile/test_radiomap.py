@@ -232,4 +232,4 @@ def test_show_summary_and_png(survey_log, tmp_path, stridefix_main, capsys):
 
 
 def test_registered_in_cli():
-    assert cli.SUBCOMMANDS["radiomap"] == "stridefix_analyzer.radiomap.build"
+    assert cli.SUBCOMMANDS["radiomap"] == "stridefix_analyzer.radiomap.cli"

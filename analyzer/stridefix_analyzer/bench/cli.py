@@ -1,0 +1,151 @@
+"""``stridefix bench``: benchmarks that run the whole SIL chain and print numbers against targets.
+
+Registers the sub-benches (:data:`BENCHES`: name → runner); the work is in :mod:`.sil_pdr` and
+:mod:`.fusion`. Each runner writes its JSON, prints its table and returns the lines of the targets
+it missed.
+
+Exit status: 0 every target met; 1 a target missed (one ``TARGET MISSED: ...`` line per miss on
+stdout, naming the figure, its value and the target; the JSON is written either way) or a stage of
+the chain failed; 2 bad usage (no firmware binary, bad ``--seeds``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from stridefix_analyzer.bench import fusion, sil_pdr
+from stridefix_analyzer.firmware import Firmware, FirmwareError, default_path
+from stridefix_analyzer.stages import StageError
+
+DEFAULT_OUT = "out/bench"
+
+
+def _run_sil_pdr(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    scenarios = [s for s in args.scenarios.split(",") if s]
+    doc = sil_pdr.run_sil_pdr(
+        scenarios, seeds, firmware, out, calibrate=not args.no_calibration, sets=args.sets
+    )
+    print(sil_pdr.format_table(doc["runs"]))
+    print(f"wrote {os.path.join(args.out, 'sil_pdr.json')}")
+    return sil_pdr.missed_targets(doc)
+
+
+def _run_aadr2015(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    paces = [p for p in args.paces.split(",") if p]
+    doc = fusion.run_aadr2015(seeds, paces, firmware, out / "aadr2015", args.sets)
+    print(fusion.format_table(doc["table"], paper=True))
+    red = doc["adaptive_reduction_pct"]
+    print(
+        f"adaptive vs Wi-Fi only: mean error {'-' if red is None else f'{red:.1f} %'} lower "
+        f"(paper: 43 %); targets met: {doc['targets_met']}"
+    )
+    print(f"wrote {out / 'aadr2015' / 'aadr2015.json'} ({doc['run_s']:.0f} s)")
+    return fusion.missed_targets_aadr2015(doc)
+
+
+def _run_office(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    doc = fusion.run_office(seeds, firmware, out / "office_wifi", args.sets)
+    print(fusion.format_table(doc["table"], paper=False))
+    print(f"targets (kalman mean <= 2.0 m, p95 <= 4.5 m) met: {doc['targets_met']}")
+    print(f"wrote {out / 'office_wifi' / 'office_wifi.json'} ({doc['run_s']:.0f} s)")
+    return fusion.missed_targets_office(doc)
+
+
+Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
+#: sub-bench name → (runner, default seeds)
+BENCHES: dict[str, tuple[Runner, str]] = {
+    "sil-pdr": (_run_sil_pdr, "1,2,3"),
+    "aadr2015": (_run_aadr2015, "1,2,3,4,5"),
+    "office-wifi": (_run_office, "1,2,3"),
+}
+
+
+def exit_status(missed: list[str]) -> int:
+    """Prints one ``TARGET MISSED:`` line per miss; 1 when there is any, else 0."""
+    for line in missed:
+        print(f"TARGET MISSED: {line}")
+    return 1 if missed else 0
+
+
+def add_parser(subparsers: Any) -> argparse.ArgumentParser:
+    p: argparse.ArgumentParser = subparsers.add_parser(
+        "bench",
+        help="SIL benchmarks: simulate, replay through stridefixd, score against targets",
+        description=f"{__doc__}\nsil-pdr: {sil_pdr.__doc__}",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "which",
+        choices=list(BENCHES),
+        help="sil-pdr: PDR targets at each pace; aadr2015: the auto-adaptive DR paper's "
+        "experiment (fusion schemes at the reference points); office-wifi: the fusion "
+        "schemes on the default office walk with a surveyed radio map",
+    )
+    p.add_argument(
+        "--paces",
+        default="slow,normal,fast",
+        metavar="LIST",
+        help="aadr2015: comma-separated paces (default: slow,normal,fast)",
+    )
+    p.add_argument(
+        "--scenarios",
+        default=",".join(sil_pdr.DEFAULT_SCENARIOS),
+        metavar="LIST",
+        help=f"comma-separated scenario names (default: {','.join(sil_pdr.DEFAULT_SCENARIOS)})",
+    )
+    p.add_argument(
+        "--seeds",
+        default=None,
+        metavar="LIST",
+        help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5)",
+    )
+    p.add_argument(
+        "--stridefixd",
+        default=str(default_path()),
+        metavar="PATH",
+        help=f"the firmware binary (default: {default_path()})",
+    )
+    p.add_argument(
+        "--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default: {DEFAULT_OUT})"
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        dest="sets",
+        help="passed to stridefixd (e.g. attitude.mode=1), to compare variants; repeatable",
+    )
+    p.add_argument(
+        "--no-calibration",
+        action="store_true",
+        help="skip the per-person stride calibration walk (use the configured default K)",
+    )
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``stridefix bench``; returns the exit status (module docstring)."""
+    firmware = Firmware(args.stridefixd)
+    try:
+        firmware.check_executable()
+    except FirmwareError as exc:
+        print(f"stridefix bench: error: {exc}", file=sys.stderr)
+        return 2
+    runner, default_seeds = BENCHES[args.which]
+    try:
+        seeds = [int(s) for s in (args.seeds or default_seeds).split(",") if s]
+    except ValueError:
+        print(f"stridefix bench: error: --seeds {args.seeds!r}: expected integers", file=sys.stderr)
+        return 2
+    try:
+        missed = runner(args, firmware, seeds, Path(args.out))
+    except StageError as exc:
+        print(f"stridefix bench: error: {exc}", file=sys.stderr)
+        return 1
+    return exit_status(missed)

@@ -1,0 +1,170 @@
+"""``stridefix radiomap build|show``: the command line of the radio-map builder.
+
+``build`` reads the logs (:mod:`.recordings`), builds the site (:func:`~.build.build_site`) and
+writes it; ``show`` checks a site file and prints its summary (and a PNG, :mod:`.show`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from stridefix import site_t
+
+from stridefix_analyzer.io.logread import LogReadError
+from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
+from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
+from stridefix_analyzer.radiomap.build import MODES, build_site
+from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
+from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
+from stridefix_analyzer.radiomap.recordings import RadioMapInputError, load_recordings
+from stridefix_analyzer.radiomap.show import format_summary, plot_site
+
+
+def _float_list(text: str) -> list[float]:
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Declare ``radiomap build`` and ``radiomap show``."""
+    p = subparsers.add_parser(
+        "radiomap",
+        help="build a site file (radio map) from logs; show one",
+        description="Radio maps: build a site file from Wi-Fi scans with "
+        "ground truth, or summarise/plot a site file.",
+    )
+    sub = p.add_subparsers(dest="radiomap_command", metavar="ACTION", required=True)
+    b = sub.add_parser(
+        "build",
+        help="site file from LCM logs with WIFI + TRUTH",
+        description="Build a site file from LCM logs with WIFI and TRUTH. An argument 'a,b' is "
+        "one recording of both files; an argument holding WIFI and TRUTH is a "
+        "recording; the other arguments (e.g. firmware log + truth log) are merged "
+        "into one recording.",
+    )
+    b.add_argument("logs", nargs="+", metavar="LOG")
+    b.add_argument("--out", required=True, metavar="SITE.sfsite", help="site file to write")
+    b.add_argument(
+        "--mode",
+        choices=MODES,
+        default="auto",
+        help="survey: one RP per surveyed point; walk: RPs on a grid; auto: survey "
+        "when the truth is static during most scans, repeated per spot (default)",
+    )
+    b.add_argument(
+        "--cell-size-m",
+        type=float,
+        default=DEFAULT_CELL_SIZE_M,
+        help=f"grid cell of walk mode [m] (default {DEFAULT_CELL_SIZE_M:g})",
+    )
+    b.add_argument("--name", default="", help="site name (default: the output file's stem)")
+    b.add_argument(
+        "--map-rotation-deg",
+        type=float,
+        default=0.0,
+        help="map frame = magnetic east-north turned CCW by this angle [deg]",
+    )
+    g = b.add_mutually_exclusive_group()
+    g.add_argument(
+        "--floor-height-m",
+        type=float,
+        default=DEFAULT_FLOOR_HEIGHT_M,
+        help=f"storey height: floor f at f × this [m] (default {DEFAULT_FLOOR_HEIGHT_M:g})",
+    )
+    g.add_argument(
+        "--floor-heights-m",
+        type=_float_list,
+        default=None,
+        metavar="H0,H1,...",
+        help="walking-surface height of each floor from the lowest [m]",
+    )
+    b.add_argument(
+        "--lowest-floor",
+        type=int,
+        default=None,
+        help="lowest floor index (default: the lowest with reference points)",
+    )
+    b.add_argument(
+        "--min-count",
+        type=int,
+        default=DEFAULT_MIN_COUNT,
+        help=f"drop (RP, AP) entries heard in fewer scans (default {DEFAULT_MIN_COUNT})",
+    )
+    b.add_argument(
+        "--origin-deg",
+        type=_float_list,
+        default=None,
+        metavar="LAT,LON",
+        help="geo-reference of the map origin (sets has_geo)",
+    )
+    b.add_argument(
+        "--scan-duration-ms",
+        type=float,
+        default=DEFAULT_SCAN_DURATION_MS,
+        help="truth must stay put this long after a scan's start for it to count as "
+        "static [ms] (default 0: the samples around the start)",
+    )
+    b.add_argument(
+        "--static-tol-m",
+        type=float,
+        default=DEFAULT_STATIC_TOL_M,
+        help=f"truth within this distance counts as the same spot [m] (default {DEFAULT_STATIC_TOL_M:g})",
+    )
+    s = sub.add_parser(
+        "show",
+        help="summary (and PNG) of a site file",
+        description="Check a site file and print its summary; --png plots the "
+        "reference points per floor coloured by APs heard.",
+    )
+    s.add_argument("site", metavar="SITE.sfsite")
+    s.add_argument("--png", default=None, metavar="PATH", help="write a PNG of the RPs")
+    return p
+
+
+def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
+    """Build and write the site of ``args`` (the ``build`` options); return (site, summary)."""
+    if args.origin_deg is not None and len(args.origin_deg) != 2:
+        raise RadioMapInputError("--origin-deg needs LAT,LON")
+    recordings = load_recordings(args.logs)
+    name = args.name or os.path.splitext(os.path.basename(args.out))[0]
+    site, summary = build_site(
+        recordings,
+        mode=args.mode,
+        cell_size_m=args.cell_size_m,
+        min_count=args.min_count,
+        name=name,
+        map_rotation_deg=args.map_rotation_deg,
+        floor_height_m=args.floor_height_m,
+        floor_heights_m=args.floor_heights_m,
+        lowest_floor=args.lowest_floor,
+        origin_deg=tuple(args.origin_deg) if args.origin_deg else None,
+        scan_duration_ms=args.scan_duration_ms,
+        static_tol_m=args.static_tol_m,
+    )
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    summary["bytes"] = write_site(args.out, site)
+    return site, summary
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry point of ``stridefix radiomap``; returns the exit status."""
+    prog = f"stridefix radiomap {args.radiomap_command}"
+    try:
+        if args.radiomap_command == "build":
+            _, summary = run_build(args)
+            print(format_summary(summary))
+            print(f"wrote {args.out} ({summary['bytes']} bytes)")
+        else:
+            site = read_site(args.site)
+            print(format_summary(site_summary(site)))
+            if args.png:
+                plot_site(site, args.png)
+                print(f"wrote {args.png}")
+    except (LogReadError, RadioMapInputError, SiteFileError) as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,43 @@
+/* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (one per scheme), FIX (the audit
+ * record), HEALTH (input, estimator and log counters) and CONFIG (the effective parameters). The raw
+ * inputs (IMU, MAG, BARO, WIFI, GNSS) are written by sf_rx_lcm.h, from the same kind table the
+ * replay reads.
+ *
+ * Each call converts a core struct into its generated stridefix type and queues it on the log with the
+ * caller's log timestamp (the host receive time of the frame being handled, so replaying the same
+ * input gives the same log). Cannot fail: a full queue is counted by sf_lcm_out. Cost: one encode
+ * into a stack buffer; CONFIG, once per run, builds its key/value text on the stack: 112 B per key,
+ * ≈ 14 KiB for the 124 keys of today, asserted ≤ 16 KiB (plus its encoded copy, about a third). */
+#ifndef SF_PUBLISH_H
+#define SF_PUBLISH_H
+
+#include <stdint.h>
+
+#include "sf_estimator.h"
+#include "sf_input.h"
+#include "sf_lcm_out.h"
+#include "sf_params.h"
+
+/* The main loop's timing, for HEALTH.loop_mean_us / loop_max_us. */
+typedef struct {
+    double sum_us;
+    double max_us;
+    uint64_t n;
+} sf_publish_loop_t;
+
+void sf_publish_step(sf_lcm_out_t *out, int64_t log_t_us, const sf_step_t *step);
+void sf_publish_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
+
+/* FIX: every field of the audit, accuracy_factor and drift included (0 unless the adaptive scheme
+ * blended the fix). */
+void sf_publish_fix(sf_lcm_out_t *out, int64_t log_t_us, const sf_fix_audit_t *audit);
+
+/* HEALTH at board time board_t_us; the log counters are read from out. */
+void sf_publish_health(sf_lcm_out_t *out, int64_t log_t_us, int64_t board_t_us, const sf_input_counters_t *in,
+                       const sf_estimator_status_t *est, const sf_publish_loop_t *loop);
+
+/* CONFIG: every key of sf_param_table as "section.name" with its value (%.9g). */
+void sf_publish_config(sf_lcm_out_t *out, int64_t log_t_us, int64_t board_t_us, const sf_params_t *params,
+                       const char *version, const char *dbc_sha256);
+
+#endif

@@ -1,0 +1,90 @@
+/* sf_rx_event.h — the one tagged sensor sample that every input produces: the CAN decoder
+ * (sf_board_rx.h) and the raw-sensor LCM replay (sf_lcm_input.h) both fill an sf_rx_event_t, and the
+ * daemon feeds the estimator from it in one switch.
+ *
+ * SF_RX_KINDS is the single list of sample kinds, each with the LCM channel that carries it. From it
+ * come the kind enum, the union and the LCM codec table (sf_rx_lcm.c), which needs a decode_<kind> and
+ * an encode_<kind> for every row or does not compile; the daemon's switch has no default, so -Wswitch
+ * (-Werror) stops a build that forgets a kind. A replay therefore cannot silently ignore a kind the
+ * CAN path produces.
+ *
+ * Units are in the names; times are board time [µs]. Memory: sizeof(sf_rx_event_t) = 4112 B on
+ * x86-64 (a full Wi-Fi scan of SF_WIFI_MAX_AP access points; asserted ≤ 4200 B). */
+#ifndef SF_RX_EVENT_H
+#define SF_RX_EVENT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define SF_WIFI_MAX_AP 255 /* WIFI_SCAN_END.n_ap is 8 bits */
+
+/*              kind  LCM channel */
+#define SF_RX_KINDS(X) \
+    X(imu,  "IMU")     \
+    X(mag,  "MAG")     \
+    X(baro, "BARO")    \
+    X(wifi, "WIFI")    \
+    X(gnss, "GNSS")
+
+typedef enum {
+    sf_rx_none = 0,
+#define SF_RX_KIND_ENUM(kind, channel) sf_rx_##kind,
+    SF_RX_KINDS(SF_RX_KIND_ENUM)
+#undef SF_RX_KIND_ENUM
+} sf_rx_kind_t;
+
+/* Number of kinds (sf_rx_none not counted; kinds are 1 .. SF_RX_KIND_COUNT). */
+#define SF_RX_KIND_ONE(kind, channel) +1
+enum { SF_RX_KIND_COUNT = 0 SF_RX_KINDS(SF_RX_KIND_ONE) };
+#undef SF_RX_KIND_ONE
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double accel_mps2[3];
+    double gyro_radps[3];
+} sf_rx_imu_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double field_ut[3];
+} sf_rx_mag_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t seq;
+    double pressure_pa;
+    double temperature_degc;
+} sf_rx_baro_t;
+
+typedef struct {
+    int64_t t_us;
+    int64_t scan_id;
+    bool complete;
+    int32_t n_ap;
+    int64_t bssid[SF_WIFI_MAX_AP];
+    float rssi_dbm[SF_WIFI_MAX_AP];
+    int32_t freq_mhz[SF_WIFI_MAX_AP];
+} sf_rx_wifi_t;
+
+typedef struct {
+    int64_t t_us;
+    double lat_deg;
+    double lon_deg;
+    double alt_m;
+    float accuracy_m;
+} sf_rx_gnss_t;
+
+typedef struct {
+    sf_rx_kind_t kind;
+    union {
+#define SF_RX_KIND_MEMBER(kind, channel) sf_rx_##kind##_t kind;
+        SF_RX_KINDS(SF_RX_KIND_MEMBER)
+#undef SF_RX_KIND_MEMBER
+    } u;
+} sf_rx_event_t;
+
+_Static_assert(sizeof(sf_rx_event_t) <= 4200, "sf_rx_event.h promises at most 4200 B");
+
+#endif

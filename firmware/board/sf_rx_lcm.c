@@ -1,0 +1,181 @@
+/* sf_rx_lcm.c — sf_rx_event_t ↔ the raw-sensor LCM types, one row per kind (see sf_rx_lcm.h). */
+#include "sf_rx_lcm.h"
+
+#include <string.h>
+
+#include "sf_error.h"
+#include "stridefix_baro_t.h"
+#include "stridefix_gnss_t.h"
+#include "stridefix_imu_t.h"
+#include "stridefix_mag_t.h"
+#include "stridefix_wifi_scan_t.h"
+
+/* ---- per kind: decode (LCM → event, 1 or SF_ESYNTAX) and encode (event → log) ---------------------- */
+
+static int decode_imu(const void *const data, const int size, sf_rx_event_t *const ev)
+{
+    stridefix_imu_t m;
+    if (stridefix_imu_t_decode(data, 0, size, &m) < 0) {
+        return SF_ESYNTAX;
+    }
+    ev->u.imu.t_us = m.t_us;
+    ev->u.imu.seq = m.seq;
+    memcpy(ev->u.imu.accel_mps2, m.accel_mps2, sizeof m.accel_mps2);
+    memcpy(ev->u.imu.gyro_radps, m.gyro_radps, sizeof m.gyro_radps);
+    return 1;
+}
+
+static void encode_imu(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                       const sf_rx_event_t *const ev)
+{
+    const sf_rx_imu_t *const s = &ev->u.imu;
+    stridefix_imu_t msg = {.t_us = s->t_us, .seq = s->seq};
+    memcpy(msg.accel_mps2, s->accel_mps2, sizeof msg.accel_mps2);
+    memcpy(msg.gyro_radps, s->gyro_radps, sizeof msg.gyro_radps);
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_imu_t, &msg);
+}
+
+static int decode_mag(const void *const data, const int size, sf_rx_event_t *const ev)
+{
+    stridefix_mag_t m;
+    if (stridefix_mag_t_decode(data, 0, size, &m) < 0) {
+        return SF_ESYNTAX;
+    }
+    ev->u.mag.t_us = m.t_us;
+    ev->u.mag.seq = m.seq;
+    memcpy(ev->u.mag.field_ut, m.field_ut, sizeof m.field_ut);
+    return 1;
+}
+
+static void encode_mag(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                       const sf_rx_event_t *const ev)
+{
+    const sf_rx_mag_t *const s = &ev->u.mag;
+    stridefix_mag_t msg = {.t_us = s->t_us, .seq = s->seq};
+    memcpy(msg.field_ut, s->field_ut, sizeof msg.field_ut);
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_mag_t, &msg);
+}
+
+static int decode_baro(const void *const data, const int size, sf_rx_event_t *const ev)
+{
+    stridefix_baro_t m;
+    if (stridefix_baro_t_decode(data, 0, size, &m) < 0) {
+        return SF_ESYNTAX;
+    }
+    ev->u.baro = (sf_rx_baro_t){m.t_us, m.seq, m.pressure_pa, m.temperature_degc};
+    return 1;
+}
+
+static void encode_baro(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                        const sf_rx_event_t *const ev)
+{
+    const sf_rx_baro_t *const s = &ev->u.baro;
+    stridefix_baro_t msg = {.t_us = s->t_us, .seq = s->seq, .pressure_pa = s->pressure_pa,
+                            .temperature_degc = s->temperature_degc};
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_baro_t, &msg);
+}
+
+static int decode_wifi(const void *const data, const int size, sf_rx_event_t *const ev)
+{
+    stridefix_wifi_scan_t m;
+    if (stridefix_wifi_scan_t_decode(data, 0, size, &m) < 0) {
+        return SF_ESYNTAX;
+    }
+    sf_rx_wifi_t *const w = &ev->u.wifi;
+    w->t_us = m.t_us;
+    w->scan_id = m.scan_id;
+    w->complete = m.complete != 0;
+    w->n_ap = m.n_ap < SF_WIFI_MAX_AP ? m.n_ap : SF_WIFI_MAX_AP;
+    for (int32_t i = 0; i < w->n_ap; i++) {
+        w->bssid[i] = m.bssid[i];
+        w->rssi_dbm[i] = m.rssi_dbm[i];
+        w->freq_mhz[i] = m.freq_mhz[i];
+    }
+    stridefix_wifi_scan_t_decode_cleanup(&m);
+    return 1;
+}
+
+static void encode_wifi(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                        const sf_rx_event_t *const ev)
+{
+    const sf_rx_wifi_t *const s = &ev->u.wifi;
+    /* DEVIATION: the generated type has non-const array pointers; encoding only reads them. */
+    stridefix_wifi_scan_t msg = {.t_us = s->t_us,
+                                 .scan_id = s->scan_id,
+                                 .complete = s->complete,
+                                 .n_ap = s->n_ap,
+                                 .bssid = (int64_t *)s->bssid,
+                                 .rssi_dbm = (float *)s->rssi_dbm,
+                                 .freq_mhz = (int32_t *)s->freq_mhz};
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_wifi_scan_t, &msg);
+}
+
+static int decode_gnss(const void *const data, const int size, sf_rx_event_t *const ev)
+{
+    stridefix_gnss_t m;
+    if (stridefix_gnss_t_decode(data, 0, size, &m) < 0) {
+        return SF_ESYNTAX;
+    }
+    ev->u.gnss = (sf_rx_gnss_t){m.t_us, m.lat_deg, m.lon_deg, m.alt_m, m.accuracy_m};
+    return 1;
+}
+
+static void encode_gnss(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                        const sf_rx_event_t *const ev)
+{
+    const sf_rx_gnss_t *const s = &ev->u.gnss;
+    stridefix_gnss_t msg = {.t_us = s->t_us, .lat_deg = s->lat_deg, .lon_deg = s->lon_deg, .alt_m = s->alt_m,
+                            .accuracy_m = s->accuracy_m};
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_gnss_t, &msg);
+}
+
+/* ---- the table, generated from SF_RX_KINDS ------------------------------------------------------- */
+
+typedef struct {
+    sf_rx_kind_t kind;
+    const char *channel;
+    int (*decode)(const void *data, int size, sf_rx_event_t *ev);
+    void (*encode)(sf_lcm_out_t *out, const char *channel, int64_t ts_us, const sf_rx_event_t *ev);
+} kind_row_t;
+
+static const kind_row_t kind_rows[] = {
+#define SF_RX_KIND_ROW(kind, channel) {sf_rx_##kind, channel, decode_##kind, encode_##kind},
+    SF_RX_KINDS(SF_RX_KIND_ROW)
+#undef SF_RX_KIND_ROW
+};
+_Static_assert(sizeof kind_rows / sizeof kind_rows[0] == SF_RX_KIND_COUNT, "one row per SF_RX_KINDS entry");
+
+static const kind_row_t *row_of_kind(const sf_rx_kind_t kind)
+{
+    const int i = (int)kind - 1; /* rows follow the enum: kind k is row k - 1 */
+    return i >= 0 && i < SF_RX_KIND_COUNT ? &kind_rows[i] : NULL;
+}
+
+const char *sf_rx_lcm_channel(const sf_rx_kind_t kind)
+{
+    const kind_row_t *const row = row_of_kind(kind);
+    return row != NULL ? row->channel : NULL;
+}
+
+int sf_rx_lcm_decode(const char *const channel, const void *const data, const size_t size,
+                     sf_rx_event_t *const ev)
+{
+    for (size_t i = 0; i < sizeof kind_rows / sizeof kind_rows[0]; i++) {
+        if (strcmp(channel, kind_rows[i].channel) == 0) {
+            if (size > (size_t)INT32_MAX || kind_rows[i].decode(data, (int)size, ev) != 1) {
+                return SF_ESYNTAX;
+            }
+            ev->kind = kind_rows[i].kind;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+void sf_rx_lcm_write(sf_lcm_out_t *const out, const int64_t ts_us, const sf_rx_event_t *const ev)
+{
+    const kind_row_t *const row = row_of_kind(ev->kind);
+    if (row != NULL) {
+        row->encode(out, row->channel, ts_us, ev);
+    }
+}

@@ -1,0 +1,30 @@
+/* sf_rx_lcm.h — the raw sensor samples as LCM messages, both ways: sf_rx_event_t → IMU, MAG, BARO,
+ * WIFI, GNSS messages (what stridefixd logs for every input) and back (what a raw-sensor log replay
+ * reads, sf_lcm_input.h).
+ *
+ * One row per SF_RX_KINDS entry (sf_rx_event.h) with its channel, decode and encode, generated from
+ * that list: a kind without both functions does not compile, so the CAN path, the replay and the log
+ * always carry the same kinds. Cost: one generated LCM encode or decode per call; the encode buffer
+ * is on the stack (at most 4109 B: a full scan of SF_WIFI_MAX_AP access points). */
+#ifndef SF_RX_LCM_H
+#define SF_RX_LCM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "sf_lcm_out.h"
+#include "sf_rx_event.h"
+
+/* The LCM channel of a kind ("IMU", ...); NULL for sf_rx_none or an unknown kind. */
+const char *sf_rx_lcm_channel(sf_rx_kind_t kind);
+
+/* Decodes one logged message. 1 *event filled, 0 the channel is not a sensor input (event untouched),
+ * SF_ESYNTAX a sensor channel whose payload does not decode. A scan longer than SF_WIFI_MAX_AP keeps
+ * its first SF_WIFI_MAX_AP access points (the rest cannot be used anyway). */
+int sf_rx_lcm_decode(const char *channel, const void *data, size_t size, sf_rx_event_t *event);
+
+/* Writes the event as its message on its channel with log timestamp ts_us; sf_rx_none writes nothing.
+ * Drops are counted by sf_lcm_out. */
+void sf_rx_lcm_write(sf_lcm_out_t *out, int64_t ts_us, const sf_rx_event_t *event);
+
+#endif

@@ -1,0 +1,320 @@
+/* test_input.c — sf_input (firmware/board/sf_input.h), the one input interface: a candump snippet of
+ * every sample kind gives events; those events logged with sf_rx_lcm_write and replayed through
+ * "lcmlog:" give the same events with the same log times and the same counters; bad lines and unknown
+ * ids are counted and worded with file and line; and closing a replay leaves standard input open. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "sf_can_input.h"
+#include "sf_candump.h"
+#include "sf_error.h"
+#include "sf_input.h"
+#include "sf_lcm_out.h"
+#include "sf_rx_lcm.h"
+#include "sf_test_frames.h"
+
+#define MAX_EVENTS 64
+#define T0_US 1700000000000000LL
+
+typedef struct {
+    int n;
+    int64_t log_t_us[MAX_EVENTS];
+    sf_rx_event_t ev[MAX_EVENTS];
+} events_t;
+
+static void temp_path(char *const path, const size_t size, const char *const stem)
+{
+    snprintf(path, size, "/tmp/sf_test_input_%s_XXXXXX", stem);
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+}
+
+static sf_can_frame_t baro_frame(const uint8_t seq, const uint8_t t_lo_ms, const double pressure_pa)
+{
+    sf_can_frame_t f = tf_frame(BOARD_BARO_FRAME_ID);
+    const struct board_baro_t m = {.pressure = (uint32_t)TF_RAW(baro, pressure, pressure_pa),
+                                   .temperature = (int16_t)TF_RAW(baro, temperature, 21.5),
+                                   .seq = seq,
+                                   .t_lo_ms = t_lo_ms};
+    (void)board_baro_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+/* A walk in miniature: board time, 4 IMU samples, 2 MAG, 2 BARO, one scan of 3 APs, one GNSS fix,
+ * plus a garbage line and an unknown id. Returns the number of lines written. */
+static int write_candump(const char *const path)
+{
+    sf_can_frame_t frames[32];
+    int n = 0;
+    frames[n++] = tf_board_time(5000, 1);
+    for (uint8_t i = 0; i < 4; i++) {
+        const uint8_t t_lo = (uint8_t)((5000 + 10 * (i + 1)) & 0xFF);
+        frames[n++] = tf_accel(i, t_lo, 0.1 * i, -0.2, 9.81);
+        frames[n++] = tf_gyro(i, t_lo, 1.0, -2.0, 0.5 * i);
+    }
+    frames[n++] = tf_mag(0, (uint8_t)(5020 & 0xFF), 20.0, -5.0, -40.0);
+    frames[n++] = tf_mag(1, (uint8_t)(5040 & 0xFF), 21.0, -5.5, -40.5);
+    frames[n++] = baro_frame(0, (uint8_t)(5050 & 0xFF), 101325.0);
+    frames[n++] = tf_scan_begin(7, 5060);
+    frames[n++] = tf_scan_ap(0x001122334455ULL, -60, 6);
+    frames[n++] = tf_frame(0x7FF); /* unknown id */
+    frames[n++] = tf_scan_ap(0x001122334466ULL, -71, 11);
+    frames[n++] = tf_scan_ap(0x001122334477ULL, -80, 36);
+    frames[n++] = tf_scan_end(7, 3);
+    frames[n++] = baro_frame(1, (uint8_t)(5100 & 0xFF), 101320.0);
+    frames[n++] = tf_gnss_info(5100, 120.0, 8.0);
+    frames[n++] = tf_gnss_position(48.1, 11.5);
+    FILE *const f = fopen(path, "w");
+    assert_non_null(f);
+    for (int i = 0; i < n; i++) {
+        frames[i].host_t_us = T0_US + 1000LL * i;
+        char line[80];
+        assert_true(sf_candump_format(&frames[i], "can0", line, sizeof line) > 0);
+        fputs(line, f);
+        if (i == 3) {
+            fputs("this is not a candump line\n", f);
+        }
+    }
+    fclose(f);
+    return n + 1;
+}
+
+/* Every event of an input, with the counters at its end. */
+static void read_all(const char *const spec, events_t *const out, sf_input_counters_t *const counters)
+{
+    sf_input_t *in = NULL;
+    char err[256];
+    assert_int_equal(sf_input_open(&in, spec, err, sizeof err), SF_OK);
+    sf_input_item_t *const item = malloc(sizeof *item);
+    assert_non_null(item);
+    out->n = 0;
+    for (;;) {
+        const int rc = sf_input_next(in, item);
+        if (rc == 0) {
+            break;
+        }
+        assert_true(rc == 1 || rc == SF_ESYNTAX);
+        if (rc == 1 && item->status == SF_OK && item->event.kind != sf_rx_none) {
+            assert_true(out->n < MAX_EVENTS);
+            out->log_t_us[out->n] = item->log_t_us;
+            out->ev[out->n] = item->event;
+            out->n++;
+        }
+    }
+    sf_input_counters(in, counters);
+    free(item);
+    sf_input_close(in);
+}
+
+static void assert_same_event(const sf_rx_event_t *const a, const sf_rx_event_t *const b)
+{
+    assert_int_equal(a->kind, b->kind);
+    switch (a->kind) {
+    case sf_rx_imu:
+        assert_int_equal(a->u.imu.t_us, b->u.imu.t_us);
+        assert_int_equal(a->u.imu.seq, b->u.imu.seq);
+        assert_memory_equal(a->u.imu.accel_mps2, b->u.imu.accel_mps2, sizeof a->u.imu.accel_mps2);
+        assert_memory_equal(a->u.imu.gyro_radps, b->u.imu.gyro_radps, sizeof a->u.imu.gyro_radps);
+        break;
+    case sf_rx_mag:
+        assert_int_equal(a->u.mag.t_us, b->u.mag.t_us);
+        assert_int_equal(a->u.mag.seq, b->u.mag.seq);
+        assert_memory_equal(a->u.mag.field_ut, b->u.mag.field_ut, sizeof a->u.mag.field_ut);
+        break;
+    case sf_rx_baro:
+        assert_int_equal(a->u.baro.t_us, b->u.baro.t_us);
+        assert_int_equal(a->u.baro.seq, b->u.baro.seq);
+        assert_true(a->u.baro.pressure_pa == b->u.baro.pressure_pa);
+        assert_true(a->u.baro.temperature_degc == b->u.baro.temperature_degc);
+        break;
+    case sf_rx_wifi:
+        assert_int_equal(a->u.wifi.t_us, b->u.wifi.t_us);
+        assert_int_equal(a->u.wifi.scan_id, b->u.wifi.scan_id);
+        assert_int_equal(a->u.wifi.complete, b->u.wifi.complete);
+        assert_int_equal(a->u.wifi.n_ap, b->u.wifi.n_ap);
+        for (int32_t i = 0; i < a->u.wifi.n_ap; i++) {
+            assert_int_equal(a->u.wifi.bssid[i], b->u.wifi.bssid[i]);
+            assert_true(a->u.wifi.rssi_dbm[i] == b->u.wifi.rssi_dbm[i]);
+            assert_int_equal(a->u.wifi.freq_mhz[i], b->u.wifi.freq_mhz[i]);
+        }
+        break;
+    case sf_rx_gnss:
+        assert_int_equal(a->u.gnss.t_us, b->u.gnss.t_us);
+        assert_true(a->u.gnss.lat_deg == b->u.gnss.lat_deg && a->u.gnss.lon_deg == b->u.gnss.lon_deg);
+        assert_true(a->u.gnss.alt_m == b->u.gnss.alt_m && a->u.gnss.accuracy_m == b->u.gnss.accuracy_m);
+        break;
+    case sf_rx_none: fail_msg("an event without a kind"); break;
+    }
+}
+
+/* GIVEN a candump of every kind, WHEN its events are logged as the daemon logs inputs and the log is
+ * replayed, THEN the replay gives the same events at the same log times, and the same sample counts. */
+static void test_candump_and_lcm_replay_give_the_same_events(void **state)
+{
+    (void)state;
+    char candump[64], lcmlog[64], spec[80];
+    temp_path(candump, sizeof candump, "candump");
+    temp_path(lcmlog, sizeof lcmlog, "lcmlog");
+    (void)write_candump(candump);
+
+    static events_t can, replay;
+    sf_input_counters_t cc, rc;
+    read_all(candump, &can, &cc);
+    assert_int_equal(can.n, 4 + 2 + 2 + 1 + 1);
+    assert_int_equal(cc.bad_syntax, 1);
+    assert_int_equal(cc.rx.unknown_id, 1);
+    assert_int_equal(cc.frames_total, cc.rx.frames + 1);
+    assert_int_equal(cc.rx.imu, 4);
+    assert_int_equal(cc.rx.wifi, 1);
+    assert_int_equal(cc.rx.gnss, 1);
+
+    sf_lcm_out_t *out = NULL;
+    char err[256];
+    assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 16, true, err, sizeof err), SF_OK);
+    for (int i = 0; i < can.n; i++) {
+        sf_rx_lcm_write(out, can.log_t_us[i], &can.ev[i]);
+    }
+    assert_int_equal(sf_lcm_out_close(out, NULL), SF_OK);
+
+    snprintf(spec, sizeof spec, "%s%s", SF_INPUT_LCMLOG_PREFIX, lcmlog);
+    read_all(spec, &replay, &rc);
+    assert_int_equal(replay.n, can.n);
+    for (int i = 0; i < can.n; i++) {
+        assert_int_equal(replay.log_t_us[i], can.log_t_us[i]);
+        assert_same_event(&replay.ev[i], &can.ev[i]);
+    }
+    assert_int_equal(rc.frames_total, (uint64_t)can.n);
+    assert_int_equal(rc.rx.frames_ok, (uint64_t)can.n);
+    assert_int_equal(rc.bad_syntax, 0);
+    assert_true(rc.rx.imu == cc.rx.imu && rc.rx.mag == cc.rx.mag && rc.rx.baro == cc.rx.baro);
+    assert_true(rc.rx.wifi == cc.rx.wifi && rc.rx.gnss == cc.rx.gnss);
+    unlink(candump);
+    unlink(lcmlog);
+}
+
+/* Bad input is worded with the file and line; expected skips (before the first BOARD_TIME) are not. */
+static void test_describe_names_file_and_line(void **state)
+{
+    (void)state;
+    char candump[64];
+    temp_path(candump, sizeof candump, "describe");
+    FILE *const f = fopen(candump, "w");
+    assert_non_null(f);
+    fputs("(1700000000.000000) can0 110#0000000000000000\n", f); /* MAG before any BOARD_TIME */
+    fputs("garbage\n", f);
+    fputs("(1700000000.000100) can0 7FF#00\n", f);
+    fclose(f);
+    sf_input_t *in = NULL;
+    assert_int_equal(sf_input_open(&in, candump, NULL, 0), SF_OK);
+    assert_false(sf_input_is_live(in));
+    static sf_input_item_t item;
+    char text[512];
+    assert_int_equal(sf_input_next(in, &item), 1);
+    assert_int_equal(item.status, SF_ENOTSYNC);
+    assert_false(sf_input_describe(in, item.status, text, sizeof text));
+    assert_int_equal(sf_input_next(in, &item), SF_ESYNTAX);
+    assert_true(sf_input_describe(in, SF_ESYNTAX, text, sizeof text));
+    assert_non_null(strstr(text, ":2: not a candump -L line; skipped: 'garbage'"));
+    assert_int_equal(sf_input_next(in, &item), 1);
+    assert_int_equal(item.status, SF_EUNKNOWN_ID);
+    assert_int_equal(item.event.kind, sf_rx_none);
+    assert_true(sf_input_describe(in, item.status, text, sizeof text));
+    assert_non_null(strstr(text, ":3: CAN id 0x7FF is not in board.dbc; skipped"));
+    assert_int_equal(sf_input_next(in, &item), 0);
+    sf_input_close(in);
+    unlink(candump);
+}
+
+static bool stdin_open(void)
+{
+    return fcntl(0, F_GETFD) != -1;
+}
+
+/* Regression (issue 10): `stridefixd --replay` closed file descriptor 0 at exit, because it always
+ * closed the CAN input, which on a replay had never been opened (zeroed: fd 0). With stdin closed,
+ * the next file the process opens becomes fd 0. Replaying, and closing a never-opened CAN input, must
+ * both leave stdin open. */
+static void test_replay_close_does_not_close_stdin(void **state)
+{
+    (void)state;
+    if (!stdin_open()) { /* ctest may start us without a stdin: give ourselves one */
+        const int fd = open("/dev/null", O_RDONLY);
+        assert_int_equal(fd, 0);
+    }
+    char lcmlog[64], spec[80];
+    temp_path(lcmlog, sizeof lcmlog, "stdin");
+    sf_lcm_out_t *out = NULL;
+    assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 4, true, NULL, 0), SF_OK);
+    sf_rx_event_t ev = {.kind = sf_rx_mag, .u.mag = {.t_us = 1000, .seq = 1, .field_ut = {1.0, 2.0, 3.0}}};
+    sf_rx_lcm_write(out, 5, &ev);
+    assert_int_equal(sf_lcm_out_close(out, NULL), SF_OK);
+
+    snprintf(spec, sizeof spec, "%s%s", SF_INPUT_LCMLOG_PREFIX, lcmlog);
+    sf_input_t *in = NULL;
+    assert_int_equal(sf_input_open(&in, spec, NULL, 0), SF_OK);
+    static sf_input_item_t item;
+    while (sf_input_next(in, &item) != 0) {
+    }
+    sf_input_close(in);
+    assert_true(stdin_open());
+
+    sf_can_input_t never_opened;
+    memset(&never_opened, 0, sizeof never_opened);
+    sf_can_input_close(&never_opened);
+    assert_true(stdin_open());
+    sf_input_close(NULL);
+    unlink(lcmlog);
+}
+
+static void test_missing_inputs_fail_with_a_message(void **state)
+{
+    (void)state;
+    sf_input_t *in = NULL;
+    char err[256];
+    assert_int_equal(sf_input_open(&in, "/nonexistent/x.candump", err, sizeof err), SF_ENOENT);
+    assert_null(in);
+    assert_non_null(strstr(err, "/nonexistent/x.candump"));
+    assert_int_equal(sf_input_open(&in, "lcmlog:/nonexistent/x.lcmlog", err, sizeof err), SF_ENOENT);
+    assert_null(in);
+    assert_int_equal(sf_input_open(&in, "", err, sizeof err), SF_EINVAL);
+}
+
+/* The kind table: every kind has a channel that decodes back to it; other channels are not inputs,
+ * and a payload that does not decode is SF_ESYNTAX. */
+static void test_every_kind_has_a_channel(void **state)
+{
+    (void)state;
+    assert_null(sf_rx_lcm_channel(sf_rx_none));
+    static const unsigned char junk[3] = {1, 2, 3};
+    for (int k = 1; k <= SF_RX_KIND_COUNT; k++) {
+        const char *const ch = sf_rx_lcm_channel((sf_rx_kind_t)k);
+        assert_non_null(ch);
+        sf_rx_event_t ev;
+        assert_int_equal(sf_rx_lcm_decode(ch, junk, sizeof junk, &ev), SF_ESYNTAX);
+    }
+    sf_rx_event_t ev;
+    assert_int_equal(sf_rx_lcm_decode("TRUTH", junk, sizeof junk, &ev), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_candump_and_lcm_replay_give_the_same_events),
+        cmocka_unit_test(test_describe_names_file_and_line),
+        cmocka_unit_test(test_replay_close_does_not_close_stdin),
+        cmocka_unit_test(test_missing_inputs_fail_with_a_message),
+        cmocka_unit_test(test_every_kind_has_a_channel),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
