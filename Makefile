@@ -17,7 +17,7 @@ all: build
 help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
-	@echo "make lint   - ruff (lint + format check) on all Python"
+	@echo "make lint   - ruff (lint + format check) on all Python, mypy on the analyzer (strict on io, datasets)"
 	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
@@ -46,6 +46,7 @@ test: build
 lint: deps
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/mypy
 
 test-c:
 	cd $(BUILD) && ctest --output-on-failure
