@@ -4,7 +4,7 @@
     that the modules below it imported back (bench.sil_pdr <-> bench.fusion, crowd.cli <->
     crowd.experiment). Function-level imports count; imports under ``if TYPE_CHECKING:`` do not
     (annotations only, never run).
-(b) No module over :data:`MAX_LINES` lines.
+(b) No module over :data:`MAX_LINES` lines, and no firmware C source or header either.
 (c) CLI modules only register commands: nothing imports ``stridefix_analyzer.cli`` or any ``*.cli``
     module, except the top-level ``stridefix_analyzer.cli`` (which loads them by name).
 """
@@ -14,8 +14,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
-
 REPO = Path(__file__).resolve().parents[3]
 ROOTS = {
     "stridefix_analyzer": REPO / "analyzer" / "stridefix_analyzer",
@@ -23,11 +21,6 @@ ROOTS = {
 }
 MAX_LINES = 500
 TOP_CLI = "stridefix_analyzer.cli"
-
-# Known offenders in realbench/ and datasets/ (branch rb reworks them at the same time). The lead
-# empties this after merging rb: then every package is held to the rules. Entries: ("cycle", module
-# set as a sorted tuple), ("lines", module) or ("cli-import", importer, imported).
-KNOWN_RB_OFFENDERS_TO_EMPTY_AFTER_RB_MERGE: set[tuple] = set()
 
 
 def _modules() -> dict[str, Path]:
@@ -127,10 +120,6 @@ def _cycles(graph: dict[str, set[str]]) -> list[tuple[str, ...]]:
     return out
 
 
-def _unknown(found: set[tuple]) -> list[tuple]:
-    return sorted(found - KNOWN_RB_OFFENDERS_TO_EMPTY_AFTER_RB_MERGE)
-
-
 def test_the_graph_sees_function_level_imports():
     # the parser must see a lazy import: crowd.cli imports experiment at module level, and the top
     # CLI's sub-commands are loaded by name (no import edge)
@@ -140,36 +129,30 @@ def test_the_graph_sees_function_level_imports():
 
 
 def test_no_import_cycles():
-    assert _unknown({("cycle", c) for c in _cycles(GRAPH)}) == []
+    assert _cycles(GRAPH) == []
 
 
 def test_no_module_over_max_lines():
-    long = {
-        ("lines", m)
-        for m, p in MODULES.items()
+    long = {m for m, p in MODULES.items() if len(p.read_text(encoding="utf-8").splitlines()) > MAX_LINES}
+    assert sorted(long) == []
+
+
+def test_no_firmware_source_over_max_lines():
+    firmware = REPO / "firmware"
+    long = [
+        str(p.relative_to(REPO))
+        for p in sorted(firmware.rglob("*.[ch]"))
         if len(p.read_text(encoding="utf-8").splitlines()) > MAX_LINES
-    }
-    assert _unknown(long) == []
+    ]
+    assert long == []
 
 
 def test_cli_modules_are_imported_only_by_the_top_cli():
     bad = {
-        ("cli-import", m, dep)
+        (m, dep)
         for m, deps in GRAPH.items()
         if m != TOP_CLI
         for dep in deps
         if dep == TOP_CLI or dep.endswith(".cli")
     }
-    assert _unknown(bad) == []
-
-
-@pytest.mark.parametrize("entry", sorted(KNOWN_RB_OFFENDERS_TO_EMPTY_AFTER_RB_MERGE))
-def test_known_offenders_are_still_offending(entry):
-    # an entry that no longer offends must leave the list (the list only shrinks)
-    kind = entry[0]
-    if kind == "cycle":
-        assert entry[1] in _cycles(GRAPH)
-    elif kind == "lines":
-        assert len(MODULES[entry[1]].read_text(encoding="utf-8").splitlines()) > MAX_LINES
-    else:
-        assert entry[2] in GRAPH[entry[1]]
+    assert sorted(bad) == []
