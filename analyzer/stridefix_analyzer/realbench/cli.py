@@ -26,6 +26,7 @@ from stridefix_analyzer.realbench.pdr_distance import (
     JSON_FILE,
     PNG_FILE,
     format_table,
+    missed_targets,
     run_pdr_distance,
 )
 from stridefix_analyzer.realbench.strides import DEFAULT_MIN_SEGMENT_M
@@ -135,7 +136,12 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
         f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
         f"({doc['run_s']:.1f} s)"
     )
-    return 0 if doc["segments"]["scored"] else 1
+    if not doc["segments"]["scored"]:
+        return 1
+    missed = missed_targets(doc)
+    for line in missed:  # the same contract as `stridefix bench`: exit 1 when a target is missed
+        print(f"TARGET MISSED: {line}")
+    return 1 if missed else 0
 
 
 def run(args: argparse.Namespace) -> int:

@@ -344,6 +344,19 @@ def _median(values: ArrayLike) -> float:
     return float(np.median(x)) if len(x) else math.nan
 
 
+def missed_targets(doc: dict[str, Any]) -> list[str]:
+    """One line per missed target of a pdr-distance document (empty when every target is met)."""
+    t = doc["target"]
+    if t["met"]:
+        return []
+    med = doc["weinberg_lowo"]["abs_error_pct"]["median"]
+    shown = "n/a" if med is None or not math.isfinite(med) else f"{med:.2f}"
+    return [
+        f"realbench pdr-distance [{doc['floor']}]: median |distance error| (Weinberg, leave one walk out) "
+        f"= {shown} % (target <= {t['median_abs_error_pct_max']:g} %)"
+    ]
+
+
 def format_table(doc: dict) -> str:
     """A readable plain-text table of one floor's results."""
 
