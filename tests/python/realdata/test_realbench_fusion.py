@@ -235,7 +235,9 @@ def test_end_to_end_on_five_real_walks(realbench_fusion_small):
         for k in ("mean", "median", "p75", "p90", "max", "rmse", "ipin_score"):
             assert s[k] is not None and math.isfinite(s[k]), (name, k)
         assert 0.0 <= s["share_walks_mean_over_15m"] <= 1.0
-    assert table["kalman"]["mean"] < 30.0
+    # measured 5.23 m mean / 5.75 m p75 on these five walks (2026-12-01); about 1.5x of that, so a
+    # change that loses metres fails here (the change-indication CSVs catch any change at all)
+    assert table["kalman"]["mean"] < 8.0 and table["kalman"]["p75"] < 9.0
     for row in g["walk_rows"]:
         fold = row["fold"]
         assert 0.25 < fold["K"] < 0.8 and math.isfinite(fold["rotation_deg"])
@@ -294,7 +296,7 @@ def test_replay_with_a_site_is_deterministic(realbench_fusion_small, tmp_path):
         )
         streams.append(_pose_stream(log))
     a, b = streams
-    assert len(a["t_us"]) > 100 and set(np.unique(a["scheme"])) == set(range(6))
+    assert len(a["t_us"]) > 100 and set(np.unique(a["scheme"])) == {s.id for s in schemes.SCHEMES}
     for k in a:
         assert_array_equal(a[k], b[k], err_msg=k)
 
