@@ -193,3 +193,12 @@ def test_stride_is_recalibrated_from_fixes(office_walk):
     assert len(changes) >= 2
     assert np.all(np.abs(np.diff(k)) <= 0.1 * k[:-1] + 1e-4)
     assert 0.25 <= k.min() and k.max() <= 0.80
+
+
+def test_the_analyzer_decodes_every_channel_of_a_site_run(walk):
+    # with a site the log also carries FIX: every channel known to io/channels.py, none undecodable
+    from stridefix_analyzer.io.logread import read_logs
+
+    data = read_logs([walk["log"]])
+    assert data.unknown_channels == {} and data.decode_errors == {}
+    assert len(data.table("FIX")) > 0 and len(data.table("POSE")) > 0

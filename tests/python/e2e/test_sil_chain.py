@@ -208,3 +208,13 @@ def test_lost_frames_and_board_time_wrap(stridefixd, tmp_path, cli):
     assert max(t for _, t in t_lossy) > 2**32 * 1000  # past the wrap
     assert all(t_clean[seq] == t for seq, t in t_lossy)
     assert counts["STEP"] == pytest.approx(got["steps"], rel=0.03)
+
+
+def test_the_analyzer_knows_every_channel_the_firmware_writes(replay):
+    # io/channels.py maps channel names to the generated LCM types; a channel the firmware starts
+    # writing (or a type whose hash changed without a rebuild) must not be skipped silently
+    from stridefix_analyzer.io.logread import read_logs
+
+    data = read_logs([replay["log"]])  # every known channel decoded
+    assert data.unknown_channels == {} and data.decode_errors == {}
+    assert {"IMU", "MAG", "BARO", "WIFI", "STEP", "POSE", "HEALTH", "CONFIG"} <= set(replay["counts"])
