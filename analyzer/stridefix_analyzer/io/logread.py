@@ -129,6 +129,10 @@ class LogData:
         Events on channels the analyzer has no type for.
     decode_errors : dict of str to int
         Events on known channels whose payload failed to decode.
+    type_mismatches : dict of str to int
+        Of those, the events whose payload carries another LCM type hash than this build's type, the
+        same foreign hash on more than one event: the log was written by another version of
+        ``lcmtypes/`` (e.g. a stale stridefixd binary), not corrupted.
     health : dict
         Fields of the last ``HEALTH`` report (latest host time), ``{}`` if none.
     config : dict of str to str
@@ -144,6 +148,7 @@ class LogData:
     messages: dict[str, int] = dataclasses.field(default_factory=dict)
     unknown_channels: dict[str, int] = dataclasses.field(default_factory=dict)
     decode_errors: dict[str, int] = dataclasses.field(default_factory=dict)
+    type_mismatches: dict[str, int] = dataclasses.field(default_factory=dict)
     health: dict[str, Any] = dataclasses.field(default_factory=dict)
     config: dict[str, str] = dataclasses.field(default_factory=dict)
     versions: dict[str, str] = dataclasses.field(default_factory=dict)
@@ -167,6 +172,8 @@ class _Collector:
         self.rows: dict[str, list[Any]] = {ch: [] for ch in CHANNELS}
         self.wifi_aps: list[tuple[int, int, float, int]] = []  # (scan row, bssid, rssi_dbm, freq_mhz)
         self.data = LogData()
+        # channel -> leading 8 payload bytes that are not this build's type hash -> count
+        self.foreign_hashes: dict[str, dict[bytes, int]] = {}
 
     def add_event(self, path: str, channel: str, payload: bytes) -> None:
         d = self.data
@@ -185,6 +192,10 @@ class _Collector:
             values = spec.row(msg)
         except Exception:  # noqa: BLE001 - any decode failure is bad data, counted not fatal
             d.decode_errors[channel] = d.decode_errors.get(channel, 0) + 1
+            msg_type = CONFIG_TYPE if channel == "CONFIG" else CHANNELS[channel].msg_type
+            if payload[:8] != msg_type._get_packed_fingerprint():
+                foreign = self.foreign_hashes.setdefault(channel, {})
+                foreign[payload[:8]] = foreign.get(payload[:8], 0) + 1
             return
         if channel == "WIFI":
             scan_row = len(self.rows["WIFI"])
@@ -241,6 +252,12 @@ class _Collector:
             d.warnings.append(
                 f"{n} message(s) on channel {channel} failed to decode (wrong type or corrupt payload)"
             )
+        for channel, foreign in sorted(self.foreign_hashes.items()):
+            # one hash seen again and again is another type version; a lone one is a corrupt payload
+            n = sum(k for k in foreign.values() if k > 1)
+            if n:
+                d.type_mismatches[channel] = n
+                d.warnings.append(_mismatch_text(channel, n))
         return d
 
 
@@ -286,9 +303,22 @@ def read_logs(paths: Iterable[str | os.PathLike[str]], decode: Iterable[str] | N
     return collector.finish()
 
 
+def _mismatch_text(channel: str, n: int) -> str:
+    return (
+        f"{n} message(s) on channel {channel} carry another LCM type hash than this build's: the log "
+        "was written by another version of lcmtypes/ (a stale stridefixd? run make build)"
+    )
+
+
 def read_table(path: str | os.PathLike[str], channel: str) -> Table | None:
     """One channel of one log (``None`` when it has none), a truncated tail read silently: the
-    stridefixd logs the benchmarks read back may end mid-record when a run is cut short."""
+    stridefixd logs the benchmarks read back may end mid-record when a run is cut short.
+
+    Raises :class:`LogReadError` when the channel's messages carry another type hash than this build
+    knows: a benchmark must not score a stale firmware's log as if it had no such messages."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)
-        return read_logs([path], decode=(channel,)).table(channel)
+        data = read_logs([path], decode=(channel,))
+    if channel in data.type_mismatches:
+        raise LogReadError(os.fspath(path), _mismatch_text(channel, data.type_mismatches[channel]))
+    return data.table(channel)

@@ -17,6 +17,7 @@ from typing import Any
 
 from stridefix_analyzer import datasets
 from stridefix_analyzer.firmware import default_path
+from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.realbench import tuning
 from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT
 from stridefix_analyzer.realbench.fusion import DEFAULT_CELL_SIZE_M, FusionConfig, run_fusion
@@ -128,7 +129,7 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
             args.reimport,
             progress,
         )
-    except RealbenchError as exc:
+    except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return 2
     print(format_table(doc))
@@ -238,7 +239,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             param_sets=args.param_sets,
         )
         doc = run_fusion(cfg)
-    except RealbenchError as exc:
+    except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return 2
     print(format_tables(doc, tuning.axes(args.param_sets)))

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import wifi_scan_t
-from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs
+from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 
 
 def test_columns_and_sorting(msg, write_log):
@@ -59,8 +59,21 @@ def test_unknown_channel_and_decode_error_are_counted(msg, write_log):
     assert d.table("TRUTH") is None
     assert d.decode_errors == {"POSE": 1, "TRUTH": 1}
     assert d.unknown_channels == {"CAMERA": 2}
+    assert d.type_mismatches == {}  # one odd payload each: corruption, not a type version
     assert d.messages == {"POSE": 2, "TRUTH": 1, "CAMERA": 2}
     assert any("POSE" in w and "decode" in w for w in d.warnings)
+
+
+def test_another_type_version_is_told_apart_from_corruption(msg, write_log):
+    # regression: a stale stridefixd wrote FIX with an older fix_t; realbench read "no FIX" silently
+    path = write_log(
+        "stale.lcmlog", [("POSE", msg.truth(i, 0, 0)) for i in range(3)] + [("POSE", msg.pose(9, 0, 0))]
+    )
+    d = read_logs([path])
+    assert d.decode_errors == {"POSE": 3} and d.type_mismatches == {"POSE": 3}
+    assert any("another LCM type hash" in w and "POSE" in w for w in d.warnings)
+    with pytest.raises(LogReadError, match="POSE.*another LCM type hash"):
+        read_table(path, "POSE")
 
 
 def test_truncated_log_reads_whole_records(msg, write_log, tmp_path):
