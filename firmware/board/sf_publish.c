@@ -3,6 +3,7 @@
 
 #include <stdio.h>
 
+#include "sf_channels.h"
 #include "stridefix_config_t.h"
 #include "stridefix_fix_t.h"
 #include "stridefix_health_t.h"
@@ -19,7 +20,7 @@ void sf_publish_step(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_s
                             .heading_rad = (float)st->heading_rad,
                             .activity = st->activity,
                             .floor = st->floor};
-    SF_LCM_WRITE(out, "STEP", log_t_us, stridefix_step_t, &msg);
+    SF_LCM_WRITE(out, SF_CHANNEL_STEP, log_t_us, stridefix_step_t, &msg);
 }
 
 void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_pose_t *const p)
@@ -32,7 +33,7 @@ void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_p
                             .sigma_m = (float)p->sigma_m,
                             .step_count = p->step_count,
                             .scheme = p->scheme};
-    SF_LCM_WRITE(out, "POSE", log_t_us, stridefix_pose_t, &msg);
+    SF_LCM_WRITE(out, SF_CHANNEL_POSE, log_t_us, stridefix_pose_t, &msg);
 }
 
 void sf_publish_fix(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_fix_audit_t *const a)
@@ -55,7 +56,7 @@ void sf_publish_fix(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_fi
                            .reason = a->reason,
                            /* DEVIATION: the generated type's string is non-const; encoding only reads it. */
                            .reason_text = (char *)sf_fix_reason_text(a->reason)};
-    SF_LCM_WRITE(out, "FIX", log_t_us, stridefix_fix_t, &msg);
+    SF_LCM_WRITE(out, SF_CHANNEL_FIX, log_t_us, stridefix_fix_t, &msg);
 }
 
 void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
@@ -91,7 +92,7 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .loop_mean_us = loop->n > 0 ? (float)(loop->sum_us / (double)loop->n) : 0.0f,
         .loop_max_us = (float)loop->max_us,
     };
-    SF_LCM_WRITE(out, "HEALTH", log_t_us, stridefix_health_t, &msg);
+    SF_LCM_WRITE(out, SF_CHANNEL_HEALTH, log_t_us, stridefix_health_t, &msg);
 }
 
 #define CONFIG_KEY_BYTES 64
@@ -120,5 +121,5 @@ void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const in
                               .n = (int32_t)sf_param_count,
                               .key = key_ptrs,
                               .value = value_ptrs};
-    SF_LCM_WRITE(out, "CONFIG", log_t_us, stridefix_config_t, &msg);
+    SF_LCM_WRITE(out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
 }

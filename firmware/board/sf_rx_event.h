@@ -16,15 +16,17 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_channels.h"
+
 #define SF_WIFI_MAX_AP 255 /* WIFI_SCAN_END.n_ap is 8 bits */
 
-/*              kind  LCM channel */
-#define SF_RX_KINDS(X) \
-    X(imu,  "IMU")     \
-    X(mag,  "MAG")     \
-    X(baro, "BARO")    \
-    X(wifi, "WIFI")    \
-    X(gnss, "GNSS")
+/*              kind  LCM channel (lcmtypes/channels.csv, generated sf_channels.h) */
+#define SF_RX_KINDS(X)        \
+    X(imu,  SF_CHANNEL_IMU)   \
+    X(mag,  SF_CHANNEL_MAG)   \
+    X(baro, SF_CHANNEL_BARO)  \
+    X(wifi, SF_CHANNEL_WIFI)  \
+    X(gnss, SF_CHANNEL_GNSS)
 
 typedef enum {
     sf_rx_none = 0,

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 import stridefix
+import stridefix_channels
 
 _AXES = "xyz"
 
@@ -79,20 +80,11 @@ def channel_of(msg_type: Any) -> Channel:
     return Channel(msg_type, columns, row)
 
 
-#: channel name → its Channel (CONFIG is not a table: logread reads it into a dict)
+#: channel name → its Channel, from the one channel table (lcmtypes/channels.csv, generated into
+#: stridefix_channels at build time); CONFIG is not a table: logread reads it into a dict
 CHANNELS: dict[str, Channel] = {
-    name: channel_of(t)
-    for name, t in (
-        ("IMU", stridefix.imu_t),
-        ("MAG", stridefix.mag_t),
-        ("BARO", stridefix.baro_t),
-        ("WIFI", stridefix.wifi_scan_t),
-        ("GNSS", stridefix.gnss_t),
-        ("STEP", stridefix.step_t),
-        ("FIX", stridefix.fix_t),
-        ("POSE", stridefix.pose_t),
-        ("TRUTH", stridefix.truth_t),
-        ("HEALTH", stridefix.health_t),
-    )
+    name: channel_of(getattr(stridefix, type_name))
+    for name, type_name, _writer in stridefix_channels.CHANNELS
+    if name != "CONFIG"
 }
 CONFIG_TYPE = stridefix.config_t
