@@ -46,6 +46,7 @@ from stridefix_analyzer.realbench.strides import (
     WEINBERG_EXPONENT,
     build_segments,
     calibrate_lowo,
+    spread,
     stride_lowo,
 )
 from stridefix_analyzer.realbench.strides import error_stats as error_stats
@@ -155,20 +156,6 @@ def score_segments(seg: Table, n_walks: int) -> tuple[Table, dict]:
 
 
 # --- the benchmark ---------------------------------------------------------------------------------
-
-
-def _spread(values: np.ndarray) -> dict:
-    v = np.asarray(values, float)
-    v = v[np.isfinite(v)]
-    if not len(v):
-        return {"n": 0, "mean": math.nan, "std": math.nan, "min": math.nan, "max": math.nan}
-    return {
-        "n": int(len(v)),
-        "mean": float(v.mean()),
-        "std": float(v.std()),
-        "min": float(v.min()),
-        "max": float(v.max()),
-    }
 
 
 def run_pdr_distance(
@@ -307,12 +294,12 @@ def summarize(
             "abs_error_pct_by_length_m": _by_length(seg, used),
             "abs_error_pct_unflagged": error_stats(seg["err_pct"][used & ~seg["suspect"]]),
             "signed_error_pct_median": _median(seg["err_pct"][used]),
-            "K": {**_spread(k_scored), "all_walks": fits["K_all_walks"]},
+            "K": {**spread(k_scored), "all_walks": fits["K_all_walks"]},
         },
         "baseline_fixed_stride_lowo": {
             "abs_error_pct": error_stats(seg["baseline_err_pct"][used]),
             "signed_error_pct_median": _median(seg["baseline_err_pct"][used]),
-            "stride_m": _spread(fits["stride_m"][scored_walks] if scored_walks else []),
+            "stride_m": spread(fits["stride_m"][scored_walks] if scored_walks else []),
         },
         "firmware_length_as_configured": {
             "abs_error_pct": error_stats(seg["fw_err_pct"][used]),

@@ -12,7 +12,7 @@ leave-one-walk-out calibrations both realbench benchmarks use.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -196,3 +196,18 @@ def stride_k(seg: Table, mask: np.ndarray) -> float:
     """Weinberg K of the segments in ``mask``: Σ true distance / Σ Weinberg sum (NaN when empty)."""
     w = seg["weinberg"][mask].sum()
     return float(seg["true_m"][mask].sum() / w) if w > 0 else math.nan
+
+
+def spread(values: Iterable[float | None]) -> dict[str, Any]:
+    """n, mean, std, min, max of the finite values (None and NaN left out): a fold statistic's spread."""
+    v = np.asarray([x for x in values if x is not None], float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return {"n": 0, "mean": math.nan, "std": math.nan, "min": math.nan, "max": math.nan}
+    return {
+        "n": int(len(v)),
+        "mean": float(v.mean()),
+        "std": float(v.std()),
+        "min": float(v.min()),
+        "max": float(v.max()),
+    }

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from stridefix_analyzer import schemes
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.realbench.fold import IPIN_FLOOR_PENALTY_M, FoldJob, ipin_score
-from stridefix_analyzer.realbench.strides import error_stats
+from stridefix_analyzer.realbench.strides import error_stats, spread
 from stridefix_analyzer.realbench.tuning import Axis
 
 #: a walk whose mean error exceeds this is a failure for the robustness share [m]
@@ -83,10 +83,10 @@ def build_doc(
         entry["fold_errors"] = [{"walk": r["walk"], "error": r["error"]} for r in rs if r["error"]]
         folds = [r["fold"] for r in rs if r.get("fold")]
         entry["constants"] = {
-            "K": _spread([f["K"] for f in folds]),
-            "rotation_deg": _spread([f["rotation_deg"] for f in folds]),
-            "n_rp": _spread([f["n_rp"] for f in folds]),
-            "n_ap": _spread([f["n_ap"] for f in folds]),
+            "K": spread([f["K"] for f in folds]),
+            "rotation_deg": spread([f["rotation_deg"] for f in folds]),
+            "n_rp": spread([f["n_rp"] for f in folds]),
+            "n_ap": spread([f["n_ap"] for f in folds]),
             **{
                 key: {
                     v: sum(1 for f in folds if f.get(key) == v)
@@ -121,20 +121,6 @@ def build_doc(
         "inputs": [str(d) for d in dirs],
         "true_start": true_start,
         "groups": per_group,
-    }
-
-
-def _spread(values: Iterable[float | None]) -> dict[str, Any]:
-    v = np.asarray([x for x in values if x is not None], float)
-    v = v[np.isfinite(v)]
-    if not len(v):
-        return {"n": 0, "mean": math.nan, "min": math.nan, "max": math.nan, "std": math.nan}
-    return {
-        "n": int(len(v)),
-        "mean": float(v.mean()),
-        "min": float(v.min()),
-        "max": float(v.max()),
-        "std": float(v.std()),
     }
 
 
