@@ -92,6 +92,29 @@ def stride_scale(walks) -> float:
     return num / den if den > 0 else 1.0
 
 
+def _table_row(
+    key: str,
+    label: str,
+    thesis_mean_m: float | None,
+    thesis_std_m: float | None,
+    e: dict[str, Any],
+    rows: dict[str, int],
+    solver: str,
+    run_s: float,
+) -> dict[str, Any]:
+    """One row of the experiment's table: its error statistics next to the thesis's numbers."""
+    return {
+        "key": key,
+        "label": label,
+        "thesis_mean_m": thesis_mean_m,
+        "thesis_std_m": thesis_std_m,
+        **{k: e.get(k) for k in ("mean_m", "std_m", "median_m", "p90_m", "n", "mean_all_m")},
+        "rows": rows,
+        "solver": solver,
+        "run_s": run_s,
+    }
+
+
 def run_table(
     walks, model, anchors: str, solver: str, band: str, scale: float, progress=print
 ) -> tuple[list[dict], dict]:
@@ -108,45 +131,18 @@ def run_table(
         )
         e = res["error"]
         out.append(
-            {
-                "key": key,
-                "label": label,
-                "thesis_mean_m": tm,
-                "thesis_std_m": ts,
-                "mean_m": e.get("mean_m"),
-                "std_m": e.get("std_m"),
-                "median_m": e.get("median_m"),
-                "p90_m": e.get("p90_m"),
-                "n": e.get("n"),
-                "mean_all_m": e.get("mean_all_m"),
-                "rows": res["rows"],
-                "solver": res["solver"]["solver"],
-                "run_s": time.perf_counter() - t0,
-                "problem": res["problem"],
-            }
+            _table_row(key, label, tm, ts, e, res["rows"], res["solver"]["solver"], time.perf_counter() - t0)
+            | {"problem": res["problem"]}
         )
         positions[key] = (xy, points, prob)
         progress(f"  {label:<55} mean {e.get('mean_m', float('nan')):6.2f} m  ({out[-1]['run_s']:.1f} s)")
     # reference: the initial guess alone (anchors interpolated linearly in time, no range rows)
     xy, points, prob = positions[ROWS[0][0]]
     e = error_stats(prob.x0, points, prob)
+    rows = {"anchors": int(len(prob.anchor_index)), "pdr": 0, "wifi": 0}
     out.append(
-        {
-            "key": "anchors_interp",
-            "label": "reference: anchors only, linear in time",
-            "thesis_mean_m": None,
-            "thesis_std_m": None,
-            "mean_m": e.get("mean_m"),
-            "std_m": e.get("std_m"),
-            "median_m": e.get("median_m"),
-            "p90_m": e.get("p90_m"),
-            "n": e.get("n"),
-            "mean_all_m": e.get("mean_all_m"),
-            "rows": {"anchors": int(len(prob.anchor_index)), "pdr": 0, "wifi": 0},
-            "solver": "-",
-            "run_s": 0.0,
-            "problem": {},
-        }
+        _table_row("anchors_interp", "reference: anchors only, linear in time", None, None, e, rows, "-", 0.0)
+        | {"problem": {}}
     )
     return out, positions
 
