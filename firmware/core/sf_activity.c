@@ -113,39 +113,75 @@ static void credit(sf_activity_t *const a, const int64_t t_us)
     a->accepted_steps++;
 }
 
+/* Ends the bout being held: its detections were no walk. */
+static void drop_held(sf_activity_t *const a)
+{
+    a->lone_steps += (uint32_t)a->held_n;
+    a->held_n = 0;
+}
+
 int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const sf_step_event_t *const ev)
 {
     SF_ASSERT(a != NULL && p != NULL && ev != NULL);
+    SF_ASSERT(p->activity_bout_steps >= 2 && p->activity_bout_steps <= SF_ACTIVITY_BOUT_MAX);
     if (!a->started || sf_activity_variance_m2ps4(a) < p->activity_still_var_m2ps4 ||
         fabs(a->vspeed_mps) > 2.0 * p->activity_elevator_vspeed_mps) {
         a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */
         return 0;
     }
+    if (a->rotation_radps > p->activity_max_rotation_radps) {
+        a->rejected_steps++; /* turning faster than a walker turns: a gesture; the walk starts anew */
+        a->turning_steps++;
+        drop_held(a);
+        a->last_detection_t_us = INT64_MIN / 2;
+        return 0;
+    }
     const int64_t since_us = ev->t_us - a->last_detection_t_us;
-    /* a second step of the same walk comes one gait period later: not sooner than a fast walker's
-     * step (activity_min_step_period_ms), not later than steps_max_period_ms */
+    /* the next step of the same walk comes one gait period later: not sooner than a fast walker's
+     * step (activity_min_step_period_ms) while the bout is unconfirmed, not later than steps_max_period_ms */
     const bool in_bout = since_us <= (int64_t)p->steps_max_period_ms * 1000 &&
-                         (!a->held || since_us >= (int64_t)p->activity_min_step_period_ms * 1000);
+                         (a->held_n == 0 || since_us >= (int64_t)p->activity_min_step_period_ms * 1000);
     a->last_detection_t_us = ev->t_us;
     int credited = 0;
     if (!in_bout) {
-        if (a->held) {
-            a->lone_steps++; /* the previous held detection never got its second step */
+        drop_held(a); /* the held detections never got their confirmation */
+        a->held_t_us[a->held_n++] = ev->t_us;
+    } else if (a->held_n > 0) {
+        a->held_t_us[a->held_n++] = ev->t_us;
+        if (a->held_n >= p->activity_bout_steps) {
+            for (int32_t i = 0; i < a->held_n; i++) {
+                credit(a, a->held_t_us[i]);
+            }
+            credited = a->held_n;
+            a->held_n = 0;
         }
-        a->held = true;
-        a->held_t_us = ev->t_us;
     } else {
-        if (a->held) {
-            credit(a, a->held_t_us);
-            a->held = false;
-            credited++;
-        }
         credit(a, ev->t_us);
-        credited++;
+        credited = 1;
     }
     advance_time(a, ev->t_us);
     classify(a, p);
     return credited;
+}
+
+void sf_activity_gyro(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,
+                      const double rate_radps)
+{
+    if (!isfinite(rate_radps)) {
+        return;
+    }
+    if (!a->gyro_started) {
+        a->gyro_started = true;
+        a->gyro_t_us = t_us;
+        a->rotation_radps = rate_radps;
+        return;
+    }
+    if (t_us <= a->gyro_t_us) {
+        return;
+    }
+    const double dt_s = (double)(t_us - a->gyro_t_us) * 1e-6;
+    a->rotation_radps += -expm1(-dt_s / p->activity_var_tau_s) * (rate_radps - a->rotation_radps);
+    a->gyro_t_us = t_us;
 }
 
 void sf_activity_vspeed(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,

@@ -26,20 +26,33 @@
  *      gait), else unknown (handling the device without steps).
  * Before any a_v sample the class is unknown.
  *
- * A walk has at least two steps. The first detection after steps_max_period_ms without one is held,
- * not credited: it is credited together with the next detection if that comes between
- * activity_min_step_period_ms (0.4 s, a fast walker's step) and steps_max_period_ms after it, and
- * dropped (counted in lone_steps) otherwise. A lone jolt — a lift starting
- * or stopping, a door slammed, the device knocked — therefore never moves the position, and a real
- * walk loses nothing; its first step is credited one step late.
+ * A walk that has not started moves nothing. The first detection after steps_max_period_ms without one
+ * starts a bout and is held, not credited; so are the next ones, each between
+ * activity_min_step_period_ms (0.4 s, a fast walker's step) and steps_max_period_ms after the one before.
+ * When activity_bout_steps detections are held (2 by default: one gait cycle; 4, two cycles, removed a
+ * few more handling steps on the gsd trials but made msindoor site1/F2 0.1 m worse), all of them are
+ * credited at once; a detection that breaks the chain drops the held
+ * ones (counted in lone_steps) and starts a new bout. A lone jolt — a lift starting or stopping, a door
+ * slammed, the device knocked, the phone picked up and put down — therefore never moves the position,
+ * and a real walk loses nothing; its first steps are credited activity_bout_steps − 1 steps late.
+ *
+ * Gestures are not steps. A phone waved or turned in the hand (the calibration figure-eights of a
+ * phone's magnetometer, handling it while standing) shakes a_v like a walk, but it turns far faster
+ * than a walker does. The mean rotation rate |ω| (exponentially weighted like σ², activity_var_tau_s)
+ * above activity_max_rotation_radps (π rad/s: a U-turn, the sharpest turn of a walk, takes at least a
+ * stride, two steps at the usual ≈ 2 Hz, ≈ 1 s) refuses the detection (counted in rejected_steps and
+ * in turning_steps) and ends the bout: the walk must start again after the gesture. Measured on the
+ * gsd hand-held walks: ≤ 1.8 rad/s while walking, 3–7 rad/s while waving. DEVIATION: a phone swung in
+ * the hand at the arm's pendulum (±45° at 1 Hz is ≈ 3 rad/s) would be refused as well; no data set
+ * here has one.
  *
  * False steps while still. sf_activity_step refuses (returns false, counts in `rejected_steps`) a
  * step that comes while σ² < activity_still_var_m2ps4: a body that quiet is not walking, whatever the
  * detector saw. A refused step does not count for the rules above; the estimator must not move the
  * position for it. While the class is still, the estimator also holds the position (zero-velocity).
  *
- * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v sample. Memory: sizeof(sf_activity_t) = 160 B on
- * x86-64 (152 B on i686), at most 192 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
+ * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v or |ω| sample. Memory: sizeof(sf_activity_t) =
+ * 248 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
 #ifndef SF_ACTIVITY_H
 #define SF_ACTIVITY_H
 
@@ -54,6 +67,8 @@
  * the rules only need activity_min_steps (≤ 8) of them, so 8 suffice. */
 #define SF_ACTIVITY_STEPS 8
 _Static_assert(SF_ACTIVITY_STEPS >= 8, "activity_min_steps may be 8");
+/* Detections a bout may hold before it is credited: activity_bout_steps is at most 8. */
+#define SF_ACTIVITY_BOUT_MAX 8
 
 typedef struct {
     bool started;
@@ -66,21 +81,29 @@ typedef struct {
     int32_t step_head, step_count;
     int8_t activity;
     uint32_t accepted_steps, rejected_steps; /* counters, never decrease */
-    uint32_t lone_steps;       /* held first detections that no second one confirmed */
-    bool held;                 /* a first detection waits for its confirmation */
-    int64_t held_t_us;
+    uint32_t lone_steps;       /* held detections of bouts that were never confirmed */
+    int32_t held_n;            /* detections of a bout not yet credited */
+    int64_t held_t_us[SF_ACTIVITY_BOUT_MAX];
+    bool gyro_started;
+    int64_t gyro_t_us;         /* newest |ω| time */
+    double rotation_radps;     /* EW mean of |ω| */
+    uint32_t turning_steps;    /* detections refused as gestures (also in rejected_steps) */
     int64_t last_detection_t_us; /* newest detection that was not refused */
 } sf_activity_t;
-_Static_assert(sizeof(sf_activity_t) <= 192, "sf_activity.h promises at most 192 B");
+_Static_assert(sizeof(sf_activity_t) <= 320, "sf_activity.h promises at most 320 B");
 
 void sf_activity_init(sf_activity_t *a, const sf_params_t *p);
 
 /* One a_v sample [m/s²]. Non-finite values and samples at or before the previous a_v time are ignored. */
 void sf_activity_accel(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double accel_v_mps2);
 
+/* One rotation-rate sample |ω| [rad/s] of the device. Non-finite values and samples at or before the
+ * previous |ω| time are ignored. */
+void sf_activity_gyro(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double rate_radps);
+
 /* One step event. Returns how many steps the estimator should move now: 0 (refused: the body is
- * quiet; or held: the first detection of a bout), 1 (this step), or 2 (the held first step of the
- * bout, confirmed by this one, and this step). */
+ * quiet or turning like a gesture; or held: a detection of a bout not yet confirmed), 1 (this step),
+ * or activity_bout_steps (the held detections of the bout, confirmed by this one, which is the last). */
 int sf_activity_step(sf_activity_t *a, const sf_params_t *p, const sf_step_event_t *ev);
 
 /* One vertical-speed estimate [m/s] (sf_floor_vertical_speed_mps after a baro sample). */

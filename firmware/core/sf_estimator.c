@@ -3,6 +3,7 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 
 static double wrap_pi(const double a)
@@ -121,6 +122,9 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 
     sf_heading_update(&e->heading, p, s->t_us, f_nav, sf_attitude_yaw_rad(&e->attitude));
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
+    sf_activity_gyro(&e->activity, p, s->t_us,
+                     sqrt(s->gyro_radps[0] * s->gyro_radps[0] + s->gyro_radps[1] * s->gyro_radps[1] +
+                          s->gyro_radps[2] * s->gyro_radps[2]));
     e->heading_rad = walk_heading(e, p);
 
     sf_step_event_t ev;
@@ -128,21 +132,22 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
         return 0;
     }
     sf_heading_on_step(&e->heading, p, s->t_us);
+    const sf_activity_t *const a = &e->activity;
     const int credited = sf_activity_step(&e->activity, p, &ev);
     if (credited == 0) {
-        if (e->activity.held && e->activity.held_t_us == ev.t_us) {
-            e->held_event = ev; /* the first step of a bout waits for its second */
+        if (a->held_n > 0 && a->held_t_us[a->held_n - 1] == ev.t_us) {
+            e->held_events[a->held_n - 1] = ev; /* a detection of a bout waits for its confirmation */
         } else {
             e->steps_refused++;
         }
         return 0;
     }
-    int n = 0;
-    if (credited == 2) {
-        move(e, p, &e->held_event, s->t_us, &steps[n++]);
+    SF_ASSERT(credited <= SF_ESTIMATOR_MAX_STEPS);
+    for (int i = 0; i < credited - 1; i++) {
+        move(e, p, &e->held_events[i], s->t_us, &steps[i]);
     }
-    move(e, p, &ev, s->t_us, &steps[n++]);
-    return n;
+    move(e, p, &ev, s->t_us, &steps[credited - 1]);
+    return credited;
 }
 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,

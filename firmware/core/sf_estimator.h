@@ -6,7 +6,8 @@
  *   heading (sf_heading: mounting offset from the gait)   activity (sf_activity: a_v variance)
  *   steps (sf_steps: Pan–Tompkins or trough-peak)  → step event
  *   the step is accepted by sf_activity (a body that quiet is not walking: no drift while still; a
- *   lone detection is no walk: the first step of a bout is credited when the second confirms it),
+ *   phone turning faster than a walker turns is a gesture; a walk that has not started moves nothing:
+ *   a bout's detections are credited together when the activity_bout_steps-th confirms it),
  *   its length is Weinberg's (sf_stride), its direction the walking direction in the map frame, and
  *   the position advances by length·(cos h, sin h).
  * MAG samples pass the online hard-iron calibration (sf_magcal: sphere fit, disturbance gated), and
@@ -72,7 +73,7 @@ typedef struct {
     double weinberg_sum; /* Σ range^¼ since the last stride calibration (for absolute fixes) */
     int32_t step_count;
     uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
-    sf_step_event_t held_event; /* the held first step of a bout (sf_activity.h) */
+    sf_step_event_t held_events[SF_ACTIVITY_BOUT_MAX]; /* the held detections of a bout (sf_activity.h) */
     /* absolute fixes (issue 4): the site and the matcher's workspace are the caller's */
     const sf_site_t *site;          /* NULL: no site, no Wi-Fi fixes */
     sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
@@ -89,12 +90,12 @@ _Static_assert(sizeof(sf_estimator_t) <= 32 * 1024, "sf_estimator.h promises at 
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);
 
-/* Most steps one IMU sample can credit: a bout's held first step and the step that confirms it. */
-#define SF_ESTIMATOR_MAX_STEPS 2
+/* Most steps one IMU sample can credit: a bout's held detections, the last of which confirms it. */
+#define SF_ESTIMATOR_MAX_STEPS SF_ACTIVITY_BOUT_MAX
 
 /* One IMU sample. Returns how many steps it credited (0..SF_ESTIMATOR_MAX_STEPS) and fills steps[]
- * in order; the position has then moved by each. The first detection of a bout is held until a
- * second one confirms it (sf_activity.h), so a lone jolt never moves the position. */
+ * in order; the position has then moved by each. The detections of a bout are held until
+ * activity_bout_steps of them confirm it (sf_activity.h), so a jolt or a gesture never moves the position. */
 int sf_estimator_imu(sf_estimator_t *est, const sf_params_t *p, const sf_imu_sample_t *sample,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS]);
 

@@ -97,10 +97,12 @@
 #define SF_PARAMS_ACTIVITY(X)                                                                          \
     X(activity, var_tau_s,         double,  1.0,     0.1,     20.0,    "s",     "time constant of the a_v mean/variance") \
     X(activity, still_var_m2ps4,   double,  0.05,    0.0,     100.0,   "m2/s4", "a_v variance below which the body is quiet (steps rejected)") \
-    X(activity, min_step_period_ms, int32_t, 400,    200,     2000,    "ms",    "a detection this soon after a bout's held first one does not confirm it") \
+    X(activity, min_step_period_ms, int32_t, 400,    200,     2000,    "ms",    "a detection this soon after a bout's previous held one does not continue it") \
     X(activity, still_time_ms,     int32_t, 2000,    100,     60000,   "ms",    "no step for this long (and quiet) is still") \
     X(activity, step_window_ms,    int32_t, 2500,    500,     10000,   "ms",    "steps counted over this window for the step rate") \
     X(activity, min_steps,         int32_t, 2,       1,       8,       "steps", "steps in the window needed to be walking") \
+    X(activity, bout_steps,        int32_t, 2,       2,       8,       "steps", "detections held before a walk is credited: 2 = one gait cycle (4, two cycles, was worse on msindoor site1/F2)") \
+    X(activity, max_rotation_radps, double, 3.14159, 0.1,     100.0,   "rad/s", "mean |gyro| above which detections are gestures, not steps: a U-turn takes a walker at least one stride (1 s)") \
     X(activity, stairs_vspeed_mps, double,  0.15,    0.01,    5.0,     "m/s",   "|baro vertical speed| beyond this while stepping is stairs") \
     X(activity, elevator_vspeed_mps, double, 0.30,   0.01,    10.0,    "m/s",   "|baro vertical speed| beyond this without steps is an elevator") \
     X(floor,  height_m,            double,  3.5,     1.0,     20.0,    "m",     "uniform floor-to-floor height (until a site file gives a table)") \

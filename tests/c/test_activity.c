@@ -1,6 +1,6 @@
 /* test_activity.c — sf_activity fed by sf_steps and sf_floor, as the estimator will wire them, on
  * synthetic IMU (sf_test_gait.h) and barometer signals: still, walking, stairs up and down, an
- * elevator ride, refused steps while still, determinism. */
+ * elevator ride, refused steps while still, gestures and handling that are no walk, determinism. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -159,7 +159,7 @@ static void test_still(void **state)
 }
 
 /* GIVEN a walker standing 5 s, WHEN she walks 60 steps on one floor and stops, THEN walking from the
- * second step to the last, still again 5 s after the last step (the walking variance, ≈ 2 m²/s⁴,
+ * bout's confirming (fourth) step to the last, still again 5 s after the last step (the walking variance, ≈ 2 m²/s⁴,
  * takes ≈ 3.7 τ to fall below 0.05), never stairs or elevator. */
 static void check_walk(const pace_t *const pace, const clock_t_ *const clk)
 {
@@ -167,9 +167,12 @@ static void check_walk(const pace_t *const pace, const clock_t_ *const clk)
     run(&g_tr, &sc, clk, 2);
     const gait_t *const g = &g_tr.gait;
     assert_true(fraction(&g_tr, 1.0, 4.0, sf_activity_still) == 1.0);
-    /* the second heel strike is detected ≈ 0.3 s late (Pan–Tompkins holds a peak for the refractory
-     * time) and only then credits the bout's held first step: walking from 0.4 s after it */
-    assert_true(fraction(&g_tr, g->t_s[1] + 0.4, g->t_s[60], sf_activity_walking) == 1.0);
+    /* the bout's fourth heel strike (activity_bout_steps) is detected ≈ 0.3 s late (Pan–Tompkins holds a
+     * peak for the refractory time) and only then credits the bout's held steps: walking from 0.4 s
+     * after it */
+    sf_params_t p;
+    sf_params_default(&p);
+    assert_true(fraction(&g_tr, g->t_s[p.activity_bout_steps - 1] + 0.4, g->t_s[60], sf_activity_walking) == 1.0);
     const double stop_s = g->t_s[60];
     assert_true(fraction(&g_tr, stop_s + 5.0, 60.0, sf_activity_still) == 1.0);
     assert_int_equal(count(&g_tr, 0, 60, sf_activity_stairs_up) + count(&g_tr, 0, 60, sf_activity_stairs_down) +
@@ -203,7 +206,9 @@ static void check_stairs(const double dh_m, const int16_t init_floor, const int8
     assert_true(fraction(&g_tr, up0 + 3.0, up1, want) > 0.95);
     assert_int_equal(count(&g_tr, 0, 60, never), 0);
     assert_int_equal(count(&g_tr, 0, 60, sf_activity_elevator), 0);
-    assert_true(fraction(&g_tr, g_tr.gait.t_s[2], up0, sf_activity_walking) == 1.0);
+    sf_params_t p;
+    sf_params_default(&p);
+    assert_true(fraction(&g_tr, g_tr.gait.t_s[p.activity_bout_steps], up0, sf_activity_walking) == 1.0);
     assert_true(fraction(&g_tr, up1 + 4.0, g_tr.gait.t_s[80], sf_activity_walking) == 1.0);
     assert_int_equal(g_tr.floor_at_end, floor_after);
 }
@@ -276,7 +281,9 @@ static void test_step_refused_while_still(void **state)
     for (int i = 0; i < 100; i++, t_us += 10000) {
         sf_activity_accel(&a, &p, t_us, 2.0 * sin(i * 0.35));
     }
-    /* the first detection of the bout is held, the second credits both, the third itself */
+    /* with bouts of two (activity_bout_steps = 2): the first detection of the bout is held, the second
+     * credits both, the third itself (bouts of the default length: test_walk_after_gesture) */
+    p.activity_bout_steps = 2;
     const int want[3] = {0, 2, 1};
     for (int i = 0; i < 3; i++) {
         const sf_step_event_t ev = {.t_us = t_us - 500000 * (3 - i), .amax_mps2 = 1, .amin_mps2 = -1, .period_s = 0.5};
@@ -284,6 +291,98 @@ static void test_step_refused_while_still(void **state)
     }
     assert_int_equal(sf_activity_current(&a), sf_activity_walking);
     assert_true(fabs(sf_activity_step_rate_hz(&a, &p) - 3 / 2.5) < 1e-12);
+}
+
+/* Feeds a_v and |ω| at 100 Hz over [t0, t1): a_v a 2 Hz sine of amp_mps2 (a moving body), |ω| constant. */
+static int64_t shake(sf_activity_t *const a, const sf_params_t *const p, const int64_t t0_us, const int64_t t1_us,
+                     const double amp_mps2, const double rate_radps)
+{
+    int64_t t_us = t0_us;
+    for (; t_us < t1_us; t_us += 10000) {
+        sf_activity_accel(a, p, t_us, amp_mps2 * sin(2.0 * 3.14159265358979 * 2.0 * (double)t_us * 1e-6));
+        sf_activity_gyro(a, p, t_us, rate_radps);
+    }
+    return t_us;
+}
+
+/* One detection at t_us, reported at the newest input (as sf_steps does). */
+static int detect(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us)
+{
+    const sf_step_event_t ev = {.t_us = t_us, .amax_mps2 = 3, .amin_mps2 = -3, .period_s = 0.5};
+    return sf_activity_step(a, p, &ev);
+}
+
+/* GIVEN a phone waved in the hand (the calibration figure-eights: a_v ±6 m/s², |ω| 5 rad/s) for 30 s
+ * WHEN the detector reports a step every 0.5 s, as it does on the gsd trials
+ * THEN none is credited; AND a walk that follows (|ω| 0.3 rad/s, 20 steps at 0.55 s) is credited in
+ * full, its first two steps together when the second confirms the bout. */
+static void test_walk_after_gesture(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_activity_t a;
+    sf_activity_init(&a, &p);
+    int64_t t_us = shake(&a, &p, 0, 1000000, 6.0, 5.0);
+    int credited = 0;
+    for (int i = 0; i < 60; i++) {
+        t_us = shake(&a, &p, t_us, t_us + 500000, 6.0, 5.0);
+        credited += detect(&a, &p, t_us - 100000);
+    }
+    assert_int_equal(credited, 0);
+    assert_int_equal(a.turning_steps, 60);
+    assert_int_equal(a.accepted_steps, 0);
+    assert_true(sf_activity_current(&a) != sf_activity_walking);
+    /* the hand calms down within the averaging time, then the person walks */
+    t_us = shake(&a, &p, t_us, t_us + 5000000, 1.0, 0.3);
+    const int want[6] = {0, 2, 1, 1, 1, 1};
+    for (int i = 0; i < 20; i++) {
+        t_us = shake(&a, &p, t_us, t_us + 550000, 1.0, 0.3);
+        const int n = detect(&a, &p, t_us - 100000);
+        if (i < 6) {
+            assert_int_equal(n, want[i]);
+        }
+        credited += n;
+    }
+    assert_int_equal(credited, 20);
+    assert_int_equal(a.accepted_steps, 20);
+    assert_int_equal(sf_activity_current(&a), sf_activity_walking);
+}
+
+/* GIVEN bouts of two gait cycles (activity_bout_steps = 4) and a person standing still and handling
+ * the phone (slow turns, |ω| 0.5 rad/s, a_v ±1 m/s²)
+ * WHEN the detector reports short runs of one to three detections 3 s apart (Trial01 repetition01's
+ * 43 s stop gave 25 steps)
+ * THEN none moves the position: each run is a bout that never reaches four steps (lone_steps); AND a
+ * run of four is credited at once. */
+static void test_handling_is_no_walk(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    p.activity_bout_steps = 4;
+    sf_activity_t a;
+    sf_activity_init(&a, &p);
+    int64_t t_us = shake(&a, &p, 0, 2000000, 1.0, 0.5);
+    int credited = 0, detections = 0;
+    for (int run = 0; run < 12; run++) {
+        const int n = 1 + run % 3;
+        for (int i = 0; i < n; i++, detections++) {
+            t_us = shake(&a, &p, t_us, t_us + 600000, 1.0, 0.5);
+            credited += detect(&a, &p, t_us - 100000);
+        }
+        t_us = shake(&a, &p, t_us, t_us + 3000000, 1.0, 0.5);
+    }
+    assert_int_equal(detections, 24);
+    assert_int_equal(credited, 0);
+    assert_int_equal(a.accepted_steps, 0);
+    assert_int_equal(a.lone_steps + (uint32_t)a.held_n, 24);
+    const int want[5] = {0, 0, 0, 4, 1};
+    for (int i = 0; i < 5; i++) {
+        t_us = shake(&a, &p, t_us, t_us + 600000, 1.0, 0.5);
+        assert_int_equal(detect(&a, &p, t_us - 100000), want[i]);
+    }
+    assert_int_equal(a.accepted_steps, 5);
 }
 
 static void test_deterministic(void **state)
@@ -304,6 +403,8 @@ int main(void)
         cmocka_unit_test(test_stairs_down),
         cmocka_unit_test(test_elevator),
         cmocka_unit_test(test_step_refused_while_still),
+        cmocka_unit_test(test_walk_after_gesture),
+        cmocka_unit_test(test_handling_is_no_walk),
         cmocka_unit_test(test_deterministic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
