@@ -25,8 +25,8 @@
  * clamp and bounds there), so one bad fix cannot wreck it.
  *
  * Absolute fixes: Wi-Fi scans are matched against the site's radio map (sf_fingerprint) and every
- * fix is offered to each of the six fusion schemes (sf_fusion: pdr_only, wifi_only, overwrite,
- * static, adaptive, kalman), which all run side by side on the same steps and fixes, so one log
+ * fix is offered to every fusion scheme of pose_t.SCHEME_* (sf_fusion.h; today pdr_only, wifi_only,
+ * overwrite, static, adaptive, kalman), which all run side by side on the same steps and fixes, so one log
  * compares them all. Each scheme's pose is sf_estimator_scheme_pose; sf_estimator_pose is the PDR
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
