@@ -156,3 +156,36 @@ def test_cli_modules_are_imported_only_by_the_top_cli():
         if dep == TOP_CLI or dep.endswith(".cli")
     }
     assert sorted(bad) == []
+
+
+# The analyzer's packages in data-flow order (docs/ARCHITECTURE.md): a module imports only from its own
+# package or from one above it in this list.
+LAYERS = (
+    "schemes",
+    "firmware",
+    "stages",
+    "io",
+    "datasets",
+    "radiomap",
+    "scoring",
+    "realbench",
+    "bench",
+    "crowd",
+    "cli",
+)
+
+
+def test_analyzer_imports_go_down_the_layers():
+    def layer(module: str) -> str | None:
+        parts = module.split(".")
+        return parts[1] if parts[0] == "stridefix_analyzer" and len(parts) > 1 else None
+
+    unlisted = {layer(m) for m in MODULES} - set(LAYERS) - {None, "__init__"}
+    assert unlisted == set(), "a new analyzer package needs its place in LAYERS (and in ARCHITECTURE.md)"
+    upward = sorted(
+        (m, dep)
+        for m, deps in GRAPH.items()
+        for dep in deps
+        if layer(m) in LAYERS and layer(dep) in LAYERS and LAYERS.index(layer(dep)) > LAYERS.index(layer(m))
+    )
+    assert upward == []
