@@ -122,9 +122,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 
     sf_heading_update(&e->heading, p, s->t_us, f_nav, sf_attitude_yaw_rad(&e->attitude));
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
-    sf_activity_gyro(&e->activity, p, s->t_us,
-                     sqrt(s->gyro_radps[0] * s->gyro_radps[0] + s->gyro_radps[1] * s->gyro_radps[1] +
-                          s->gyro_radps[2] * s->gyro_radps[2]));
+    sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
     e->heading_rad = walk_heading(e, p);
 
     sf_step_event_t ev;
