@@ -9,7 +9,9 @@
  *   phone turning faster than a walker turns, or about two axes at once, is a gesture; a walk that
  *   has not started moves nothing: a bout's detections are credited together when the
  *   activity_bout_steps-th confirms it),
- *   its length is Weinberg's (sf_stride), its direction the walking direction in the map frame, and
+ *   its length is Weinberg's (sf_stride) — on stairs (activity stairs_up/down) the stair's going,
+ *   L − 2R by Blondel's rule (2R + G = the level step), R = |vertical speed| × step period the rise —
+ *   its direction the walking direction in the map frame, and
  *   the position advances by length·(cos h, sin h).
  * MAG samples pass the online hard-iron calibration (sf_magcal: sphere fit, disturbance gated), and
  * the corrected field goes to the attitude; BARO samples to the floor (sf_floor), whose vertical
