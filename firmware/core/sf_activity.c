@@ -129,8 +129,10 @@ int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const s
         a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */
         return 0;
     }
-    if (a->rotation_radps > p->activity_max_rotation_radps) {
-        a->rejected_steps++; /* turning faster than a walker turns: a gesture; the walk starts anew */
+    if (a->rotation_radps > p->activity_max_rotation_radps ||
+        sf_activity_off_axis_radps(a) > p->activity_max_off_axis_radps) {
+        /* turning faster than a walker turns, or about two axes at once: a gesture; the walk starts anew */
+        a->rejected_steps++;
         a->turning_steps++;
         drop_held(a);
         a->last_detection_t_us = INT64_MIN / 2;
@@ -165,23 +167,57 @@ int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const s
 }
 
 void sf_activity_gyro(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,
-                      const double rate_radps)
+                      const double gyro_radps[3])
 {
+    const double w0 = gyro_radps[0], w1 = gyro_radps[1], w2 = gyro_radps[2];
+    const double rate_radps = sqrt(w0 * w0 + w1 * w1 + w2 * w2);
     if (!isfinite(rate_radps)) {
         return;
     }
+    /* ω ωᵀ: xx, yy, zz, xy, xz, yz */
+    const double outer[6] = {w0 * w0, w1 * w1, w2 * w2, w0 * w1, w0 * w2, w1 * w2};
     if (!a->gyro_started) {
         a->gyro_started = true;
         a->gyro_t_us = t_us;
         a->rotation_radps = rate_radps;
+        for (int i = 0; i < 6; i++) {
+            a->gyro_moment_r2ps2[i] = outer[i];
+        }
         return;
     }
     if (t_us <= a->gyro_t_us) {
         return;
     }
     const double dt_s = (double)(t_us - a->gyro_t_us) * 1e-6;
-    a->rotation_radps += -expm1(-dt_s / p->activity_var_tau_s) * (rate_radps - a->rotation_radps);
+    const double k = -expm1(-dt_s / p->activity_var_tau_s);
+    a->rotation_radps += k * (rate_radps - a->rotation_radps);
+    for (int i = 0; i < 6; i++) {
+        a->gyro_moment_r2ps2[i] += k * (outer[i] - a->gyro_moment_r2ps2[i]);
+    }
     a->gyro_t_us = t_us;
+}
+
+double sf_activity_off_axis_radps(const sf_activity_t *const a)
+{
+    /* middle eigenvalue of the symmetric 3×3 M (trigonometric solution of the characteristic cubic,
+     * Smith 1961): λ1 ≥ λ2 ≥ λ3, λ2 = tr M − λ1 − λ3 */
+    const double *const m = a->gyro_moment_r2ps2;
+    const double off = m[3] * m[3] + m[4] * m[4] + m[5] * m[5];
+    const double q = (m[0] + m[1] + m[2]) / 3.0;
+    const double d0 = m[0] - q, d1 = m[1] - q, d2 = m[2] - q;
+    const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * off;
+    if (!(p2 > 0.0)) {
+        return sqrt(fmax(q, 0.0)); /* isotropic (or no sample yet: 0) */
+    }
+    const double pp = sqrt(p2 / 6.0);
+    /* det((M − qI)/pp) / 2 */
+    const double b0 = d0 / pp, b1 = d1 / pp, b2 = d2 / pp, b3 = m[3] / pp, b4 = m[4] / pp, b5 = m[5] / pp;
+    const double det = b0 * (b1 * b2 - b5 * b5) - b3 * (b3 * b2 - b5 * b4) + b4 * (b3 * b5 - b1 * b4);
+    const double r = fmin(fmax(0.5 * det, -1.0), 1.0);
+    const double phi = acos(r) / 3.0;
+    const double l1 = q + 2.0 * pp * cos(phi);
+    const double l3 = q + 2.0 * pp * cos(phi + 2.0 * 3.14159265358979323846 / 3.0);
+    return sqrt(fmax(3.0 * q - l1 - l3, 0.0));
 }
 
 void sf_activity_vspeed(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us,

@@ -42,17 +42,28 @@
  * above activity_max_rotation_radps (π rad/s: a U-turn, the sharpest turn of a walk, takes at least a
  * stride, two steps at the usual ≈ 2 Hz, ≈ 1 s) refuses the detection (counted in rejected_steps and
  * in turning_steps) and ends the bout: the walk must start again after the gesture. Measured on the
- * gsd hand-held walks: ≤ 1.8 rad/s while walking, 3–7 rad/s while waving. DEVIATION: a phone swung in
- * the hand at the arm's pendulum (±45° at 1 Hz is ≈ 3 rad/s) would be refused as well; no data set
- * here has one.
+ * gsd hand-held walks: ≤ 1.8 rad/s while walking, 3–7 rad/s while waving. A slower wave is caught by
+ * how it turns: a walker's device turns about one axis at a time — the vertical in a turn, the
+ * shoulder's pendulum axis when swung in the hand — and only sways about the others with the gait,
+ * while a figure-eight turns it about two or three axes at once. The EW mean (activity_var_tau_s) of
+ * ω ωᵀ (body frame, no attitude needed) has eigenvalues λ1 ≥ λ2 ≥ λ3; √λ2, the RMS rate about the
+ * second principal axis (sf_activity_off_axis_radps), above activity_max_off_axis_radps refuses the
+ * detection the same way. The bound is the sway's: a sine of amplitude A at the step rate f has RMS
+ * rate A·2πf/√2; A = 5° at the fastest step rate, 2.5 Hz (the 0.4 s of activity_min_step_period_ms),
+ * gives 0.97 rad/s, rounded to 1.0. Measured over the second before each detection: gsd walks
+ * ≤ 0.69 rad/s, msindoor site2/F3 walks ≤ 0.90 (a phone swung at a walk's start: its tilt rate reached
+ * 3 rad/s, about one axis, so a tilt-rate bound refused those steps and this one does not), the gsd
+ * gestures that the |ω| rule let through 0.46 (10th percentile), 0.98 (median).
+ * DEVIATION: a phone swung in the hand at the arm's pendulum (±45° at 1 Hz is ≈ 3 rad/s) would be
+ * refused as well; no data set here has one.
  *
  * False steps while still. sf_activity_step refuses (returns false, counts in `rejected_steps`) a
  * step that comes while σ² < activity_still_var_m2ps4: a body that quiet is not walking, whatever the
  * detector saw. A refused step does not count for the rules above; the estimator must not move the
  * position for it. While the class is still, the estimator also holds the position (zero-velocity).
  *
- * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v or |ω| sample. Memory: sizeof(sf_activity_t) =
- * 248 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
+ * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v or gyro sample, one 3×3 eigenvalue (an acos,
+ * two cos) per detection. Memory: sizeof(sf_activity_t) = 296 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
 #ifndef SF_ACTIVITY_H
 #define SF_ACTIVITY_H
 
@@ -87,6 +98,7 @@ typedef struct {
     bool gyro_started;
     int64_t gyro_t_us;         /* newest |ω| time */
     double rotation_radps;     /* EW mean of |ω| */
+    double gyro_moment_r2ps2[6]; /* EW mean of ω ωᵀ (body): xx, yy, zz, xy, xz, yz */
     uint32_t turning_steps;    /* detections refused as gestures (also in rejected_steps) */
     int64_t last_detection_t_us; /* newest detection that was not refused */
 } sf_activity_t;
@@ -97,9 +109,13 @@ void sf_activity_init(sf_activity_t *a, const sf_params_t *p);
 /* One a_v sample [m/s²]. Non-finite values and samples at or before the previous a_v time are ignored. */
 void sf_activity_accel(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double accel_v_mps2);
 
-/* One rotation-rate sample |ω| [rad/s] of the device. Non-finite values and samples at or before the
- * previous |ω| time are ignored. */
-void sf_activity_gyro(sf_activity_t *a, const sf_params_t *p, int64_t t_us, double rate_radps);
+/* One gyroscope sample ω [rad/s] of the device (body axes). Non-finite values and samples at or before
+ * the previous one's time are ignored. */
+void sf_activity_gyro(sf_activity_t *a, const sf_params_t *p, int64_t t_us, const double gyro_radps[3]);
+
+/* RMS rotation rate about the device's second principal rotation axis [rad/s]: the square root of
+ * the middle eigenvalue of the EW mean of ω ωᵀ; 0 before any gyro sample. */
+double sf_activity_off_axis_radps(const sf_activity_t *a);
 
 /* One step event. Returns how many steps the estimator should move now: 0 (refused: the body is
  * quiet or turning like a gesture; or held: a detection of a bout not yet confirmed), 1 (this step),

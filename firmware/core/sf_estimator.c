@@ -80,14 +80,25 @@ static double walk_heading(const sf_estimator_t *const e, const sf_params_t *con
 static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_step_event_t *const ev,
                  const int64_t now_us, sf_step_t *const step)
 {
-    const double length_m = sf_stride_length_m(&e->stride, ev);
+    /* On stairs the body climbs while it steps, and a stair's going G is what the step advances.
+     * Blondel's rule of stair design (2R + G = the level step, 0.63 m in building codes: a rise costs
+     * the walker twice its height in stride) turned around gives G = L − 2R, L the walker's own level
+     * (Weinberg) step and R = |v|·T the rise of this step from the barometric vertical speed and the
+     * step period. Only on the stairs class, whose speed threshold keeps baro noise off level ground. */
+    const int8_t activity = sf_activity_current(&e->activity);
+    const double level_m = sf_stride_length_m(&e->stride, ev);
+    const double rise_m = activity == sf_activity_stairs_up || activity == sf_activity_stairs_down
+                              ? fabs(sf_floor_vertical_speed_mps(&e->floor)) * ev->period_s
+                              : 0.0;
+    const double length_m = fmax(level_m - 2.0 * rise_m, 0.0);
     e->step_count++;
     e->x_m += length_m * cos(e->heading_rad);
     e->y_m += length_m * sin(e->heading_rad);
     /* (the fusion schemes move by the same displacement below) */
     e->distance_m += length_m;
     e->sigma_m += p->estimator_sigma_per_m * length_m;
-    e->weinberg_sum += sf_stride_weinberg_term(ev);
+    /* the calibration sum scaled like the length, so K·sum stays the distance moved */
+    e->weinberg_sum += level_m > 0.0 ? sf_stride_weinberg_term(ev) * (length_m / level_m) : 0.0;
     const double dx_m = length_m * cos(e->heading_rad), dy_m = length_m * sin(e->heading_rad);
     for (int s = 0; s < sf_scheme_count; s++) {
         sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
@@ -99,7 +110,7 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
     step->accel_range_mps2 = sf_stride_range_mps2(ev);
     step->period_s = ev->period_s;
     step->heading_rad = e->heading_rad;
-    step->activity = sf_activity_current(&e->activity);
+    step->activity = activity;
     step->floor = sf_floor_current(&e->floor);
 }
 
@@ -122,9 +133,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 
     sf_heading_update(&e->heading, p, s->t_us, f_nav, sf_attitude_yaw_rad(&e->attitude));
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
-    sf_activity_gyro(&e->activity, p, s->t_us,
-                     sqrt(s->gyro_radps[0] * s->gyro_radps[0] + s->gyro_radps[1] * s->gyro_radps[1] +
-                          s->gyro_radps[2] * s->gyro_radps[2]));
+    sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
     e->heading_rad = walk_heading(e, p);
 
     sf_step_event_t ev;

@@ -6,9 +6,12 @@
  *   heading (sf_heading: mounting offset from the gait)   activity (sf_activity: a_v variance)
  *   steps (sf_steps: Pan–Tompkins or trough-peak)  → step event
  *   the step is accepted by sf_activity (a body that quiet is not walking: no drift while still; a
- *   phone turning faster than a walker turns is a gesture; a walk that has not started moves nothing:
- *   a bout's detections are credited together when the activity_bout_steps-th confirms it),
- *   its length is Weinberg's (sf_stride), its direction the walking direction in the map frame, and
+ *   phone turning faster than a walker turns, or about two axes at once, is a gesture; a walk that
+ *   has not started moves nothing: a bout's detections are credited together when the
+ *   activity_bout_steps-th confirms it),
+ *   its length is Weinberg's (sf_stride) — on stairs (activity stairs_up/down) the stair's going,
+ *   L − 2R by Blondel's rule (2R + G = the level step), R = |vertical speed| × step period the rise —
+ *   its direction the walking direction in the map frame, and
  *   the position advances by length·(cos h, sin h).
  * MAG samples pass the online hard-iron calibration (sf_magcal: sphere fit, disturbance gated), and
  * the corrected field goes to the attitude; BARO samples to the floor (sf_floor), whose vertical
@@ -31,7 +34,7 @@
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 30 064 B on x86-64 (29 844 B on i686), at most 32 KiB (checked); the
+ * Memory: sizeof(sf_estimator_t) = 30 424 B on x86-64 (i686 not rechecked), at most 32 KiB (checked); the
  * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B). Cost per IMU sample:
  * a few hundred flops; per MAG sample a few kflop (the sf_magcal solve). */
 #ifndef SF_ESTIMATOR_H

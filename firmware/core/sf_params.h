@@ -103,6 +103,7 @@
     X(activity, min_steps,         int32_t, 2,       1,       8,       "steps", "steps in the window needed to be walking") \
     X(activity, bout_steps,        int32_t, 2,       2,       8,       "steps", "detections held before a walk is credited: 2 = one gait cycle (4, two cycles, was worse on msindoor site1/F2)") \
     X(activity, max_rotation_radps, double, 3.14159, 0.1,     100.0,   "rad/s", "mean |gyro| above which detections are gestures, not steps: a U-turn takes a walker at least one stride (1 s)") \
+    X(activity, max_off_axis_radps, double, 1.0,     0.1,     100.0,   "rad/s", "RMS gyro rate about the second principal axis above which detections are gestures: a walker turns about one axis at a time, the others only sway (5 deg at 2.5 Hz: 0.97 rad/s)") \
     X(activity, stairs_vspeed_mps, double,  0.15,    0.01,    5.0,     "m/s",   "|baro vertical speed| beyond this while stepping is stairs") \
     X(activity, elevator_vspeed_mps, double, 0.30,   0.01,    10.0,    "m/s",   "|baro vertical speed| beyond this without steps is an elevator") \
     X(floor,  height_m,            double,  3.5,     1.0,     20.0,    "m",     "uniform floor-to-floor height (until a site file gives a table)") \

@@ -293,16 +293,28 @@ static void test_step_refused_while_still(void **state)
     assert_true(fabs(sf_activity_step_rate_hz(&a, &p) - 3 / 2.5) < 1e-12);
 }
 
-/* Feeds a_v and |ω| at 100 Hz over [t0, t1): a_v a 2 Hz sine of amp_mps2 (a moving body), |ω| constant. */
-static int64_t shake(sf_activity_t *const a, const sf_params_t *const p, const int64_t t0_us, const int64_t t1_us,
-                     const double amp_mps2, const double rate_radps)
+/* Feeds a_v and ω at 100 Hz over [t0, t1): a_v a 2 Hz sine of amp_mps2 (a moving body); ω =
+ * (wx cos 2π·2t, wy sin 2π·2t, wz) [rad/s]: with wx = wy = 0 a constant rate about one axis, otherwise
+ * an axis that sweeps the x-y plane (√λ2 of ω ωᵀ = min(wx, wy)/√2 when wz = 0). */
+static int64_t shake_gyro(sf_activity_t *const a, const sf_params_t *const p, const int64_t t0_us,
+                          const int64_t t1_us, const double amp_mps2, const double wx, const double wy,
+                          const double wz)
 {
     int64_t t_us = t0_us;
     for (; t_us < t1_us; t_us += 10000) {
-        sf_activity_accel(a, p, t_us, amp_mps2 * sin(2.0 * 3.14159265358979 * 2.0 * (double)t_us * 1e-6));
-        sf_activity_gyro(a, p, t_us, rate_radps);
+        const double ph = 2.0 * 3.14159265358979 * 2.0 * (double)t_us * 1e-6;
+        sf_activity_accel(a, p, t_us, amp_mps2 * sin(ph));
+        const double w[3] = {wx * cos(ph), wy * sin(ph), wz};
+        sf_activity_gyro(a, p, t_us, w);
     }
     return t_us;
+}
+
+/* shake_gyro about one fixed axis: |ω| = rate_radps constant, nothing off that axis. */
+static int64_t shake(sf_activity_t *const a, const sf_params_t *const p, const int64_t t0_us, const int64_t t1_us,
+                     const double amp_mps2, const double rate_radps)
+{
+    return shake_gyro(a, p, t0_us, t1_us, amp_mps2, 0.0, 0.0, rate_radps);
 }
 
 /* One detection at t_us, reported at the newest input (as sf_steps does). */
@@ -385,6 +397,54 @@ static void test_handling_is_no_walk(void **state)
     assert_int_equal(a.accepted_steps, 5);
 }
 
+/* GIVEN a phone waved slowly in the hand (the gsd calibration gestures that the |ω| rule let through:
+ * |ω| 2 rad/s, below π, its axis sweeping two directions, √λ2 = 1.41 rad/s)
+ * WHEN the detector reports a step every 0.5 s for 20 s
+ * THEN none is credited (all refused as gestures); AND a walker swinging the phone at 3 rad/s about one
+ * axis while turning at 0.5 rad/s, then one whose phone sways about a second axis at √λ2 = 0.9 rad/s
+ * (inside the 1.0 rad/s bound), have all their 2 × 20 steps credited; AND a sway of 1.1 rad/s is refused. */
+static void test_two_axis_gesture_is_no_walk(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    assert_true(fabs(p.activity_max_off_axis_radps - 1.0) < 1e-12);
+    sf_activity_t a;
+    sf_activity_init(&a, &p);
+    assert_true(sf_activity_off_axis_radps(&a) == 0.0);
+    int64_t t_us = shake_gyro(&a, &p, 0, 1000000, 4.0, 2.0, 2.0, 0.0);
+    int credited = 0;
+    for (int i = 0; i < 40; i++) {
+        t_us = shake_gyro(&a, &p, t_us, t_us + 500000, 4.0, 2.0, 2.0, 0.0);
+        assert_true(sf_activity_off_axis_radps(&a) > 1.2); /* √2 within the EW ripple and start */
+        credited += detect(&a, &p, t_us - 100000);
+    }
+    assert_int_equal(credited, 0);
+    assert_int_equal(a.turning_steps, 40);
+    /* swung about x, turning about z: two axes, but the second is slow */
+    t_us = shake_gyro(&a, &p, t_us, t_us + 5000000, 1.0, 3.0, 0.0, 0.5);
+    for (int i = 0; i < 20; i++) {
+        t_us = shake_gyro(&a, &p, t_us, t_us + 550000, 1.0, 3.0, 0.0, 0.5);
+        assert_true(sf_activity_off_axis_radps(&a) < 0.6);
+        credited += detect(&a, &p, t_us - 100000);
+    }
+    assert_int_equal(credited, 20);
+    const double sway_in = 0.9 * sqrt(2.0), sway_out = 1.1 * sqrt(2.0);
+    t_us = shake_gyro(&a, &p, t_us, t_us + 5000000, 1.0, 2.5, sway_in, 0.0);
+    for (int i = 0; i < 20; i++) {
+        t_us = shake_gyro(&a, &p, t_us, t_us + 550000, 1.0, 2.5, sway_in, 0.0);
+        assert_true(fabs(sf_activity_off_axis_radps(&a) - 0.9) < 0.05);
+        credited += detect(&a, &p, t_us - 100000);
+    }
+    assert_int_equal(credited, 40);
+    assert_int_equal(a.accepted_steps, 40);
+    assert_int_equal(a.turning_steps, 40);
+    t_us = shake_gyro(&a, &p, t_us, t_us + 5000000, 1.0, 2.5, sway_out, 0.0);
+    assert_true(fabs(sf_activity_off_axis_radps(&a) - 1.1) < 0.05);
+    assert_int_equal(detect(&a, &p, t_us - 100000), 0);
+    assert_int_equal(a.turning_steps, 41);
+}
+
 static void test_deterministic(void **state)
 {
     (void)state;
@@ -405,6 +465,7 @@ int main(void)
         cmocka_unit_test(test_step_refused_while_still),
         cmocka_unit_test(test_walk_after_gesture),
         cmocka_unit_test(test_handling_is_no_walk),
+        cmocka_unit_test(test_two_axis_gesture_is_no_walk),
         cmocka_unit_test(test_deterministic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

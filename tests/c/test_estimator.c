@@ -46,7 +46,10 @@ static void nav_to_body(const double v[3], double yaw, double out[3])
     out[2] = v[2];
 }
 
-static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offset_rad, double step_hz)
+/* climb_mps: the walker rises at this speed while walking (stairs; the barometer at 10 Hz sees it,
+ * the IMU does not: the same gait as on level ground) */
+static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offset_rad, double step_hz,
+                             double climb_mps)
 {
     sf_params_t p;
     sf_params_default(&p);
@@ -84,6 +87,11 @@ static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offs
             nav_to_body(m_nav, device_yaw, m_body);
             sf_estimator_mag(&est, &p, s.t_us, m_body);
         }
+        if (k % 10 == 0) {
+            const double h_m = climb_mps * fmin(fmax(tw, 0.0), walk_s);
+            /* the inverse of sf_floor's height(p) = 44330.77 (1 − (p/101325)^0.190263) */
+            sf_estimator_baro(&est, &p, s.t_us, 101325.0 * pow(1.0 - h_m / 44330.77, 1.0 / 0.190263));
+        }
         sf_step_t steps[SF_ESTIMATOR_MAX_STEPS];
         memset(steps, 0, sizeof steps); /* padding too: the digest hashes raw bytes */
         const int n = sf_estimator_imu(&est, &p, &s, steps);
@@ -119,7 +127,7 @@ static void test_counts_steps_and_walks_straight(void **state)
 {
     (void)state;
     const double dir = 30.0 * PI / 180.0;
-    const run_result_t r = run_walk(100, dir, 0.0, 1.8);
+    const run_result_t r = run_walk(100, dir, 0.0, 1.8, 0.0);
     assert_int_equal(r.steps, 100);
     const double dist = hypot(r.x_m, r.y_m);
     assert_true(dist > 30.0 && dist < 120.0); /* Weinberg with the default K, 0.3–1.2 m per step */
@@ -131,7 +139,7 @@ static void test_counts_steps_and_walks_straight(void **state)
 static void test_still_does_not_drift(void **state)
 {
     (void)state;
-    const run_result_t r = run_walk(60, 0.0, 0.0, 1.8);
+    const run_result_t r = run_walk(60, 0.0, 0.0, 1.8, 0.0);
     /* 9 s of standing after the walk: not a millimetre */
     assert_true(r.x_m == r.walk_end_x_m && r.y_m == r.walk_end_y_m);
 }
@@ -140,7 +148,7 @@ static void test_mounting_offset_is_learnt(void **state)
 {
     (void)state;
     const double dir = -60.0 * PI / 180.0;
-    const run_result_t r = run_walk(120, dir, 90.0 * PI / 180.0, 1.8);
+    const run_result_t r = run_walk(120, dir, 90.0 * PI / 180.0, 1.8, 0.0);
     /* the second half of the walk, after the offset is learnt, goes the right way */
     const double dx = r.x_m - r.mid_x_m, dy = r.y_m - r.mid_y_m;
     assert_true(angle_deg(atan2(dy, dx) - dir) < 5.0);
@@ -152,16 +160,34 @@ static void test_paces(void **state)
     (void)state;
     const double hz[] = {1.4, 1.8, 2.2};
     for (int i = 0; i < 3; i++) {
-        const run_result_t r = run_walk(150, 1.0, 0.0, hz[i]);
+        const run_result_t r = run_walk(150, 1.0, 0.0, hz[i], 0.0);
         assert_int_equal(r.steps, 150);
     }
+}
+
+/* GIVEN the same gait on level ground and climbing stairs (0.3 m/s: a 17 cm riser per step at 1.8 Hz)
+ * WHEN both walks go through the estimator
+ * THEN a stairs step advances Blondel's going G = L − 2R (L the level step, R = v·T its rise) and a
+ * level step L: the last steps differ by 2 · 0.3 m/s · T, within 1 cm. */
+static void test_stairs_step_is_the_going(void **state)
+{
+    (void)state;
+    const run_result_t level = run_walk(60, 0.5, 0.0, 1.8, 0.0);
+    const run_result_t stairs = run_walk(60, 0.5, 0.0, 1.8, 0.3);
+    assert_int_equal(level.last_step.activity, sf_activity_walking);
+    assert_int_equal(stairs.last_step.activity, sf_activity_stairs_up);
+    assert_int_equal(stairs.steps, level.steps);
+    const double rise_m = 0.3 * stairs.last_step.period_s;
+    assert_true(fabs(stairs.last_step.period_s - 1.0 / 1.8) < 0.05);
+    assert_true(fabs((level.last_step.length_m - stairs.last_step.length_m) - 2.0 * rise_m) < 0.01);
+    assert_true(stairs.last_step.length_m > 0.2 && stairs.last_step.length_m < level.last_step.length_m - 0.25);
 }
 
 static void test_same_input_gives_identical_output(void **state)
 {
     (void)state;
-    const run_result_t a = run_walk(80, 2.0, 0.5, 1.9);
-    const run_result_t b = run_walk(80, 2.0, 0.5, 1.9);
+    const run_result_t a = run_walk(80, 2.0, 0.5, 1.9, 0.0);
+    const run_result_t b = run_walk(80, 2.0, 0.5, 1.9, 0.0);
     assert_true(a.digest == b.digest);
     assert_true(a.x_m == b.x_m && a.y_m == b.y_m && a.steps == b.steps);
     assert_true(a.last_step.length_m == b.last_step.length_m && a.last_step.t_us == b.last_step.t_us);
@@ -174,6 +200,7 @@ int main(void)
         cmocka_unit_test(test_still_does_not_drift),
         cmocka_unit_test(test_mounting_offset_is_learnt),
         cmocka_unit_test(test_paces),
+        cmocka_unit_test(test_stairs_step_is_the_going),
         cmocka_unit_test(test_same_input_gives_identical_output),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

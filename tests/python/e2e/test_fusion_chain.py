@@ -181,13 +181,25 @@ def office_walk(stridefixd, cli, default_walk, tmp_path_factory) -> list:
 
 
 def test_stride_is_recalibrated_from_fixes(office_walk):
-    """Weinberg's K (length / range^¼ of each STEP) starts at the configured 0.47 and is moved by
+    """Weinberg's K (length / range^¼ of each level STEP) starts at the configured 0.47 and is moved by
     Kalman-accepted fixes over the corridors' straight stretches, within its bounds and by at most
-    10 % a time."""
+    10 % a time. A stairs STEP is shorter than K · range^¼ (the going, L − 2R: sf_estimator.h)."""
     from stridefix import step_t
 
     steps = [step_t.decode(e.data) for e in office_walk if e.channel == "STEP"]
-    k = np.array([s.length_m / s.accel_range_mps2**0.25 for s in steps if s.accel_range_mps2 > 0])
+    stairs = (step_t.ACTIVITY_STAIRS_UP, step_t.ACTIVITY_STAIRS_DOWN)
+    level = [s for s in steps if s.accel_range_mps2 > 0 and s.activity not in stairs]
+    k = np.array([s.length_m / s.accel_range_mps2**0.25 for s in level])
+    level_t_us = [lv.t_us for lv in level]
+    n_stairs = 0
+    for s in steps:
+        if s.activity in stairs:
+            i = max(
+                int(np.searchsorted(level_t_us, s.t_us, side="right")) - 1, 0
+            )  # K of the level step before
+            assert s.length_m < k[i] * s.accel_range_mps2**0.25 + 1e-4
+            n_stairs += 1
+    assert n_stairs > 0  # the default walk climbs the staircase
     assert abs(k[0] - 0.47) < 1e-3
     changes = np.flatnonzero(np.abs(np.diff(k)) > 1e-4)
     assert len(changes) >= 2
