@@ -31,12 +31,12 @@ def run_fw(stridefixd: Path, walk: Path, log: Path, *extra: str) -> subprocess.C
     )
 
 
-@pytest.fixture(scope="module")
-def site(stridefixd, cli, tmp_path_factory) -> Path:
-    """The surveyed foyer as a site file (survey seed 1000, never a scored walk)."""
-    out = tmp_path_factory.mktemp("survey")
-    assert cli("sim", "--scenario", "aadr2015_survey", "--seed", "1000", "--out", str(out)).returncode == 0
-    summary = json.loads((out / "sim_summary.json").read_text())
+def survey_site(stridefixd: Path, cli, out: Path, scenario: str, rotation_deg: float | None) -> Path:
+    """A survey (seed 1000, never a scored walk) recorded through stridefixd and built into a site
+    file; the map rotation is the survey's own (from its summary) unless given."""
+    assert cli("sim", "--scenario", scenario, "--seed", "1000", "--out", str(out)).returncode == 0
+    if rotation_deg is None:
+        rotation_deg = json.loads((out / "sim_summary.json").read_text())["map_rotation_deg"]
     assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
     site = out / "site.sfsite"
     proc = cli(
@@ -49,10 +49,17 @@ def site(stridefixd, cli, tmp_path_factory) -> Path:
         "--out",
         str(site),
         "--map-rotation-deg",
-        str(summary["map_rotation_deg"]),
+        str(rotation_deg),
     )
     assert proc.returncode == 0, proc.stderr
     return site
+
+
+@pytest.fixture(scope="module")
+def site(stridefixd, cli, tmp_path_factory) -> Path:
+    """The surveyed foyer as a site file (survey seed 1000, never a scored walk)."""
+    out = tmp_path_factory.mktemp("survey")
+    return survey_site(stridefixd, cli, out, "aadr2015_survey", rotation_deg=None)
 
 
 @pytest.fixture(scope="module")
@@ -158,22 +165,7 @@ def test_bad_site_file_stops_startup(stridefixd, walk, site, tmp_path, damage):
 def office_walk(stridefixd, cli, default_walk, tmp_path_factory) -> list:
     """The default office walk replayed with a site from a survey of the office (seed 1000)."""
     out = tmp_path_factory.mktemp("office_survey")
-    assert cli("sim", "--scenario", "office_survey", "--seed", "1000", "--out", str(out)).returncode == 0
-    assert run_fw(stridefixd, out, out / "fw.lcmlog").returncode == 0
-    site = out / "site.sfsite"
-    proc = cli(
-        "radiomap",
-        "build",
-        str(out / "fw.lcmlog"),
-        str(out / "truth.lcmlog"),
-        "--mode",
-        "survey",
-        "--out",
-        str(site),
-        "--map-rotation-deg",
-        "20",
-    )
-    assert proc.returncode == 0, proc.stderr
+    site = survey_site(stridefixd, cli, out, "office_survey", rotation_deg=20.0)
     log = out / "walk.lcmlog"
     proc = run_fw(stridefixd, default_walk["dir"], log, "--site", str(site))
     assert proc.returncode == 0, proc.stderr
