@@ -8,8 +8,8 @@ Four cases, each a committed CSV beside this file:
 - ``gsd.csv``        one gsd trial on a map built from the other three trials of the building
 
 The harness only drives the public commands (``stridefix sim|import|radiomap build`` and
-``stridefixd``) and reads the firmware's LCM log with the generated bindings, so a refactor of the
-analyzer cannot change what it measures. Each row is one scheme at one whole second of board time:
+``stridefixd``, with a real data set's declared ``firmware_sets``) and reads the firmware's LCM log
+with the generated bindings, so a refactor of the analyzer cannot change what it measures. Each row is one scheme at one whole second of board time:
 the latest POSE at or before it (x, y, floor, heading, σ, step count) and the FIX verdicts of the
 second that ended then (accepted, rejected, the last reason code). Values are printed at fixed
 precision, so the files are byte-identical when behaviour is.
@@ -146,11 +146,16 @@ def case_aadr2015(work: Path, stridefixd: Path) -> Path:
     return _sim_case(work, stridefixd, "aadr2015_survey", ["--scenario", "aadr2015", "--seed", "1"])
 
 
-def _replay_on_map(work: Path, stridefixd: Path, held: Path, others: list[Path]) -> Path:
+def _replay_on_map(work: Path, stridefixd: Path, fmt: str, held: Path, others: list[Path]) -> Path:
+    """The held-out walk replayed on a map of the others, with the data set's own firmware overrides
+    (``Dataset.firmware_sets``: what realbench replays with too)."""
+    from stridefix_analyzer import datasets
+
     site = work / "site.sfsite"
     _run([_stridefix(), "radiomap", "build", *others, "--mode", "walk", "--min-count", "1", "--out", site])
     log = work / "run.lcmlog"
-    _run([stridefixd, "--replay", held, "--log", log, "--site", site, "-q"])
+    sets = [a for kv in datasets.get(fmt).firmware_sets for a in ("--set", kv)]
+    _run([stridefixd, "--replay", held, "--log", log, "--site", site, "-q", *sets])
     return log
 
 
@@ -165,7 +170,7 @@ def case_msindoor(work: Path, stridefixd: Path) -> Path:
     imp = work / "import"
     _run([_stridefix(), "import", "msindoor", *chosen, "--out", imp])
     logs = [imp / f"{t.stem}.lcmlog" for t in chosen]
-    return _replay_on_map(work, stridefixd, logs[0], logs[1:])
+    return _replay_on_map(work, stridefixd, "msindoor", logs[0], logs[1:])
 
 
 def _first_posi(path: Path) -> str:
@@ -185,7 +190,7 @@ def case_gsd(work: Path, stridefixd: Path) -> Path:
     _run([_stridefix(), "import", "gsd", *trials, "--out", imp, f"--origin={_first_posi(trials[0])}"])
     logs = [imp / f"{t.stem}.lcmlog" for t in trials]
     held = logs[-1]  # the shortest-named last trial; the other three build the map
-    return _replay_on_map(work, stridefixd, held, logs[:-1])
+    return _replay_on_map(work, stridefixd, "gsd", held, logs[:-1])
 
 
 CASES: dict[str, Callable[[Path, Path], Path]] = {

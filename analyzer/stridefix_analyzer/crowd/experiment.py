@@ -301,7 +301,14 @@ def _ms_walk(trace: Path, cache: Path, firmware: Firmware) -> dict:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             datasets.get("msindoor").import_walk(trace, log)
-        replay(firmware, f"stridefixd {trace.name}", CrowdInputError, input=f"lcmlog:{log}", log=fw)
+        replay(
+            firmware,
+            f"stridefixd {trace.name}",
+            CrowdInputError,
+            input=f"lcmlog:{log}",
+            log=fw,
+            sets=datasets.get("msindoor").firmware_sets,
+        )
     return {"trace": trace.name, "spec": f"{fw},{log}"}
 
 

@@ -112,6 +112,10 @@ class Dataset(abc.ABC):
     #: bump when the log content for the same input changes (caches compare it)
     version: ClassVar[int] = 1
     defaults: ClassVar[Defaults] = Defaults(max_wifi_age_s=2.0)
+    #: firmware overrides (KEY=VALUE) for what the recording device already did to its samples, so the
+    #: firmware does not do it twice; realbench and crowd replay this set's walks with them, before any
+    #: ``--set`` of the user (which wins)
+    firmware_sets: ClassVar[tuple[str, ...]] = ()
     #: position in listings (help texts, choices); the built-in sets in the order they were added
     list_order: ClassVar[int] = 100
 

@@ -107,8 +107,10 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     Returns the JSON document (non-finite numbers still NaN). Raises :class:`.walks.RealbenchError`.
     """
     t_start = time.perf_counter()
-    fw = firmware(cfg.stridefixd or Firmware().path, cfg.param_sets)
     ds = dataset(cfg.fmt)
+    # the data set's own overrides first, the user's --set after them (the later one wins)
+    cfg = dataclasses.replace(cfg, param_sets=(*ds.firmware_sets, *cfg.param_sets))
+    fw = firmware(cfg.stridefixd or Firmware().path, cfg.param_sets)
     age = ds.defaults.max_wifi_age_s if cfg.max_wifi_age_s is None else cfg.max_wifi_age_s
     out_dir = cfg.out_json.parent if str(cfg.out_json.parent) else Path(".")
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -96,7 +96,7 @@ def prepare_walk(
     walk["warnings"] += summary.get("warnings", [])
     fw_log = fw_dir / f"{trace.stem}.lcmlog"
     try:
-        fw.run(input=f"lcmlog:{summary['out']}", log=fw_log)
+        fw.run(input=f"lcmlog:{summary['out']}", log=fw_log, sets=dataset(DATASET).firmware_sets)
     except FirmwareError as exc:
         walk["error"] = str(exc)
         return walk

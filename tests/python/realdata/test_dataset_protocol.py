@@ -228,3 +228,11 @@ def test_side_files_of_the_builtin_sets():
     assert plan is not None and plan.width_m == pytest.approx(239.8175, abs=1e-3)
     assert plan.image is not None and plan.geojson["type"] == "FeatureCollection"
     assert datasets.get("msindoor").beacons(MSINDOOR / "site1" / "F2") is None
+
+
+def test_phone_data_sets_switch_the_second_hard_iron_fit_off():
+    # both record Android's TYPE_MAGNETIC_FIELD, already hard-iron calibrated by the phone's OS
+    from stridefix_analyzer import datasets as registry
+
+    for name in ("msindoor", "gsd"):
+        assert "magcal.enable=0" in registry.get(name).firmware_sets

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import truth_t, wifi_scan_t
-from stridefix_analyzer import schemes
+from stridefix_analyzer import datasets, schemes
 from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
@@ -25,6 +25,7 @@ from stridefix_analyzer.realbench import floors, heading
 from stridefix_analyzer.realbench import fold as rfold
 
 SCHEMES = schemes.NAMES
+MSINDOOR_SETS = datasets.get("msindoor").firmware_sets
 
 
 # --- synthetic walks with WIFI + TRUTH -------------------------------------------------------------
@@ -228,6 +229,8 @@ def test_end_to_end_on_five_real_walks(realbench_fusion_small):
     assert "kalman" in r["proc"].stdout and "adaptive vs wifi_only" in r["proc"].stdout
     (g,) = r["doc"]["groups"]
     assert g["label"] == "site1/F2" and g["walks"] == 5 and not g["fold_errors"]
+    # the data set's own firmware overrides are applied and recorded (its magnetometer is OS-calibrated)
+    assert r["doc"]["params"]["firmware_sets"][: len(MSINDOOR_SETS)] == list(MSINDOOR_SETS)
     table = g["summary"]["schemes"]
     assert set(table) == set(SCHEMES)
     for name, s in table.items():
