@@ -9,6 +9,7 @@ of ``firmware/core/sf_params.h``). Python never spells the list of parameter key
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import functools
 import json
@@ -41,6 +42,16 @@ class Param:
 def default_path() -> Path:
     """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary."""
     return Path(os.environ.get("STRIDEFIXD") or DEFAULT_STRIDEFIXD)
+
+
+def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
+    """The ``--stridefixd PATH`` option every command that replays through the firmware takes."""
+    parser.add_argument(
+        "--stridefixd",
+        default=str(default_path()),
+        metavar="PATH",
+        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd)",
+    )
 
 
 def set_args(sets: Iterable[str]) -> list[str]:

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer.bench import fusion, sil_pdr
-from stridefix_analyzer.firmware import Firmware, FirmwareError, default_path
+from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
 DEFAULT_OUT = "out/bench"
@@ -104,12 +104,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="LIST",
         help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5)",
     )
-    p.add_argument(
-        "--stridefixd",
-        default=str(default_path()),
-        metavar="PATH",
-        help=f"the firmware binary (default: {default_path()})",
-    )
+    add_stridefixd_argument(p)
     p.add_argument(
         "--out", default=DEFAULT_OUT, metavar="DIR", help=f"output directory (default: {DEFAULT_OUT})"
     )

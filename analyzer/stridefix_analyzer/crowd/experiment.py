@@ -35,7 +35,7 @@ from stridefix_analyzer.crowd.positions import solve_walks
 from stridefix_analyzer.crowd.sites import build_crowd_sites
 from stridefix_analyzer.crowd.solve import error_stats
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
-from stridefix_analyzer.firmware import Firmware, default_path
+from stridefix_analyzer.firmware import Firmware, add_stridefixd_argument
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
 DEFAULT_OUT = os.path.join("out", "crowd", "experiment")
@@ -383,11 +383,7 @@ def add_arguments(p) -> None:
     p.add_argument(
         "--out", default=DEFAULT_OUT, metavar="DIR", help=f"outputs and caches (default {DEFAULT_OUT})"
     )
-    p.add_argument(
-        "--stridefixd",
-        default=str(default_path()),
-        help="firmware binary (default $STRIDEFIXD or build/firmware/stridefixd)",
-    )
+    add_stridefixd_argument(p)
     p.add_argument("--scenario", default="pace_normal", help="SIL scenario (default pace_normal)")
     p.add_argument("--seeds", default="1,2,3,4,5,6", help="SIL scored walkers (default 1..6)")
     p.add_argument("--fit-seeds", default="101,102", help="SIL model-fitting walkers")

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer import datasets
-from stridefix_analyzer.firmware import default_path
+from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.realbench import tuning
 from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT
@@ -71,12 +71,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="DIR",
         help="floor folder, e.g. ../shared/data/msindoor/site1/F2[/path_data_files]",
     )
-    d.add_argument(
-        "--stridefixd",
-        default=str(default_path()),
-        metavar="PATH",
-        help="firmware binary (default: $STRIDEFIXD or build/firmware/stridefixd)",
-    )
+    add_stridefixd_argument(d)
     d.add_argument(
         "--out",
         default=None,
@@ -171,12 +166,7 @@ def add_fusion_parser(sub: Any) -> None:
     )
     d.add_argument("--format", required=True, choices=datasets.names(), help="data set format")
     d.add_argument("--out", required=True, metavar="results.json", help="JSON results file")
-    d.add_argument(
-        "--stridefixd",
-        default=str(default_path()),
-        metavar="PATH",
-        help="firmware binary ($STRIDEFIXD or build/firmware/stridefixd)",
-    )
+    add_stridefixd_argument(d)
     d.add_argument(
         "--limit",
         type=int,
