@@ -31,6 +31,11 @@ void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_p
                             .floor = p->floor,
                             .heading_rad = (float)p->heading_rad,
                             .sigma_m = (float)p->sigma_m,
+                            .cov_xx_m2 = (float)p->cov_m2[0],
+                            .cov_xy_m2 = (float)p->cov_m2[1],
+                            .cov_yy_m2 = (float)p->cov_m2[2],
+                            .heading_bias_rad = (float)p->heading_bias_rad,
+                            .stride_scale = (float)p->stride_scale,
                             .step_count = p->step_count,
                             .scheme = p->scheme};
     SF_LCM_WRITE(out, SF_CHANNEL_POSE, log_t_us, stridefix_pose_t, &msg);

@@ -183,6 +183,10 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->floor = sf_floor_current(&e->floor);
     pose->heading_rad = e->heading_rad;
     pose->sigma_m = e->sigma_m;
+    pose->cov_m2[0] = pose->cov_m2[2] = e->sigma_m * e->sigma_m;
+    pose->cov_m2[1] = 0.0;
+    pose->heading_bias_rad = 0.0;
+    pose->stride_scale = 1.0;
     pose->step_count = e->step_count;
     pose->scheme = sf_scheme_pdr_only;
 }

@@ -29,9 +29,9 @@ static int16_t to_floor(const int32_t v)
 /* ---- the scheme registry: one row per pose_t.SCHEME_* ------------------------------------------- */
 
 /* How a scheme uses steps and fixes (sf_fusion.h): dead reckoning only (fixes initialise, then are
- * ignored), following the fixes (no prediction, no gate), or predicting and blending gated fixes with
- * the row's gain law. */
-typedef enum { mode_dead_reckoning = 1, mode_follow_fixes, mode_blend } scheme_mode_t;
+ * ignored), following the fixes (no prediction, no gate), predicting and blending gated fixes with
+ * the row's gain law, or the error-state filter of sf_ekf.h (its own prediction, gain and R). */
+typedef enum { mode_dead_reckoning = 1, mode_follow_fixes, mode_blend, mode_ekf } scheme_mode_t;
 
 typedef double (*alpha_law_t)(const sf_fusion_t *f, const sf_params_t *p, const sf_fix_t *fix, double r_m2,
                               sf_fix_audit_t *audit);
@@ -82,6 +82,7 @@ static const scheme_row_t scheme_rows[] = {
     [sf_scheme_static] = {mode_blend, alpha_static, false},
     [sf_scheme_adaptive] = {mode_blend, alpha_adaptive, false},
     [sf_scheme_kalman] = {mode_blend, alpha_kalman, true},
+    [sf_scheme_ekf] = {mode_ekf, NULL, false},
 };
 _Static_assert(sizeof scheme_rows / sizeof scheme_rows[0] == sf_scheme_count,
                "one scheme_rows entry per pose_t.SCHEME_* (sf_schemes.h)");
@@ -107,27 +108,25 @@ static bool predicts(const sf_fusion_t *const f)
     return row_of(f)->mode != mode_follow_fixes;
 }
 
+static bool is_ekf(const sf_fusion_t *const f)
+{
+    return row_of(f)->mode == mode_ekf;
+}
+
+/* An isotropic variance as a covariance [xx, xy, yy]. */
+static void iso_cov(const double var_m2, double cov_m2[3])
+{
+    cov_m2[0] = var_m2;
+    cov_m2[1] = 0.0;
+    cov_m2[2] = var_m2;
+}
+
 static int16_t scheme_floor(const sf_fusion_t *const f, const int16_t baro_floor)
 {
     if (row_of(f)->mode == mode_follow_fixes) {
         return to_floor(f->floor_offset);
     }
     return to_floor((int32_t)baro_floor + f->floor_offset);
-}
-
-/* Piecewise-linear over four knots, flat outside. Reaching segment i means xs[i] < x ≤ xs[i+1], so the
- * width is positive: badly ordered knots make a jump, never a division by zero. NaN gives vs[0]. */
-static double interp4(const double xs[4], const double vs[4], const double x)
-{
-    if (!(x > xs[0])) {
-        return vs[0];
-    }
-    for (int i = 0; i < 3; i++) {
-        if (x <= xs[i + 1]) {
-            return vs[i] + (x - xs[i]) / (xs[i + 1] - xs[i]) * (vs[i + 1] - vs[i]);
-        }
-    }
-    return vs[3];
 }
 
 /* ---- fusion: the math ---------------------------------------------------------------------------- */
@@ -139,7 +138,9 @@ static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const i
         f->backwards++;
         return;
     }
-    if (f->initialised && predicts(f)) {
+    if (f->initialised && is_ekf(f)) {
+        sf_ekf_time(&f->ekf, p, us_to_s(t_us - f->t_us));
+    } else if (f->initialised && predicts(f)) {
         f->var_m2 += p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us);
     }
     f->t_us = t_us;
@@ -164,14 +165,18 @@ static void blend(sf_fusion_t *const f, const sf_params_t *const p, const double
     f->var_m2 = fmax(var, p->fusion_var_min_m2);
 }
 
-/* position ← fix, variance ← R, floor from the fix: initialisation, recovery, wifi_only. */
+/* position ← fix, variance ← R, floor from the fix: initialisation, recovery, wifi_only. The ekf's
+ * position block restarts at its 2×2 R (ekf_r_m2), bias and scale keep what they learnt. */
 static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                         const double r_m2, const int16_t baro_floor)
+                         const double r_m2, const double ekf_r_m2[3], const int16_t baro_floor)
 {
     f->initialised = true;
     f->x_m = fix->x_m;
     f->y_m = fix->y_m;
     f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
+    if (is_ekf(f)) {
+        sf_ekf_restart_position(&f->ekf, ekf_r_m2);
+    }
     f->floor_offset = predicts(f) ? (int32_t)fix->floor - baro_floor : (int32_t)fix->floor;
 }
 
@@ -243,6 +248,11 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
     f->x_m = x_m;
     f->y_m = y_m;
     f->var_m2 = fmax(sigma_m * sigma_m, p->fusion_var_min_m2);
+    if (is_ekf(f)) {
+        double cov_m2[3];
+        iso_cov(f->var_m2, cov_m2);
+        sf_ekf_start(&f->ekf, p, cov_m2);
+    }
     f->floor_offset = predicts(f) ? (int32_t)floor - baro_floor : (int32_t)floor;
     f->t_us = t_us;
     f->last_fix_t_us = t_us;
@@ -265,9 +275,16 @@ void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int6
     if (!f->initialised) {
         return; /* nothing to move yet */
     }
-    f->x_m += dx_m;
-    f->y_m += dy_m;
-    f->var_m2 += p->fusion_q_step_m2_per_m * length_m;
+    if (is_ekf(f)) { /* the filter applies its learnt bias and scale to the PDR step */
+        double d_m[2];
+        sf_ekf_step(&f->ekf, p, length_m, atan2(dy_m, dx_m), d_m);
+        f->x_m += d_m[0];
+        f->y_m += d_m[1];
+    } else {
+        f->x_m += dx_m;
+        f->y_m += dy_m;
+        f->var_m2 += p->fusion_q_step_m2_per_m * length_m;
+    }
     f->steps++;
 }
 
@@ -285,14 +302,23 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
 
     /* fusion: predict to the fix's time */
     predict_to(f, p, fix->t_us);
+    /* the ekf: one fix's R (start, recovery) and an update's R (a fix in a correlated run) */
+    double ekf_r_m2[3] = {r_m2, 0.0, r_m2}, ekf_run_r_m2[3] = {r_m2, 0.0, r_m2};
+    if (is_ekf(f)) {
+        if (!f->initialised) {
+            sf_ekf_start(&f->ekf, p, ekf_r_m2); /* the prior fix model, bias and scale */
+        }
+        sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
+        sf_ekf_update_r(&f->ekf, p, fix->accuracy_m, ekf_run_r_m2);
+    }
 
     /* control: start */
     if (!f->initialised) {
-        reset_to_fix(f, p, fix, r_m2, baro_floor);
+        reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
         f->last_fix_t_us = fix->t_us;
         f->rejections = 0;
         f->initialisations++;
-        audit->innovation_var_m2 = r_m2;
+        audit->innovation_var_m2 = is_ekf(f) ? 0.5 * (ekf_r_m2[0] + ekf_r_m2[2]) : r_m2;
         audit->alpha = 1.0;
         audit->accepted = true;
         audit->reason = sf_fix_reason_initialised;
@@ -302,30 +328,44 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
     /* fusion: innovation, its variance, the test ratio */
     const double nu_x = fix->x_m - f->x_m;
     const double nu_y = fix->y_m - f->y_m;
+    const double nu_m[2] = {nu_x, nu_y};
     const double s_m2 = f->var_m2 + r_m2;
     const double gate = p->fusion_gate_sigma;
     audit->innovation_m[0] = nu_x;
     audit->innovation_m[1] = nu_y;
     audit->innovation_var_m2 = s_m2;
     audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
+    if (is_ekf(f)) { /* the full 2×2 S of the update: NIS, χ² with 2 dof, on the same gate */
+        double s3_m2[3];
+        audit->test_ratio = sf_ekf_nis(&f->ekf, nu_m, ekf_run_r_m2, s3_m2) / (gate * gate);
+        audit->innovation_var_m2 = 0.5 * (s3_m2[0] + s3_m2[2]);
+    }
 
     /* control: judge, then apply */
     const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor);
     audit->reason = reason;
+    if (is_ekf(f) && reason == sf_fix_reason_accepted) { /* a rejected fix says nothing about R */
+        sf_ekf_learn_fix_model(&f->ekf, p, nu_m, fix->accuracy_m, gate * gate);
+    }
     switch (reason) {
     case sf_fix_reason_accepted:
         if (blends(f)) {
             audit->alpha = scheme_alpha(f, p, fix, r_m2, audit);
             blend(f, p, audit->alpha, nu_x, nu_y, r_m2);
+        } else if (is_ekf(f)) {
+            double dpos_m[2];
+            audit->alpha = sf_ekf_update(&f->ekf, p, nu_m, ekf_run_r_m2, dpos_m);
+            f->x_m += dpos_m[0];
+            f->y_m += dpos_m[1];
         } else { /* wifi_only */
             audit->alpha = 1.0;
-            reset_to_fix(f, p, fix, r_m2, baro_floor);
+            reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
         }
         f->accepted++;
         break;
     case sf_fix_reason_recovery:
         audit->alpha = 1.0;
-        reset_to_fix(f, p, fix, r_m2, baro_floor);
+        reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
         f->recoveries++;
         break;
     case sf_fix_reason_gate:
@@ -354,51 +394,29 @@ bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, cons
         pose->y_m = 0.0;
         pose->floor = baro_floor;
         pose->sigma_m = SF_FUSION_SIGMA_UNKNOWN_M;
+        iso_cov(SF_FUSION_SIGMA_UNKNOWN_M * SF_FUSION_SIGMA_UNKNOWN_M, pose->cov_m2);
+        pose->heading_bias_rad = 0.0;
+        pose->stride_scale = 1.0;
         return false;
     }
-    double var = f->var_m2;
-    if (predicts(f) && t_us > f->t_us) {
-        var += p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us);
+    const double q_m2 = predicts(f) && t_us > f->t_us ? p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us) : 0.0;
+    iso_cov(f->var_m2 + q_m2, pose->cov_m2);
+    pose->heading_bias_rad = 0.0;
+    pose->stride_scale = 1.0;
+    if (is_ekf(f)) {
+        pose->cov_m2[0] = f->ekf.P[0][0] + q_m2;
+        pose->cov_m2[1] = f->ekf.P[0][1];
+        pose->cov_m2[2] = f->ekf.P[1][1] + q_m2;
+        pose->heading_bias_rad = f->ekf.heading_bias_rad;
+        pose->stride_scale = f->ekf.stride_scale;
+        pose->heading_rad = atan2(sin(pose->heading_rad + f->ekf.heading_bias_rad),
+                                  cos(pose->heading_rad + f->ekf.heading_bias_rad));
     }
     pose->x_m = f->x_m;
     pose->y_m = f->y_m;
     pose->floor = scheme_floor(f, baro_floor);
-    pose->sigma_m = sqrt(var);
+    pose->sigma_m = sqrt(0.5 * (pose->cov_m2[0] + pose->cov_m2[2]));
     return true;
-}
-
-double sf_fusion_accuracy_factor(const sf_params_t *const p, const sf_fix_t *const fix)
-{
-    switch (fix->method) {
-    case sf_fix_wifi: {
-        const double xs[4] = {p->fusion_acc_wifi_ap1, p->fusion_acc_wifi_ap2, p->fusion_acc_wifi_ap3,
-                              p->fusion_acc_wifi_ap4};
-        const double vs[4] = {p->fusion_acc_wifi_val1, p->fusion_acc_wifi_val2, p->fusion_acc_wifi_val3,
-                              p->fusion_acc_wifi_val4};
-        return p->fusion_acc_wifi_scale * interp4(xs, vs, (double)fix->n_ap_used);
-    }
-    case sf_fix_gnss: {
-        const double xs[4] = {p->fusion_acc_gnss_m1, p->fusion_acc_gnss_m2, p->fusion_acc_gnss_m3,
-                              p->fusion_acc_gnss_m4};
-        const double vs[4] = {p->fusion_acc_gnss_val1, p->fusion_acc_gnss_val2, p->fusion_acc_gnss_val3,
-                              p->fusion_acc_gnss_val4};
-        return interp4(xs, vs, fix->accuracy_m);
-    }
-    case sf_fix_landmark:
-        return p->fusion_acc_landmark;
-    default:
-        return 0.0;
-    }
-}
-
-double sf_fusion_drift(const sf_params_t *const p, const double dt_s)
-{
-    return dt_s > 0.0 ? fmin(p->fusion_drift_per_s * dt_s, p->fusion_drift_max) : 0.0;
-}
-
-double sf_fusion_adaptive_alpha(const sf_params_t *const p, const sf_fix_t *const fix, const double dt_s)
-{
-    return clamp(sf_fusion_accuracy_factor(p, fix) + sf_fusion_drift(p, dt_s), 0.0, 1.0);
 }
 
 void sf_fusion_audit_refused(const sf_fusion_t *const f, const sf_fix_t *const fix, const int8_t reason,

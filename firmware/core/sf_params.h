@@ -167,9 +167,27 @@
     X(fusion, drift_per_s,         double,  0.01,    0.0,     10.0,    "1/s",   "adaptive: drift term per second since the last accepted fix (placeholder)") \
     X(fusion, drift_max,           double,  0.5,     0.0,     1.0,     "",      "adaptive: cap of the drift term (placeholder)")
 
+/* sf_ekf.h: the ekf scheme. Noise figures from the sensors' physics, not fitted to a data set. */
+#define SF_PARAMS_EKF(X)                                                                               \
+    X(ekf,    step_length_sigma,   double,  0.1,     0.0,     1.0,     "",      "step-length noise per step, relative (Weinberg's model scatters ~10 % step to step)") \
+    X(ekf,    step_heading_sigma_rad, double, 0.1,   0.0,     1.0,     "rad",   "walking-direction noise per step (body sway ~6 deg step to step)") \
+    X(ekf,    bias_rw_rad2_per_m,  double,  0.002,   0.0,     1.0,     "rad2/m","heading-bias random walk per metre walked (0.45 rad after 100 m: re-grips, magnetic disturbances)") \
+    X(ekf,    scale_rw_per_m,      double,  1e-4,    0.0,     1.0,     "1/m",   "stride-scale random walk (variance) per metre walked (0.1 after 100 m: pace changes)") \
+    X(ekf,    init_bias_sigma_rad, double,  0.5,     0.0,     3.2,     "rad",   "heading bias sigma at the start: unknown (a magnetometer indoors is off by tens of degrees)") \
+    X(ekf,    init_scale_sigma,    double,  0.15,    0.0,     1.0,     "",      "stride-scale sigma at the start (walkers differ by ~15 % from Weinberg's K)") \
+    X(ekf,    scale_min,           double,  0.5,     0.1,     1.0,     "",      "smallest stride scale") \
+    X(ekf,    scale_max,           double,  2.0,     1.0,     10.0,    "",      "largest stride scale") \
+    X(ekf,    fix_var_x_per_acc2,  double,  1.0,     1e-3,    1e3,     "",      "fix-error model prior: variance along x per accuracy_m^2 (1: the matcher's accuracy taken as its sigma; realbench measures it on the training walks)") \
+    X(ekf,    fix_var_y_per_acc2,  double,  1.0,     1e-3,    1e3,     "",      "fix-error model prior: variance along y per accuracy_m^2") \
+    X(ekf,    fix_cov_xy_per_acc2, double,  0.0,     -1e3,    1e3,     "",      "fix-error model prior: x-y covariance per accuracy_m^2 (kept positive definite)") \
+    X(ekf,    fix_run_factor,      double,  1.0,     1.0,     100.0,   "",      "R of an update = the model times this: consecutive fixes err alike, so a run of them carries less than independent fixes would (1: independent; realbench measures it from the fix errors' autocorrelation); a start or recovery takes one fix's own model") \
+    X(ekf,    r_window,            int32_t, 30,      0,       100000,  "fixes", "innovations the fix-error model averages (running mean, then exponential); 0 = never learn") \
+    X(ekf,    r_min,               double,  0.25,    1e-3,    1e3,     "",      "smallest eigenvalue of the learnt fix-error model (per accuracy_m^2)") \
+    X(ekf,    r_max,               double,  100.0,   1e-3,    1e4,     "",      "largest eigenvalue of the learnt fix-error model (per accuracy_m^2)")
+
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

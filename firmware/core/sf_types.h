@@ -79,6 +79,9 @@ typedef struct {
     int16_t floor;
     double heading_rad;
     double sigma_m;
+    double cov_m2[3];        /* [xx, xy, yy] map frame */
+    double heading_bias_rad; /* ekf: learnt; 0 otherwise */
+    double stride_scale;     /* ekf: learnt; 1 otherwise */
     int32_t step_count;
     int8_t scheme;
 } sf_pose_t;

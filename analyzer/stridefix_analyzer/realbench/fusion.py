@@ -243,7 +243,11 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                 lowest_floor=lowest,
                 min_count=run.cfg.min_count,
                 true_start=run.cfg.true_start,
-                param_sets=[*run.cfg.param_sets, *tuning.settings(run.axes, variants)],
+                param_sets=[
+                    *run.cfg.param_sets,
+                    *tuning.settings(run.axes, variants),
+                    *tuning.walk_settings(choices, j),
+                ],
                 variants=variants,
                 extra={k: v for c in choices.values() for k, v in c.extra[j].items()},
                 first_waypoint=walks[i]["first_waypoint"],

@@ -42,7 +42,7 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 #: what each stage replays (--fusion) and scores
-STAGES = {"matcher": "wifi_only", "adaptive": "adaptive"}
+STAGES = {"matcher": "wifi_only", "adaptive": "adaptive", "fixmodel": "wifi_only"}
 DEFAULT_BLOCKS = 4
 #: fewest walks in a group for a choice (fewer: the firmware default)
 MIN_WALKS = 6
@@ -64,6 +64,22 @@ def fix_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> 
     return np.hypot(fix["x_m"][first] - x, fix["y_m"][first] - y)
 
 
+def fix_residuals_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
+    """Every Wi-Fi fix's error against the truth (interpolated as in :func:`fix_errors_m`), in time
+    order: rows (error x [m], error y [m], the matcher's accuracy_m [m])."""
+    fix = read_table(fw_log, "FIX")
+    wp_t_us = np.asarray(wp_t_us, np.int64)
+    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
+    if fix is None or not len(fix) or len(wp_t_us) < 2:
+        return np.zeros((0, 3))
+    t, first = np.unique(fix["t_us"], return_index=True)
+    keep = (t >= wp_t_us[0]) & (t <= wp_t_us[-1]) & (fix["accuracy_m"][first] > 0)
+    t, first = t[keep], first[keep]
+    ex = fix["x_m"][first] - np.interp(t, wp_t_us, wp[:, 0])
+    ey = fix["y_m"][first] - np.interp(t, wp_t_us, wp[:, 1])
+    return np.column_stack([ex, ey, fix["accuracy_m"][first]])
+
+
 def pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
     """2-D error [m] at each waypoint of the latest POSE at or before it (causal, as realbench scores;
     the log holds one scheme); waypoints before the first pose are left out."""
@@ -78,7 +94,7 @@ def pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) ->
     return np.hypot(pose["x_m"][k[ok]] - wp[ok, 0], pose["y_m"][k[ok]] - wp[ok, 1])
 
 
-def _replay(job: dict[str, Any]) -> dict[str, Any]:
+def replay_task(job: dict[str, Any]) -> dict[str, Any]:
     proc = Firmware(job["stridefixd"]).run(
         input=f"lcmlog:{job['import_log']}",
         site=job["site"],
@@ -89,10 +105,82 @@ def _replay(job: dict[str, Any]) -> dict[str, Any]:
     )
     if proc.returncode != 0:
         return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
-    score = fix_errors_m if job["stage"] == "matcher" else pose_errors_m
+    score = SCORES[job["stage"]]
     err = score(job["log"], job["wp_t_us"], job["wp_xy_m"])
     Path(job["log"]).unlink(missing_ok=True)  # only the numbers are kept
     return {**job, "errors": err, "failure": None}
+
+
+#: what each stage measures on a replay
+SCORES: dict[str, Callable[[str | Path, ArrayLike, ArrayLike], np.ndarray]] = {
+    "matcher": fix_errors_m,
+    "adaptive": pose_errors_m,
+    "fixmodel": fix_residuals_m,
+}
+
+
+def block_replays(
+    sub: list[dict[str, Any]],
+    build_site: Callable[[Any, list[dict[str, Any]], str, Path], list[str] | None] | None,
+    *,
+    stridefixd: str | Path,
+    work_dir: Path,
+    base_sets: list[str],
+    candidates: dict[str, list[str]],
+    jobs: int,
+    n_blocks: int,
+    progress: Callable[[], None] | None,
+    replay: Callable[[dict[str, Any]], dict[str, Any]],
+    stage: str,
+    block_sets: Mapping[int, Sequence[str]] | None,
+) -> tuple[list[int], Iterator[dict[str, Any]]]:
+    """The block of every walk, and the replays of every (a, b ≠ a) block pair for every candidate
+    (walks of block b on the map without blocks a and b), as they finish (see the module text)."""
+    block = [i % n_blocks for i in range(len(sub))]
+    tasks = []
+    for a in range(n_blocks):
+        for b in range(n_blocks):
+            if a == b:
+                continue
+            inside = [i for i in range(len(sub)) if block[i] in (a, b)]
+            removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
+            others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
+            site_path = work_dir / f"site_{a}_{b}.sfsite"
+            assert build_site is not None  # only None when no choice is made (tests)
+            site_sets = build_site(removed, others, f"select {a}/{b}", site_path) or []
+            for i in (i for i in range(len(sub)) if block[i] == b):
+                for name in candidates:
+                    sets = [*base_sets, *site_sets, *(block_sets or {}).get(a, []), *candidates[name]]
+                    tasks.append(
+                        {
+                            "a": a,
+                            "name": name,
+                            "walk": sub[i]["walk"],
+                            "stage": stage,
+                            "stridefixd": str(stridefixd),
+                            "import_log": sub[i]["import_log"],
+                            "site": str(site_path),
+                            "sets": sets,
+                            "log": str(
+                                work_dir / f"{stage}_{a}_{b}_{i}_{list(candidates).index(name)}.lcmlog"
+                            ),
+                            "wp_t_us": sub[i]["waypoint_t_us"],
+                            "wp_xy_m": sub[i]["waypoint_xy_m"],
+                        }
+                    )
+
+    def run() -> Iterator[dict[str, Any]]:
+        with (
+            concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs))
+            if jobs > 1
+            else _InProcess() as pool
+        ):
+            for r in pool.map(replay, tasks, chunksize=4):
+                yield r
+                if progress:
+                    progress()
+
+    return block, run()
 
 
 def select(
@@ -125,51 +213,29 @@ def select(
     if len(names) < 2 or len(sub) < MIN_WALKS:
         why = "one candidate" if len(names) < 2 else f"fewer than {MIN_WALKS} walks"
         return [names[0]] * len(sub), {"chosen_by": f"default ({why})", "blocks": {}}
-    replay = replay or _replay
     work_dir = Path(work_dir)
     work_dir.mkdir(parents=True, exist_ok=True)
-    block = [i % n_blocks for i in range(len(sub))]
-    tasks = []
-    for a in range(n_blocks):
-        for b in range(n_blocks):
-            if a == b:
-                continue
-            inside = [i for i in range(len(sub)) if block[i] in (a, b)]
-            removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
-            others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
-            site_path = work_dir / f"site_{a}_{b}.sfsite"
-            assert build_site is not None  # only None when no choice is made (tests)
-            site_sets = build_site(removed, others, f"select {a}/{b}", site_path) or []
-            for i in (i for i in range(len(sub)) if block[i] == b):
-                for name in names:
-                    sets = [*base_sets, *site_sets, *(block_sets or {}).get(a, []), *candidates[name]]
-                    tasks.append(
-                        {
-                            "a": a,
-                            "name": name,
-                            "walk": sub[i]["walk"],
-                            "stage": stage,
-                            "stridefixd": str(stridefixd),
-                            "import_log": sub[i]["import_log"],
-                            "site": str(site_path),
-                            "sets": sets,
-                            "log": str(work_dir / f"{a}_{b}_{i}_{names.index(name)}.lcmlog"),
-                            "wp_t_us": sub[i]["waypoint_t_us"],
-                            "wp_xy_m": sub[i]["waypoint_xy_m"],
-                        }
-                    )
+    block, results = block_replays(
+        sub,
+        build_site,
+        stridefixd=stridefixd,
+        work_dir=work_dir,
+        base_sets=base_sets,
+        candidates=candidates,
+        jobs=jobs,
+        n_blocks=n_blocks,
+        progress=progress,
+        replay=replay or replay_task,
+        stage=stage,
+        block_sets=block_sets,
+    )
     pooled: dict[int, dict[str, list[np.ndarray]]] = {a: {n: [] for n in names} for a in range(n_blocks)}
     failures = []
-    with (
-        concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs)) if jobs > 1 else _InProcess() as pool
-    ):
-        for r in pool.map(replay, tasks, chunksize=4):
-            if r["errors"] is None:
-                failures.append(f"{r['walk']} ({r['name']}): {r['failure']}")
-            else:
-                pooled[r["a"]][r["name"]].append(r["errors"])
-            if progress:
-                progress()
+    for r in results:
+        if r["errors"] is None:
+            failures.append(f"{r['walk']} ({r['name']}): {r['failure']}")
+        else:
+            pooled[r["a"]][r["name"]].append(r["errors"])
     what = "mean Wi-Fi fix error" if stage == "matcher" else f"mean {STAGES[stage]} error at waypoints"
     report: dict[str, Any] = {
         "chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, {what})",

@@ -13,6 +13,8 @@ sees the prepared walks of one group and returns the candidate of every walk's f
 * ``adaptive`` (:class:`InnerCV`): the adaptive scheme's Wi-Fi accuracy-factor scale, the same way on
   the adaptive POSE error, with each block's matcher (settings chosen by earlier inner-CV rows carry
   over per block).
+* ``fixmodel`` (:class:`Measured`): not a choice: the ``ekf`` scheme's fix-error model, measured on the
+  other walks' Wi-Fi fixes against the truth (:mod:`.fixmodel`).
 
 A user's ``--set`` of any key an axis varies replaces that axis's candidates by ``{"given": []}``
 (:func:`axes`). A new tuning idea is one more row, not a new stage in ``run_fusion``.
@@ -26,6 +28,7 @@ from pathlib import Path
 from typing import Any, Protocol, TextIO
 
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.realbench import fixmodel
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.heading import (
     HEADING_VARIANTS,
@@ -79,6 +82,8 @@ class Choice:
     extra: list[dict[str, Any]]  # per walk, further fold fields (results.json)
     #: settings chosen per inner-CV block, for the inner-CV rows after this one
     block_sets: dict[int, list[str]] = dataclasses.field(default_factory=dict)
+    #: per walk, settings measured rather than chosen from the candidates (``fixmodel``)
+    walk_sets: list[list[str]] | None = None
 
 
 class Chooser(Protocol):
@@ -134,6 +139,34 @@ class InnerCV:
 
 
 @dataclasses.dataclass(frozen=True)
+class Measured:
+    """Not a choice but a measurement (:func:`.fixmodel.measure`): the ``ekf`` scheme's fix-error
+    model from the other walks' Wi-Fi fixes against the truth, with each block's matcher. The one
+    candidate stands for "measured"; a user's ``--set`` of a model key keeps the given value."""
+
+    def __call__(self, axis: Axis, group: Group, block_sets: Mapping[int, Sequence[str]]) -> Choice:
+        n = len(group.walks)
+        if "given" in axis.candidates or n < fixmodel.MIN_WALKS:
+            why = "given by --set" if "given" in axis.candidates else f"fewer than {fixmodel.MIN_WALKS} walks"
+            info = {f"{axis.name}_model": {"measured_by": f"firmware prior ({why})"}}
+            return Choice([next(iter(axis.candidates))] * n, info, [{} for _ in range(n)])
+        sets, factor, report = fixmodel.measure(
+            group.walks,
+            group.sites,
+            group.firmware,
+            group.work_dir / axis.name,
+            group.base_sets,
+            block_sets,
+            group.jobs,
+            group.stream,
+        )
+        extra = [
+            {f"{axis.name}_sets": s, f"{axis.name}_factor": f} for s, f in zip(sets, factor, strict=True)
+        ]
+        return Choice(["measured"] * n, {f"{axis.name}_model": report}, extra, walk_sets=sets)
+
+
+@dataclasses.dataclass(frozen=True)
 class Axis:
     """One tuning row: ``name`` (fold field ``<name>_variant``), ``label`` (console), the candidates
     (name → --set list) and the chooser."""
@@ -148,6 +181,7 @@ AXES: tuple[Axis, ...] = (
     Axis("heading", "heading variant", HEADING_VARIANTS, TruthAgreement()),
     Axis("matcher", "matcher", MATCHER_VARIANTS, InnerCV("matcher")),
     Axis("adaptive", "adaptive", ADAPTIVE_VARIANTS, InnerCV("adaptive")),
+    Axis("fixmodel", "ekf fix model", {"measured": [f"{k}=" for k in fixmodel.KEYS]}, Measured()),
 )
 
 
@@ -185,5 +219,11 @@ def choose(rows: Sequence[Axis], group: Group) -> dict[str, Choice]:
 
 
 def settings(rows: Sequence[Axis], variants: Mapping[str, str]) -> list[str]:
-    """The --set list of the chosen candidate of every row, in row order."""
-    return [kv for a in rows for kv in a.candidates[variants[a.name]]]
+    """The --set list of the chosen candidate of every row, in row order (a measured row's one
+    candidate only names its keys: its values are the choice's ``walk_sets``)."""
+    return [kv for a in rows if not isinstance(a.chooser, Measured) for kv in a.candidates[variants[a.name]]]
+
+
+def walk_settings(choices: Mapping[str, Choice], j: int) -> list[str]:
+    """The measured settings of walk ``j``'s fold, from every row that measures."""
+    return [kv for c in choices.values() if c.walk_sets for kv in c.walk_sets[j]]

@@ -20,7 +20,21 @@ def test_columns_and_sorting(msg, write_log):
     )
     d = read_logs([path])
     pose = d.table("POSE")
-    assert pose.names == ["t_us", "x_m", "y_m", "floor", "heading_rad", "sigma_m", "step_count", "scheme"]
+    assert pose.names == [
+        "t_us",
+        "x_m",
+        "y_m",
+        "floor",
+        "heading_rad",
+        "sigma_m",
+        "cov_xx_m2",
+        "cov_xy_m2",
+        "cov_yy_m2",
+        "heading_bias_rad",
+        "stride_scale",
+        "step_count",
+        "scheme",
+    ]
     assert_array_equal(pose["t_us"], [1_000, 3_000])
     assert_allclose(pose["x_m"], [1.0, 3.0])
     assert pose["t_us"].dtype == np.int64
