@@ -288,7 +288,8 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
     """The scheme whose numbers go at the top level.
 
     ``requested`` if given (it must occur in the log); else the scheme with most POSE messages,
-    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only.
+    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only, then any other
+    scheme in id order (a scheme new to ``pose_t.lcm`` needs no row here).
     """
     codes, counts = np.unique(pose["scheme"], return_counts=True)
     if requested is not None:
