@@ -147,7 +147,7 @@ def pdr_true_start(group: Mapping[str, Any]) -> dict[str, Any] | None:
 def pdr_true_start_text(fmt: str, group: Mapping[str, Any]) -> str:
     """One line on pdr_only from the true start in a group of data set ``fmt`` (console and HTML)."""
     r = pdr_true_start(group)
-    head = f"{fmt} {group['label']}: {schemes.PDR_ONLY} from the TRUE START (truth-initialised)"
+    head = f"[{fmt}] {group['label']}: {schemes.PDR_ONLY} from the TRUE START (truth-initialised)"
     if r is None:
         return f"{head}: not run (realbench --true-start runs it)"
     return (

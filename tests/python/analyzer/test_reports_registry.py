@@ -124,7 +124,7 @@ def test_realbench_labels_truth_initialised_pdr_per_data_set():
         # the row under the first-fix table, and the line naming the data set
         first_fix = console.split("[TRUTH-INITIALISED start]")[0]
         assert any(line.strip().startswith(label) for line in first_fix.splitlines())
-        line = f"{fmt} F2: pdr_only from the TRUE START (truth-initialised): mean {k + 1.0:.2f} m"
+        line = f"[{fmt}] F2: pdr_only from the TRUE START (truth-initialised): mean {k + 1.0:.2f} m"
         assert line in console and line in page
         assert f"<td>{label}</td>" in page and f"{label} mean" in page
     # without --true-start the line says it was not run, and there is no such row
