@@ -74,3 +74,7 @@ def scheme_colour(code: int) -> str:
     """The report colour of scheme id ``code``."""
     s = _BY_ID.get(int(code))
     return s.colour if s else _FALLBACK_COLOURS[int(code) % len(_FALLBACK_COLOURS)]
+
+
+PDR_ONLY: str = scheme_name(pose_t.SCHEME_PDR_ONLY)
+"""The dead-reckoning baseline's name (its truth-initialised run is reported per data set)."""

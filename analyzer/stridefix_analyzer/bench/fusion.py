@@ -12,8 +12,11 @@ office-wifi does the same on the default two-floor office: survey both floors (`
 build the site, walk the default tour, and score every scheme on the 10 Hz truth (targets: kalman
 mean ≤ 2.0 m, p95 ≤ 4.5 m).
 
-Every scheme starts at its first fix (no truth initialisation). The survey, the map and the scored
-walks use different seeds: the map is never built from the walk it scores.
+Every scheme starts at its first fix (no truth initialisation), pdr_only too: its row says so
+(``bench sil-pdr`` is the truth-initialised PDR run). Beside mean, p75, p95 and max, the table has
+the IPIN score (:func:`~stridefix_analyzer.scoring.metrics.ipin_score`) of the pooled samples. The
+survey, the map and the scored walks use different seeds: the map is never built from the walk it
+scores.
 """
 
 from __future__ import annotations
@@ -27,16 +30,27 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer import schemes
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
-from stridefix_analyzer.schemes import NAMES, scheme_name
 from stridefix_analyzer.scoring.analyze import run_analyze
+from stridefix_analyzer.scoring.metrics import ipin_score, scored_errors
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
-# table order: the schemes in id order, the PDR-only baseline last
-SCHEME_ORDER = [n for n in NAMES if n != "pdr_only"] + ["pdr_only"]
 SURVEY_SEED = 1000  # the survey is its own recording, never one of the scored walks
+#: how the table labels the PDR baseline: with a site it starts at its first fix like every scheme
+PDR_ROW_LABEL = f"{schemes.PDR_ONLY} (from its first fix)"
+
+#: one walk's scored samples per scheme: (2-D error [m], |floor error|), finite errors only
+WalkErrors = dict[str, tuple[np.ndarray, np.ndarray]]
+
+
+def scheme_order(names: Sequence[str]) -> list[str]:
+    """Table order of ``names``: the registry's schemes in id order with the PDR-only baseline last,
+    then any name the registry does not know (read at call time, so a new scheme needs no edit here)."""
+    order = [n for n in schemes.NAMES if n != schemes.PDR_ONLY] + [schemes.PDR_ONLY]
+    return [n for n in order if n in names] + sorted(set(names) - set(order))
 
 
 def simulate_and_log(
@@ -91,46 +105,51 @@ def build_site(survey_scenario: str, firmware: Firmware, out: Path) -> Path:
     return site
 
 
-def score(out: Path, truth_source: str | None, label: str) -> dict[str, np.ndarray]:
-    """Per-scheme arrays of the scored errors [m] of one walk."""
-    run_analyze(
+def score(out: Path, truth_source: str | None, label: str) -> WalkErrors:
+    """Per scheme of one walk: its scored samples (see :data:`WalkErrors`)."""
+    _, metrics = run_analyze(
         [str(out / "stridefixd.lcmlog"), str(out / "truth.lcmlog")],
         str(out),
         label=label,
         truth_source=truth_source,
     )
-    series = np.load(out / "analysis.npz")
-    errors: dict[str, np.ndarray] = {}
-    for code in series["scheme_codes"]:
-        e = series[f"s{int(code)}_error_m"]
-        errors[scheme_name(int(code))] = e[np.isfinite(e)]
+    errors: WalkErrors = {}
+    for s in metrics.schemes.values():
+        e, f = scored_errors(s.match)
+        ok = np.isfinite(e)
+        errors[s.name] = (e[ok], f[ok])
     return errors
 
 
-def pooled_table(pooled: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
+def pooled_table(pooled: dict[str, list[tuple[np.ndarray, np.ndarray]]]) -> dict[str, dict[str, Any]]:
+    """Per scheme over the pooled walks: n, mean, p75, p95, max [m] and the IPIN score [m]."""
     table = {}
-    for name in SCHEME_ORDER:
-        if name not in pooled:
-            continue
-        e = np.concatenate(pooled[name])
+    for name in scheme_order(list(pooled)):
+        e = np.concatenate([w[0] for w in pooled[name]])
+        f = np.concatenate([w[1] for w in pooled[name]])
         table[name] = {
             "n": int(e.size),
             "mean_m": float(np.mean(e)),
             "p75_m": float(np.percentile(e, 75)),
             "p95_m": float(np.percentile(e, 95)),
             "max_m": float(np.max(e)),
+            "ipin_score_m": ipin_score(e, f),
         }
     return table
 
 
 def format_table(table: dict[str, dict[str, Any]], paper: bool) -> str:
-    head = f"{'scheme':<11}{'n':>6}{'mean m':>9}{'p75 m':>8}{'p95 m':>8}{'max m':>8}"
+    """The console table; the PDR row is labelled :data:`PDR_ROW_LABEL`."""
+    labels = {n: PDR_ROW_LABEL if n == schemes.PDR_ONLY else n for n in table}
+    w = max(11, *(len(v) + 1 for v in labels.values())) if labels else 11
+    head = f"{'scheme':<{w}}{'n':>6}{'mean m':>9}{'p75 m':>8}{'p95 m':>8}{'max m':>8}{'ipin m':>8}"
     if paper:
         head += f"{'paper mean':>12}{'paper p75':>11}"
     lines = [head]
     for name, r in table.items():
         line = (
-            f"{name:<11}{r['n']:>6}{r['mean_m']:>9.2f}{r['p75_m']:>8.2f}{r['p95_m']:>8.2f}{r['max_m']:>8.2f}"
+            f"{labels[name]:<{w}}{r['n']:>6}{r['mean_m']:>9.2f}{r['p75_m']:>8.2f}{r['p95_m']:>8.2f}"
+            f"{r['max_m']:>8.2f}{r['ipin_score_m']:>8.2f}"
         )
         if paper:
             pm = PAPER.get(name)
@@ -145,7 +164,7 @@ def run_aadr2015(
     t0 = time.perf_counter()
     print("bench aadr2015: survey and radio map", file=sys.stderr, flush=True)
     site = build_site("aadr2015_survey", firmware, out / "survey")
-    pooled: dict[str, list[np.ndarray]] = {}
+    pooled: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     runs = []
     n = len(seeds) * len(paces)
     for i, (pace, seed) in enumerate((p, s) for p in paces for s in seeds):
@@ -158,7 +177,7 @@ def run_aadr2015(
             {
                 "scenario": scenario,
                 "seed": seed,
-                "mean_m": {k: float(np.mean(v)) for k, v in errors.items() if v.size},
+                "mean_m": {k: float(np.mean(e)) for k, (e, _) in errors.items() if e.size},
             }
         )
         for k, v in errors.items():
@@ -191,14 +210,16 @@ def run_office(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[s
     t0 = time.perf_counter()
     print("bench office-wifi: survey of both floors and radio map", file=sys.stderr, flush=True)
     site = build_site("office_survey", firmware, out / "survey")
-    pooled: dict[str, list[np.ndarray]] = {}
+    pooled: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     runs = []
     for i, seed in enumerate(seeds):
         print(f"bench office-wifi: [{i + 1}/{len(seeds)}] default seed {seed}", file=sys.stderr, flush=True)
         walk = out / f"default-s{seed}"
         simulate_and_log("default", seed, firmware, walk, site, sets)
         errors = score(walk, None, f"default seed {seed}, every scheme from its first fix")
-        runs.append({"seed": seed, "mean_m": {k: float(np.mean(v)) for k, v in errors.items() if v.size}})
+        runs.append(
+            {"seed": seed, "mean_m": {k: float(np.mean(e)) for k, (e, _) in errors.items() if e.size}}
+        )
         for k, v in errors.items():
             pooled.setdefault(k, []).append(v)
     table = pooled_table(pooled)

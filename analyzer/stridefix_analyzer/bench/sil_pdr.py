@@ -3,7 +3,8 @@
 For each scenario and seed, simulate the walk, replay it through the real
 ``stridefixd`` binary in PDR-only mode, and score the log with the evaluation protocol of DESIGN.md.
 It reports step-count error, heading RMS error, final position error as % of the distance walked
-and the floor hit rate, next to the targets, and writes ``OUT/sil_pdr.json``.
+and the floor hit rate, next to the targets, the mean error and the IPIN score
+(:func:`~stridefix_analyzer.scoring.metrics.ipin_score`), and writes ``OUT/sil_pdr.json``.
 
 The start position is truth-initialised (the simulator's ``init_truth.ini``): PDR alone has no
 absolute position. Site facts the firmware will later read from the site file (map rotation) are
@@ -26,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.scoring.analyze import run_analyze
@@ -40,6 +42,9 @@ pause = []
 """
 
 DEFAULT_SCENARIOS = ["default", "pace_slow", "pace_normal", "pace_fast"]
+
+#: how every row started: the replay has no site, so pdr_only starts at the config pose, the truth
+START = f"{schemes.PDR_ONLY}, truth-initialised (the simulator's init_truth.ini)"
 
 # Issue 3's targets on the default scenarios.
 TARGETS = {"step_error_pct_abs_max": 1.0, "floor_hit_rate_min": 0.99, "final_error_pct_max": 2.0}
@@ -111,12 +116,13 @@ def run_one(
     metrics, _ = run_analyze(
         [str(log), str(out_dir / "truth.lcmlog")],
         str(out_dir),
-        label=f"{scenario} seed {seed}, PDR only, truth-initialised start",
+        label=f"{scenario} seed {seed}, {START}",
     )
     steps = metrics["steps"]
     return {
         "scenario": scenario,
         "seed": seed,
+        "start": START,
         "weinberg_k_used": weinberg_k,
         "weinberg_k_true": summary.get("weinberg_k"),
         "duration_s": summary.get("duration_s"),
@@ -126,6 +132,7 @@ def run_one(
         "step_error_pct": steps["error_pct"],
         "heading_rms_deg": metrics["heading_error"]["rms_deg"],
         "mean_error_m": metrics["position_error_m"]["mean"],
+        "ipin_score_m": metrics["ipin_score"],
         "final_error_m": metrics["final_error_m"],
         "final_error_pct": metrics["final_error_pct_of_distance"],
         "floor_hit_rate": metrics["floor_hit_rate"],
@@ -147,12 +154,16 @@ def meets_targets(row: dict[str, Any]) -> dict[str, bool | None]:
     }
 
 
+def _nan(value: float | None) -> float:
+    return float("nan") if value is None else value
+
+
 def format_table(rows: list[dict[str, Any]]) -> str:
     head = (
         f"{'scenario':<12}{'seed':>5}{'K used':>7}{'K true':>7}{'dist m':>8}{'steps':>7}{'err %':>7}{'hdg°':>6}"
-        f"{'mean m':>8}{'final m':>8}{'final %':>8}{'floor':>7}  targets (steps/floor/final)"
+        f"{'mean m':>8}{'ipin m':>8}{'final m':>8}{'final %':>8}{'floor':>7}  targets (steps/floor/final)"
     )
-    lines = [head]
+    lines = [f"[{START}]", head]
     for r in rows:
         t = r["targets"]
         mark = " ".join({True: "ok", False: "MISS", None: "-"}[t[k]] for k in ("steps", "floor", "final"))
@@ -163,6 +174,7 @@ def format_table(rows: list[dict[str, Any]]) -> str:
             f"{r['scenario']:<12}{r['seed']:>5}{(ku if ku else float('nan')):>7.3f}"
             f"{(kt if kt else float('nan')):>7.3f}{r['distance_m']:>8.1f}{r['steps_truth']:>7}"
             f"{r['step_error_pct']:>+7.2f}{r['heading_rms_deg']:>6.1f}{r['mean_error_m']:>8.2f}"
+            f"{_nan(r['ipin_score_m']):>8.2f}"
             f"{r['final_error_m']:>8.2f}{r['final_error_pct']:>8.2f}"
             f"{(100 * fh if fh is not None else float('nan')):>6.1f}%  {mark}"
         )

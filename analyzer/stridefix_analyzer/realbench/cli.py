@@ -152,8 +152,8 @@ def add_fusion_parser(sub: Any) -> None:
         help="all fusion schemes on real walks, leave one walk out (default benchmark)",
         description="Leave one walk out per floor (msindoor) or building (gsd): build the site "
         "(walk-mode radio map, floors, map rotation) and Weinberg K from the other "
-        "walks, replay the held-out walk through stridefixd --site and score all six "
-        "schemes at its ground-truth times. Writes results.json, an HTML report next "
+        "walks, replay the held-out walk through stridefixd --site and score every "
+        "fusion scheme at its ground-truth times. Writes results.json, an HTML report next "
         "to it, and per-walk work files under its folder.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
@@ -238,5 +238,5 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
         f"wrote {args.out}{extra} ({doc['run_s']['total']:.1f} s: prepare "
         f"{doc['run_s']['prepare']:.1f} s, folds {doc['run_s']['folds']:.1f} s)"
     )
-    scored = sum(g["summary"]["schemes"].get("kalman", {}).get("n", 0) for g in doc["groups"])
+    scored = sum(s["n"] for g in doc["groups"] for s in g["summary"]["schemes"].values())
     return 0 if scored else 1

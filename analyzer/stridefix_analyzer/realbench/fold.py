@@ -18,9 +18,6 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from numpy.typing import ArrayLike
-
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError, read_table
 from stridefix_analyzer.radiomap.build import WalkStats
@@ -28,8 +25,6 @@ from stridefix_analyzer.radiomap.build import WalkStats
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
 #: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
 DEFAULT_MIN_COUNT = 1
-#: IPIN competition score: p75 of (2-D error + this × |floor error|) [m per floor]
-IPIN_FLOOR_PENALTY_M = 15.0
 STATS_KEYS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
 
 
@@ -185,25 +180,17 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
 
 def score_walk(metrics: Any) -> dict[str, dict[str, Any]]:
     """Per scheme of one walk: stats, floor hit rate, IPIN score and the raw per-sample errors."""
+    from stridefix_analyzer.scoring.metrics import scored_errors
+
     res = {}
     for s in metrics.schemes.values():
-        m = s.match
-        sc = m["scored"]
-        err = m["error_m"][sc]
-        ferr = np.abs(m["pose_floor"][sc] - m["truth_floor"][sc]).astype(float)
+        err, ferr = scored_errors(s.match)
         res[s.name] = {
             **{k: s.summary["position_error_m"][k] for k in STATS_KEYS},
             "unscored": s.summary["unscored"],
             "floor_hit_rate": s.summary["floor_hit_rate"],
-            "ipin_score": ipin_score(err, ferr),
-            "errors_m": err.astype(float).tolist(),
-            "floor_errors": ferr.astype(int).tolist(),
+            "ipin_score": s.summary["ipin_score"],
+            "errors_m": err.tolist(),
+            "floor_errors": ferr.tolist(),
         }
     return res
-
-
-def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:
-    """IPIN score [m]: 75th percentile of 2-D error + :data:`IPIN_FLOOR_PENALTY_M` × |floor error|."""
-    e = np.asarray(error_m, float) + IPIN_FLOOR_PENALTY_M * np.abs(np.asarray(floor_error, float))
-    e = e[np.isfinite(e)]
-    return float(np.percentile(e, 75)) if len(e) else math.nan

@@ -40,7 +40,7 @@ from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import tuning
 from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M, fold_floors
-from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT, IPIN_FLOOR_PENALTY_M, FoldJob, run_fold
+from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT, FoldJob, run_fold
 from stridefix_analyzer.realbench.heading import (
     ROT_MIN_RESULTANT,
     ROT_MIN_SEGMENT_M,
@@ -53,6 +53,7 @@ from stridefix_analyzer.realbench.select_sites import SelectionSites
 from stridefix_analyzer.realbench.strides import build_segments, calibrate_lowo, stride_k
 from stridefix_analyzer.realbench.summary import ROBUST_MEAN_M, build_doc, strip_samples
 from stridefix_analyzer.realbench.walks import dataset, find_groups, firmware
+from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
 
 DEFAULT_CELL_SIZE_M = 2.0
 

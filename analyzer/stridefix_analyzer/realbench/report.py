@@ -27,7 +27,12 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from stridefix_analyzer import datasets  # noqa: E402
 from stridefix_analyzer.datasets.protocol import DatasetError  # noqa: E402
-from stridefix_analyzer.schemes import UnknownSchemeError, scheme_code, scheme_colour  # noqa: E402
+from stridefix_analyzer.realbench.summary import (  # noqa: E402
+    PDR_TRUE_START_LABEL,
+    pdr_true_start,
+    pdr_true_start_text,
+)
+from stridefix_analyzer.schemes import PDR_ONLY, UnknownSchemeError, scheme_code, scheme_colour  # noqa: E402
 from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
@@ -167,7 +172,8 @@ def _matched(series: Mapping[str, np.ndarray]) -> dict[str, Any]:
     return out
 
 
-def _scheme_table(summary: dict) -> str:
+def _scheme_table(summary: dict, extra: Sequence[tuple[str, dict]] = ()) -> str:
+    """The scheme table of one run; ``extra`` rows (label, row) come last, in bold."""
     head = [
         "scheme",
         "n",
@@ -183,7 +189,7 @@ def _scheme_table(summary: dict) -> str:
         "walks mean > 15 m",
     ]
     rows = []
-    for name, r in summary["schemes"].items():
+    for name, r in [*summary["schemes"].items(), *extra]:
         rows.append(
             [
                 name,
@@ -200,19 +206,25 @@ def _scheme_table(summary: dict) -> str:
                 f"{r['walks_mean_over_15m']}/{r['walks']} ({_f(100 * r['share_walks_mean_over_15m'], 1)} %)",
             ]
         )
-    return _table(head, rows)
+    return _table(head, rows, bold_last=len(extra))
 
 
-def _table(head: Sequence[object], rows: Iterable[Sequence[object]]) -> str:
+def _table(head: Sequence[object], rows: Iterable[Sequence[object]], bold_last: int = 0) -> str:
     th = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
+    rows = list(rows)
+    body = "".join(
+        ("<tr style='font-weight:bold'>" if i >= len(rows) - bold_last else "<tr>")
+        + "".join(f"<td>{html.escape(str(c))}</td>" for c in r)
+        + "</tr>"
+        for i, r in enumerate(rows)
+    )
     return f"<table><tr>{th}</tr>{body}</table>"
 
 
 def render(doc: dict) -> str:
     parts = [
         f"<h1>StrideFix realbench: fusion schemes, leave one walk out ({doc['format']})</h1>",
-        "<p>Every scheme starts from the fixes; the radio map, map rotation, floor heights and "
+        "<p>Every scheme starts from the fixes (except the runs labelled truth-initialised); the radio map, map rotation, floor heights and "
         "stride constant K of each walk come from the other walks of its floor/building only. "
         "Errors are taken at the walk's ground-truth times against the latest POSE at or "
         "before them (causal).</p>",
@@ -231,7 +243,11 @@ def render(doc: dict) -> str:
             f"{_f(g['summary']['adaptive_vs_wifi_only_reduction_pct'], 1)} % lower mean."
             f"</p>"
         )
-        parts.append(_scheme_table(g["summary"]))
+        true_pdr = pdr_true_start(g)
+        parts.append(
+            _scheme_table(g["summary"], [(PDR_TRUE_START_LABEL, true_pdr)] if true_pdr is not None else [])
+        )
+        parts.append(f"<p><b>{html.escape(pdr_true_start_text(doc['format'], g))}</b></p>")
         if "summary_true_start" in g:
             parts.append("<h3>Truth-initialised start (labelled run)</h3>")
             parts.append(_scheme_table(g["summary_true_start"]))
@@ -263,6 +279,8 @@ def render(doc: dict) -> str:
             title = f"{r['walk']}: best {best} {means[best]:.1f} m, worst {worst} {means[worst]:.1f} m (mean)"
             parts.append(_img(to_png(plot_walk(series, r["walk"], [best, worst], plan, title)), r["walk"]))
         head = ["walk", "waypoints", "K", "rotation °", "RPs"] + [f"{n} mean" for n in sch]
+        if true_pdr is not None:
+            head.append(f"{PDR_TRUE_START_LABEL} mean")
         trows = []
         for r in g["walk_rows"]:
             fo = r.get("fold") or {}
@@ -275,6 +293,11 @@ def render(doc: dict) -> str:
                     fo.get("n_rp", "-"),
                 ]
                 + [_f((r.get("fixes") or {}).get(n, {}).get("mean")) for n in sch]
+                + (
+                    [_f((r.get("true_start") or {}).get(PDR_ONLY, {}).get("mean"))]
+                    if true_pdr is not None
+                    else []
+                )
             )
         parts.append("<h3>Per walk</h3>" + _table(head, trows))
     style = (

@@ -18,12 +18,15 @@ from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.io.jsonio import json_ready
-from stridefix_analyzer.realbench.fold import IPIN_FLOOR_PENALTY_M, FoldJob, ipin_score
+from stridefix_analyzer.realbench.fold import FoldJob
 from stridefix_analyzer.realbench.strides import error_stats, spread
 from stridefix_analyzer.realbench.tuning import Axis
+from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M, ipin_score
 
 #: a walk whose mean error exceeds this is a failure for the robustness share [m]
 ROBUST_MEAN_M = 15.0
+#: the row of pdr_only's truth-initialised run (--true-start), shown beside the first-fix table
+PDR_TRUE_START_LABEL = f"{schemes.PDR_ONLY} (truth-initialised)"
 
 
 def stats_of(errors: ArrayLike) -> dict[str, Any]:
@@ -136,31 +139,49 @@ def strip_samples(doc: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def pdr_true_start(group: Mapping[str, Any]) -> dict[str, Any] | None:
+    """pdr_only's row of a group's truth-initialised run; None when it was not run (no --true-start)."""
+    return group.get("summary_true_start", {}).get("schemes", {}).get(schemes.PDR_ONLY)
+
+
+def pdr_true_start_text(fmt: str, group: Mapping[str, Any]) -> str:
+    """One line on pdr_only from the true start in a group of data set ``fmt`` (console and HTML)."""
+    r = pdr_true_start(group)
+    head = f"[{fmt}] {group['label']}: {schemes.PDR_ONLY} from the TRUE START (truth-initialised)"
+    if r is None:
+        return f"{head}: not run (realbench --true-start runs it)"
+    return (
+        f"{head}: mean {_f(r['mean'])} m, p75 {_f(r['p75'])} m, IPIN score {_f(r['ipin_score'])} m, "
+        f"floor hit {_f(100 * r['floor_hit_rate'], 1)} % ({r['n']} samples, {r['walks']} walks)"
+    )
+
+
 # --- console ---------------------------------------------------------------------------------------
 
 
+def _f(v: Any, d: int = 2) -> str:
+    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
+
+
 def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
-    """Per group: scheme × n, mean, median, p75, p90, max, RMSE, IPIN, floor %, walks > 15 m."""
-
-    def f(v: Any, d: int = 2) -> str:
-        return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{d}f}"
-
+    """Per group: scheme × n, mean, median, p75, p90, max, RMSE, IPIN, floor %, walks > 15 m; under the
+    first-fix table pdr_only's truth-initialised row (:data:`PDR_TRUE_START_LABEL`) and its line."""
     lines = []
     for g in doc["groups"]:
         c = g["constants"]
         lines.append(
             f"{g['label']}: {g['walks']} walks ({g['ran']} ran, "
             f"{len(g['walk_rows']) - len(g['fold_errors'])} scored), leave one walk out; "
-            f"K {f(c['K']['mean'], 3)} ({f(c['K']['min'], 3)}..{f(c['K']['max'], 3)}), "
-            f"rotation {f(c['rotation_deg']['mean'], 1)} deg "
-            f"({f(c['rotation_deg']['min'], 1)}..{f(c['rotation_deg']['max'], 1)}), "
+            f"K {_f(c['K']['mean'], 3)} ({_f(c['K']['min'], 3)}..{_f(c['K']['max'], 3)}), "
+            f"rotation {_f(c['rotation_deg']['mean'], 1)} deg "
+            f"({_f(c['rotation_deg']['min'], 1)}..{_f(c['rotation_deg']['max'], 1)}), "
             + "".join(
                 f"{a.label} "
                 + ", ".join(f"{v} in {n} folds" for v, n in c.get(f"{a.name}_variant", {}).items())
                 + ", "
                 for a in axes
             )
-            + f"map {f(c['n_rp']['mean'], 0)} RPs / {f(c['n_ap']['mean'], 0)} APs"
+            + f"map {_f(c['n_rp']['mean'], 0)} RPs / {_f(c['n_ap']['mean'], 0)} APs"
         )
         for key, title in (
             ("summary", "every scheme from its first fix"),
@@ -169,25 +190,31 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
             if key not in g:
                 continue
             s = g[key]
+            rows = list(s["schemes"].items())
+            true_pdr = pdr_true_start(g)
+            if key == "summary" and true_pdr is not None:
+                rows.append((PDR_TRUE_START_LABEL, true_pdr))
+            w = max(10, *(len(name) + 1 for name, _ in rows))
             lines.append(f"  [{title}]  errors in m at the ground-truth times")
             lines.append(
-                f"  {'scheme':<10}{'n':>6}{'mean':>8}{'median':>8}{'p75':>8}{'p90':>8}"
+                f"  {'scheme':<{w}}{'n':>6}{'mean':>8}{'median':>8}{'p75':>8}{'p90':>8}"
                 f"{'max':>8}{'rmse':>8}{'ipin':>8}{'floor%':>8}{'>15m':>10}"
             )
-            for name, r in s["schemes"].items():
+            for name, r in rows:
                 share = r["share_walks_mean_over_15m"]
                 lines.append(
-                    f"  {name:<10}{r['n']:>6}{f(r['mean']):>8}{f(r['median']):>8}"
-                    f"{f(r['p75']):>8}{f(r['p90']):>8}{f(r['max']):>8}{f(r['rmse']):>8}"
-                    f"{f(r['ipin_score']):>8}{f(100 * r['floor_hit_rate'], 1):>8}"
-                    f"{(f(100 * share, 1) + '%') if share == share else '-':>10}"
+                    f"  {name:<{w}}{r['n']:>6}{_f(r['mean']):>8}{_f(r['median']):>8}"
+                    f"{_f(r['p75']):>8}{_f(r['p90']):>8}{_f(r['max']):>8}{_f(r['rmse']):>8}"
+                    f"{_f(r['ipin_score']):>8}{_f(100 * r['floor_hit_rate'], 1):>8}"
+                    f"{(_f(100 * share, 1) + '%') if share == share else '-':>10}"
                 )
             lines.append(
                 f"  adaptive vs wifi_only: mean error reduced by "
-                f"{f(s['adaptive_vs_wifi_only_reduction_pct'], 1)} %  (>15m = share of walks "
+                f"{_f(s['adaptive_vs_wifi_only_reduction_pct'], 1)} %  (>15m = share of walks "
                 f"whose mean error exceeds {ROBUST_MEAN_M:g} m; ipin = p75 of 2-D error + "
                 f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|)"
             )
+        lines.append(f"  {pdr_true_start_text(doc['format'], g)}")
         for e in g["failed"] + g["fold_errors"]:
             lines.append(f"  failed {e['walk']}: {e['error']}")
     return "\n".join(lines)

@@ -2,7 +2,8 @@
 
 Outputs in ``--out DIR`` (default ``out/analyze``):
 
-- ``metrics.json``: the summary (see :meth:`stridefix_analyzer.metrics.Metrics.summary`) plus
+- ``metrics.json``: the summary (see :meth:`stridefix_analyzer.metrics.Metrics.summary`; per scheme
+  and for the primary scheme the ``ipin_score`` [m], p75 of 2-D error + 15 m × |floor error|) plus
   ``inputs``, ``messages`` (events per channel), ``unknown_channels``, ``decode_errors``,
   ``health`` (last HEALTH fields), ``config`` (``version``, ``dbc_sha256``, ``params``) and
   ``warnings``. Non-finite numbers are written as ``null``.
@@ -32,7 +33,14 @@ from stridefix_analyzer.io.logread import (
     LogTruncatedWarning,
     read_logs,
 )
-from stridefix_analyzer.scoring.metrics import Metrics, MetricsInputError, run_metrics, scheme_code
+from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.scoring.metrics import (
+    IPIN_FLOOR_PENALTY_M,
+    Metrics,
+    MetricsInputError,
+    run_metrics,
+    scheme_code,
+)
 
 DEFAULT_OUT = os.path.join("out", "analyze")
 METRICS_FILE = "metrics.json"
@@ -63,8 +71,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         metavar="NAME",
         help="pose scheme reported at the top level when POSE holds several "
-        "(pdr_only, wifi_only, overwrite, static, adaptive, kalman or a number; "
-        "default: the one with most POSE messages)",
+        f"({', '.join(NAMES)} or a number; default: the one with most POSE messages)",
     )
     p.add_argument(
         "--truth-source",
@@ -138,7 +145,7 @@ def format_summary(summary: dict) -> str:
     lines = [
         f"{'scheme':<11}"
         + "".join(f"{c:>8}" for c in cols)
-        + f"{'floor%':>8}{'final':>8}{'final%':>8}{'hdgRMS':>8}{'steps':>8}"
+        + f"{'ipin':>8}{'floor%':>8}{'final':>8}{'final%':>8}{'hdgRMS':>8}{'steps':>8}"
     ]
     for name, s in summary["per_scheme"].items():
         e = s["position_error_m"]
@@ -147,6 +154,7 @@ def format_summary(summary: dict) -> str:
         lines.append(
             f"{mark}{name:<10}"
             + "".join(f"{_fmt(e[c]):>8}" for c in cols)
+            + f"{_fmt(s.get('ipin_score')):>8}"
             + f"{_fmt(None if floor is None else 100 * floor, 1):>8}"
             + f"{_fmt(s['final_error_m']):>8}"
             + f"{_fmt(s['final_error_pct_of_distance']):>8}"
@@ -155,8 +163,8 @@ def format_summary(summary: dict) -> str:
         )
     st = summary["steps"]
     lines.append(
-        f"(errors in m; final% of distance walked; hdgRMS in deg; * primary scheme; "
-        f"steps = detected - truth)  "
+        f"(errors in m; ipin = IPIN score, p75 of 2-D error + {IPIN_FLOOR_PENALTY_M:g} m x |floor "
+        f"error|; final% of distance walked; hdgRMS in deg; * primary scheme; steps = detected - truth)  "
         f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
         f"walked {summary['distance_walked_m']:.1f} m, "
         f"steps detected {st['detected']} / truth {_fmt(st['truth'])}"

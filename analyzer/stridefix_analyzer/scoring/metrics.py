@@ -4,8 +4,9 @@ Protocol (causal, nothing looks ahead): for each truth time t the estimate is th
 with ``t_us ≤ t`` (of the same fusion scheme); the position error is the horizontal distance
 between the two [m]. Truth samples before the scheme's first POSE are not scored but counted as
 ``unscored``. Statistics: n, mean, median, 75th/90th/95th percentile (numpy's default linear
-interpolation), max and RMSE, plus the empirical CDF. Also floor hit rate, step count against the
-truth, distance walked along the truth, and the final error.
+interpolation), max and RMSE, plus the empirical CDF. Also floor hit rate, the IPIN score (the IPIN
+competition's metric, :func:`ipin_score`), step count against the truth, distance walked along the
+truth, and the final error.
 
 When a log holds POSE messages of several schemes (``pose_t.scheme``), each is scored on its own
 and reported under its name; one of them is the *primary* scheme whose numbers are repeated at the
@@ -19,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes as registry
 from stridefix_analyzer.io.logread import LogData, Table
@@ -29,6 +31,8 @@ _PRIMARY_PREFERENCE = ["adaptive", "kalman", "static", "overwrite", "wifi_only",
 
 #: percentiles reported, in percent
 PERCENTILES = (50, 75, 90, 95)
+#: IPIN competition score: p75 of (2-D error + this × |floor error|) [m per floor]
+IPIN_FLOOR_PENALTY_M = 15.0
 
 
 class MetricsInputError(ValueError):
@@ -157,6 +161,22 @@ def error_stats(error_m: np.ndarray) -> dict:
     return stats
 
 
+def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:
+    """The IPIN competition score [m]: 75th percentile of 2-D error + :data:`IPIN_FLOOR_PENALTY_M`
+    × |floor error|, over the samples where that sum is finite (NaN when there is none).
+
+    Parameters
+    ----------
+    error_m : array_like, shape (n,)
+        Horizontal position errors [m].
+    floor_error : array_like, shape (n,)
+        Floor errors at the same samples [floors]; the sign does not matter.
+    """
+    e = np.asarray(error_m, float) + IPIN_FLOOR_PENALTY_M * np.abs(np.asarray(floor_error, float))
+    e = e[np.isfinite(e)]
+    return float(np.percentile(e, 75)) if len(e) else float("nan")
+
+
 def error_cdf(error_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Empirical CDF of the finite errors.
 
@@ -213,8 +233,8 @@ class SchemeScore:
         pose_t.scheme code and its name.
     summary : dict
         JSON-ready numbers: ``n_pose``, ``position_error_m`` (see :func:`error_stats`),
-        ``unscored``, ``floor_hit_rate``, ``within_1sigma_rate``, ``steps``, ``final_error_m``,
-        ``final_error_pct_of_distance``.
+        ``unscored``, ``floor_hit_rate``, ``ipin_score`` [m] (:func:`ipin_score`),
+        ``within_1sigma_rate``, ``steps``, ``final_error_m``, ``final_error_pct_of_distance``.
     match : Table
         Per-truth-sample series from :func:`match_causal`, shape (n_truth,).
     pose : Table
@@ -228,16 +248,23 @@ class SchemeScore:
     pose: Table
 
 
+def scored_errors(match: Table) -> tuple[np.ndarray, np.ndarray]:
+    """(2-D error [m], |floor error| [floors]) at the scored rows of a :func:`match_causal` table
+    (a :attr:`SchemeScore.match`), shape (n_scored,) each: what :func:`ipin_score` takes, and what a
+    benchmark pools over walks."""
+    sc = match["scored"]
+    floor_error = np.abs(match["pose_floor"][sc] - match["truth_floor"][sc]).astype(np.int64)
+    return match["error_m"][sc].astype(np.float64), floor_error
+
+
 def score_scheme(
     pose: Table, truth: Table, n_step_messages: int, distance_m: float, code: int
 ) -> SchemeScore:
     """Score one scheme's POSE rows (sorted by time) against the TRUTH rows (sorted by time)."""
     m = match_causal(pose, truth)
     scored = m["scored"]
-    err = m["error_m"][scored]
-    floor_hit = (
-        float(np.mean(m["pose_floor"][scored] == m["truth_floor"][scored])) if scored.any() else float("nan")
-    )
+    err, floor_err = scored_errors(m)
+    floor_hit = float(np.mean(floor_err == 0)) if scored.any() else float("nan")
     sig = m["pose_sigma_m"][scored]
     ok = np.isfinite(err) & np.isfinite(sig) & (sig > 0)
     within = float(np.mean(err[ok] <= sig[ok])) if ok.any() else float("nan")
@@ -247,6 +274,7 @@ def score_scheme(
         "position_error_m": error_stats(err),
         "unscored": int(np.count_nonzero(~scored)),
         "floor_hit_rate": floor_hit,
+        "ipin_score": ipin_score(err, floor_err),
         "within_1sigma_rate": within,
         "heading_error": heading_stats(m["heading_error_rad"][scored]),
         "steps": step_metrics(pose, truth, n_step_messages),
@@ -260,7 +288,8 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
     """The scheme whose numbers go at the top level.
 
     ``requested`` if given (it must occur in the log); else the scheme with most POSE messages,
-    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only.
+    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only, then any other
+    scheme in id order (a scheme new to ``pose_t.lcm`` needs no row here).
     """
     codes, counts = np.unique(pose["scheme"], return_counts=True)
     if requested is not None:
@@ -309,6 +338,7 @@ class Metrics:
             "unscored": top["unscored"],
             "n_truth": len(self.truth),
             "floor_hit_rate": top["floor_hit_rate"],
+            "ipin_score": top["ipin_score"],
             "floors_in_truth": sorted({int(f) for f in self.truth["floor"]}),
             "within_1sigma_rate": top["within_1sigma_rate"],
             "heading_error": top["heading_error"],

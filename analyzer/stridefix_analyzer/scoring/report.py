@@ -20,6 +20,7 @@ import numpy as np
 
 from stridefix_analyzer.scoring import plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
+from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
 
 
 class ReportInputError(Exception):
@@ -109,7 +110,7 @@ def _scheme_table(summary: dict) -> str:
     head = (
         "<tr><th class='k'>scheme</th><th>POSE msgs</th>"
         + "".join(f"<th>{c}{'' if c == 'n' else ' [m]'}</th>" for c in _STAT_COLS)
-        + "<th>unscored</th><th>floor hit</th><th>within 1σ</th><th>final [m]</th>"
+        + "<th>IPIN score [m]</th><th>unscored</th><th>floor hit</th><th>within 1σ</th><th>final [m]</th>"
         "<th>final / distance</th></tr>"
     )
     rows = []
@@ -120,6 +121,7 @@ def _scheme_table(summary: dict) -> str:
         rows.append(
             f"<tr{cls}><td class='k'>{html.escape(name)}</td><td>{_cell(s.get('n_pose'))}</td>"
             + "".join(f"<td>{_cell(e.get(c))}</td>" for c in _STAT_COLS)
+            + f"<td>{_cell(s.get('ipin_score'))}</td>"
             + f"<td>{_cell(s.get('unscored'))}</td><td>{_cell(_pct(s.get('floor_hit_rate')))}</td>"
             f"<td>{_cell(_pct(s.get('within_1sigma_rate')))}</td>"
             f"<td>{_cell(s.get('final_error_m'))}</td>"
@@ -172,6 +174,7 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         ("distance walked (truth) [m]", summary.get("distance_walked_m")),
         ("final error [m]", summary.get("final_error_m")),
         ("floor hit rate", _pct(summary.get("floor_hit_rate"))),
+        ("IPIN score [m]", summary.get("ipin_score")),
         ("floors in truth", ", ".join(str(f) for f in summary.get("floors_in_truth", []))),
     ]
     health = summary.get("health") or {}
@@ -188,7 +191,9 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
         "<p class='note'>Error at each truth time = horizontal distance to the latest POSE at or "
-        "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation.</p>",
+        "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation. "
+        f"IPIN score (the IPIN competition's metric): p75 of 2-D error + {IPIN_FLOOR_PENALTY_M:g} m "
+        "× |floor error|.</p>",
         _kv_table(overview, ("summary", "")),
         f"<ul>{warnings_html}</ul>" if warnings_html else "",
         "<h2>Position error by scheme</h2>",

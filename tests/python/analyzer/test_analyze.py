@@ -75,3 +75,20 @@ def test_nothing_scored_exits_1(msg, write_log, tmp_path, cli_main):
     assert cli_main(["analyze", str(path), "--out", str(tmp_path / "o")]) == 1
     m = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert m["position_error_m"]["n"] == 0 and m["position_error_m"]["mean"] is None
+
+
+def test_analyze_json_and_console_carry_the_ipin_score(walk_logs, tmp_path, cli_main, capsys):
+    # one floor throughout, so the IPIN score is the p75 of the 2-D error: adaptive is a constant
+    # hypot(0.1, 1) m off (scored against the previous sample's pose), pdr_only 1.9 m
+    fw, sim = walk_logs
+    out = tmp_path / "ipin"
+    assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    assert_allclose(m["per_scheme"]["adaptive"]["ipin_score"], np.hypot(0.1, 1.0), rtol=1e-9)
+    assert_allclose(m["per_scheme"]["pdr_only"]["ipin_score"], 1.9, rtol=1e-9)
+    assert m["ipin_score"] == m["per_scheme"][m["primary_scheme"]]["ipin_score"]
+    console = capsys.readouterr().out
+    assert "ipin" in console.splitlines()[0]
+    assert cli_main(["report", str(out)]) == 0
+    page = (out / "report.html").read_text()
+    assert "IPIN score [m]" in page and f"{np.hypot(0.1, 1.0):.2f}" in page

@@ -6,8 +6,10 @@ from numpy.testing import assert_allclose
 from stridefix import pose_t
 from stridefix_analyzer.io.logread import Table, read_logs
 from stridefix_analyzer.scoring.metrics import (
+    IPIN_FLOOR_PENALTY_M,
     MetricsInputError,
     error_stats,
+    ipin_score,
     run_metrics,
     scheme_code,
     step_metrics,
@@ -206,3 +208,34 @@ def test_truth_source_waypoint_scores_only_reference_points(msg, write_log, stra
     assert_allclose(wp_only["position_error_m"]["mean"], 2.0, rtol=1e-12)
     with pytest.raises(MetricsInputError):
         run_metrics(data, truth_source="nonsense")
+
+
+# --- the IPIN score ---------------------------------------------------------------------------------
+
+# eight samples with 2-D errors 1..8 m; the last two one floor off (either sign): error + 15 m x |floor
+# error| = 1, 2, 3, 4, 5, 6, 22, 23; the 75th percentile (linear) sits at index 0.75 x 7 = 5.25, so
+# 6 + 0.25 x (22 - 6) = 10.0 m. Without the floor errors: 6 + 0.25 x 1 = 6.25 m.
+IPIN_ERRORS_M = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
+IPIN_FLOOR_ERRORS = [0, 0, 0, 0, 0, 0, 1, -1]
+
+
+def test_ipin_score_of_a_handmade_series_is_the_formula():
+    assert IPIN_FLOOR_PENALTY_M == 15.0
+    assert_allclose(ipin_score(IPIN_ERRORS_M, IPIN_FLOOR_ERRORS), 10.0, rtol=1e-12)
+    assert_allclose(ipin_score(IPIN_ERRORS_M, np.zeros(8)), 6.25, rtol=1e-12)
+    # a non-finite sample is left out, not counted as zero: [1, 2, 3, 4, 22] -> index 3 -> 4.0 m
+    assert_allclose(ipin_score([1.0, 2.0, np.nan, 3.0, 4.0, 7.0], [0, 0, 0, 0, 0, 1]), 4.0, rtol=1e-12)
+    assert np.isnan(ipin_score([], []))
+
+
+def test_ipin_score_per_scheme_from_the_pose_stream(msg, write_log):
+    # truth along x on floor 0; pdr_only 1..8 m ahead, on floor 1 for the last two samples
+    events = []
+    for k, (e_m, f) in enumerate(zip(IPIN_ERRORS_M, IPIN_FLOOR_ERRORS)):
+        t = 1_000_000 * (k + 1)
+        events.append(("POSE", msg.pose(t, k + e_m, 0.0, floor=abs(f), scheme=pose_t.SCHEME_PDR_ONLY)))
+        events.append(("TRUTH", msg.truth(t, float(k), 0.0, floor=0)))
+    m = run_metrics(read_logs([write_log("ipin.lcmlog", events)])).summary()
+    assert_allclose(m["per_scheme"]["pdr_only"]["ipin_score"], 10.0, rtol=1e-12)
+    assert_allclose(m["ipin_score"], 10.0, rtol=1e-12)  # the primary scheme's, at the top level
+    assert_allclose(m["floor_hit_rate"], 0.75, rtol=1e-12)
