@@ -22,6 +22,11 @@ class LogReadError(Exception):
         self.path = path
         self.reason = reason
 
+    def __reduce__(self) -> tuple[type[LogReadError], tuple[str, str]]:
+        # a realbench worker's error must reach the parent process whole (pickling rebuilds an exception
+        # from self.args, which is the one formatted message here)
+        return (type(self), (self.path, self.reason))
+
 
 class LogTruncatedWarning(UserWarning):
     """A log ends with a partial record (or contains unreadable bytes); the whole records were read."""

@@ -245,3 +245,16 @@ def test_fix_columns_are_the_fields_of_fix_t():
             expected.append(field)
     assert CHANNELS["FIX"].names == expected
     assert {"t_us", "method", "scheme", "x_m", "accepted", "reason", "reason_text"} <= set(expected)
+
+
+def test_log_read_error_crosses_processes():
+    """realbench's workers raise it; the pool pickles it back to the parent whole."""
+    import pickle
+
+    err = pickle.loads(pickle.dumps(LogReadError("walk.lcmlog", "not an LCM event log")))
+    assert isinstance(err, LogReadError)
+    assert (err.path, err.reason, str(err)) == (
+        "walk.lcmlog",
+        "not an LCM event log",
+        "walk.lcmlog: not an LCM event log",
+    )
