@@ -175,7 +175,7 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     f->y_m = fix->y_m;
     f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
     if (is_ekf(f)) {
-        sf_ekf_restart_position(&f->ekf, ekf_r_m2);
+        sf_ekf_restart_at_fix(&f->ekf, p, ekf_r_m2);
     }
     f->floor_offset = predicts(f) ? (int32_t)fix->floor - baro_floor : (int32_t)fix->floor;
 }
@@ -251,7 +251,8 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
     if (is_ekf(f)) {
         double cov_m2[3];
         iso_cov(f->var_m2, cov_m2);
-        sf_ekf_start(&f->ekf, p, cov_m2);
+        sf_ekf_start(&f->ekf, p);
+        sf_ekf_restart_known(&f->ekf, p, cov_m2);
     }
     f->floor_offset = predicts(f) ? (int32_t)floor - baro_floor : (int32_t)floor;
     f->t_us = t_us;
@@ -302,14 +303,13 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
 
     /* fusion: predict to the fix's time */
     predict_to(f, p, fix->t_us);
-    /* the ekf: one fix's R (start, recovery) and an update's R (a fix in a correlated run) */
-    double ekf_r_m2[3] = {r_m2, 0.0, r_m2}, ekf_run_r_m2[3] = {r_m2, 0.0, r_m2};
+    /* the ekf's white R from its fix-error model */
+    double ekf_r_m2[3] = {r_m2, 0.0, r_m2};
     if (is_ekf(f)) {
         if (!f->initialised) {
-            sf_ekf_start(&f->ekf, p, ekf_r_m2); /* the prior fix model, bias and scale */
+            sf_ekf_start(&f->ekf, p); /* the prior fix model, bias and scale */
         }
         sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
-        sf_ekf_update_r(&f->ekf, p, fix->accuracy_m, ekf_run_r_m2);
     }
 
     /* control: start */
@@ -318,7 +318,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
         f->last_fix_t_us = fix->t_us;
         f->rejections = 0;
         f->initialisations++;
-        audit->innovation_var_m2 = is_ekf(f) ? 0.5 * (ekf_r_m2[0] + ekf_r_m2[2]) : r_m2;
+        audit->innovation_var_m2 = is_ekf(f) ? 0.5 * (f->ekf.P[0][0] + f->ekf.P[1][1]) : r_m2;
         audit->alpha = 1.0;
         audit->accepted = true;
         audit->reason = sf_fix_reason_initialised;
@@ -326,18 +326,21 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
     }
 
     /* fusion: innovation, its variance, the test ratio */
-    const double nu_x = fix->x_m - f->x_m;
-    const double nu_y = fix->y_m - f->y_m;
-    const double nu_m[2] = {nu_x, nu_y};
+    double nu_m[2] = {fix->x_m - f->x_m, fix->y_m - f->y_m};
+    if (is_ekf(f)) { /* the ekf predicts the fix at its position plus the fixes' correlated error */
+        const double z_minus_p_m[2] = {nu_m[0], nu_m[1]};
+        sf_ekf_innovation(&f->ekf, z_minus_p_m, nu_m);
+    }
+    const double nu_x = nu_m[0], nu_y = nu_m[1];
     const double s_m2 = f->var_m2 + r_m2;
     const double gate = p->fusion_gate_sigma;
     audit->innovation_m[0] = nu_x;
     audit->innovation_m[1] = nu_y;
     audit->innovation_var_m2 = s_m2;
     audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
-    if (is_ekf(f)) { /* the full 2×2 S of the update: NIS, χ² with 2 dof, on the same gate */
+    if (is_ekf(f)) { /* the full 2×2 S: NIS, χ² with 2 dof, on the same gate */
         double s3_m2[3];
-        audit->test_ratio = sf_ekf_nis(&f->ekf, nu_m, ekf_run_r_m2, s3_m2) / (gate * gate);
+        audit->test_ratio = sf_ekf_nis(&f->ekf, nu_m, ekf_r_m2, s3_m2) / (gate * gate);
         audit->innovation_var_m2 = 0.5 * (s3_m2[0] + s3_m2[2]);
     }
 
@@ -354,7 +357,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
             blend(f, p, audit->alpha, nu_x, nu_y, r_m2);
         } else if (is_ekf(f)) {
             double dpos_m[2];
-            audit->alpha = sf_ekf_update(&f->ekf, p, nu_m, ekf_run_r_m2, dpos_m);
+            audit->alpha = sf_ekf_update(&f->ekf, p, nu_m, ekf_r_m2, dpos_m);
             f->x_m += dpos_m[0];
             f->y_m += dpos_m[1];
         } else { /* wifi_only */

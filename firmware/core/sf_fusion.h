@@ -42,11 +42,12 @@
  *              Knots must increase; if not, the value jumps at the first knot reached (no division by 0).
  *   kalman     (ours) α = var / (var + R), the Kalman gain of the random-walk model above.
  *   ekf        (ours) the error-state Kalman filter of sf_ekf.h: state position, heading bias, stride
- *              scale, a full 4×4 covariance propagated per step, R a full 2×2 from its online-learnt
- *              fix-error model, the gate on the NIS (test ratio NIS / gate², χ² 2 dof like the others),
- *              α recorded = the mean position gain; its initialisation and recovery restart the position
- *              block at R (bias and scale keep what they learnt); its pose carries the covariance, the
- *              bias (added to the heading) and the scale. Floors and control as for the blends.
+ *              scale and the fixes' correlated error, a full 6×6 covariance propagated per step, R a full
+ *              2×2 from the site's fix-error model, ν = fix − position − correlated error, the gate on
+ *              the NIS (test ratio NIS / gate², χ² 2 dof like the others), α recorded = the mean
+ *              position gain; its initialisation and recovery restart the position from the fix (bias
+ *              and scale keep what they learnt); its pose carries the covariance, the bias (added to the
+ *              heading) and the scale. Floors and control as for the blends.
  * Variance after an accepted fix: kalman var ← (1 − α)·var; the fixed-gain schemes take the Joseph form
  * var ← (1 − α)²·var + α²·R (the true variance of a blend with an arbitrary gain; equal to the Kalman
  * form when α is the Kalman gain). Every variance is floored at fusion_var_min_m2.
@@ -88,8 +89,8 @@
  * sf_fusion_init_at SF_OK or SF_EINVAL (non-finite x, y or sigma, negative sigma; state unchanged);
  * sf_fusion_fix SF_OK or SF_ERANGE (bad fix, see above). Everything else cannot fail.
  * Cost: O(1), a few tens of flops and one sqrt per call (the ekf a few hundred, sf_ekf.h). Memory:
- * sizeof(sf_fusion_t) = 280 B per scheme on x86-64 (the sf_ekf_t in every scheme, 176 B, keeps the array
- * uniform), sf_fix_audit_t 120 B; at most 320 B and 160 B (checked). No heap, no I/O, no
+ * sizeof(sf_fusion_t) = 464 B per scheme on x86-64 (the sf_ekf_t in every scheme, 360 B, keeps the array
+ * uniform), sf_fix_audit_t 120 B; at most 480 B and 160 B (checked). No heap, no I/O, no
  * clock, no hidden state: the same inputs give bit-identical outputs. */
 #ifndef SF_FUSION_H
 #define SF_FUSION_H
@@ -155,9 +156,10 @@ typedef struct {
     /* counters, never decrease */
     uint32_t steps, bad_steps, fixes, accepted, rejected_gate, rejected_floor, recoveries,
         initialisations, bad_fixes, backwards;
-    sf_ekf_t ekf; /* the ekf scheme's filter (bias, scale, 4×4 covariance, fix model); unused by the others */
+    sf_ekf_t ekf; /* the ekf scheme's filter (bias, scale, fix error, 6×6 covariance, fix model); unused by
+                   * the others */
 } sf_fusion_t;
-_Static_assert(sizeof(sf_fusion_t) <= 320, "sf_fusion.h promises at most 320 B per scheme");
+_Static_assert(sizeof(sf_fusion_t) <= 480, "sf_fusion.h promises at most 480 B per scheme");
 
 /* An uninitialised scheme. SF_OK, or SF_EINVAL for NULL or an unknown scheme. */
 int sf_fusion_init(sf_fusion_t *f, int8_t scheme);

@@ -44,7 +44,8 @@ static void test_step_jacobian(void **state)
     p.ekf_scale_rw_per_m = 0.0;
     const double zero[3] = {0, 0, 0};
     sf_ekf_t e;
-    sf_ekf_start(&e, &p, zero);
+    sf_ekf_start(&e, &p);
+    sf_ekf_restart_known(&e, &p, zero);
     e.heading_bias_rad = 0.3;
     e.stride_scale = 1.1;
     const double vb = e.P[2][2], vs = e.P[3][3], L = 0.7, psi = 1.2;
@@ -81,7 +82,8 @@ static void test_update_is_kalman(void **state)
     sf_params_t p = params();
     const double cov[3] = {4.0, 0.0, 4.0}, r[3] = {1.0, 0.0, 1.0}, nu[2] = {2.0, -1.0};
     sf_ekf_t e;
-    sf_ekf_start(&e, &p, cov);
+    sf_ekf_start(&e, &p);
+    sf_ekf_restart_known(&e, &p, cov);
     double s[3];
     near(sf_ekf_nis(&e, nu, r, s), (4.0 + 1.0) / 5.0, 1e-12);
     double dpos[2];
@@ -105,7 +107,8 @@ static void test_learns_bias_and_scale(void **state)
     const double true_bias = 0.25, true_scale = 1.25, L = 0.6, sigma_fix = 2.0;
     const double cov0[3] = {4.0, 0.0, 4.0};
     sf_ekf_t e;
-    sf_ekf_start(&e, &p, cov0);
+    sf_ekf_start(&e, &p);
+    sf_ekf_restart_known(&e, &p, cov0);
     double x = 0, y = 0, tx = 0, ty = 0, px = 0, py = 0, err_ekf = 0, err_pdr = 0;
     int n = 0;
     for (int k = 0; k < 800; k++) {
@@ -150,7 +153,8 @@ static void test_fix_model_only_grows(void **state)
     p.ekf_fix_var_y_per_acc2 = 2.0;
     const double cov[3] = {1.0, 0.0, 1.0};
     sf_ekf_t e;
-    sf_ekf_start(&e, &p, cov);
+    sf_ekf_start(&e, &p);
+    sf_ekf_restart_known(&e, &p, cov);
     double r[3];
     sf_ekf_fix_r(&e, &p, 3.0, r);
     near(r[0], 18.0, 1e-12);
@@ -173,6 +177,51 @@ static void test_fix_model_only_grows(void **state)
         sf_ekf_learn_fix_model(&e, &p, wild, 3.0, 9.0);
     }
     assert_true(e.fix_model[0] <= p.ekf_r_max + 1e-9);
+}
+
+/* A standing walker known at the origin (σ 1 m) gets the same wrong fix 5 m east 20 times. Taken as
+ * independent, the fixes pull the position onto the wrong place; with the fixes' correlated error as a
+ * state (σ_c 4 m) the filter sees one wrong fix repeated and the position stays near the truth. Then
+ * 60 m of walking decorrelates c (ℓ 10 m): its variance returns to σ_c². */
+static double stuck_fix_run(const double sigma_c_m, sf_ekf_t *const out)
+{
+    sf_params_t p = params();
+    p.ekf_fix_var_x_per_acc2 = p.ekf_fix_var_y_per_acc2 = 25.0 / 9.0; /* one fix: 5 m σ at accuracy 3 m */
+    p.ekf_fix_bias_sigma_m = sigma_c_m;
+    p.ekf_r_window = 0;
+    const double cov[3] = {1.0, 0.0, 1.0};
+    sf_ekf_t e;
+    sf_ekf_start(&e, &p);
+    sf_ekf_restart_known(&e, &p, cov);
+    double x = 0.0, y = 0.0;
+    for (int i = 0; i < 20; i++) {
+        const double zp[2] = {5.0 - x, 0.0 - y};
+        double nu[2], r[3], dpos[2];
+        sf_ekf_innovation(&e, zp, nu);
+        sf_ekf_fix_r(&e, &p, 3.0, r);
+        (void)sf_ekf_update(&e, &p, nu, r, dpos);
+        x += dpos[0], y += dpos[1];
+    }
+    *out = e;
+    for (int k = 0; k < 100; k++) {
+        double d[2];
+        sf_ekf_step(out, &p, 0.6, 1.0, d);
+    }
+    return x;
+}
+
+static void test_correlated_fix_error(void **state)
+{
+    (void)state;
+    sf_ekf_t white, coloured;
+    const double x_white = stuck_fix_run(0.0, &white), x_coloured = stuck_fix_run(4.0, &coloured);
+    printf("after 20 identical fixes 5 m off: position %.2f m (independent fixes), %.2f m (correlated error "
+           "state, c = %.2f m)\n",
+           x_white, x_coloured, coloured.fix_bias_m[0]);
+    assert_true(x_white > 2.0); /* (0/1 + 20·5/25) / (1 + 20/25) = 2.22 m */
+    assert_true(x_coloured < 0.5);
+    near(coloured.P[4][4], 16.0, 0.3); /* after 60 m, c's variance is σ_c² again */
+    near(coloured.fix_bias_m[0], 0.0, 0.05);
 }
 
 /* Through sf_fusion: the ekf initialises at the first fix with its R, publishes covariance, bias and
@@ -223,6 +272,7 @@ int main(void)
         cmocka_unit_test(test_update_is_kalman),
         cmocka_unit_test(test_learns_bias_and_scale),
         cmocka_unit_test(test_fix_model_only_grows),
+        cmocka_unit_test(test_correlated_fix_error),
         cmocka_unit_test(test_scheme_in_fusion),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -12,17 +12,16 @@ The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather tha
   axis: a corridor's error runs along it), pooled over the other blocks' walks; |u| is winsorised at
   its :data:`WINSOR_QUANTILE` quantile, because a fix outside the training walks' coverage is off by
   tens of metres and one of them would set M alone (the gate handles those);
-* consecutive fixes err alike (neighbouring scans match the same wrong reference points), and a
-  filter that takes them as independent follows them. With ρ the lag-1 autocorrelation of u (within
-  each walk, both axes pooled), the errors as AR(1), the mean of N consecutive fixes has the variance
-  of one fix times c = (1 + 2 Σ_{k<N} (1 − k/N) ρ^k) / N instead of 1 / N: the run carries the
-  information of 1 / c fixes, not N: the run factor N·c (≤ N), N = :data:`RUN_FIXES` the run a
-  converged filter effectively averages, multiplies R in the scheme's updates (not in its start,
-  recovery or gate, which rest on one fix).
+* consecutive fixes err alike (neighbouring scans match the same wrong reference points; a standing
+  walker gets the same wrong fix again), and a filter that takes them as independent follows them. The
+  scheme carries that part of the error as a state c (a Gauss–Markov process in the distance walked);
+  its σ_c and correlation length ℓ come from the covariance of two fixes' errors (in metres, per axis)
+  against the distance walked between them along the truth, C(Δd) = σ_c²·exp(−Δd/ℓ)
+  (:func:`correlation`), with σ_c² kept below the one-fix variance so a white part is left.
 
 The result goes to the fold as ``ekf.fix_var_x_per_acc2``, ``ekf.fix_var_y_per_acc2``,
-``ekf.fix_cov_xy_per_acc2`` (the firmware's prior, which the scheme can only raise online) and
-``ekf.fix_run_factor``.
+``ekf.fix_cov_xy_per_acc2`` (the firmware's prior, which the scheme can only raise online),
+``ekf.fix_bias_sigma_m`` and ``ekf.fix_bias_length_m``.
 """
 
 from __future__ import annotations
@@ -38,55 +37,113 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.progress import Progress
 
-#: fewest walks in a group to measure the model (fewer: the firmware prior)
-MIN_WALKS = 3
-#: ρ is clamped to [0, RHO_MAX]: a negative lag-1 correlation is noise
-RHO_MAX = 1.0
+#: fewest walks in a group to measure the model (fewer: the firmware prior), as for the inner
+#: cross-validation: with 4 walks the inner maps hold 2 walks and cover too little of the building, so
+#: the errors they give (10× those of the fold's 3-walk map on gsd) are not the fold's
+MIN_WALKS = rs.MIN_WALKS
 #: fewest fixes per block for a model (fewer: the firmware prior for that block)
 MIN_FIXES = 20
-#: |u| above this quantile is pulled onto it
+#: |u| (and |e| for the correlation) above this quantile is pulled onto it
 WINSOR_QUANTILE = 0.9
-#: fixes a converged filter averages (a Kalman gain of ~0.2 per fix): the horizon of the correlation
-#: factor
-RUN_FIXES = 5
-KEYS = ("ekf.fix_var_x_per_acc2", "ekf.fix_var_y_per_acc2", "ekf.fix_cov_xy_per_acc2", "ekf.fix_run_factor")
+#: pairs of fixes at most this many fixes apart enter the correlation
+MAX_LAG = 20
+#: bins of the distance walked between two fixes [m] for the correlation's decay
+DISTANCE_BINS_M = (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
+#: fewest pairs in a bin for it to count
+MIN_PAIRS = 10
+#: the correlation length is kept in this range [m]
+LENGTH_RANGE_M = (1.0, 200.0)
+#: σ_c² at most this share of the smallest one-fix variance at the median accuracy, so a white part is left
+MAX_CORRELATED_SHARE = 0.9
+KEYS = (
+    "ekf.fix_var_x_per_acc2",
+    "ekf.fix_var_y_per_acc2",
+    "ekf.fix_cov_xy_per_acc2",
+    "ekf.fix_bias_sigma_m",
+    "ekf.fix_bias_length_m",
+)
+
+
+def _winsorise(v: np.ndarray) -> np.ndarray:
+    radius = np.hypot(v[:, 0], v[:, 1])
+    cap = float(np.quantile(radius, WINSOR_QUANTILE))
+    return v * np.minimum(1.0, cap / np.maximum(radius, 1e-12))[:, None]
+
+
+def correlation(rows: Sequence[np.ndarray]) -> tuple[float, float, list[dict[str, float]]]:
+    """σ_c² [m²] and ℓ [m] of C(Δd) = σ_c²·exp(−Δd/ℓ), the per-axis covariance of two fixes' errors
+    against the distance walked between them (pairs within a walk, 1..:data:`MAX_LAG` fixes apart,
+    binned by :data:`DISTANCE_BINS_M`, a log-linear fit weighted by the pairs per bin); and the bins.
+    σ_c² = 0 when no bin has a positive covariance."""
+    prods: list[np.ndarray] = []
+    dists: list[np.ndarray] = []
+    for r in rows:
+        e = r[:, :2]
+        for k in range(1, min(MAX_LAG, len(r) - 1) + 1):
+            prods.append(0.5 * np.sum(e[k:] * e[:-k], axis=1))
+            dists.append(np.abs(r[k:, 3] - r[:-k, 3]))
+    if not prods:
+        return 0.0, LENGTH_RANGE_M[0], []
+    q, d = np.concatenate(prods), np.concatenate(dists)
+    bins = []
+    edges = (*DISTANCE_BINS_M, np.inf)
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        m = (d >= lo) & (d < hi)
+        if m.sum() >= MIN_PAIRS:
+            bins.append({"d_m": float(d[m].mean()), "cov_m2": float(q[m].mean()), "pairs": int(m.sum())})
+    pos = [b for b in bins if b["cov_m2"] > 0]
+    if not pos:
+        return 0.0, LENGTH_RANGE_M[0], bins
+    if len(pos) == 1:
+        return pos[0]["cov_m2"], LENGTH_RANGE_M[0], bins
+    x = np.array([b["d_m"] for b in pos])
+    y = np.log([b["cov_m2"] for b in pos])
+    w = np.sqrt([b["pairs"] for b in pos])
+    slope, intercept = np.polyfit(x, y, 1, w=w)
+    length = float(np.clip(-1.0 / slope, *LENGTH_RANGE_M)) if slope < 0 else LENGTH_RANGE_M[1]
+    return float(np.exp(intercept)), length, bins
 
 
 def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
-    """M (xx, yy, xy per accuracy²), ρ and the inflated model from per-walk residual arrays
-    (rows: error x, error y, accuracy; time order), or None with fewer than :data:`MIN_FIXES` fixes."""
-    rows = [np.asarray(r, float).reshape(-1, 3) for r in residuals]
+    """The fix-error model from per-walk residual arrays (rows: error x, error y [m], accuracy [m],
+    distance walked along the truth [m]; time order), or None with fewer than :data:`MIN_FIXES` fixes:
+    M (one fix's error covariance per accuracy²) and the correlated part σ_c, ℓ (:func:`correlation`)."""
+    rows = [np.asarray(r, float).reshape(-1, 4) for r in residuals]
     rows = [r[np.all(np.isfinite(r), axis=1) & (r[:, 2] > 0)] for r in rows]
+    rows = [r for r in rows if len(r)]
     n = sum(len(r) for r in rows)
     if n < MIN_FIXES:
         return None
-    u = [r[:, :2] / r[:, 2:3] for r in rows]  # errors per unit accuracy
-    allu = np.concatenate(u)
-    cap = float(np.quantile(np.hypot(allu[:, 0], allu[:, 1]), WINSOR_QUANTILE))
-    radius = np.hypot(allu[:, 0], allu[:, 1])
-    allu = allu * np.minimum(1.0, cap / np.maximum(radius, 1e-12))[:, None]
+    u = _winsorise(np.concatenate([r[:, :2] / r[:, 2:3] for r in rows]))  # errors per unit accuracy
     m_xx, m_yy, m_xy = (
-        float(np.mean(allu[:, 0] ** 2)),
-        float(np.mean(allu[:, 1] ** 2)),
-        float(np.mean(allu[:, 0] * allu[:, 1])),
+        float(np.mean(u[:, 0] ** 2)),
+        float(np.mean(u[:, 1] ** 2)),
+        float(np.mean(u[:, 0] * u[:, 1])),
     )
-    lag = sum(float(np.sum(w[1:] * w[:-1])) for w in u if len(w) > 1)
-    energy = sum(float(np.sum(w[:-1] ** 2)) for w in u if len(w) > 1)
-    rho = min(max(lag / energy, 0.0), RHO_MAX) if energy > 0 else 0.0
-    k = np.arange(1, RUN_FIXES)
-    factor = float(1.0 + 2.0 * np.sum((1.0 - k / RUN_FIXES) * rho**k))
+    cap = _winsorise(np.concatenate([r[:, :2] for r in rows]))
+    capped, start = [], 0
+    for r in rows:
+        capped.append(np.column_stack([cap[start : start + len(r)], r[:, 2:]]))
+        start += len(r)
+    c2, length, bins = correlation(capped)
+    acc_med = float(np.median(np.concatenate([r[:, 2] for r in rows])))
+    c2 = min(c2, MAX_CORRELATED_SHARE * acc_med**2 * min(m_xx, m_yy))
+    sigma_c = math.sqrt(max(c2, 0.0))
     return {
         "fixes": n,
         "m_xx": m_xx,
         "m_yy": m_yy,
         "m_xy": m_xy,
-        "rho_lag1": rho,
-        "factor": factor,
+        "accuracy_median_m": acc_med,
+        "correlated_sigma_m": sigma_c,
+        "correlation_length_m": length,
+        "correlation_bins": bins,
         "sets": [
             f"{KEYS[0]}={m_xx:.6g}",
             f"{KEYS[1]}={m_yy:.6g}",
             f"{KEYS[2]}={m_xy:.6g}",
-            f"{KEYS[3]}={factor:.6g}",
+            f"{KEYS[3]}={sigma_c:.6g}",
+            f"{KEYS[4]}={length:.6g}",
         ],
     }
 
@@ -102,8 +159,8 @@ def measure(
     stream: TextIO,
     n_blocks: int = rs.DEFAULT_BLOCKS,
 ) -> tuple[list[list[str]], list[float], dict[str, Any]]:
-    """The model of every walk's fold (as settings; [] where too few fixes), its inflation factor,
-    and the group's report (results.json)."""
+    """The model of every walk's fold (as settings; [] where too few fixes), its σ_c, and the group's
+    report (results.json)."""
     n_blocks = min(n_blocks, len(walks))
     prog = Progress("measure fix errors", (n_blocks - 1) * len(walks), stream)
     work_dir.mkdir(parents=True, exist_ok=True)
@@ -133,5 +190,5 @@ def measure(
         },
     }
     sets = [list((models[block[i]] or {}).get("sets", [])) for i in range(len(walks))]
-    factor = [float((models[block[i]] or {}).get("factor", math.nan)) for i in range(len(walks))]
-    return sets, factor, report
+    sigma = [float((models[block[i]] or {}).get("correlated_sigma_m", math.nan)) for i in range(len(walks))]
+    return sets, sigma, report

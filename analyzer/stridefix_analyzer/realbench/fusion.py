@@ -38,7 +38,7 @@ from stridefix_analyzer.datasets.protocol import Dataset, WalkGroup
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.radiomap.build import WalkStats
-from stridefix_analyzer.realbench import tuning
+from stridefix_analyzer.realbench import priors, tuning
 from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M, fold_floors
 from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT, FoldJob, run_fold
 from stridefix_analyzer.realbench.heading import (
@@ -228,6 +228,19 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
         # the map rotation comes from the STEP headings of the chosen heading candidate
         rot = learn_rotation_deg([r[variants["heading"]] for r in rotation], exclude=j)
         heights, src, lowest = fold_floors([w for jj, w in enumerate(sub) if jj != j], sub[j]["floors"])
+        # the ekf's start priors: this walk's likely offset from the fold's rotation and K
+        given = {kv.split("=", 1)[0].strip() for kv in run.cfg.param_sets}
+        ekf_priors = {
+            k: v
+            for k, v in priors.ekf_start_priors(
+                [r[variants["heading"]] for r in rotation],
+                seg["walk"][used],
+                seg["true_m"][used],
+                seg["weinberg"][used],
+                j,
+            ).items()
+            if k not in given
+        }
         jobs.append(
             FoldJob(
                 index=i,
@@ -248,9 +261,13 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                     *run.cfg.param_sets,
                     *tuning.settings(run.axes, variants),
                     *tuning.walk_settings(choices, j),
+                    *(f"{k}={v:.6g}" for k, v in ekf_priors.items()),
                 ],
                 variants=variants,
-                extra={k: v for c in choices.values() for k, v in c.extra[j].items()},
+                extra={
+                    **{k: v for c in choices.values() for k, v in c.extra[j].items()},
+                    "ekf_priors": ekf_priors,
+                },
                 first_waypoint=walks[i]["first_waypoint"],
                 total=total,
                 held=walks[i]["stats"],

@@ -66,18 +66,20 @@ def fix_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> 
 
 def fix_residuals_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
     """Every Wi-Fi fix's error against the truth (interpolated as in :func:`fix_errors_m`), in time
-    order: rows (error x [m], error y [m], the matcher's accuracy_m [m])."""
+    order: rows (error x [m], error y [m], the matcher's accuracy_m [m], distance walked along the
+    truth since its first waypoint [m])."""
     fix = read_table(fw_log, "FIX")
     wp_t_us = np.asarray(wp_t_us, np.int64)
     wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
     if fix is None or not len(fix) or len(wp_t_us) < 2:
-        return np.zeros((0, 3))
+        return np.zeros((0, 4))
     t, first = np.unique(fix["t_us"], return_index=True)
     keep = (t >= wp_t_us[0]) & (t <= wp_t_us[-1]) & (fix["accuracy_m"][first] > 0)
     t, first = t[keep], first[keep]
     ex = fix["x_m"][first] - np.interp(t, wp_t_us, wp[:, 0])
     ey = fix["y_m"][first] - np.interp(t, wp_t_us, wp[:, 1])
-    return np.column_stack([ex, ey, fix["accuracy_m"][first]])
+    walked_m = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(wp, axis=0).T))])
+    return np.column_stack([ex, ey, fix["accuracy_m"][first], np.interp(t, wp_t_us, walked_m)])
 
 
 def pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:

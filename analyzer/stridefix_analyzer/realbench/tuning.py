@@ -150,7 +150,7 @@ class Measured:
             why = "given by --set" if "given" in axis.candidates else f"fewer than {fixmodel.MIN_WALKS} walks"
             info = {f"{axis.name}_model": {"measured_by": f"firmware prior ({why})"}}
             return Choice([next(iter(axis.candidates))] * n, info, [{} for _ in range(n)])
-        sets, factor, report = fixmodel.measure(
+        sets, sigma_c, report = fixmodel.measure(
             group.walks,
             group.sites,
             group.firmware,
@@ -161,7 +161,8 @@ class Measured:
             group.stream,
         )
         extra = [
-            {f"{axis.name}_sets": s, f"{axis.name}_factor": f} for s, f in zip(sets, factor, strict=True)
+            {f"{axis.name}_sets": s, f"{axis.name}_correlated_sigma_m": c}
+            for s, c in zip(sets, sigma_c, strict=True)
         ]
         return Choice(["measured"] * n, {f"{axis.name}_model": report}, extra, walk_sets=sets)
 
