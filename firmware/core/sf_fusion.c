@@ -172,14 +172,15 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     f->x_m = fix->x_m;
     f->y_m = fix->y_m;
     f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
-    f->floor_offset = predicts(f) ? (int32_t)fix->floor - baro_floor : (int32_t)fix->floor;
+    (void)baro_floor;
+    f->floor_offset = predicts(f) ? 0 : (int32_t)fix->floor; /* the caller's floor is the floor */
 }
 
 /* ---- control: which fixes to fuse ---------------------------------------------------------------- */
 
 /* The decision for an initialised scheme, from the named conditions of the header. */
 static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                    const double test_ratio, const int16_t baro_floor)
+                    const double test_ratio, const int16_t baro_floor, const bool between_floors)
 {
     if (row_of(f)->mode == mode_dead_reckoning) {
         return sf_fix_reason_scheme_ignores;
@@ -187,15 +188,20 @@ static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, cons
     if (row_of(f)->mode == mode_follow_fixes) {
         return sf_fix_reason_accepted; /* no gate: the scheme is the fixes */
     }
-    const bool floor_ok = fix->floor == scheme_floor(f, baro_floor);
-    const bool gate_ok = test_ratio <= 1.0;
-    if (floor_ok && gate_ok) {
+    /* The floor: between floors no fix is of the map's floors; on a floor, the fix's floor is one vote
+     * on the caller's floor (sf_floor_vote.h) and its position is judged on the gate like any other (a
+     * radio map's floor guess fails far more often than its position; sf_fusion.h, Floors). */
+    (void)fix, (void)baro_floor;
+    if (between_floors) {
+        return sf_fix_reason_floor_mismatch;
+    }
+    if (test_ratio <= 1.0) {
         return sf_fix_reason_accepted;
     }
     if (f->rejections >= p->fusion_max_rejections) {
         return sf_fix_reason_recovery;
     }
-    return floor_ok ? sf_fix_reason_gate : sf_fix_reason_floor_mismatch;
+    return sf_fix_reason_gate;
 }
 
 static bool fix_usable(const sf_fix_t *const fix)
@@ -243,7 +249,8 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
     f->x_m = x_m;
     f->y_m = y_m;
     f->var_m2 = fmax(sigma_m * sigma_m, p->fusion_var_min_m2);
-    f->floor_offset = predicts(f) ? (int32_t)floor - baro_floor : (int32_t)floor;
+    (void)baro_floor;
+    f->floor_offset = predicts(f) ? 0 : (int32_t)floor;
     f->t_us = t_us;
     f->last_fix_t_us = t_us;
     f->rejections = 0;
@@ -273,6 +280,12 @@ void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int6
 
 int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                   const int16_t baro_floor, sf_fix_audit_t *const audit)
+{
+    return sf_fusion_fix_on_floor(f, p, fix, baro_floor, false, audit);
+}
+
+int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
     audit_begin(audit, f, fix);
     f->fixes++;
@@ -310,7 +323,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
     audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
 
     /* control: judge, then apply */
-    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor);
+    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor, between_floors);
     audit->reason = reason;
     switch (reason) {
     case sf_fix_reason_accepted:
@@ -333,8 +346,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
         f->rejections++;
         return SF_OK;
     case sf_fix_reason_floor_mismatch:
-        f->rejected_floor++;
-        f->rejections++;
+        f->rejected_floor++; /* not the scheme's divergence: no step toward recovery */
         return SF_OK;
     default: /* scheme_ignores: pdr_only keeps its dead reckoning */
         return SF_OK;
