@@ -15,7 +15,7 @@ static double wrap_pi(const double a)
 static void start_at_config(sf_estimator_t *const e, const sf_params_t *const p)
 {
     for (int s = 0; s < sf_scheme_count; s++) {
-        (void)sf_fusion_init_at(&e->fusion[s], p, 0, p->init_x_m, p->init_y_m, (int16_t)p->init_floor,
+        (void)sf_fusion_init_at(&e->fusion[s], p, SF_FUSION_T_FIRST_INPUT, p->init_x_m, p->init_y_m, (int16_t)p->init_floor,
                                 p->init_sigma_m, (int16_t)p->init_floor);
     }
 }
@@ -58,6 +58,11 @@ int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p
     }
     e->site = site;
     e->ws = ws;
+    if (site->n_floors > 0) {
+        sf_floor_vote_init(&e->floor_vote, site->lowest_floor, site->n_floors, sf_floor_current(&e->floor),
+                           p->init_use_config_pose != 0);
+        e->floor_vote_active = true;
+    }
     if (!p->init_use_config_pose) { /* with a site, schemes start at their first fix */
         for (int s = 0; s < sf_scheme_count; s++) {
             (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
@@ -172,6 +177,11 @@ void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, cons
                        const double pressure_pa)
 {
     sf_floor_update(&e->floor, p, t_us, pressure_pa);
+    if (e->floor_vote_active) {
+        bool rereference;
+        const int32_t k = sf_floor_vote_baro(&e->floor_vote, sf_floor_current(&e->floor), &rereference);
+        sf_floor_shift(&e->floor, k, rereference);
+    }
     sf_activity_vspeed(&e->activity, p, t_us, sf_floor_vertical_speed_mps(&e->floor));
 }
 
@@ -237,8 +247,20 @@ int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const
         return sf_scheme_count;
     }
     *has_fix = true;
+    const bool settled = sf_floor_settled(&e->floor, p);
+    if (e->floor_vote_active) { /* the fix votes before the schemes see it */
+        sf_floor_shift(&e->floor, sf_floor_vote_fix(&e->floor_vote, p, fix, baro_floor, settled), false);
+    }
+    /* between floors (the activity's stairs or moving lift, or a landing half-way up) only where there
+     * are floors to be between; a phone moved in the hand is not (settled's 0.1 m/s is for the vote) */
+    const int8_t activity = sf_activity_current(&e->activity);
+    const bool climbing = activity == sf_activity_stairs_up || activity == sf_activity_stairs_down ||
+                          activity == sf_activity_elevator;
+    const bool between = p->floor_between_reject && e->floor_vote_active && e->floor_vote.n_floors > 1 &&
+                         (climbing || !sf_floor_at_floor(&e->floor, p));
+    const int16_t floor = sf_floor_current(&e->floor);
     for (int s = 0; s < sf_scheme_count; s++) {
-        (void)sf_fusion_fix(&e->fusion[s], p, fix, baro_floor, &audits[s]);
+        (void)sf_fusion_fix_on_floor(&e->fusion[s], p, fix, floor, between, &audits[s]);
     }
     if (audits[sf_scheme_kalman].accepted) {
         calibrate_stride(e, p, fix);

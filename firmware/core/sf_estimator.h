@@ -17,6 +17,11 @@
  * the corrected field goes to the attitude; BARO samples to the floor (sf_floor), whose vertical
  * speed feeds the activity (stairs, elevator).
  *
+ * Floors. With a site's floor table, the start floor is a vote (sf_floor_vote.h): the barometer counts
+ * the floor changes, every Wi-Fi fix votes for the start floor its floor implies, the building's floors
+ * bound what the barometer may count, and the barometric floor is renumbered when the vote moves. That
+ * one floor is every scheme's (sf_fusion.h), so a scheme gets it for free; the matcher's floor hint too.
+ *
  * Heading without a magnetometer: the yaw is then relative (it starts at 0), and the walking
  * direction is init_heading_rad + yaw + offset; once a magnetometer sample is accepted the yaw is
  * magnetic and the map rotation applies.
@@ -34,7 +39,7 @@
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 33 048 B on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
+ * Memory: sizeof(sf_estimator_t) = 33 648 B on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
  * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the seven schemes 3 248 B
  * (each carries the ekf's 360 B filter). Cost per IMU sample:
  * a few hundred flops; per MAG sample a few kflop (the sf_magcal solve). */
@@ -48,6 +53,7 @@
 #include "sf_attitude.h"
 #include "sf_fingerprint.h"
 #include "sf_floor.h"
+#include "sf_floor_vote.h"
 #include "sf_fusion.h"
 #include "sf_heading.h"
 #include "sf_magcal.h"
@@ -65,6 +71,8 @@ typedef struct {
     sf_stride_t stride;
     sf_activity_t activity;
     sf_floor_t floor;
+    sf_floor_vote_t floor_vote; /* the start floor (sf_floor_vote.h); active once a site gives floors */
+    bool floor_vote_active;
     bool started;
     int64_t t_us;        /* newest input time */
     double gravity_mps2; /* ĝ */

@@ -18,21 +18,53 @@ static double lp_gain(const double dt_s, const double tau_s)
     return -expm1(-dt_s / tau_s);
 }
 
+static int16_t to_floor16(const int32_t v)
+{
+    return (int16_t)(v < INT16_MIN ? INT16_MIN : (v > INT16_MAX ? INT16_MAX : v));
+}
+
 static int32_t index_of(const sf_floor_t *const f, const int16_t floor)
 {
     return (int32_t)floor - (int32_t)f->lowest_floor;
 }
 
+/* Storey [m] beyond an end of the table: the end storey, or floor_height_m for a one-floor table. */
+static double end_storey_m(const sf_floor_t *const f, const bool top)
+{
+    const int32_t n = f->n_floors;
+    if (n < 2) {
+        return f->storey_m;
+    }
+    return top ? f->height_m[n - 1] - f->height_m[n - 2] : f->height_m[1] - f->height_m[0];
+}
+
+/* Height of any floor: the table's, or extrapolated beyond its ends by the end storey (virtual floors:
+ * where a wrong start floor puts the walk; sf_floor_vote.h finds it out). */
 static double floor_height(const sf_floor_t *const f, const int16_t floor)
 {
-    SF_ASSERT(index_of(f, floor) >= 0 && index_of(f, floor) < f->n_floors);
-    return f->height_m[index_of(f, floor)];
+    const int32_t i = index_of(f, floor);
+    if (i < 0) {
+        return f->height_m[0] + (double)i * end_storey_m(f, false);
+    }
+    if (i >= f->n_floors) {
+        return f->height_m[f->n_floors - 1] + (double)(i - f->n_floors + 1) * end_storey_m(f, true);
+    }
+    return f->height_m[i];
 }
 
 static int16_t nearest_floor(const sf_floor_t *const f, const double h_m)
 {
+    const int32_t n = f->n_floors;
+    if (h_m < f->height_m[0]) { /* below the table: the nearest virtual floor (or the lowest) */
+        const double k = floor((f->height_m[0] - h_m) / end_storey_m(f, false) + 0.5);
+        return to_floor16((int32_t)f->lowest_floor - (int32_t)fmin(k, (double)SF_FLOOR_CAPACITY));
+    }
+    if (h_m > f->height_m[n - 1]) {
+        const double k = floor((h_m - f->height_m[n - 1]) / end_storey_m(f, true) + 0.5);
+        return to_floor16((int32_t)f->lowest_floor + n - 1 + (int32_t)fmin(k, (double)SF_FLOOR_CAPACITY));
+    }
     int32_t best = 0;
-    for (int32_t i = 1; i < f->n_floors; i++) {
+    for (int32_t i = 1; i < n; i++) {
         if (fabs(h_m - f->height_m[i]) < fabs(h_m - f->height_m[best])) {
             best = i;
         }
@@ -62,6 +94,7 @@ void sf_floor_init(sf_floor_t *const f, const sf_params_t *const p)
     for (int32_t i = 0; i < SF_FLOOR_CAPACITY; i++) {
         f->height_m[i] = p->floor_height_m * (double)(lowest + i);
     }
+    f->storey_m = p->floor_height_m;
     f->floor = (int16_t)p->init_floor;
     f->candidate = f->floor;
 }
@@ -97,12 +130,42 @@ int sf_floor_set_heights(sf_floor_t *const f, const double *const floor_height_m
     return SF_OK;
 }
 
+/* Whether height h_m is at the current floor: nearer its height than the neighbour's on that side by
+ * the margin a floor change needs (2 · floor_hysteresis_m). Not a landing half-way up; a table storey
+ * 40 % off still passes (gsd: 2.4 m storeys against a 4 m default table). */
+static bool near_own_floor(const sf_floor_t *const f, const sf_params_t *const p, const double h_m)
+{
+    const double h0 = floor_height(f, f->floor);
+    const int32_t side = h_m >= h0 ? 1 : -1;
+    const double h1 = floor_height(f, to_floor16((int32_t)f->floor + side));
+    return fabs(h_m - h0) < fabs(h_m - h1) - 2.0 * p->floor_hysteresis_m;
+}
+
+/* The most the drift relaxation can lag the weather [m]: the fastest pressure tendency times its time
+ * constant, at the sea-level slope 1/12 m/Pa. */
+static double weather_lag_m(const sf_params_t *const p)
+{
+    return p->floor_weather_max_hpa_per_h * 100.0 / 3600.0 / 12.0 * p->floor_drift_tau_s;
+}
+
+static void move_altimeter(sf_floor_t *const f, const double shift_m)
+{
+    f->offset_m += shift_m;
+    f->height_m_f += shift_m;
+}
+
 /* Floor control after the filters moved: start, continue, commit a change; re-reference; drift. */
 static void control(sf_floor_t *const f, const sf_params_t *const p, const int64_t t_us, const double dt_s)
 {
-    const int16_t g = nearest_floor(f, f->height_m_f);
-    const double margin = fabs(f->height_m_f - floor_height(f, f->floor)) - fabs(f->height_m_f - floor_height(f, g));
-    if (g == f->floor || margin < 2.0 * p->floor_hysteresis_m) {
+    /* the low-pass lags a climb at speed v by v·τ (exact for a ramp): judge the lead-corrected height */
+    const double h_m = f->height_m_f + f->vspeed_mps * p->floor_height_tau_s;
+    const int16_t g = nearest_floor(f, h_m);
+    const double margin = fabs(h_m - floor_height(f, f->floor)) - fabs(h_m - floor_height(f, g));
+    /* climbing toward g, the mid-height is enough (a dog-leg's landing sits there); standing, the
+     * hysteresis keeps noise and drift from flipping the floor */
+    const bool toward = fabs(f->vspeed_mps) >= p->floor_settle_vspeed_mps &&
+                        f->vspeed_mps * (floor_height(f, g) - floor_height(f, f->floor)) > 0.0;
+    if (g == f->floor || margin < (toward ? 0.0 : 2.0 * p->floor_hysteresis_m)) {
         f->change_pending = false; /* back on (or near) the current floor: cancel */
     } else if (!f->change_pending || g != f->candidate) {
         f->change_pending = true; /* start, or restart with another candidate */
@@ -116,12 +179,31 @@ static void control(sf_floor_t *const f, const sf_params_t *const p, const int64
         f->changes++;
     }
     const bool settled = fabs(f->vspeed_mps) < p->floor_settle_vspeed_mps;
-    if (f->reref_due && settled && !f->change_pending) {
+    if (f->reref_due && settled && !f->change_pending && near_own_floor(f, p, f->height_m_f)) {
         rereference(f);
     } else if (!f->reref_due && !f->change_pending && settled) {
-        const double shift = lp_gain(dt_s, p->floor_drift_tau_s) * (floor_height(f, f->floor) - f->height_m_f);
-        f->offset_m += shift;
-        f->height_m_f += shift;
+        move_altimeter(f, lp_gain(dt_s, p->floor_drift_tau_s) * (floor_height(f, f->floor) - f->height_m_f));
+    } else if (!settled && f->was_settled && !f->reref_due && f->stood_valid &&
+               fabs(f->stood_height_m - floor_height(f, f->floor)) <= weather_lag_m(p)) {
+        /* leaving the floor: the body stood on it until the climb began, so the climb counts from there
+         * (the drift relaxation lags a weather trend by rate · floor_drift_tau_s: 0.15–0.4 m on the
+         * SIL tours). The height a filter delay before (τ_h + τ_v) is the one the climb has not yet
+         * moved; only a gap the weather can make is closed, a pause part-way down a stair is not a
+         * floor (gsd Trial51). */
+        move_altimeter(f, floor_height(f, f->floor) - f->stood_height_m);
+        f->rereferences++;
+    }
+    f->was_settled = settled;
+    const int64_t delay_us = (int64_t)((p->floor_height_tau_s + p->floor_vspeed_tau_s) * 1e6);
+    if (!settled || f->reref_due) {
+        f->stood_valid = false; /* a climb or an arrival: what stood before is history */
+        f->recent_t_us = t_us;
+        f->recent_height_m = f->height_m_f;
+    } else if (t_us - f->recent_t_us >= delay_us) { /* two snapshots: the older is a delay old or more */
+        f->stood_valid = true;
+        f->stood_height_m = f->recent_height_m;
+        f->recent_t_us = t_us;
+        f->recent_height_m = f->height_m_f;
     }
 }
 
@@ -175,4 +257,34 @@ double sf_floor_vertical_speed_mps(const sf_floor_t *const f)
 double sf_floor_height_m(const sf_floor_t *const f)
 {
     return f->height_m_f;
+}
+
+bool sf_floor_at_floor(const sf_floor_t *const f, const sf_params_t *const p)
+{
+    return f->started && !f->change_pending && near_own_floor(f, p, f->height_m_f);
+}
+
+bool sf_floor_settled(const sf_floor_t *const f, const sf_params_t *const p)
+{
+    return sf_floor_at_floor(f, p) && fabs(f->vspeed_mps) < p->floor_settle_vspeed_mps;
+}
+
+void sf_floor_shift(sf_floor_t *const f, const int32_t delta, const bool rereference_now)
+{
+    if (delta == 0) {
+        return;
+    }
+    const int16_t to = to_floor16((int32_t)f->floor + delta);
+    const double shift = floor_height(f, to) - floor_height(f, f->floor); /* keeps h_f − H(floor) */
+    f->floor = to;
+    f->candidate = to;
+    f->change_pending = false;
+    f->shifts++;
+    if (f->started) {
+        f->offset_m += shift;
+        f->height_m_f += shift;
+        if (rereference_now) {
+            rereference(f);
+        }
+    }
 }

@@ -15,17 +15,36 @@
  * SF_FLOOR_CAPACITY). Default (from params): uniform, H = floor_height_m · floor, for floors
  * init_floor − SF_FLOOR_DEFAULT_BELOW … up to the capacity. A site file replaces it with
  * sf_floor_set_heights.
- * Control (current floor f; candidate g = the floor whose height is nearest to h_f):
- *   - start a change: g ≠ f and |h_f − H(f)| − |h_f − H(g)| ≥ 2 · floor_hysteresis_m, i.e. h_f lies
- *     floor_hysteresis_m beyond the mid-height between the two floors;
+ * Beyond the table's ends the floors go on as virtual floors, one end storey apart (floor_height_m for
+ * a one-floor table): a walk started on a wrong floor number goes on counting the barometer's floor
+ * changes past the building's end, and sf_floor_vote.h reads that as proof against the start floor.
+ * Control (current floor f; candidate g = the floor whose height is nearest to the lead-corrected
+ * height ĥ = h_f + v·floor_height_tau_s: a first-order low-pass lags a climb at speed v by v·τ exactly,
+ * so ĥ crosses the mid-height when the body does, not a time constant later; SIL tour, stairs at
+ * 0.25 m/s: ≈ 1 s earlier per change):
+ *   - start a change: g ≠ f and |ĥ − H(f)| − |ĥ − H(g)| ≥ 2 · floor_hysteresis_m, i.e. ĥ lies
+ *     floor_hysteresis_m beyond the mid-height between the two floors; while moving toward g
+ *     (|v| ≥ floor_settle_vspeed_mps) the mid-height itself is enough: a dog-leg stair's landing sits
+ *     exactly there, and the SIL truth counts it upper (hysteresis there cost 5 s per climb);
  *   - continue: the same g holds; any other candidate restarts the clock, f itself cancels it;
  *   - commit: after floor_confirm_ms, f ← g, and a re-reference is due;
- *   - re-reference: once |v| < floor_settle_vspeed_mps (standing or walking on the landing, not still
- *     climbing through an intermediate floor), the offset is moved so h_f = H(f) exactly. So baro drift
- *     does not accumulate across floors;
+ *   - at the floor: h_f nearer H(f) than the neighbour's height on its side by 2 · floor_hysteresis_m
+ *     (sf_floor_at_floor; a half-way landing is not, a table storey 40 % off still is);
+ *   - re-reference: once |v| < floor_settle_vspeed_mps and at the floor (arrived: not still climbing,
+ *     not on a half-way landing), the offset is moved so h_f = H(f) exactly. So baro drift does not
+ *     accumulate across floors;
  *   - drift: while no change is pending and |v| < floor_settle_vspeed_mps, h_f relaxes toward H(f)
  *     with floor_drift_tau_s (120 s), which absorbs weather drift on one floor (≈ 0.01 Pa/s) without
- *     touching a climb (stairs ≥ 0.2 m/s, elevators more).
+ *     touching a climb (stairs ≥ 0.2 m/s, elevators more);
+ *   - leaving: when |v| first exceeds floor_settle_vspeed_mps, h_f of one to two filter delays before
+ *     (τ_h + τ_v: the climb had not moved it yet) is taken as H(f) if it is within the drift's largest
+ *     lag (floor_weather_max_hpa_per_h · floor_drift_tau_s, 0.83 m): the relaxation lags a weather
+ *     trend by rate · τ (0.15–0.4 m on the SIL tours), and the climb counts from the floor. A larger gap
+ *     is a pause part-way down a stair (gsd Trial51), not a floor.
+ *
+ * Shift (sf_floor_shift): the floor number moves by k floors while the body stays where it is (the
+ * floor vote found the start floor wrong): h_f − H(f) is kept, or, for a change the barometer made up
+ * (beyond every floor of the building), the altimeter is re-referenced at once.
  *
  * Bad data: a non-finite pressure or one outside [SF_FLOOR_MIN_PA, SF_FLOOR_MAX_PA] is counted in `bad`
  * and skipped; a sample at or before the previous time in `backwards`; a gap longer than
@@ -35,7 +54,7 @@
  * [1, SF_FLOOR_CAPACITY], a height not finite or not strictly above the one below, or a table that
  * would leave int16 floor numbers). Everything else cannot fail.
  * Cost: one pow() and two exp() per sample, O(n_floors) for the nearest floor. Memory:
- * sizeof(sf_floor_t) = 592 B on x86-64 and i686 (at most 640 B, checked). No heap, no I/O, no clock. */
+ * sizeof(sf_floor_t) = 640 B on x86-64 (i686 not rechecked) (at most 704 B, checked). No heap, no I/O, no clock. */
 #ifndef SF_FLOOR_H
 #define SF_FLOOR_H
 
@@ -56,6 +75,7 @@ typedef struct {
     double height_m[SF_FLOOR_CAPACITY];
     int32_t n_floors;
     int16_t lowest_floor;
+    double storey_m; /* beyond a one-floor table (floor_height_m) */
     /* altimeter */
     bool started;
     int64_t last_t_us;
@@ -68,10 +88,15 @@ typedef struct {
     bool change_pending;
     int64_t candidate_since_us;
     bool reref_due;
+    bool was_settled;        /* the previous sample was settled */
+    bool stood_valid;        /* stood_height_m is from this stay on the floor */
+    double stood_height_m;   /* h_f one to two filter delays ago, while settled */
+    int64_t recent_t_us;     /* the newer snapshot */
+    double recent_height_m;
     /* counters, never decrease */
-    uint32_t changes, rereferences, gaps, backwards, bad;
+    uint32_t changes, rereferences, shifts, gaps, backwards, bad;
 } sf_floor_t;
-_Static_assert(sizeof(sf_floor_t) <= 640, "sf_floor.h promises at most 640 B");
+_Static_assert(sizeof(sf_floor_t) <= 704, "sf_floor.h promises at most 704 B");
 
 /* Default uniform table from floor_height_m around init_floor; current floor = init_floor. */
 void sf_floor_init(sf_floor_t *f, const sf_params_t *p);
@@ -92,6 +117,19 @@ double sf_floor_vertical_speed_mps(const sf_floor_t *f);
 
 /* The low-passed height [m] in the floor table's datum. */
 double sf_floor_height_m(const sf_floor_t *f);
+
+/* Whether the height is at the current floor: started, no change pending, h_f nearer the floor's
+ * height than the neighbour's on that side by 2 · floor_hysteresis_m (not on a landing half-way up). */
+bool sf_floor_at_floor(const sf_floor_t *f, const sf_params_t *p);
+
+/* At the floor and still: |vertical speed| below floor_settle_vspeed_mps too (not on the stairs, not in
+ * a moving lift). */
+bool sf_floor_settled(const sf_floor_t *f, const sf_params_t *p);
+
+/* Renumbers the current floor by delta floors (the body stays): h_f − H(floor) is kept, or with
+ * rereference_now the altimeter is re-referenced to the new floor's height at once. Any pending change
+ * is cancelled. Table floors and virtual floors alike. */
+void sf_floor_shift(sf_floor_t *f, int32_t delta, bool rereference_now);
 
 /* ICAO standard-atmosphere height for a pressure [Pa → m]. */
 double sf_floor_pressure_to_height_m(double pressure_pa);

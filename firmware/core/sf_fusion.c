@@ -134,6 +134,11 @@ static int16_t scheme_floor(const sf_fusion_t *const f, const int16_t baro_floor
 /* Time update of the variance up to t_us (Δt < 0 counts as backwards and adds nothing). */
 static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us)
 {
+    if (f->t_us == SF_FUSION_T_FIRST_INPUT) { /* a config start: its time is the first input's */
+        f->t_us = t_us;
+        f->last_fix_t_us = t_us;
+        return;
+    }
     if (t_us < f->t_us) {
         f->backwards++;
         return;
@@ -177,14 +182,15 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     if (is_ekf(f)) {
         sf_ekf_restart_at_fix(&f->ekf, p, ekf_r_m2);
     }
-    f->floor_offset = predicts(f) ? (int32_t)fix->floor - baro_floor : (int32_t)fix->floor;
+    (void)baro_floor;
+    f->floor_offset = predicts(f) ? 0 : (int32_t)fix->floor; /* the caller's floor is the floor */
 }
 
 /* ---- control: which fixes to fuse ---------------------------------------------------------------- */
 
 /* The decision for an initialised scheme, from the named conditions of the header. */
 static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                    const double test_ratio, const int16_t baro_floor)
+                    const double test_ratio, const int16_t baro_floor, const bool between_floors)
 {
     if (row_of(f)->mode == mode_dead_reckoning) {
         return sf_fix_reason_scheme_ignores;
@@ -192,15 +198,20 @@ static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, cons
     if (row_of(f)->mode == mode_follow_fixes) {
         return sf_fix_reason_accepted; /* no gate: the scheme is the fixes */
     }
-    const bool floor_ok = fix->floor == scheme_floor(f, baro_floor);
-    const bool gate_ok = test_ratio <= 1.0;
-    if (floor_ok && gate_ok) {
+    /* The floor: between floors no fix is of the map's floors; on a floor, the fix's floor is one vote
+     * on the caller's floor (sf_floor_vote.h) and its position is judged on the gate like any other (a
+     * radio map's floor guess fails far more often than its position; sf_fusion.h, Floors). */
+    (void)fix, (void)baro_floor;
+    if (between_floors) {
+        return sf_fix_reason_floor_mismatch;
+    }
+    if (test_ratio <= 1.0) {
         return sf_fix_reason_accepted;
     }
     if (f->rejections >= p->fusion_max_rejections) {
         return sf_fix_reason_recovery;
     }
-    return floor_ok ? sf_fix_reason_gate : sf_fix_reason_floor_mismatch;
+    return sf_fix_reason_gate;
 }
 
 static bool fix_usable(const sf_fix_t *const fix)
@@ -254,7 +265,8 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
         sf_ekf_start(&f->ekf, p);
         sf_ekf_restart_known(&f->ekf, p, cov_m2);
     }
-    f->floor_offset = predicts(f) ? (int32_t)floor - baro_floor : (int32_t)floor;
+    (void)baro_floor;
+    f->floor_offset = predicts(f) ? 0 : (int32_t)floor;
     f->t_us = t_us;
     f->last_fix_t_us = t_us;
     f->rejections = 0;
@@ -291,6 +303,12 @@ void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int6
 
 int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                   const int16_t baro_floor, sf_fix_audit_t *const audit)
+{
+    return sf_fusion_fix_on_floor(f, p, fix, baro_floor, false, audit);
+}
+
+int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
     audit_begin(audit, f, fix);
     f->fixes++;
@@ -345,7 +363,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
     }
 
     /* control: judge, then apply */
-    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor);
+    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor, between_floors);
     audit->reason = reason;
     if (is_ekf(f) && reason == sf_fix_reason_accepted) { /* a rejected fix says nothing about R */
         sf_ekf_learn_fix_model(&f->ekf, p, nu_m, fix->accuracy_m, gate * gate);
@@ -376,8 +394,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
         f->rejections++;
         return SF_OK;
     case sf_fix_reason_floor_mismatch:
-        f->rejected_floor++;
-        f->rejections++;
+        f->rejected_floor++; /* not the scheme's divergence: no step toward recovery */
         return SF_OK;
     default: /* scheme_ignores: pdr_only keeps its dead reckoning */
         return SF_OK;
@@ -402,7 +419,9 @@ bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, cons
         pose->stride_scale = 1.0;
         return false;
     }
-    const double q_m2 = predicts(f) && t_us > f->t_us ? p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us) : 0.0;
+    const bool clock = f->t_us != SF_FUSION_T_FIRST_INPUT;
+    const double q_m2 =
+        clock && predicts(f) && t_us > f->t_us ? p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us) : 0.0;
     iso_cov(f->var_m2 + q_m2, pose->cov_m2);
     pose->heading_bias_rad = 0.0;
     pose->stride_scale = 1.0;

@@ -93,7 +93,7 @@
     X(stride, calib_straightness,  double,  0.9,     0.0,     1.0,     "",      "calibrate only over walks whose PDR displacement is at least this x distance walked") \
     X(stride, calib_enable,        int32_t, 1,       0,       1,       "",      "1 = recalibrate K online from accepted Kalman fixes (needs a site)")
 
-/* sf_activity.h, sf_floor.h */
+/* sf_activity.h, sf_floor.h, sf_floor_vote.h */
 #define SF_PARAMS_ACTIVITY(X)                                                                          \
     X(activity, var_tau_s,         double,  1.0,     0.1,     20.0,    "s",     "time constant of the a_v mean/variance") \
     X(activity, still_var_m2ps4,   double,  0.05,    0.0,     100.0,   "m2/s4", "a_v variance below which the body is quiet (steps rejected)") \
@@ -113,7 +113,10 @@
     X(floor,  confirm_ms,          int32_t, 500,     0,       60000,   "ms",    "the new floor must hold this long") \
     X(floor,  settle_vspeed_mps,   double,  0.10,    0.01,    5.0,     "m/s",   "|vertical speed| below which the altimeter may be re-referenced") \
     X(floor,  drift_tau_s,         double,  120.0,   1.0,     1e6,     "s",     "while settled, height relaxes to the floor's height (drift removal)") \
-    X(floor,  max_gap_ms,          int32_t, 5000,    100,     600000,  "ms",    "baro gap beyond which the filters restart")
+    X(floor,  weather_max_hpa_per_h, double, 3.0,    0.0,     100.0,   "hPa/h", "fastest weather pressure tendency (1 hPa/h is already 'rapid' in aviation, 3 hPa/h a severe storm): leaving a floor closes a height gap up to this x drift_tau_s (0.83 m), a larger one is a pause on the stairs") \
+    X(floor,  max_gap_ms,          int32_t, 5000,    100,     600000,  "ms",    "baro gap beyond which the filters restart") \
+    X(floor,  vote_margin,         double,  3.0,     0.5,     1000.0,  "fixes", "start-floor vote (sf_floor_vote.h): lead in full-weight agreeing fixes that decides or moves the start floor; 3: a floor classifier right 80 % of the time among 3 floors is then 512 times likelier right than wrong ((0.8/0.1)^3), and one scan never flips") \
+    X(floor,  between_reject,      int32_t, 1,       0,       1,       "",      "1 = fixes taken between floors (stairs, a moving lift, a landing half-way up; multi-floor sites) are rejected FLOOR_MISMATCH: a radio map is of floors (SIL tour: such fixes 6.9 m mean error against 1.2 m on the floors; gsd Trial51, open stairs: 4.8 against 4.3 m)")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \

@@ -193,6 +193,41 @@ static void test_same_input_gives_identical_output(void **state)
     assert_true(a.last_step.length_m == b.last_step.length_m && a.last_step.t_us == b.last_step.t_us);
 }
 
+/* GIVEN a site of floors −2, −1, 0 (3 m storeys, no radio map) and the default init.floor 0, WHEN the
+ * barometer climbs one storey, THEN the start floor is proven wrong (nothing is above 0): the walk
+ * started on −1 and is on 0 now, for the status and for every scheme alike. */
+static void test_site_floors_prove_the_start(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    static sf_estimator_t est;
+    sf_estimator_init(&est, &p);
+    const double heights[] = {0.0, 3.0, 6.0};
+    const sf_site_t site = {.lowest_floor = -2, .n_floors = 3, .floor_height_m = heights};
+    static sf_fingerprint_workspace_t ws;
+    assert_int_equal(sf_estimator_attach_site(&est, &p, &site, &ws), 0);
+    assert_true(est.floor_vote_active);
+    const double pa0 = 100000.0, pa_per_m = 1.0 / 0.0843; /* near 100 kPa */
+    for (int i = 0; i <= 60 * 25; i++) { /* 25 Hz: 10 s still, 12 s up 3 m, still again */
+        const double t_s = i / 25.0;
+        const double h_m = t_s < 10.0 ? 0.0 : (t_s < 22.0 ? (t_s - 10.0) * 0.25 : 3.0);
+        sf_estimator_baro(&est, &p, 1000000 + (int64_t)i * 40000, pa0 - pa_per_m * h_m);
+    }
+    sf_estimator_status_t st;
+    sf_estimator_status(&est, &st);
+    assert_int_equal(st.floor, 0);
+    assert_int_equal(est.floor_vote.start, -1);
+    assert_int_equal(est.floor_vote.proofs, 1);
+    assert_int_equal(est.floor.changes, 1);
+    assert_true(fabs(sf_floor_height_m(&est.floor) - 6.0) < 0.2); /* H(0), re-referenced */
+    sf_pose_t pose;
+    for (int s = 0; s < sf_scheme_count; s++) {
+        (void)sf_estimator_scheme_pose(&est, &p, s, &pose);
+        assert_int_equal(pose.floor, 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -202,6 +237,7 @@ int main(void)
         cmocka_unit_test(test_paces),
         cmocka_unit_test(test_stairs_step_is_the_going),
         cmocka_unit_test(test_same_input_gives_identical_output),
+        cmocka_unit_test(test_site_floors_prove_the_start),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* test_floor.c — sf_floor on simulated barometer signals (seeded noise and drift): stair climbs and
  * descents, a 5-minute flat walk without false changes, an elevator ride over three floors, a site
- * table with uneven floors, bad samples, gaps, determinism. */
+ * table with uneven floors, bad samples, gaps, determinism; a dog-leg landing at half a storey after
+ * weather drift, a lift's commit time, virtual floors beyond the table, shift and at-floor. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -292,6 +293,103 @@ static void test_bad_samples_gaps_backwards(void **state)
     assert_int_equal(sf_floor_current(&f), 1);
 }
 
+/* A dog-leg stair (issue 11, SIL tour): the landing sits at exactly half a storey, where the truth
+ * already counts the upper floor. Climbing, the mid-height is enough, so the change commits on the
+ * landing (confirm_ms after arriving), not a flight later; and the landing is no floor, so nothing is
+ * re-referenced there (a re-reference would put floor 1 at 1.75 m and make the second flight floor 2).
+ * 200 s of weather drift first (0.02 Pa/s: the relaxation lags it by 0.2 m, more than the landing's
+ * margin): leaving floor 0 re-references it. */
+static void test_dogleg_landing(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    const profile_t stair = {6, {0, 200, 207, 211, 218, 1000}, {0, 0, 1.75, 1.75, 3.5, 3.5}};
+    run(&g_res, &p, &stair, 260.0, &k_baro25, NULL, 0, 0);
+    assert_int_equal(g_res.changes, 1);
+    assert_int_equal(g_res.floor_at_end, 1);
+    assert_true(g_res.first_change_s > 207.0 && g_res.first_change_s < 208.5);
+    assert_true(fabs(sf_floor_height_m(&g_res.f) - 3.5) < 0.3);
+    /* descending the same stair commits on the landing too (toward the lower floor) */
+    const profile_t down = {6, {0, 20, 27, 31, 38, 1000}, {3.5, 3.5, 1.75, 1.75, 0, 0}};
+    sf_params_t p1 = p;
+    p1.init_floor = 1;
+    run(&g_res, &p1, &down, 80.0, &k_baro25, NULL, 0, 0);
+    assert_int_equal(g_res.changes, 1);
+    assert_int_equal(g_res.floor_at_end, 0);
+    assert_true(g_res.first_change_s > 27.0 && g_res.first_change_s < 28.5);
+}
+
+/* The lead-corrected height: a lift at 1 m/s over one storey commits within 1 s of passing the
+ * mid-height (the low-passed height alone lags it by τ = 1 s). */
+static void test_lift_commits_near_mid_height(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    const profile_t lift = {4, {0, 10, 13.5, 1000}, {0, 0, 3.5, 3.5}}; /* mid-height at 11.75 s */
+    run(&g_res, &p, &lift, 40.0, &k_baro25, NULL, 0, 0);
+    assert_int_equal(g_res.changes, 1);
+    assert_true(g_res.first_change_s > 11.75 && g_res.first_change_s < 12.75);
+}
+
+/* Beyond the table the floors go on, one end storey apart (a wrong start floor shows there). */
+static void test_virtual_floors(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    const double table[] = {0.0, 2.5, 6.0};
+    const profile_t down2 = {4, {0, 10, 30, 1000}, {0, 0, -5.0, -5.0}};
+    run(&g_res, &p, &down2, 60.0, &k_baro25, table, 3, 0); /* floor 0 is the lowest */
+    assert_int_equal(g_res.floor_at_end, -2); /* two virtual floors of 2.5 m (the bottom storey) */
+    assert_true(fabs(sf_floor_height_m(&g_res.f) + 5.0) < 0.3);
+    const profile_t up = {4, {0, 10, 30, 1000}, {0, 0, 9.5, 9.5}};
+    run(&g_res, &p, &up, 60.0, &k_baro25, table, 3, 0);
+    assert_int_equal(g_res.floor_at_end, 3); /* 6 + 3.5 m (the top storey) */
+}
+
+/* sf_floor_shift renumbers the floor and keeps the body where it is, or re-references it. */
+static void test_shift_and_at_floor(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_floor_t f;
+    sf_floor_init(&f, &p);
+    const double table[] = {0.0, 3.0, 7.0};
+    assert_int_equal(sf_floor_set_heights(&f, table, 3, -1), SF_OK); /* floors −1, 0, 1 */
+    assert_int_equal(sf_floor_current(&f), 0);
+    const double pa0 = 100000.0;
+    int64_t t = T0_US;
+    for (int i = 0; i < 50; i++, t += 40000) {
+        sf_floor_update(&f, &p, t, pa0);
+    }
+    assert_true(fabs(sf_floor_height_m(&f) - 3.0) < 1e-9);
+    assert_true(sf_floor_at_floor(&f, &p) && sf_floor_settled(&f, &p));
+    /* 1.9 m up at 0.05 m/s (a ramp, slower than settle_vspeed) and held, drift removal off: short of
+     * the change (5.15 m) and no longer at floor 0, |4.9 − 3| = 1.9 ≥ |4.9 − 7| − 2 · 0.15 = 1.8 */
+    p.floor_drift_tau_s = 1e6;
+    const double pa_up = pa0 - 1.9 / 0.0843;
+    for (int i = 0; i < 1500; i++, t += 40000) {
+        const double w = i < 950 ? (double)i / 950.0 : 1.0; /* 38 s ramp, then 22 s held */
+        sf_floor_update(&f, &p, t, pa0 + w * (pa_up - pa0));
+    }
+    assert_int_equal(sf_floor_current(&f), 0);
+    assert_true(fabs(sf_floor_height_m(&f) - 4.9) < 0.05);
+    assert_false(sf_floor_at_floor(&f, &p));
+    assert_false(sf_floor_settled(&f, &p));
+    sf_floor_shift(&f, 1, false);
+    assert_int_equal(sf_floor_current(&f), 1);
+    assert_true(fabs(sf_floor_height_m(&f) - 8.9) < 0.05); /* H(1) + the same 1.9 m */
+    sf_floor_shift(&f, -2, true);
+    assert_int_equal(sf_floor_current(&f), -1);
+    assert_true(sf_floor_height_m(&f) == 0.0); /* re-referenced to H(−1) */
+    assert_int_equal(f.shifts, 2);
+    sf_floor_shift(&f, 0, true);
+    assert_int_equal(f.shifts, 2);
+}
+
 static void test_deterministic(void **state)
 {
     (void)state;
@@ -317,6 +415,10 @@ int main(void)
         cmocka_unit_test(test_set_heights_validation),
         cmocka_unit_test(test_default_table),
         cmocka_unit_test(test_bad_samples_gaps_backwards),
+        cmocka_unit_test(test_dogleg_landing),
+        cmocka_unit_test(test_lift_commits_near_mid_height),
+        cmocka_unit_test(test_virtual_floors),
+        cmocka_unit_test(test_shift_and_at_floor),
         cmocka_unit_test(test_deterministic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

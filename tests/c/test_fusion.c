@@ -268,6 +268,32 @@ static void test_schemes_by_hand(void **state)
     }
 }
 
+/* A config start (truth-initialised) comes before any input: the clock starts at the first input, so a
+ * log in epoch time (1.57e9 s) does not add 1.57e9 s of variance and the first fix is weighed against
+ * the start's σ, not snapped to. */
+static void test_config_start_clock(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    for (int s = sf_scheme_kalman; s <= sf_scheme_ekf; s++) {
+        sf_fusion_t k;
+        sf_fusion_init(&k, (int8_t)s);
+        assert_int_equal(sf_fusion_init_at(&k, &p, SF_FUSION_T_FIRST_INPUT, 0.0, 0.0, 0, 1.0, 0), SF_OK);
+        sf_pose_t pose;
+        assert_true(sf_fusion_pose(&k, &p, 1574586414000000LL, 0, &pose));
+        near(pose.sigma_m, 1.0);
+        sf_fix_audit_t a;
+        const sf_fix_t fx = wifi(1574586414.0, 4.0, 0.0, 2.0, 6);
+        sf_fusion_fix(&k, &p, &fx, 0, &a);
+        if (s == sf_scheme_kalman) {
+            check_audit(&a, &fx, sf_scheme_kalman, sf_fix_reason_accepted, true, 0.2, 4.0, 0.0, 5.0, 3.0);
+        } else {
+            assert_true(a.alpha > 0.1 && a.alpha < 0.3); /* 1 / (1 + 4·M) with M = 1 */
+        }
+    }
+}
+
 /* Time term: a still walker's variance grows by q_time per second, also between events (pose). */
 static void test_kalman_time_term(void **state)
 {
@@ -457,12 +483,14 @@ static void test_uninitialised_until_first_fix(void **state)
         assert_true(a.test_ratio == 0.0);
         assert_true(sf_fusion_pose(&f[s], &p, 2 * S_US, 2, &pose));
         assert_true(pose.x_m == 10.0 && pose.y_m == -4.0 && pose.sigma_m == 2.5);
-        assert_int_equal(pose.floor, 1);
+        assert_int_equal(pose.floor, s == sf_scheme_wifi_only ? 1 : 2); /* the caller's (issue 11) */
         assert_int_equal(f[s].initialisations, 1);
     }
 }
 
-/* Floors: the barometer gives changes, fixes give the number; one wrong-floor fix is refused. */
+/* Floors (issue 11): every predicting scheme is on the caller's floor, whatever its fixes say; a fix on
+ * another floor is judged on the gate alone (its floor voted already, sf_floor_vote.h); between floors
+ * every fix is refused FLOOR_MISMATCH without counting toward a recovery. */
 static void test_floors(void **state)
 {
     (void)state;
@@ -472,43 +500,67 @@ static void test_floors(void **state)
     sf_fusion_init(&f, sf_scheme_kalman);
     sf_fix_audit_t a;
     sf_pose_t pose;
-    /* barometer says floor 0 (init_floor), the first fix says floor 2: the fix wins */
+    /* the caller says floor 0, the first fix says floor 2: the scheme starts at the fix, on floor 0 */
     sf_fix_t fx = fix_at(0.0, sf_fix_wifi, 0.0, 0.0, 2, 2.0, 6);
     sf_fusion_fix(&f, &p, &fx, 0, &a);
+    assert_int_equal(a.reason, sf_fix_reason_initialised);
     sf_fusion_pose(&f, &p, 0, 0, &pose);
-    assert_int_equal(pose.floor, 2);
-    /* a lift: barometer 0 → 1, so the scheme is on floor 3 */
+    assert_int_equal(pose.floor, 0);
+    /* the caller's floor moves (a lift, or its vote renumbered it): so does the scheme's */
     sf_fusion_pose(&f, &p, 0, 1, &pose);
-    assert_int_equal(pose.floor, 3);
-    fx = fix_at(1.0, sf_fix_wifi, 0.5, 0.0, 3, 2.0, 6);
-    sf_fusion_fix(&f, &p, &fx, 1, &a);
-    assert_int_equal(a.reason, sf_fix_reason_accepted);
-    /* a fix on floor 5 at the same spot: floor mismatch (even though it passes the gate) */
+    assert_int_equal(pose.floor, 1);
+    /* fixes on floor 5 at the same spot: accepted on the gate, the floor stays the caller's */
     for (int k = 0; k < 3; k++) {
-        fx = fix_at(2.0 + k, sf_fix_wifi, 0.5, 0.0, 5, 2.0, 6);
+        fx = fix_at(1.0 + k, sf_fix_wifi, 0.5, 0.0, 5, 2.0, 6);
         sf_fusion_fix(&f, &p, &fx, 1, &a);
+        assert_int_equal(a.reason, sf_fix_reason_accepted);
+        assert_true(a.accepted && a.alpha > 0.0 && a.test_ratio <= 1.0);
+    }
+    sf_fusion_pose(&f, &p, 4 * S_US, 1, &pose);
+    assert_int_equal(pose.floor, 1);
+    assert_int_equal(f.rejected_floor, 0);
+    /* between floors: five fixes in a row refused, none a step toward recovery, the state untouched */
+    const sf_fusion_t before = f;
+    for (int k = 0; k < 5; k++) {
+        fx = fix_at(5.0 + k, sf_fix_wifi, 40.0, 0.0, 1, 2.0, 6); /* far: would also fail the gate */
+        assert_int_equal(sf_fusion_fix_on_floor(&f, &p, &fx, 1, true, &a), SF_OK);
         assert_int_equal(a.reason, sf_fix_reason_floor_mismatch);
         assert_false(a.accepted);
-        assert_true(a.alpha == 0.0 && a.test_ratio <= 1.0);
+        assert_true(a.alpha == 0.0 && a.test_ratio > 1.0);
     }
-    assert_int_equal(f.rejected_floor, 3);
-    /* the fourth in a row: recovery adopts floor 5 */
-    fx = fix_at(5.0, sf_fix_wifi, 0.5, 0.0, 5, 2.0, 6);
+    assert_int_equal(f.rejected_floor, 5);
+    assert_int_equal(f.rejections, 0);
+    assert_int_equal(f.recoveries, 0);
+    assert_true(f.x_m == before.x_m && f.y_m == before.y_m);
+    /* back on a floor, the same far fix is a gate rejection, and the fourth in a row recovers */
+    for (int k = 0; k < 3; k++) {
+        fx = fix_at(10.0 + k, sf_fix_wifi, 40.0, 0.0, 1, 2.0, 6);
+        sf_fusion_fix_on_floor(&f, &p, &fx, 1, false, &a);
+        assert_int_equal(a.reason, sf_fix_reason_gate);
+    }
+    fx = fix_at(13.0, sf_fix_wifi, 40.0, 0.0, 1, 2.0, 6);
     sf_fusion_fix(&f, &p, &fx, 1, &a);
     assert_int_equal(a.reason, sf_fix_reason_recovery);
-    sf_fusion_pose(&f, &p, 5 * S_US, 1, &pose);
-    assert_int_equal(pose.floor, 5);
-    sf_fusion_pose(&f, &p, 5 * S_US, 0, &pose);
+    assert_true(f.x_m == 40.0);
+    /* wifi_only is the fixes: its floor is the latest fix's, and between floors it still follows */
+    sf_fusion_t w;
+    sf_fusion_init(&w, sf_scheme_wifi_only);
+    fx = fix_at(0.0, sf_fix_wifi, 1.0, 1.0, 3, 2.0, 6);
+    sf_fusion_fix_on_floor(&w, &p, &fx, 0, true, &a);
+    fx = fix_at(1.0, sf_fix_wifi, 2.0, 1.0, 4, 2.0, 6);
+    sf_fusion_fix_on_floor(&w, &p, &fx, 0, true, &a);
+    assert_int_equal(a.reason, sf_fix_reason_accepted);
+    sf_fusion_pose(&w, &p, S_US, 0, &pose);
     assert_int_equal(pose.floor, 4);
-    /* truth initialisation on floor 3 while the barometer reads 0 */
+    /* truth initialisation on floor 3 while the caller reads 0: the caller's floor wins */
     sf_fusion_t t;
     sf_fusion_init(&t, sf_scheme_pdr_only);
     sf_fusion_init_at(&t, &p, 0, 1.0, 2.0, 3, 0.5, 0);
     sf_fusion_pose(&t, &p, 0, 0, &pose);
-    assert_int_equal(pose.floor, 3);
+    assert_int_equal(pose.floor, 0);
     assert_true(pose.x_m == 1.0 && pose.y_m == 2.0 && pose.sigma_m == 0.5);
     sf_fusion_pose(&t, &p, 0, -1, &pose);
-    assert_int_equal(pose.floor, 2);
+    assert_int_equal(pose.floor, -1);
 }
 
 /* Bad data is counted and skipped; it never moves a scheme nor counts toward a recovery. */
@@ -559,7 +611,8 @@ static void test_bad_data(void **state)
     assert_int_equal(a.n_ap_used, 1);
 }
 
-/* A pseudo-random walk with fixes (some far, some on other floors, one bad) through all six schemes. */
+/* A pseudo-random walk with fixes (some far, some on other floors, some between floors, one bad) through
+ * all six schemes. */
 static void run(sf_fusion_t f[sf_scheme_count], sf_fix_audit_t audits[][sf_scheme_count], sf_pose_t poses[][sf_scheme_count],
                 const int n)
 {
@@ -580,7 +633,7 @@ static void run(sf_fusion_t f[sf_scheme_count], sf_fix_audit_t audits[][sf_schem
                                    (double)(seed % 13u), (int16_t)(baro + (i % 17 == 0)), i == 33 ? NAN : 1.0 + i % 4,
                                    (int16_t)(i % 10));
         for (int s = 0; s < sf_scheme_count; s++) {
-            sf_fusion_fix(&f[s], &p, &fx, baro, &audits[i][s]);
+            sf_fusion_fix_on_floor(&f[s], &p, &fx, baro, i % 23 == 5, &audits[i][s]);
             poses[i][s] = (sf_pose_t){0};
             sf_fusion_pose(&f[s], &p, t + 200000, baro, &poses[i][s]);
         }
@@ -633,6 +686,7 @@ int main(void)
         cmocka_unit_test(test_alpha_law_tables),
         cmocka_unit_test(test_schemes_by_hand),
         cmocka_unit_test(test_kalman_time_term),
+        cmocka_unit_test(test_config_start_clock),
         cmocka_unit_test(test_gate_and_recovery),
         cmocka_unit_test(test_recovery_needs_consecutive_rejections),
         cmocka_unit_test(test_pdr_only_ignores_fixes),

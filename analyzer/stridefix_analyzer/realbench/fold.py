@@ -3,10 +3,10 @@ other walks of its group, every scheme scored at the walk's ground-truth times.
 
 The fold's site is the walk-mode radio map of ``total − held`` (sufficient statistics, so no map is
 rebuilt from scratch) with the fold's map rotation and floors; the replay adds
-``--set stride.weinberg_k=K`` and the tuning axes' chosen settings (:mod:`.tuning`). The firmware
-starts on ``init.floor``, so on a multi-floor site a first pass gives the first fix's floor for the
-scored pass (the start still comes from the fixes, never from the truth). Everything a worker needs
-comes in its :class:`FoldJob`: no state outside it.
+``--set stride.weinberg_k=K`` and the tuning axes' chosen settings (:mod:`.tuning`). One replay per
+start mode: the firmware decides the starting floor itself (a vote of the fixes held against the
+barometer, firmware/core/sf_floor_vote.h). Everything a worker needs comes in its :class:`FoldJob`: no
+state outside it.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer.firmware import Firmware
-from stridefix_analyzer.io.logread import LogReadError, read_table
+from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
@@ -77,14 +77,6 @@ def fold_site(
         lowest_floor=lowest_floor,
         source=f"stridefix realbench: leave-one-walk-out fold without {name}",
     )
-
-
-def _first_fix_floor(fw_log: Path) -> int | None:
-    fix = read_table(fw_log, "FIX")
-    if fix is None or not len(fix):
-        return None
-    ok = fix["n_ap_used"] > 0
-    return int(fix["floor"][ok][0]) if ok.any() else None
 
 
 def run_fold(job: FoldJob) -> dict[str, Any]:
@@ -146,15 +138,7 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
             "log": fw_log,
             "check": False,
         }
-        run_sets = sets + extra
-        if tag == "fixes" and site.n_floors > 1:
-            # the firmware starts on init.floor: take the first fix's floor from a first pass
-            proc = job.firmware.run(**replay, sets=run_sets)
-            f0 = _first_fix_floor(fw_log) if proc.returncode == 0 else None
-            if f0 is not None:
-                run_sets = run_sets + [f"init.floor={f0}"]
-                out["fold"]["init_floor_from_first_fix"] = f0
-        proc = job.firmware.run(**replay, sets=run_sets)
+        proc = job.firmware.run(**replay, sets=sets + extra)
         if proc.returncode != 0:
             out["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
             return out

@@ -158,6 +158,38 @@ def test_subtracting_a_walk_that_is_not_part_fails(synthetic_walks):
         _ = stats[0] - stats[1]
 
 
+class _RecordingFirmware:
+    """Stands in for stridefixd: records each replay's --set list and fails it (the fold stops there)."""
+
+    def __init__(self):
+        self.calls: list[list[str]] = []
+
+    def run(self, **kw):
+        self.calls.append(list(kw.get("sets") or []))
+        return subprocess.CompletedProcess(["stridefixd"], 1, "", "stub")
+
+
+def test_fold_on_a_multi_floor_site_replays_once(synthetic_walks, tmp_path):
+    # GIVEN a fold whose site has two floors (walk 2 is on floor 1)
+    stats = [rm.WalkStats.from_recordings([r]) for r in synthetic_walks]
+    total = rm.WalkStats.total(stats)
+    fw = _RecordingFirmware()
+    job = rfold.FoldJob(
+        index=0, walk="w0", group="g", dir=tmp_path / "w0", import_log="unused.lcmlog", firmware=fw,  # type: ignore[arg-type]
+        K=0.45, rotation_deg=0.0, rotation_learned=False, floor_heights_m=[0.0, 4.0],
+        floor_heights_source="test", lowest_floor=0, min_count=1, true_start=False, param_sets=[],
+        variants={}, extra={}, first_waypoint=(0, 0.0, 0.0, 0), total=total, held=stats[0],
+    )  # fmt: skip
+    # WHEN the fold runs
+    out = rfold.run_fold(job)
+    # THEN the firmware replays the walk once, deciding its start floor itself (issue 11: no first
+    # pass feeding init.floor), and the fold record has no such field
+    assert out["fold"]["n_floors"] == 2
+    assert len(fw.calls) == 1 and not any(s.startswith("init.floor") for s in fw.calls[0])
+    assert "init_floor_from_first_fix" not in out["fold"]
+    assert out["error"].startswith("stridefixd exit 1")
+
+
 # --- rotation and floor heights --------------------------------------------------------------------
 
 
