@@ -61,6 +61,7 @@ demo: build
 	@bash tools/demo.sh "$(DEMO_OUT)" "$(STRIDEFIXD)" "$(VENV)"
 
 MSINDOOR ?= ../shared/data/msindoor
+GSD ?= ../shared/data/gsd
 # Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
 	@status=0; \
@@ -68,12 +69,23 @@ bench: build
 		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
 	done; \
 	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \
+	results=""; \
 	for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
 		if [ -d "$$floor" ]; then \
+			name=$$(basename $$(dirname $$floor))-$$(basename $$floor); \
 			$(PY) -m stridefix_analyzer.cli realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
-				--out out/bench/realbench/$$(basename $$(dirname $$floor))-$$(basename $$floor) || status=1; \
+				--out out/bench/realbench/$$name || status=1; \
+			$(PY) -m stridefix_analyzer.cli realbench --format msindoor "$$floor" --true-start --quiet \
+				--stridefixd $(STRIDEFIXD) --out out/bench/realbench/$$name-fusion/results.json || status=1; \
+			results="$$results out/bench/realbench/$$name-fusion/results.json"; \
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
 	done; \
+	if [ -d "$(GSD)" ]; then \
+		$(PY) -m stridefix_analyzer.cli realbench --format gsd "$(GSD)" --true-start --quiet \
+			--stridefixd $(STRIDEFIXD) --out out/bench/realbench/gsd-fusion/results.json || status=1; \
+		results="$$results out/bench/realbench/gsd-fusion/results.json"; \
+	fi; \
+	$(PY) -m stridefix_analyzer.cli bench real-targets --stridefixd $(STRIDEFIXD) --results $$results || status=1; \
 	if [ $$status -ne 0 ]; then echo "bench: FAILED: a target was missed or a bench failed (TARGET MISSED lines above)"; fi; \
 	exit $$status
 

@@ -12,13 +12,14 @@ the chain failed; 2 bad usage (no firmware binary, bad ``--seeds``).
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import fusion, sil_pdr
+from stridefix_analyzer.bench import fusion, realdata, sil_pdr
 from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
@@ -56,12 +57,25 @@ def _run_office(args: argparse.Namespace, firmware: Firmware, seeds: list[int], 
     return fusion.missed_targets_office(doc)
 
 
+def _run_real_targets(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del firmware, seeds  # the replays were realbench's
+    rows, missed = realdata.check(realdata.load_groups(args.results))
+    print(realdata.format_table(rows))
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "real_targets.json").write_text(
+        json.dumps({"results": list(args.results), "targets": rows}, indent=1)
+    )
+    print(f"wrote {out / 'real_targets.json'}")
+    return missed
+
+
 Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
 #: sub-bench name → (runner, default seeds)
 BENCHES: dict[str, tuple[Runner, str]] = {
     "sil-pdr": (_run_sil_pdr, "1,2,3"),
     "aadr2015": (_run_aadr2015, "1,2,3,4,5"),
     "office-wifi": (_run_office, "1,2,3"),
+    "real-targets": (_run_real_targets, "1"),
 }
 
 
@@ -84,7 +98,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         choices=list(BENCHES),
         help="sil-pdr: PDR targets at each pace; aadr2015: the auto-adaptive DR paper's "
         "experiment (fusion schemes at the reference points); office-wifi: the fusion "
-        "schemes on the default office walk with a surveyed radio map",
+        "schemes on the default office walk with a surveyed radio map; real-targets: issue 11's "
+        "targets on realbench results.json files (--results)",
     )
     p.add_argument(
         "--paces",
@@ -103,6 +118,13 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         default=None,
         metavar="LIST",
         help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5)",
+    )
+    p.add_argument(
+        "--results",
+        nargs="*",
+        default=[],
+        metavar="results.json",
+        help="real-targets: the realbench results files to check (run with --true-start)",
     )
     add_stridefixd_argument(p)
     p.add_argument(

@@ -1,0 +1,95 @@
+"""Issue 11's targets on the real data sets, checked on ``stridefix realbench`` results.
+
+``make bench`` runs ``stridefix realbench`` (every scheme from its first fix, and ``--true-start``) on
+each data set it finds and passes the ``results.json`` files here; every target is one row of
+:data:`TARGETS` (data set group, start mode, scheme, metric, bound). A group that is not in any file
+is reported as not run, not as met.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+
+@dataclasses.dataclass(frozen=True)
+class Target:
+    group: str  # realbench group label ("site1/F2", "gsd/building 100")
+    start: str  # "first fix" (summary) or "true start" (summary_true_start)
+    scheme: str
+    metric: str  # a key of the scheme's summary (mean, p75, ipin_score, floor_hit_rate, ...)
+    bound: float
+    at_least: bool = False  # the value must reach the bound (floor hit) instead of staying below it
+    walk: str = ""  # one walk of the group (its name contains this) instead of the whole group
+
+    def describe(self) -> str:
+        op = ">=" if self.at_least else "<="
+        where = f"{self.group}{' ' + self.walk if self.walk else ''}"
+        return f"{where} [{self.start}] {self.scheme} {self.metric} {op} {self.bound:g}"
+
+
+TARGETS: tuple[Target, ...] = (
+    Target("site1/F2", "first fix", "ekf", "mean", 3.5),
+    Target("site1/F2", "first fix", "ekf", "p75", 4.5),
+    Target("site2/F3", "first fix", "ekf", "mean", 10.0),
+    Target("gsd/building 100", "first fix", "ekf", "ipin_score", 4.5),
+    Target("gsd/building 100", "true start", "pdr_only", "mean", 6.0),
+    # the trial that changes floors (0 → −1 → −2 and back)
+    Target("gsd/building 100", "first fix", "ekf", "floor_hit_rate", 0.99, at_least=True, walk="Trial51"),
+)
+
+_SUMMARY = {"first fix": "summary", "true start": "summary_true_start"}
+_WALK = {"first fix": "fixes", "true start": "true_start"}
+
+
+def _value(group: dict[str, Any], t: Target) -> float:
+    if t.walk:
+        rows = [r for r in group.get("walk_rows") or [] if t.walk in str(r.get("walk"))]
+        scheme = ((rows[0].get(_WALK[t.start]) or {}).get(t.scheme) or {}) if len(rows) == 1 else {}
+    else:
+        scheme = ((group.get(_SUMMARY[t.start]) or {}).get("schemes") or {}).get(t.scheme) or {}
+    value = scheme.get(t.metric)
+    return float(value) if value is not None else math.nan
+
+
+class ResultsError(ValueError):
+    """A results file that cannot be read as realbench output; the message names it."""
+
+
+def load_groups(paths: Iterable[str | Path]) -> dict[str, dict[str, Any]]:
+    """Group label → group record over every realbench ``results.json``."""
+    groups: dict[str, dict[str, Any]] = {}
+    for path in paths:
+        try:
+            doc = json.loads(Path(path).read_text())
+            for g in doc["groups"]:
+                groups[g["label"]] = g
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise ResultsError(f"{path}: not a realbench results file ({exc})") from exc
+    return groups
+
+
+def check(
+    groups: dict[str, dict[str, Any]], targets: Sequence[Target] = TARGETS
+) -> tuple[list[dict[str, Any]], list[str]]:
+    """Every target's row (value, met) and the ``TARGET MISSED`` lines (misses and targets not run)."""
+    rows, missed = [], []
+    for t in targets:
+        value = _value(groups.get(t.group) or {}, t)
+        met = math.isfinite(value) and (value >= t.bound if t.at_least else value <= t.bound)
+        rows.append({"target": t.describe(), "value": value, "met": met})
+        if not math.isfinite(value):
+            missed.append(f"realbench {t.describe()}: not run")
+        elif not met:
+            missed.append(f"realbench {t.describe()}: {value:.3g}")
+    return rows, missed
+
+
+def format_table(rows: Sequence[dict[str, Any]]) -> str:
+    lines = [f"{'target':<58} {'value':>8}  met"]
+    lines += [f"{r['target']:<58} {r['value']:>8.3g}  {'yes' if r['met'] else 'NO'}" for r in rows]
+    return "\n".join(lines)
