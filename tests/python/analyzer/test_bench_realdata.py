@@ -6,7 +6,6 @@ import json
 import math
 
 import pytest
-
 from stridefix_analyzer.bench import realdata
 
 
