@@ -1,0 +1,73 @@
+"""realbench's measurements for the ekf scheme: the fix-error model (fixmodel) and the start priors
+(priors), on synthetic residuals whose answer is known."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from stridefix_analyzer.realbench import fixmodel, priors
+
+
+def _ar_walk(
+    rng: np.random.Generator, n: int, step_m: float, sigma_c: float, length_m: float, sigma_w: float
+):
+    """Fix errors of one walk: a Gauss–Markov part (σ_c, decorrelating over length_m walked) plus white
+    noise σ_w, accuracy 2 m, one fix every step_m metres; rows as fix_residuals_m gives them."""
+    phi = math.exp(-step_m / length_m)
+    c = rng.normal(0.0, sigma_c, 2)
+    rows = []
+    for k in range(n):
+        c = phi * c + rng.normal(0.0, sigma_c * math.sqrt(1 - phi * phi), 2)
+        e = c + rng.normal(0.0, sigma_w, 2)
+        rows.append((e[0], e[1], 2.0, k * step_m))
+    return np.array(rows)
+
+
+def test_model_recovers_a_known_correlated_error():
+    rng = np.random.default_rng(7)
+    walks = [_ar_walk(rng, 60, 1.5, 3.0, 15.0, 1.5) for _ in range(80)]
+    m = fixmodel.model_of(walks)
+    assert m is not None and m["fixes"] == 4800
+    # one fix's variance per axis is 3² + 1.5² = 11.25 m², i.e. M = 11.25 / 2² = 2.81 (winsorised: less)
+    assert 2.0 < m["m_xx"] < 2.9 and 2.0 < m["m_yy"] < 2.9
+    assert abs(m["m_xy"]) < 0.2
+    assert 2.4 < m["correlated_sigma_m"] < 3.3
+    assert 8.0 < m["correlation_length_m"] < 25.0
+    keys = [s.split("=")[0] for s in m["sets"]]
+    assert keys == list(fixmodel.KEYS)
+
+
+def test_independent_fixes_have_no_correlated_part():
+    rng = np.random.default_rng(3)
+    walks = [
+        np.column_stack([rng.normal(0, 2.0, (50, 2)), np.full(50, 2.0), np.arange(50) * 1.5])
+        for _ in range(40)
+    ]
+    m = fixmodel.model_of(walks)
+    assert m is not None
+    assert m["correlated_sigma_m"] < 0.6  # noise: no bin's covariance is really positive
+    assert 0.7 < m["m_xx"] < 1.1  # σ 2 m at accuracy 2 m, winsorised
+
+
+def test_too_few_fixes_give_no_model():
+    assert fixmodel.model_of([np.zeros((5, 4))]) is None
+
+
+def test_start_priors_from_the_walks_spread():
+    # per-walk heading offsets 0, ±0.1 rad: circular σ ≈ 0.082 rad; K 0.40, 0.44, 0.36: 10 % relative σ
+    rot = [
+        {"sum_cos": 10 * math.cos(a), "sum_sin": 10 * math.sin(a), "n_steps": 10, "n_segments": 1}
+        for a in (0.0, 0.1, -0.1, 0.5)
+    ]
+    seg_walk = np.array([0, 1, 2, 3])
+    true_m = np.array([40.0, 44.0, 36.0, 10.0])
+    weinberg = np.array([100.0, 100.0, 100.0, 100.0])
+    out = priors.ekf_start_priors(rot, seg_walk, true_m, weinberg, exclude=3)
+    assert out["ekf.init_bias_sigma_rad"] == pytest.approx(
+        math.sqrt(-2 * math.log((1 + 2 * math.cos(0.1)) / 3))
+    )
+    assert out["ekf.init_scale_sigma"] == pytest.approx(0.1)
+    # two training walks are too few: the firmware's defaults stay
+    assert priors.ekf_start_priors(rot[:3], seg_walk[:3], true_m[:3], weinberg[:3], exclude=0) == {}
