@@ -37,7 +37,7 @@ HEADING_VARIANTS = {
 }
 
 RotationSums = dict[str, Any]
-"""``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments`` of one walk (:func:`rotation_stats`)."""
+"""``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments``, ``segments`` of one walk (:func:`rotation_stats`)."""
 
 
 def rotation_stats(
@@ -60,12 +60,16 @@ def rotation_stats(
     -------
     dict
         ``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments`` (add over walks; the rotation is
-        atan2(Σsin, Σcos) [rad]).
+        atan2(Σsin, Σcos) [rad]), and ``segments``: per segment (distance walked to its middle along
+        the truth [m], its mean heading offset [rad]), for the ekf's bias random walk (:mod:`.priors`).
     """
     step_t_us, h = np.asarray(step_t_us, np.int64), np.asarray(step_heading_rad, float)
     wp_t_us, wp = np.asarray(wp_t_us, np.int64), np.asarray(wp_xy_m, float).reshape(-1, 2)
-    out = {"sum_cos": 0.0, "sum_sin": 0.0, "n_steps": 0, "n_segments": 0}
+    out: RotationSums = {"sum_cos": 0.0, "sum_sin": 0.0, "n_steps": 0, "n_segments": 0, "segments": []}
+    walked_m = 0.0
     for k in range(len(wp_t_us) - 1):
+        seg_start_m = walked_m
+        walked_m += float(np.hypot(*(wp[k + 1] - wp[k])))
         d = wp[k + 1] - wp[k]
         if not (np.hypot(*d) >= min_segment_m) or wp_t_us[k + 1] <= wp_t_us[k]:
             continue
@@ -79,6 +83,8 @@ def rotation_stats(
         out["sum_sin"] += float(np.sin(off).sum())
         out["n_steps"] += int(len(hs))
         out["n_segments"] += 1
+        mid_m = 0.5 * (seg_start_m + walked_m)
+        out["segments"].append((mid_m, math.atan2(float(np.sin(off).mean()), float(np.cos(off).mean()))))
     return out
 
 

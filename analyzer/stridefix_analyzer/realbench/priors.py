@@ -10,7 +10,10 @@ of the firmware's "unknown" defaults, which fit a unit in the field that has no 
   offsets (STEP heading − truth direction over straight segments, :func:`.heading.rotation_stats`),
   R̄ the mean resultant length of one unit vector per walk;
 * ``ekf.init_scale_sigma``: the relative standard deviation of the per-walk K (Σ true distance /
-  Σ Weinberg term over the walk's scored segments).
+  Σ Weinberg term over the walk's scored segments);
+* ``ekf.bias_rw_rad2_per_m``: how fast the heading offset wanders within a walk: the mean squared
+  change of the offset between consecutive straight segments of a walk over the mean distance between
+  them (a random walk per metre; segments at most :data:`MAX_SEGMENT_GAP_M` apart).
 
 Each needs :data:`MIN_WALKS` training walks with data, else the firmware default stays.
 """
@@ -28,6 +31,25 @@ MIN_WALKS = 3
 #: the priors are kept in these ranges: below, a walk's own noise dominates; above, it is unknown
 BIAS_SIGMA_RANGE_RAD = (0.02, 1.0)
 SCALE_SIGMA_RANGE = (0.01, 0.5)
+BIAS_RW_RANGE_RAD2_PER_M = (1e-4, 0.05)
+#: consecutive straight segments further apart than this do not enter the bias random walk [m]
+MAX_SEGMENT_GAP_M = 40.0
+#: fewest segment pairs for the random walk
+MIN_SEGMENT_PAIRS = 10
+
+
+def bias_rw_rad2_per_m(rotation: Sequence[Mapping[str, Any]], exclude: int) -> float:
+    """Σ Δoffset² / Σ Δs over consecutive straight segments of every walk but ``exclude`` (NaN: too few)."""
+    sq, gap, n = 0.0, 0.0, 0
+    for j, r in enumerate(rotation):
+        segs = r.get("segments") or []
+        if j == exclude:
+            continue
+        for (s0, o0), (s1, o1) in zip(segs[:-1], segs[1:]):
+            if 0.0 < s1 - s0 <= MAX_SEGMENT_GAP_M:
+                d = math.atan2(math.sin(o1 - o0), math.cos(o1 - o0))
+                sq, gap, n = sq + d * d, gap + (s1 - s0), n + 1
+    return sq / gap if n >= MIN_SEGMENT_PAIRS and gap > 0 else math.nan
 
 
 def heading_bias_sigma_rad(rotation: Sequence[Mapping[str, Any]], exclude: int) -> float:
@@ -59,7 +81,7 @@ def stride_scale_sigma(seg_walk: np.ndarray, true_m: np.ndarray, weinberg: np.nd
 def ekf_start_priors(
     rotation: Sequence[Mapping[str, Any]], seg_walk: Any, true_m: Any, weinberg: Any, exclude: int
 ) -> dict[str, float]:
-    """Both priors of walk ``exclude``'s fold (only those with enough walks), as ``--set`` values."""
+    """The priors of walk ``exclude``'s fold (only those with enough data), as ``--set`` values."""
     out = {}
     b = heading_bias_sigma_rad(rotation, exclude)
     if math.isfinite(b):
@@ -69,4 +91,7 @@ def ekf_start_priors(
     )
     if math.isfinite(s):
         out["ekf.init_scale_sigma"] = float(np.clip(s, *SCALE_SIGMA_RANGE))
+    q = bias_rw_rad2_per_m(rotation, exclude)
+    if math.isfinite(q):
+        out["ekf.bias_rw_rad2_per_m"] = float(np.clip(q, *BIAS_RW_RANGE_RAD2_PER_M))
     return out

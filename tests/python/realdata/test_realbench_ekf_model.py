@@ -71,3 +71,11 @@ def test_start_priors_from_the_walks_spread():
     assert out["ekf.init_scale_sigma"] == pytest.approx(0.1)
     # two training walks are too few: the firmware's defaults stay
     assert priors.ekf_start_priors(rot[:3], seg_walk[:3], true_m[:3], weinberg[:3], exclude=0) == {}
+
+
+def test_bias_random_walk_from_segment_offsets():
+    # offsets change by ±0.1 rad between segments 10 m apart: 0.01 rad² per 10 m = 0.001 rad²/m
+    segs = [[(10.0 * k, 0.1 * (k % 2)) for k in range(6)] for _ in range(3)]
+    rot = [{"sum_cos": 1.0, "sum_sin": 0.0, "n_steps": 5, "n_segments": 6, "segments": s} for s in segs]
+    assert priors.bias_rw_rad2_per_m(rot, exclude=0) == pytest.approx(0.001)
+    assert math.isnan(priors.bias_rw_rad2_per_m(rot[:1], exclude=0))  # no other walk
