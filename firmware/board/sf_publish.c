@@ -102,8 +102,8 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
 
 #define CONFIG_KEY_BYTES 64
 #define CONFIG_VALUE_BYTES 32
-_Static_assert(SF_PARAM_COUNT * (CONFIG_KEY_BYTES + CONFIG_VALUE_BYTES + 2 * sizeof(char *)) <= 16 * 1024,
-               "sf_publish.h promises CONFIG's text within 16 KiB of stack");
+_Static_assert(SF_PARAM_COUNT * (CONFIG_KEY_BYTES + CONFIG_VALUE_BYTES + 2 * sizeof(char *)) <= 20 * 1024,
+               "sf_publish.h promises CONFIG's text within 20 KiB of stack");
 
 void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
                        const sf_params_t *const params, const char *const version, const char *const dbc_sha256)

@@ -164,7 +164,9 @@ void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const dou
     r_white_m2[0] = a2 * e->fix_model[0] - c2;
     r_white_m2[1] = a2 * e->fix_model[1];
     r_white_m2[2] = a2 * e->fix_model[2] - c2;
-    clamp_eigen2(r_white_m2, p->fusion_var_min_m2, INFINITY);
+    /* a fix better than the median keeps its white share: c's variance is one figure for all fixes */
+    const double white_min = p->ekf_fix_white_share * a2 * min_eigen2(e->fix_model);
+    clamp_eigen2(r_white_m2, fmax(p->fusion_var_min_m2, white_min), INFINITY);
 }
 
 void sf_ekf_innovation(const sf_ekf_t *const e, const double z_minus_p_m[2], double nu_m[2])

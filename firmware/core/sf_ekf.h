@@ -37,9 +37,11 @@
  *
  * R from the fix-error model: one fix's whole error covariance is accuracy_m² · M, M (symmetric 2×2)
  * per unit of the matcher's accuracy², because the matcher's accuracy (neighbour spread) is a shape, not
- * a calibrated σ; the white part is R_w = accuracy_m² · M − σ_c² I (eigenvalues floored at
- * fusion_var_min_m2). M starts at the prior (ekf_fix_var_x_per_acc2, ekf_fix_cov_xy_per_acc2,
- * ekf_fix_var_y_per_acc2: measured by realbench on training walks the map never saw, or 1 · I = the
+ * a calibrated σ; the white part is R_w = accuracy_m² · M − σ_c² I, its eigenvalues floored at
+ * ekf_fix_white_share · accuracy_m² · (M's smallest eigenvalue) and fusion_var_min_m2: σ_c is one
+ * figure for every fix, so a fix more accurate than most keeps the white share of its own error instead
+ * of being taken as c alone (which would make fix-to-fix jitter look like motion). M starts at the
+ * prior (ekf_fix_var_x_per_acc2, ekf_fix_cov_xy_per_acc2, ekf_fix_var_y_per_acc2: measured by realbench on training walks the map never saw, or 1 · I = the
  * matcher's word) and learns from accepted fixes' innovations, E[ννᵀ] = H P Hᵀ + R_w, a running mean
  * over the first ekf_r_window fixes and an exponential one after (innovation-based adaptive
  * estimation, Mehra 1970); an innovation beyond nis_max enters clipped onto it. It may only say the

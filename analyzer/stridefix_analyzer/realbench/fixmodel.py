@@ -15,13 +15,14 @@ The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather tha
 * consecutive fixes err alike (neighbouring scans match the same wrong reference points; a standing
   walker gets the same wrong fix again), and a filter that takes them as independent follows them. The
   scheme carries that part of the error as a state c (a Gauss–Markov process in the distance walked);
-  its σ_c and correlation length ℓ come from the covariance of two fixes' errors (in metres, per axis)
-  against the distance walked between them along the truth, C(Δd) = σ_c²·exp(−Δd/ℓ)
-  (:func:`correlation`), with σ_c² kept below the one-fix variance so a white part is left.
+  its share a of a fix's error and correlation length ℓ come from the correlation of two fixes' errors
+  (in metres, per axis) against the distance walked between them along the truth,
+  r(Δd) = a·exp(−Δd/ℓ) (:func:`correlation`); σ_c² = a times one fix's variance at the median
+  accuracy, and every fix keeps at least the white share 1 − a of its own variance.
 
 The result goes to the fold as ``ekf.fix_var_x_per_acc2``, ``ekf.fix_var_y_per_acc2``,
 ``ekf.fix_cov_xy_per_acc2`` (the firmware's prior, which the scheme can only raise online),
-``ekf.fix_bias_sigma_m`` and ``ekf.fix_bias_length_m``.
+``ekf.fix_bias_sigma_m``, ``ekf.fix_bias_length_m`` and ``ekf.fix_white_share``.
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ DISTANCE_BINS_M = (0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
 MIN_PAIRS = 10
 #: the correlation length is kept in this range [m]
 LENGTH_RANGE_M = (1.0, 200.0)
-#: σ_c² at most this share of the smallest one-fix variance at the median accuracy, so a white part is left
+#: the correlated share a is kept at most this, so every fix keeps a white part
 MAX_CORRELATED_SHARE = 0.9
 KEYS = (
     "ekf.fix_var_x_per_acc2",
@@ -62,6 +63,7 @@ KEYS = (
     "ekf.fix_cov_xy_per_acc2",
     "ekf.fix_bias_sigma_m",
     "ekf.fix_bias_length_m",
+    "ekf.fix_white_share",
 )
 
 
@@ -72,10 +74,12 @@ def _winsorise(v: np.ndarray) -> np.ndarray:
 
 
 def correlation(rows: Sequence[np.ndarray]) -> tuple[float, float, list[dict[str, float]]]:
-    """σ_c² [m²] and ℓ [m] of C(Δd) = σ_c²·exp(−Δd/ℓ), the per-axis covariance of two fixes' errors
+    """a and ℓ [m] of r(Δd) = a·exp(−Δd/ℓ), the correlation of two fixes' errors (per axis, in metres)
     against the distance walked between them (pairs within a walk, 1..:data:`MAX_LAG` fixes apart,
-    binned by :data:`DISTANCE_BINS_M`, a log-linear fit weighted by the pairs per bin); and the bins.
-    σ_c² = 0 when no bin has a positive covariance."""
+    binned by :data:`DISTANCE_BINS_M`, a log-linear fit weighted by the pairs per bin), r = covariance /
+    variance of the same errors; and the bins. a = 0 when no bin has a positive correlation."""
+    allq = np.concatenate([0.5 * np.sum(r[:, :2] ** 2, axis=1) for r in rows]) if rows else np.zeros(0)
+    variance = float(allq.mean()) if len(allq) else 0.0
     prods: list[np.ndarray] = []
     dists: list[np.ndarray] = []
     for r in rows:
@@ -83,22 +87,22 @@ def correlation(rows: Sequence[np.ndarray]) -> tuple[float, float, list[dict[str
         for k in range(1, min(MAX_LAG, len(r) - 1) + 1):
             prods.append(0.5 * np.sum(e[k:] * e[:-k], axis=1))
             dists.append(np.abs(r[k:, 3] - r[:-k, 3]))
-    if not prods:
+    if not prods or variance <= 0:
         return 0.0, LENGTH_RANGE_M[0], []
-    q, d = np.concatenate(prods), np.concatenate(dists)
+    q, d = np.concatenate(prods) / variance, np.concatenate(dists)
     bins = []
     edges = (*DISTANCE_BINS_M, np.inf)
     for lo, hi in zip(edges[:-1], edges[1:], strict=True):
         m = (d >= lo) & (d < hi)
         if m.sum() >= MIN_PAIRS:
-            bins.append({"d_m": float(d[m].mean()), "cov_m2": float(q[m].mean()), "pairs": int(m.sum())})
-    pos = [b for b in bins if b["cov_m2"] > 0]
+            bins.append({"d_m": float(d[m].mean()), "correlation": float(q[m].mean()), "pairs": int(m.sum())})
+    pos = [b for b in bins if b["correlation"] > 0]
     if not pos:
         return 0.0, LENGTH_RANGE_M[0], bins
     if len(pos) == 1:
-        return pos[0]["cov_m2"], LENGTH_RANGE_M[0], bins
+        return pos[0]["correlation"], LENGTH_RANGE_M[0], bins
     x = np.array([b["d_m"] for b in pos])
-    y = np.log([b["cov_m2"] for b in pos])
+    y = np.log([b["correlation"] for b in pos])
     w = np.sqrt([b["pairs"] for b in pos])
     slope, intercept = np.polyfit(x, y, 1, w=w)
     length = float(np.clip(-1.0 / slope, *LENGTH_RANGE_M)) if slope < 0 else LENGTH_RANGE_M[1]
@@ -126,16 +130,18 @@ def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
     for r in rows:
         capped.append(np.column_stack([cap[start : start + len(r)], r[:, 2:]]))
         start += len(r)
-    c2, length, bins = correlation(capped)
+    share, length, bins = correlation(capped)
+    share = min(max(share, 0.0), MAX_CORRELATED_SHARE)
     acc_med = float(np.median(np.concatenate([r[:, 2] for r in rows])))
-    c2 = min(c2, MAX_CORRELATED_SHARE * acc_med**2 * min(m_xx, m_yy))
-    sigma_c = math.sqrt(max(c2, 0.0))
+    # c's variance in metres: the correlated share of one fix's variance at the median accuracy
+    sigma_c = math.sqrt(share * acc_med**2 * min(m_xx, m_yy))
     return {
         "fixes": n,
         "m_xx": m_xx,
         "m_yy": m_yy,
         "m_xy": m_xy,
         "accuracy_median_m": acc_med,
+        "correlated_share": share,
         "correlated_sigma_m": sigma_c,
         "correlation_length_m": length,
         "correlation_bins": bins,
@@ -145,6 +151,7 @@ def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
             f"{KEYS[2]}={m_xy:.6g}",
             f"{KEYS[3]}={sigma_c:.6g}",
             f"{KEYS[4]}={length:.6g}",
+            f"{KEYS[5]}={1.0 - share:.6g}",
         ],
     }
 

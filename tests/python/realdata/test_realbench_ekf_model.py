@@ -34,6 +34,7 @@ def test_model_recovers_a_known_correlated_error():
     assert 2.0 < m["m_xx"] < 2.9 and 2.0 < m["m_yy"] < 2.9
     assert abs(m["m_xy"]) < 0.2
     assert 2.4 < m["correlated_sigma_m"] < 3.3
+    assert 0.7 < m["correlated_share"] < 0.9  # 3² / (3² + 1.5²) = 0.8
     assert 8.0 < m["correlation_length_m"] < 25.0
     keys = [s.split("=")[0] for s in m["sets"]]
     assert keys == list(fixmodel.KEYS)
