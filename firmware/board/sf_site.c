@@ -131,6 +131,7 @@ static int walk_site(walk_t *const w)
     rc = rc != SF_OK ? rc : skip(w, 4, "cell_size_m");
     rc = rc != SF_OK ? rc : walk_count(w, "n_rp", 4 + 4 + 2 + 4);
     rc = rc != SF_OK ? rc : walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
+    rc = rc != SF_OK ? rc : skip(w, 1 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
     if (rc == SF_OK && w->pos != w->size) {
         rc = failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload has %zu trailing bytes after the site_t",
                    w->size - w->pos);
@@ -153,6 +154,21 @@ static int check_fields(const stridefix_site_t *const s, const char *const name,
         }
         if (!(isfinite(s->origin_lon_deg) && s->origin_lon_deg >= -180.0 && s->origin_lon_deg <= 180.0)) {
             return BAD("origin_lon_deg = %g outside -180..180", s->origin_lon_deg);
+        }
+    }
+    if (s->has_fix_model) {
+        const double xx = s->fix_cov_per_acc2[0], xy = s->fix_cov_per_acc2[1], yy = s->fix_cov_per_acc2[2];
+        if (!(isfinite(xx) && isfinite(xy) && isfinite(yy) && xx > 0.0 && yy > 0.0 && xx * yy > xy * xy)) {
+            return BAD("fix_cov_per_acc2 = [%g, %g, %g] not positive definite", xx, xy, yy);
+        }
+        if (!(isfinite(s->fix_bias_sigma_m) && s->fix_bias_sigma_m >= 0.0f)) {
+            return BAD("fix_bias_sigma_m = %g, must be finite and >= 0", (double)s->fix_bias_sigma_m);
+        }
+        if (!(isfinite(s->fix_bias_length_m) && s->fix_bias_length_m > 0.0f)) {
+            return BAD("fix_bias_length_m = %g, must be finite and > 0", (double)s->fix_bias_length_m);
+        }
+        if (!(isfinite(s->fix_white_share) && s->fix_white_share >= 0.0f && s->fix_white_share <= 1.0f)) {
+            return BAD("fix_white_share = %g outside 0..1", (double)s->fix_white_share);
         }
     }
     if (s->n_floors < 1) {
@@ -314,6 +330,12 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     site->lowest_floor = s->lowest_floor;
     site->n_floors = s->n_floors;
     site->floor_height_m = s->floor_height_m;
+    site->fix_model = (sf_fix_model_t){.valid = s->has_fix_model,
+                                       .cov_per_acc2 = {s->fix_cov_per_acc2[0], s->fix_cov_per_acc2[1],
+                                                        s->fix_cov_per_acc2[2]},
+                                       .bias_sigma_m = s->fix_bias_sigma_m,
+                                       .bias_length_m = s->fix_bias_length_m,
+                                       .white_share = s->fix_white_share};
     sf_radiomap_t *const m = &site->radiomap;
     m->n_ap = s->n_ap;
     m->ap_bssid = s->ap_bssid;

@@ -77,24 +77,49 @@ static void clear_position_and_bias(sf_ekf_t *const e)
     e->fix_bias_m[0] = e->fix_bias_m[1] = 0.0;
 }
 
+/* The fix-error model's constants: M (the prior of the learning) and the correlated part. */
+static void set_model(sf_ekf_t *const e, const sf_params_t *const p, const double cov_per_acc2[3],
+                      const double bias_sigma_m, const double bias_length_m, const double white_share)
+{
+    for (int i = 0; i < 3; i++) {
+        e->fix_model[i] = cov_per_acc2[i];
+    }
+    clamp_eigen2(e->fix_model, p->ekf_r_min, p->ekf_r_max);
+    e->model_floor = min_eigen2(e->fix_model);
+    e->model_fixes = 0;
+    e->bias_sigma_m = bias_sigma_m;
+    e->bias_length_m = bias_length_m;
+    e->white_share = white_share;
+}
+
 void sf_ekf_start(sf_ekf_t *const e, const sf_params_t *const p)
 {
     *e = (sf_ekf_t){.heading_bias_rad = 0.0, .stride_scale = 1.0};
     e->P[ib][ib] = p->ekf_init_bias_sigma_rad * p->ekf_init_bias_sigma_rad;
     e->P[is][is] = p->ekf_init_scale_sigma * p->ekf_init_scale_sigma;
-    e->fix_model[0] = p->ekf_fix_var_x_per_acc2;
-    e->fix_model[1] = p->ekf_fix_cov_xy_per_acc2;
-    e->fix_model[2] = p->ekf_fix_var_y_per_acc2;
-    clamp_eigen2(e->fix_model, p->ekf_r_min, p->ekf_r_max);
-    e->model_floor = min_eigen2(e->fix_model);
-    const double c2 = p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
-    e->P[icx][icx] = e->P[icy][icy] = c2;
+    const double m[3] = {p->ekf_fix_var_x_per_acc2, p->ekf_fix_cov_xy_per_acc2, p->ekf_fix_var_y_per_acc2};
+    set_model(e, p, m, p->ekf_fix_bias_sigma_m, p->ekf_fix_bias_length_m, p->ekf_fix_white_share);
+    e->P[icx][icx] = e->P[icy][icy] = e->bias_sigma_m * e->bias_sigma_m;
 }
 
-void sf_ekf_restart_at_fix(sf_ekf_t *const e, const sf_params_t *const p, const double r_white_m2[3])
+void sf_ekf_use_site_model(sf_ekf_t *const e, const sf_params_t *const p, const sf_fix_model_t *const model)
+{
+    if (model == NULL || !model->valid) {
+        return;
+    }
+    set_model(e, p, model->cov_per_acc2, model->bias_sigma_m, model->bias_length_m, model->white_share);
+    /* c starts afresh with the site's σ_c, uncorrelated (a start before any fix) */
+    for (int j = 0; j < n; j++) {
+        e->P[icx][j] = e->P[j][icx] = e->P[icy][j] = e->P[j][icy] = 0.0;
+    }
+    e->fix_bias_m[0] = e->fix_bias_m[1] = 0.0;
+    e->P[icx][icx] = e->P[icy][icy] = e->bias_sigma_m * e->bias_sigma_m;
+}
+
+void sf_ekf_restart_at_fix(sf_ekf_t *const e, const double r_white_m2[3])
 {
     clear_position_and_bias(e);
-    const double c2 = p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
+    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
     e->P[ix][ix] = r_white_m2[0] + c2;
     e->P[ix][iy] = e->P[iy][ix] = r_white_m2[1];
     e->P[iy][iy] = r_white_m2[2] + c2;
@@ -103,10 +128,10 @@ void sf_ekf_restart_at_fix(sf_ekf_t *const e, const sf_params_t *const p, const 
     e->P[iy][icy] = e->P[icy][iy] = -c2;
 }
 
-void sf_ekf_restart_known(sf_ekf_t *const e, const sf_params_t *const p, const double pos_cov_m2[3])
+void sf_ekf_restart_known(sf_ekf_t *const e, const double pos_cov_m2[3])
 {
     clear_position_and_bias(e);
-    const double c2 = p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
+    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
     e->P[ix][ix] = pos_cov_m2[0];
     e->P[ix][iy] = e->P[iy][ix] = pos_cov_m2[1];
     e->P[iy][iy] = pos_cov_m2[2];
@@ -121,7 +146,7 @@ void sf_ekf_step(sf_ekf_t *const e, const sf_params_t *const p, const double len
     d_m[0] = sl * c;
     d_m[1] = sl * sn;
     /* c decorrelates with the distance walked */
-    const double phi = p->ekf_fix_bias_length_m > 0.0 ? exp(-sl / p->ekf_fix_bias_length_m) : 0.0;
+    const double phi = e->bias_length_m > 0.0 ? exp(-sl / e->bias_length_m) : 0.0;
     e->fix_bias_m[0] *= phi;
     e->fix_bias_m[1] *= phi;
     double F[n][n] = {{0}};
@@ -143,7 +168,7 @@ void sf_ekf_step(sf_ekf_t *const e, const sf_params_t *const p, const double len
     e->P[iy][iy] += along * sn * sn + across * c * c;
     e->P[ib][ib] += p->ekf_bias_rw_rad2_per_m * length_m;
     e->P[is][is] += p->ekf_scale_rw_per_m * length_m;
-    const double qc = (1.0 - phi * phi) * p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
+    const double qc = (1.0 - phi * phi) * e->bias_sigma_m * e->bias_sigma_m;
     e->P[icx][icx] += qc;
     e->P[icy][icy] += qc;
     symmetrise(e);
@@ -160,12 +185,12 @@ void sf_ekf_time(sf_ekf_t *const e, const sf_params_t *const p, const double dt_
 void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const double accuracy_m,
                   double r_white_m2[3])
 {
-    const double a2 = accuracy_m * accuracy_m, c2 = p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
+    const double a2 = accuracy_m * accuracy_m, c2 = e->bias_sigma_m * e->bias_sigma_m;
     r_white_m2[0] = a2 * e->fix_model[0] - c2;
     r_white_m2[1] = a2 * e->fix_model[1];
     r_white_m2[2] = a2 * e->fix_model[2] - c2;
     /* a fix better than the median keeps its white share: c's variance is one figure for all fixes */
-    const double white_min = p->ekf_fix_white_share * a2 * min_eigen2(e->fix_model);
+    const double white_min = e->white_share * a2 * min_eigen2(e->fix_model);
     clamp_eigen2(r_white_m2, fmax(p->fusion_var_min_m2, white_min), INFINITY);
 }
 
@@ -208,7 +233,7 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
     /* an innovation beyond the gate enters shrunk onto it: evidence that R is too small, bounded */
     const double k = isfinite(nis) && nis > nis_max ? sqrt(nis_max / nis) : 1.0;
     const double vx = k * nu_m[0], vy = k * nu_m[1], a2 = accuracy_m * accuracy_m;
-    const double c2 = p->ekf_fix_bias_sigma_m * p->ekf_fix_bias_sigma_m;
+    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
     hph(e, m);
     /* E[ννᵀ] = H P Hᵀ + a²M − σ_c² I, solved for M */
     const double sample[3] = {(vx * vx - m[0] + c2) / a2, (vx * vy - m[1]) / a2, (vy * vy - m[2] + c2) / a2};

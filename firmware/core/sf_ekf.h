@@ -41,8 +41,9 @@
  * ekf_fix_white_share · accuracy_m² · (M's smallest eigenvalue) and fusion_var_min_m2: σ_c is one
  * figure for every fix, so a fix more accurate than most keeps the white share of its own error instead
  * of being taken as c alone (which would make fix-to-fix jitter look like motion). M starts at the
- * prior (ekf_fix_var_x_per_acc2, ekf_fix_cov_xy_per_acc2, ekf_fix_var_y_per_acc2: measured by realbench on training walks the map never saw, or 1 · I = the
- * matcher's word) and learns from accepted fixes' innovations, E[ννᵀ] = H P Hᵀ + R_w, a running mean
+ * prior: the site file's measured model (site_t.fix_cov_per_acc2 and the correlated part, written by
+ * realbench from training walks the map never saw), else the parameters ekf_fix_var_x_per_acc2,
+ * ekf_fix_cov_xy_per_acc2, ekf_fix_var_y_per_acc2 (default 1 · I = the matcher's word), and learns from accepted fixes' innovations, E[ννᵀ] = H P Hᵀ + R_w, a running mean
  * over the first ekf_r_window fixes and an exponential one after (innovation-based adaptive
  * estimation, Mehra 1970); an innovation beyond nis_max enters clipped onto it. It may only say the
  * fixes are worse than the prior (a disturbed site, a moved access point), never better: M's
@@ -56,13 +57,14 @@
  * P_pp as given, c = 0 with σ_c², uncorrelated.
  *
  * Cost: per step ~700 flops (the 6×6 F P Fᵀ) and one sin/cos/exp; per fix ~900 flops. Memory:
- * sizeof(sf_ekf_t) = 360 B on x86-64 and i686 (at most 384 B, checked). No heap, no I/O, no clock. */
+ * sizeof(sf_ekf_t) = 384 B on x86-64 and i686 (at most 400 B, checked). No heap, no I/O, no clock. */
 #ifndef SF_EKF_H
 #define SF_EKF_H
 
 #include <stdint.h>
 
 #include "sf_params.h"
+#include "sf_radiomap.h"
 
 enum { SF_EKF_N = 6 }; /* [δx, δy, δb, δs, δc_x, δc_y] */
 
@@ -73,20 +75,28 @@ typedef struct {
     double P[SF_EKF_N][SF_EKF_N];  /* covariance of δ */
     double fix_model[3];           /* M: one fix's error covariance per accuracy_m² [xx, xy, yy] */
     double model_floor;            /* smallest eigenvalue M may learn down to: the prior's */
+    double bias_sigma_m;           /* σ_c (the site's, or ekf_fix_bias_sigma_m) */
+    double bias_length_m;          /* ℓ */
+    double white_share;            /* least white share of a fix's variance */
     uint32_t model_fixes;          /* innovations M has learnt from */
 } sf_ekf_t;
-_Static_assert(sizeof(sf_ekf_t) <= 384, "sf_ekf.h promises at most 384 B");
+_Static_assert(sizeof(sf_ekf_t) <= 400, "sf_ekf.h promises at most 400 B");
 
-/* A fresh filter: bias 0 and scale 1 with their initial σ, c = 0 with σ_c, the prior fix model; the
- * position block is then set by sf_ekf_restart_at_fix or sf_ekf_restart_known. */
+/* A fresh filter: bias 0 and scale 1 with their initial σ, c = 0 with σ_c, the fix model of the
+ * ekf.fix_* parameters; the position block is then set by sf_ekf_restart_at_fix or
+ * sf_ekf_restart_known. */
 void sf_ekf_start(sf_ekf_t *e, const sf_params_t *p);
+
+/* The site's measured fix model instead of the parameters' (NULL or not valid: nothing changes); c
+ * restarts at 0 with the site's σ_c. Call after sf_ekf_start, before the first fix. */
+void sf_ekf_use_site_model(sf_ekf_t *e, const sf_params_t *p, const sf_fix_model_t *model);
 
 /* The position taken from a fix whose white R is r_white_m2 = [xx, xy, yy] (start, recovery): c = 0 and
  * the position and c blocks as in the header; bias and scale keep their values and variances. */
-void sf_ekf_restart_at_fix(sf_ekf_t *e, const sf_params_t *p, const double r_white_m2[3]);
+void sf_ekf_restart_at_fix(sf_ekf_t *e, const double r_white_m2[3]);
 
 /* The position known with covariance pos_cov_m2 (truth-initialised): c = 0, uncorrelated. */
-void sf_ekf_restart_known(sf_ekf_t *e, const sf_params_t *p, const double pos_cov_m2[3]);
+void sf_ekf_restart_known(sf_ekf_t *e, const double pos_cov_m2[3]);
 
 /* One step of length_m in walking direction heading_rad: fills the displacement d_m = (dx, dy) the
  * nominal position moves by, decays c, and propagates P. */

@@ -68,6 +68,9 @@ int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p
             (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
         }
     }
+    for (int s = 0; s < sf_scheme_count; s++) { /* the ekf's fix-error model, if the site measured one */
+        sf_fusion_set_fix_model(&e->fusion[s], p, &site->fix_model);
+    }
     return SF_OK;
 }
 

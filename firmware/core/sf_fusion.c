@@ -180,7 +180,7 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     f->y_m = fix->y_m;
     f->var_m2 = fmax(r_m2, p->fusion_var_min_m2);
     if (is_ekf(f)) {
-        sf_ekf_restart_at_fix(&f->ekf, p, ekf_r_m2);
+        sf_ekf_restart_at_fix(&f->ekf, ekf_r_m2);
     }
     (void)baro_floor;
     f->floor_offset = predicts(f) ? 0 : (int32_t)fix->floor; /* the caller's floor is the floor */
@@ -263,7 +263,8 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
         double cov_m2[3];
         iso_cov(f->var_m2, cov_m2);
         sf_ekf_start(&f->ekf, p);
-        sf_ekf_restart_known(&f->ekf, p, cov_m2);
+        sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
+        sf_ekf_restart_known(&f->ekf, cov_m2);
     }
     (void)baro_floor;
     f->floor_offset = predicts(f) ? 0 : (int32_t)floor;
@@ -326,6 +327,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     if (is_ekf(f)) {
         if (!f->initialised) {
             sf_ekf_start(&f->ekf, p); /* the prior fix model, bias and scale */
+            sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
         }
         sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
     }
@@ -439,6 +441,14 @@ bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, cons
     pose->floor = scheme_floor(f, baro_floor);
     pose->sigma_m = sqrt(0.5 * (pose->cov_m2[0] + pose->cov_m2[2]));
     return true;
+}
+
+void sf_fusion_set_fix_model(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_model_t *const model)
+{
+    f->fix_model = model != NULL && model->valid ? model : NULL;
+    if (is_ekf(f) && f->initialised && f->fix_model != NULL) {
+        sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
+    }
 }
 
 void sf_fusion_audit_refused(const sf_fusion_t *const f, const sf_fix_t *const fix, const int8_t reason,

@@ -95,8 +95,8 @@
  * sf_fusion_init_at SF_OK or SF_EINVAL (non-finite x, y or sigma, negative sigma; state unchanged);
  * sf_fusion_fix SF_OK or SF_ERANGE (bad fix, see above). Everything else cannot fail.
  * Cost: O(1), a few tens of flops and one sqrt per call (the ekf a few hundred, sf_ekf.h). Memory:
- * sizeof(sf_fusion_t) = 464 B per scheme on x86-64 (the sf_ekf_t in every scheme, 360 B, keeps the array
- * uniform), sf_fix_audit_t 120 B; at most 480 B and 160 B (checked). No heap, no I/O, no
+ * sizeof(sf_fusion_t) = 496 B per scheme on x86-64 (the sf_ekf_t in every scheme, 384 B, keeps the array
+ * uniform), sf_fix_audit_t 120 B; at most 512 B and 160 B (checked). No heap, no I/O, no
  * clock, no hidden state: the same inputs give bit-identical outputs. */
 #ifndef SF_FUSION_H
 #define SF_FUSION_H
@@ -166,10 +166,11 @@ typedef struct {
     /* counters, never decrease */
     uint32_t steps, bad_steps, fixes, accepted, rejected_gate, rejected_floor, recoveries,
         initialisations, bad_fixes, backwards;
+    const sf_fix_model_t *fix_model; /* the site's measured fix model (ekf), caller-owned; NULL: params */
     sf_ekf_t ekf; /* the ekf scheme's filter (bias, scale, fix error, 6×6 covariance, fix model); unused by
                    * the others */
 } sf_fusion_t;
-_Static_assert(sizeof(sf_fusion_t) <= 480, "sf_fusion.h promises at most 480 B per scheme");
+_Static_assert(sizeof(sf_fusion_t) <= 512, "sf_fusion.h promises at most 512 B per scheme");
 
 /* An uninitialised scheme. SF_OK, or SF_EINVAL for NULL or an unknown scheme. */
 int sf_fusion_init(sf_fusion_t *f, int8_t scheme);
@@ -204,6 +205,11 @@ bool sf_fusion_pose(const sf_fusion_t *f, const sf_params_t *p, int64_t t_us, in
 double sf_fusion_accuracy_factor(const sf_params_t *p, const sf_fix_t *fix);
 double sf_fusion_drift(const sf_params_t *p, double dt_s);
 double sf_fusion_adaptive_alpha(const sf_params_t *p, const sf_fix_t *fix, double dt_s);
+
+/* The site's measured fix-error model for the ekf scheme (caller-owned, must outlive f; NULL or not
+ * valid: the ekf.fix_* parameters). A scheme already started at a known pose takes it at once; every
+ * later (re)start too. No effect on the other schemes. */
+void sf_fusion_set_fix_model(sf_fusion_t *f, const sf_params_t *p, const sf_fix_model_t *model);
 
 /* A record for a scan the matcher refused before any position existed (reason TOO_FEW_APS or
  * NO_MAP, or any reason the caller decides): the fix fields from *fix, ν = 0, S = 0, τ = 0, α = 0,

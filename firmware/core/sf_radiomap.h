@@ -11,6 +11,7 @@
 #ifndef SF_RADIOMAP_H
 #define SF_RADIOMAP_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 typedef struct {
@@ -29,12 +30,24 @@ typedef struct {
     const int32_t *entry_count;    /* [n_entries], 1 ≤ value ≤ rp_scans[entry_rp] */
 } sf_radiomap_t;
 
+/* The ekf's Wi-Fi fix-error model as the site measured it (sf_ekf.h; the ekf.fix_* parameters when
+ * not valid): one fix's error covariance per accuracy² [xx, xy, yy], the correlated part's σ [m] and
+ * length [m], the least white share. */
+typedef struct {
+    bool valid;
+    double cov_per_acc2[3];
+    double bias_sigma_m;
+    double bias_length_m;
+    double white_share;
+} sf_fix_model_t;
+
 /* Floors and frame of the site. */
 typedef struct {
     double map_rotation_deg;
     int16_t lowest_floor;
     int32_t n_floors;
     const double *floor_height_m; /* [n_floors], strictly increasing */
+    sf_fix_model_t fix_model;     /* measured fix errors, if the builder had held-out walks */
     sf_radiomap_t radiomap;       /* n_rp = 0: no radio map */
 } sf_site_t;
 

@@ -45,7 +45,7 @@ static void test_step_jacobian(void **state)
     const double zero[3] = {0, 0, 0};
     sf_ekf_t e;
     sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, &p, zero);
+    sf_ekf_restart_known(&e, zero);
     e.heading_bias_rad = 0.3;
     e.stride_scale = 1.1;
     const double vb = e.P[2][2], vs = e.P[3][3], L = 0.7, psi = 1.2;
@@ -83,7 +83,7 @@ static void test_update_is_kalman(void **state)
     const double cov[3] = {4.0, 0.0, 4.0}, r[3] = {1.0, 0.0, 1.0}, nu[2] = {2.0, -1.0};
     sf_ekf_t e;
     sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, &p, cov);
+    sf_ekf_restart_known(&e, cov);
     double s[3];
     near(sf_ekf_nis(&e, nu, r, s), (4.0 + 1.0) / 5.0, 1e-12);
     double dpos[2];
@@ -108,7 +108,7 @@ static void test_learns_bias_and_scale(void **state)
     const double cov0[3] = {4.0, 0.0, 4.0};
     sf_ekf_t e;
     sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, &p, cov0);
+    sf_ekf_restart_known(&e, cov0);
     double x = 0, y = 0, tx = 0, ty = 0, px = 0, py = 0, err_ekf = 0, err_pdr = 0;
     int n = 0;
     for (int k = 0; k < 800; k++) {
@@ -154,7 +154,7 @@ static void test_fix_model_only_grows(void **state)
     const double cov[3] = {1.0, 0.0, 1.0};
     sf_ekf_t e;
     sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, &p, cov);
+    sf_ekf_restart_known(&e, cov);
     double r[3];
     sf_ekf_fix_r(&e, &p, 3.0, r);
     near(r[0], 18.0, 1e-12);
@@ -192,7 +192,7 @@ static double stuck_fix_run(const double sigma_c_m, sf_ekf_t *const out)
     const double cov[3] = {1.0, 0.0, 1.0};
     sf_ekf_t e;
     sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, &p, cov);
+    sf_ekf_restart_known(&e, cov);
     double x = 0.0, y = 0.0;
     for (int i = 0; i < 20; i++) {
         const double zp[2] = {5.0 - x, 0.0 - y};
@@ -265,6 +265,25 @@ static void test_scheme_in_fusion(void **state)
     assert_true(a.test_ratio > 1.0);
 }
 
+/* A site that measured its fix errors overrides the parameters' model: R = accuracy² · the site's M. */
+static void test_site_fix_model(void **state)
+{
+    (void)state;
+    const sf_params_t p = params();
+    const sf_fix_model_t site = {
+        .valid = true, .cov_per_acc2 = {9.0, 0.0, 9.0}, .bias_sigma_m = 0.0, .bias_length_m = 10.0, .white_share = 1.0};
+    sf_fusion_t f;
+    assert_int_equal(sf_fusion_init(&f, sf_scheme_ekf), SF_OK);
+    sf_fusion_set_fix_model(&f, &p, &site);
+    const sf_fix_t fix = {.t_us = 1000000, .method = sf_fix_wifi, .x_m = 1, .y_m = 2, .accuracy_m = 2.0, .n_ap_used = 9};
+    sf_fix_audit_t a;
+    assert_int_equal(sf_fusion_fix(&f, &p, &fix, 0, &a), SF_OK);
+    near(a.innovation_var_m2, 36.0, 1e-12); /* 2² · 9, not the parameters' 2² · 1 */
+    const sf_fix_model_t invalid = {.valid = false};
+    sf_fusion_set_fix_model(&f, &p, &invalid);
+    assert_null(f.fix_model);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -274,6 +293,7 @@ int main(void)
         cmocka_unit_test(test_fix_model_only_grows),
         cmocka_unit_test(test_correlated_fix_error),
         cmocka_unit_test(test_scheme_in_fusion),
+        cmocka_unit_test(test_site_fix_model),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -42,6 +42,10 @@ _SCALAR_FIELDS = (
     "origin_lon_deg",
     "lowest_floor",
     "cell_size_m",
+    "has_fix_model",
+    "fix_bias_sigma_m",
+    "fix_bias_length_m",
+    "fix_white_share",
 )
 _ARRAY_FIELDS = (
     "floor_height_m",
@@ -55,6 +59,7 @@ _ARRAY_FIELDS = (
     "entry_mean_dbm",
     "entry_std_db",
     "entry_count",
+    "fix_cov_per_acc2",
 )
 
 
@@ -81,6 +86,11 @@ def vector_site() -> site_t:
         entry_mean_dbm=[-45.5, -60.25, -70.1, -80.0, -55.5, -90.0, -33.3],
         entry_std_db=[1.25, 0.0, 2.5, 3.0, 0.5, 0.0, 1.1],
         entry_count=[3, 4, 1, 2, 5, 1, 5],
+        has_fix_model=True,
+        fix_cov_per_acc2=[1.5, 0.25, 2.0],
+        fix_bias_sigma_m=3.5,
+        fix_bias_length_m=20.0,
+        fix_white_share=0.25,
     )
 
 
@@ -178,6 +188,10 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("cell_negative", _edited(cell_size_m=-1.0), "field", None),
         ("rotation_inf", _edited(map_rotation_deg=float("inf")), "field", None),
         ("latitude", _edited(origin_lat_deg=91.0), "field", None),
+        ("fix_model_not_pd", _edited(fix_cov_per_acc2=[1.0, 2.0, 1.0]), "field", None),
+        ("fix_bias_negative", _edited(fix_bias_sigma_m=-1.0), "field", None),
+        ("fix_length_zero", _edited(fix_bias_length_m=0.0), "field", None),
+        ("fix_white_share", _edited(fix_white_share=1.5), "field", None),
     ]
     return out
 

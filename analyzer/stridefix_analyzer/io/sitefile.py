@@ -15,7 +15,9 @@ order and word their messages alike, so a file rejected by one is rejected by th
 
 1. header: size ≥ 24, magic, version, reserved = 0, payload length = file size − 24, CRC-32;
 2. payload: LCM type hash of ``site_t``, then a whole ``site_t`` with no trailing bytes;
-3. fields (:func:`validate_site`): finite map rotation (and geo-reference in range when ``has_geo``);
+3. fields (:func:`validate_site`): finite map rotation (and geo-reference in range when ``has_geo``;
+   a positive-definite ``fix_cov_per_acc2``, ``fix_bias_sigma_m`` ≥ 0, ``fix_bias_length_m`` > 0 and
+   ``fix_white_share`` in 0 … 1 when ``has_fix_model``);
    ``n_floors`` ≥ 1 with finite, strictly increasing heights; BSSIDs in 0 … 2⁴⁸−1, strictly
    ascending; ``cell_size_m`` finite and ≥ 0; reference points with finite positions, a floor in
    ``lowest_floor`` … ``lowest_floor + n_floors − 1`` and ``rp_scans`` ≥ 1; entries with AP and RP
@@ -107,6 +109,21 @@ def validate_site(site: site_t) -> None:
             raise SiteValidationError(f"origin_lat_deg = {site.origin_lat_deg:g} outside -90..90")
         if not (_finite(site.origin_lon_deg) and -180.0 <= site.origin_lon_deg <= 180.0):
             raise SiteValidationError(f"origin_lon_deg = {site.origin_lon_deg:g} outside -180..180")
+
+    if site.has_fix_model:
+        xx, xy, yy = site.fix_cov_per_acc2
+        if not (all(_finite(v) for v in (xx, xy, yy)) and xx > 0 and yy > 0 and xx * yy > xy * xy):
+            raise SiteValidationError(f"fix_cov_per_acc2 = [{xx:g}, {xy:g}, {yy:g}] not positive definite")
+        if not (_finite(site.fix_bias_sigma_m) and site.fix_bias_sigma_m >= 0.0):
+            raise SiteValidationError(
+                f"fix_bias_sigma_m = {site.fix_bias_sigma_m:g}, must be finite and >= 0"
+            )
+        if not (_finite(site.fix_bias_length_m) and site.fix_bias_length_m > 0.0):
+            raise SiteValidationError(
+                f"fix_bias_length_m = {site.fix_bias_length_m:g}, must be finite and > 0"
+            )
+        if not (_finite(site.fix_white_share) and 0.0 <= site.fix_white_share <= 1.0):
+            raise SiteValidationError(f"fix_white_share = {site.fix_white_share:g} outside 0..1")
 
     n_floors = _check_len(site, "n_floors", "floor_height_m")
     if n_floors < 1:
@@ -310,6 +327,8 @@ def new_site(**fields: Any) -> site_t:
     s.ap_bssid, s.cell_size_m = [], 0.0
     s.rp_x_m, s.rp_y_m, s.rp_floor, s.rp_scans = [], [], [], []
     s.entry_ap, s.entry_rp, s.entry_mean_dbm, s.entry_std_db, s.entry_count = [], [], [], [], []
+    s.has_fix_model, s.fix_cov_per_acc2 = False, [1.0, 0.0, 1.0]
+    s.fix_bias_sigma_m, s.fix_bias_length_m, s.fix_white_share = 0.0, 10.0, 1.0
     for name, value in fields.items():
         if not hasattr(s, name):
             raise AttributeError(f"site_t has no field {name!r}")

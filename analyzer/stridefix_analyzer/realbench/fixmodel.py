@@ -20,9 +20,10 @@ The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather tha
   r(Δd) = a·exp(−Δd/ℓ) (:func:`correlation`); σ_c² = a times one fix's variance at the median
   accuracy, and every fix keeps at least the white share 1 − a of its own variance.
 
-The result goes to the fold as ``ekf.fix_var_x_per_acc2``, ``ekf.fix_var_y_per_acc2``,
-``ekf.fix_cov_xy_per_acc2`` (the firmware's prior, which the scheme can only raise online),
-``ekf.fix_bias_sigma_m``, ``ekf.fix_bias_length_m`` and ``ekf.fix_white_share``.
+The result goes into the fold's site file (``site_t.has_fix_model``, ``fix_cov_per_acc2`` — the
+scheme's prior, which it can only raise online — ``fix_bias_sigma_m``, ``fix_bias_length_m``,
+``fix_white_share``): the map carries its own error model. A user's ``--set`` of an ``ekf.fix_*`` key
+(:data:`KEYS`) skips the measurement, and the parameters hold.
 """
 
 from __future__ import annotations
@@ -145,14 +146,13 @@ def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
         "correlated_sigma_m": sigma_c,
         "correlation_length_m": length,
         "correlation_bins": bins,
-        "sets": [
-            f"{KEYS[0]}={m_xx:.6g}",
-            f"{KEYS[1]}={m_yy:.6g}",
-            f"{KEYS[2]}={m_xy:.6g}",
-            f"{KEYS[3]}={sigma_c:.6g}",
-            f"{KEYS[4]}={length:.6g}",
-            f"{KEYS[5]}={1.0 - share:.6g}",
-        ],
+        "site_fields": {
+            "has_fix_model": True,
+            "fix_cov_per_acc2": [m_xx, m_xy, m_yy],
+            "fix_bias_sigma_m": sigma_c,
+            "fix_bias_length_m": length,
+            "fix_white_share": 1.0 - share,
+        },
     }
 
 
@@ -166,9 +166,9 @@ def measure(
     jobs: int,
     stream: TextIO,
     n_blocks: int = rs.DEFAULT_BLOCKS,
-) -> tuple[list[list[str]], list[float], dict[str, Any]]:
-    """The model of every walk's fold (as settings; [] where too few fixes), its σ_c, and the group's
-    report (results.json)."""
+) -> tuple[list[dict[str, Any] | None], list[float], dict[str, Any]]:
+    """The model of every walk's fold (site_t fields, None where too few fixes), its σ_c, and the
+    group's report (results.json)."""
     n_blocks = min(n_blocks, len(walks))
     prog = Progress("measure fix errors", (n_blocks - 1) * len(walks), stream)
     work_dir.mkdir(parents=True, exist_ok=True)
@@ -194,9 +194,10 @@ def measure(
     report = {
         "measured_by": f"Wi-Fi fixes vs truth, {n_blocks} blocks, maps without the block",
         "blocks": {
-            str(a): {k: v for k, v in (m or {"fixes": 0}).items() if k != "sets"} for a, m in models.items()
+            str(a): {k: v for k, v in (m or {"fixes": 0}).items() if k != "site_fields"}
+            for a, m in models.items()
         },
     }
-    sets = [list((models[block[i]] or {}).get("sets", [])) for i in range(len(walks))]
+    fields = [(models[block[i]] or {}).get("site_fields") for i in range(len(walks))]
     sigma = [float((models[block[i]] or {}).get("correlated_sigma_m", math.nan)) for i in range(len(walks))]
-    return sets, sigma, report
+    return fields, sigma, report

@@ -54,6 +54,8 @@ class FoldJob:
     first_waypoint: tuple[int, float, float, int]
     total: WalkStats
     held: WalkStats
+    #: site_t fields measured for this fold (the ekf's fix-error model), written into its site
+    site_fields: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
 
 def fold_site(
@@ -102,6 +104,8 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
     except RadioMapInputError as exc:
         out["error"] = f"no site for this fold: {exc}"
         return out
+    for name, value in job.site_fields.items():
+        setattr(site, name, value)
     site_path = job.dir / "site.sfsite"
     write_site(site_path, site)
     out["fold"] = {

@@ -260,7 +260,6 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                 param_sets=[
                     *run.cfg.param_sets,
                     *tuning.settings(run.axes, variants),
-                    *tuning.walk_settings(choices, j),
                     *(f"{k}={v:.6g}" for k, v in ekf_priors.items()),
                 ],
                 variants=variants,
@@ -271,6 +270,7 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                 first_waypoint=walks[i]["first_waypoint"],
                 total=total,
                 held=walks[i]["stats"],
+                site_fields=tuning.walk_site_fields(choices, j),
             )
         )
     return info, jobs

@@ -82,8 +82,8 @@ class Choice:
     extra: list[dict[str, Any]]  # per walk, further fold fields (results.json)
     #: settings chosen per inner-CV block, for the inner-CV rows after this one
     block_sets: dict[int, list[str]] = dataclasses.field(default_factory=dict)
-    #: per walk, settings measured rather than chosen from the candidates (``fixmodel``)
-    walk_sets: list[list[str]] | None = None
+    #: per walk, site_t fields measured rather than chosen (``fixmodel``), None where not measured
+    walk_site_fields: list[dict[str, Any] | None] | None = None
 
 
 class Chooser(Protocol):
@@ -150,7 +150,7 @@ class Measured:
             why = "given by --set" if "given" in axis.candidates else f"fewer than {fixmodel.MIN_WALKS} walks"
             info = {f"{axis.name}_model": {"measured_by": f"firmware prior ({why})"}}
             return Choice([next(iter(axis.candidates))] * n, info, [{} for _ in range(n)])
-        sets, sigma_c, report = fixmodel.measure(
+        fields, sigma_c, report = fixmodel.measure(
             group.walks,
             group.sites,
             group.firmware,
@@ -161,10 +161,10 @@ class Measured:
             group.stream,
         )
         extra = [
-            {f"{axis.name}_sets": s, f"{axis.name}_correlated_sigma_m": c}
-            for s, c in zip(sets, sigma_c, strict=True)
+            {f"{axis.name}_site_fields": f, f"{axis.name}_correlated_sigma_m": c}
+            for f, c in zip(fields, sigma_c, strict=True)
         ]
-        return Choice(["measured"] * n, {f"{axis.name}_model": report}, extra, walk_sets=sets)
+        return Choice(["measured"] * n, {f"{axis.name}_model": report}, extra, walk_site_fields=fields)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -221,10 +221,12 @@ def choose(rows: Sequence[Axis], group: Group) -> dict[str, Choice]:
 
 def settings(rows: Sequence[Axis], variants: Mapping[str, str]) -> list[str]:
     """The --set list of the chosen candidate of every row, in row order (a measured row's one
-    candidate only names its keys: its values are the choice's ``walk_sets``)."""
+    candidate only names its keys: its values go into the fold's site, ``walk_site_fields``)."""
     return [kv for a in rows if not isinstance(a.chooser, Measured) for kv in a.candidates[variants[a.name]]]
 
 
-def walk_settings(choices: Mapping[str, Choice], j: int) -> list[str]:
-    """The measured settings of walk ``j``'s fold, from every row that measures."""
-    return [kv for c in choices.values() if c.walk_sets for kv in c.walk_sets[j]]
+def walk_site_fields(choices: Mapping[str, Choice], j: int) -> dict[str, Any]:
+    """The measured site_t fields of walk ``j``'s fold, from every row that measures."""
+    return {
+        k: v for c in choices.values() if c.walk_site_fields for k, v in (c.walk_site_fields[j] or {}).items()
+    }

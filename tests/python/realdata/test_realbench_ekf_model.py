@@ -36,8 +36,13 @@ def test_model_recovers_a_known_correlated_error():
     assert 2.4 < m["correlated_sigma_m"] < 3.3
     assert 0.7 < m["correlated_share"] < 0.9  # 3² / (3² + 1.5²) = 0.8
     assert 8.0 < m["correlation_length_m"] < 25.0
-    keys = [s.split("=")[0] for s in m["sets"]]
-    assert keys == list(fixmodel.KEYS)
+    f = m["site_fields"]  # what the fold's site file carries
+    assert f["has_fix_model"] and f["fix_cov_per_acc2"] == [m["m_xx"], m["m_xy"], m["m_yy"]]
+    assert f["fix_bias_sigma_m"] == m["correlated_sigma_m"]
+    assert f["fix_white_share"] == pytest.approx(1.0 - m["correlated_share"])
+    from stridefix_analyzer.io import sitefile
+
+    sitefile.validate_site(sitefile.new_site(**f))  # a valid site_t
 
 
 def test_independent_fixes_have_no_correlated_part():
