@@ -131,7 +131,7 @@ static int walk_site(walk_t *const w)
     rc = rc != SF_OK ? rc : skip(w, 4, "cell_size_m");
     rc = rc != SF_OK ? rc : walk_count(w, "n_rp", 4 + 4 + 2 + 4);
     rc = rc != SF_OK ? rc : walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
-    rc = rc != SF_OK ? rc : skip(w, 1 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
+    rc = rc != SF_OK ? rc : skip(w, 1 + 3 * 4 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
     if (rc == SF_OK && w->pos != w->size) {
         rc = failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload has %zu trailing bytes after the site_t",
                    w->size - w->pos);
@@ -157,6 +157,10 @@ static int check_fields(const stridefix_site_t *const s, const char *const name,
         }
     }
     if (s->has_fix_model) {
+        const double fxx = s->fix_floor_cov_m2[0], fxy = s->fix_floor_cov_m2[1], fyy = s->fix_floor_cov_m2[2];
+        if (!(isfinite(fxx) && isfinite(fxy) && isfinite(fyy) && fxx >= 0.0 && fyy >= 0.0 && fxx * fyy >= fxy * fxy)) {
+            return BAD("fix_floor_cov_m2 = [%g, %g, %g] not positive semi-definite", fxx, fxy, fyy);
+        }
         const double xx = s->fix_cov_per_acc2[0], xy = s->fix_cov_per_acc2[1], yy = s->fix_cov_per_acc2[2];
         if (!(isfinite(xx) && isfinite(xy) && isfinite(yy) && xx > 0.0 && yy > 0.0 && xx * yy > xy * xy)) {
             return BAD("fix_cov_per_acc2 = [%g, %g, %g] not positive definite", xx, xy, yy);
@@ -331,6 +335,8 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     site->n_floors = s->n_floors;
     site->floor_height_m = s->floor_height_m;
     site->fix_model = (sf_fix_model_t){.valid = s->has_fix_model,
+                                       .floor_cov_m2 = {s->fix_floor_cov_m2[0], s->fix_floor_cov_m2[1],
+                                                        s->fix_floor_cov_m2[2]},
                                        .cov_per_acc2 = {s->fix_cov_per_acc2[0], s->fix_cov_per_acc2[1],
                                                         s->fix_cov_per_acc2[2]},
                                        .bias_sigma_m = s->fix_bias_sigma_m,

@@ -78,12 +78,15 @@ static void clear_position_and_bias(sf_ekf_t *const e)
 }
 
 /* The fix-error model's constants: M (the prior of the learning) and the correlated part. */
-static void set_model(sf_ekf_t *const e, const sf_params_t *const p, const double cov_per_acc2[3],
-                      const double bias_sigma_m, const double bias_length_m, const double white_share)
+static void set_model(sf_ekf_t *const e, const sf_params_t *const p, const double floor_cov_m2[3],
+                      const double cov_per_acc2[3], const double bias_sigma_m, const double bias_length_m,
+                      const double white_share)
 {
     for (int i = 0; i < 3; i++) {
         e->fix_model[i] = cov_per_acc2[i];
+        e->fix_floor_m2[i] = floor_cov_m2[i];
     }
+    clamp_eigen2(e->fix_floor_m2, 0.0, INFINITY);
     clamp_eigen2(e->fix_model, p->ekf_r_min, p->ekf_r_max);
     e->model_floor = min_eigen2(e->fix_model);
     e->model_fixes = 0;
@@ -98,7 +101,8 @@ void sf_ekf_start(sf_ekf_t *const e, const sf_params_t *const p)
     e->P[ib][ib] = p->ekf_init_bias_sigma_rad * p->ekf_init_bias_sigma_rad;
     e->P[is][is] = p->ekf_init_scale_sigma * p->ekf_init_scale_sigma;
     const double m[3] = {p->ekf_fix_var_x_per_acc2, p->ekf_fix_cov_xy_per_acc2, p->ekf_fix_var_y_per_acc2};
-    set_model(e, p, m, p->ekf_fix_bias_sigma_m, p->ekf_fix_bias_length_m, p->ekf_fix_white_share);
+    const double f[3] = {p->ekf_fix_floor_xx_m2, p->ekf_fix_floor_xy_m2, p->ekf_fix_floor_yy_m2};
+    set_model(e, p, f, m, p->ekf_fix_bias_sigma_m, p->ekf_fix_bias_length_m, p->ekf_fix_white_share);
     e->P[icx][icx] = e->P[icy][icy] = e->bias_sigma_m * e->bias_sigma_m;
 }
 
@@ -107,7 +111,8 @@ void sf_ekf_use_site_model(sf_ekf_t *const e, const sf_params_t *const p, const 
     if (model == NULL || !model->valid) {
         return;
     }
-    set_model(e, p, model->cov_per_acc2, model->bias_sigma_m, model->bias_length_m, model->white_share);
+    set_model(e, p, model->floor_cov_m2, model->cov_per_acc2, model->bias_sigma_m, model->bias_length_m,
+              model->white_share);
     /* c starts afresh with the site's σ_c, uncorrelated (a start before any fix) */
     for (int j = 0; j < n; j++) {
         e->P[icx][j] = e->P[j][icx] = e->P[icy][j] = e->P[j][icy] = 0.0;
@@ -186,11 +191,15 @@ void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const dou
                   double r_white_m2[3])
 {
     const double a2 = accuracy_m * accuracy_m, c2 = e->bias_sigma_m * e->bias_sigma_m;
-    r_white_m2[0] = a2 * e->fix_model[0] - c2;
-    r_white_m2[1] = a2 * e->fix_model[1];
-    r_white_m2[2] = a2 * e->fix_model[2] - c2;
+    double total[3];
+    for (int i = 0; i < 3; i++) {
+        total[i] = e->fix_floor_m2[i] + a2 * e->fix_model[i];
+    }
+    r_white_m2[0] = total[0] - c2;
+    r_white_m2[1] = total[1];
+    r_white_m2[2] = total[2] - c2;
     /* a fix better than the median keeps its white share: c's variance is one figure for all fixes */
-    const double white_min = e->white_share * a2 * min_eigen2(e->fix_model);
+    const double white_min = e->white_share * min_eigen2(total);
     clamp_eigen2(r_white_m2, fmax(p->fusion_var_min_m2, white_min), INFINITY);
 }
 
@@ -235,8 +244,10 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
     const double vx = k * nu_m[0], vy = k * nu_m[1], a2 = accuracy_m * accuracy_m;
     const double c2 = e->bias_sigma_m * e->bias_sigma_m;
     hph(e, m);
-    /* E[ννᵀ] = H P Hᵀ + a²M − σ_c² I, solved for M */
-    const double sample[3] = {(vx * vx - m[0] + c2) / a2, (vx * vy - m[1]) / a2, (vy * vy - m[2] + c2) / a2};
+    /* E[ννᵀ] = H P Hᵀ + F + a²M − σ_c² I, solved for M */
+    const double *const f = e->fix_floor_m2;
+    const double sample[3] = {(vx * vx - m[0] + c2 - f[0]) / a2, (vx * vy - m[1] - f[1]) / a2,
+                              (vy * vy - m[2] + c2 - f[2]) / a2};
     e->model_fixes++;
     const double w = 1.0 / fmin((double)e->model_fixes + 1.0, (double)p->ekf_r_window); /* +1: the prior */
     for (int i = 0; i < 3; i++) {

@@ -35,10 +35,12 @@
  * The bias is wrapped to (−π, π], the scale clamped to [ekf_scale_min, ekf_scale_max].
  * NIS = νᵀ S⁻¹ ν is χ² with 2 dof; sf_fusion gates it like every scheme (test ratio NIS / gate²).
  *
- * R from the fix-error model: one fix's whole error covariance is accuracy_m² · M, M (symmetric 2×2)
- * per unit of the matcher's accuracy², because the matcher's accuracy (neighbour spread) is a shape, not
- * a calibrated σ; the white part is R_w = accuracy_m² · M − σ_c² I, its eigenvalues floored at
- * ekf_fix_white_share · accuracy_m² · (M's smallest eigenvalue) and fusion_var_min_m2: σ_c is one
+ * R from the fix-error model: one fix's whole error covariance is F + accuracy_m² · M (symmetric 2×2s):
+ * the matcher's accuracy (neighbour spread) is a shape, not a calibrated σ, and on real walks the error
+ * hardly follows it (site1/F2: 3.8 m rms per axis at accuracy 2 m, 5.3 m at 6 m), so a floor F that does
+ * not scale with it carries most of the error; the white part is R_w = F + accuracy_m² · M − σ_c² I, its
+ * eigenvalues floored at ekf_fix_white_share · (the smallest eigenvalue of F + accuracy_m² · M) and
+ * fusion_var_min_m2: σ_c is one
  * figure for every fix, so a fix more accurate than most keeps the white share of its own error instead
  * of being taken as c alone (which would make fix-to-fix jitter look like motion). M starts at the
  * prior: the site file's measured model (site_t.fix_cov_per_acc2 and the correlated part, written by
@@ -57,7 +59,7 @@
  * P_pp as given, c = 0 with σ_c², uncorrelated.
  *
  * Cost: per step ~700 flops (the 6×6 F P Fᵀ) and one sin/cos/exp; per fix ~900 flops. Memory:
- * sizeof(sf_ekf_t) = 384 B on x86-64 and i686 (at most 400 B, checked). No heap, no I/O, no clock. */
+ * sizeof(sf_ekf_t) = 408 B on x86-64 and i686 (at most 416 B, checked). No heap, no I/O, no clock. */
 #ifndef SF_EKF_H
 #define SF_EKF_H
 
@@ -74,13 +76,14 @@ typedef struct {
     double fix_bias_m[2];          /* c, the fixes' correlated error */
     double P[SF_EKF_N][SF_EKF_N];  /* covariance of δ */
     double fix_model[3];           /* M: one fix's error covariance per accuracy_m² [xx, xy, yy] */
+    double fix_floor_m2[3];        /* F: the part of it that does not scale with accuracy [m²] */
     double model_floor;            /* smallest eigenvalue M may learn down to: the prior's */
     double bias_sigma_m;           /* σ_c (the site's, or ekf_fix_bias_sigma_m) */
     double bias_length_m;          /* ℓ */
     double white_share;            /* least white share of a fix's variance */
     uint32_t model_fixes;          /* innovations M has learnt from */
 } sf_ekf_t;
-_Static_assert(sizeof(sf_ekf_t) <= 400, "sf_ekf.h promises at most 400 B");
+_Static_assert(sizeof(sf_ekf_t) <= 416, "sf_ekf.h promises at most 416 B");
 
 /* A fresh filter: bias 0 and scale 1 with their initial σ, c = 0 with σ_c, the fix model of the
  * ekf.fix_* parameters; the position block is then set by sf_ekf_restart_at_fix or

@@ -39,9 +39,9 @@
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 33 872 B on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
- * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the seven schemes 3 472 B
- * (each carries the ekf's 384 B filter). Cost per IMU sample:
+ * Memory: sizeof(sf_estimator_t) = 34 040 B on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
+ * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the seven schemes 3 640 B
+ * (each carries the ekf's 408 B filter). Cost per IMU sample:
  * a few hundred flops; per MAG sample a few kflop (the sf_magcal solve). */
 #ifndef SF_ESTIMATOR_H
 #define SF_ESTIMATOR_H

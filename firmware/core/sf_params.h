@@ -183,11 +183,14 @@
     X(ekf,    fix_var_x_per_acc2,  double,  1.0,     1e-3,    1e3,     "",      "fix-error model prior: variance along x per accuracy_m^2 (1: the matcher's accuracy taken as its sigma; realbench measures it on the training walks)") \
     X(ekf,    fix_var_y_per_acc2,  double,  1.0,     1e-3,    1e3,     "",      "fix-error model prior: variance along y per accuracy_m^2") \
     X(ekf,    fix_cov_xy_per_acc2, double,  0.0,     -1e3,    1e3,     "",      "fix-error model prior: x-y covariance per accuracy_m^2 (kept positive definite)") \
+    X(ekf,    fix_floor_xx_m2,     double,  0.0,     0.0,     1e4,     "m2",    "fix-error model: the part of one fix's error variance along x that does not scale with accuracy_m^2 (R = floor + accuracy^2 M)") \
+    X(ekf,    fix_floor_yy_m2,     double,  0.0,     0.0,     1e4,     "m2",    "fix-error model: that part along y") \
+    X(ekf,    fix_floor_xy_m2,     double,  0.0,     -1e4,    1e4,     "m2",    "fix-error model: that part's x-y covariance") \
     X(ekf,    fix_bias_sigma_m,    double,  0.0,     0.0,     100.0,   "m",     "sigma per axis of the fixes' correlated error c (a state of the filter; 0: independent fixes; realbench measures it on training walks against truth)") \
     X(ekf,    fix_bias_length_m,   double,  10.0,    0.1,     1e4,     "m",     "distance walked over which c decorrelates (exp(-d/l)); realbench measures it; the default is a few radio-map cells") \
     X(ekf,    fix_white_share,     double,  1.0,     0.0,     1.0,     "",      "least share of a fix's own variance that stays white (not in c): R_w >= share * accuracy^2 * M (realbench measures 1 - the correlated share)") \
     X(ekf,    r_window,            int32_t, 30,      0,       100000,  "fixes", "innovations the fix-error model averages (running mean, then exponential); 0 = never learn") \
-    X(ekf,    r_min,               double,  0.25,    1e-3,    1e3,     "",      "smallest eigenvalue of the learnt fix-error model (per accuracy_m^2)") \
+    X(ekf,    r_min,               double,  0.25,    1e-3,    1e3,     "",      "smallest eigenvalue of the fix-error model per accuracy_m^2 M, prior and learnt") \
     X(ekf,    r_max,               double,  100.0,   1e-3,    1e4,     "",      "largest eigenvalue of the learnt fix-error model (per accuracy_m^2)")
 
 #define SF_PARAM_LIST(X) \

@@ -31,10 +31,11 @@ typedef struct {
 } sf_radiomap_t;
 
 /* The ekf's Wi-Fi fix-error model as the site measured it (sf_ekf.h; the ekf.fix_* parameters when
- * not valid): one fix's error covariance per accuracy² [xx, xy, yy], the correlated part's σ [m] and
- * length [m], the least white share. */
+ * not valid): one fix's error covariance = floor [m², xx, xy, yy] + accuracy² · per-accuracy² part,
+ * the correlated part's σ [m] and length [m], the least white share. */
 typedef struct {
     bool valid;
+    double floor_cov_m2[3]; /* one fix's error = floor_cov_m2 + accuracy² · cov_per_acc2 */
     double cov_per_acc2[3];
     double bias_sigma_m;
     double bias_length_m;

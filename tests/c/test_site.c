@@ -32,7 +32,7 @@ typedef struct {
     char source[256];
     double map_rotation_deg, origin_lat_deg, origin_lon_deg, cell_size_m;
     int has_geo, lowest_floor, has_fix_model;
-    double fix_cov_per_acc2[3], fix_bias_sigma_m, fix_bias_length_m, fix_white_share;
+    double fix_floor_cov_m2[3], fix_cov_per_acc2[3], fix_bias_sigma_m, fix_bias_length_m, fix_white_share;
     int n_floors, n_ap, n_rp, n_entries;
     double floor_height_m[MAX_VALUES];
     long long ap_bssid[MAX_VALUES];
@@ -157,6 +157,8 @@ static void load_dump(dump_t *const d)
             d->fix_bias_length_m = strtod(value, NULL);
         } else if (strcmp(line, "fix_white_share") == 0) {
             d->fix_white_share = strtod(value, NULL);
+        } else if (strcmp(line, "fix_floor_cov_m2") == 0) {
+            assert_int_equal(parse_doubles(value, d->fix_floor_cov_m2), 3);
         } else if (strcmp(line, "fix_cov_per_acc2") == 0) {
             assert_int_equal(parse_doubles(value, d->fix_cov_per_acc2), 3);
         } else {
@@ -164,7 +166,7 @@ static void load_dump(dump_t *const d)
         }
     }
     fclose(f);
-    assert_int_equal(fields, 24); /* every field of site_t.lcm but the counts */
+    assert_int_equal(fields, 25); /* every field of site_t.lcm but the counts */
 }
 
 static void test_round_trip(void **state)
@@ -191,6 +193,7 @@ static void test_round_trip(void **state)
     assert_true(site.fix_model.valid == (d.has_fix_model != 0));
     for (int i = 0; i < 3; i++) {
         assert_true(site.fix_model.cov_per_acc2[i] == d.fix_cov_per_acc2[i]);
+        assert_true(site.fix_model.floor_cov_m2[i] == d.fix_floor_cov_m2[i]);
     }
     assert_true(site.fix_model.bias_sigma_m == d.fix_bias_sigma_m);
     assert_true(site.fix_model.bias_length_m == d.fix_bias_length_m);
@@ -382,8 +385,8 @@ static void test_index_out_of_range(void **state)
     size_t size = 0;
     uint8_t *const buf = read_all(SF_SITE_VECTORS_DIR "/site.sfsite", &size);
     /* the payload ends with the five entry arrays of n_entries int32/float each (rp is the second),
-     * then the fix model: has_fix_model (1 B) and six floats */
-    const size_t fix_model_bytes = 1u + 6u * 4u;
+     * then the fix model: has_fix_model (1 B) and nine floats */
+    const size_t fix_model_bytes = 1u + 9u * 4u;
     const size_t entry_rp_at = size - fix_model_bytes - 4u * (size_t)d.n_entries * 4u;
     put_be32(buf + entry_rp_at + 4u * 2u, 300);
     put_le32(buf + 16, sf_site_crc32(buf + SF_SITE_HEADER_SIZE, size - SF_SITE_HEADER_SIZE));

@@ -59,6 +59,7 @@ _ARRAY_FIELDS = (
     "entry_mean_dbm",
     "entry_std_db",
     "entry_count",
+    "fix_floor_cov_m2",
     "fix_cov_per_acc2",
 )
 
@@ -87,6 +88,7 @@ def vector_site() -> site_t:
         entry_std_db=[1.25, 0.0, 2.5, 3.0, 0.5, 0.0, 1.1],
         entry_count=[3, 4, 1, 2, 5, 1, 5],
         has_fix_model=True,
+        fix_floor_cov_m2=[9.0, -1.5, 12.25],
         fix_cov_per_acc2=[1.5, 0.25, 2.0],
         fix_bias_sigma_m=3.5,
         fix_bias_length_m=20.0,
@@ -189,6 +191,7 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("rotation_inf", _edited(map_rotation_deg=float("inf")), "field", None),
         ("latitude", _edited(origin_lat_deg=91.0), "field", None),
         ("fix_model_not_pd", _edited(fix_cov_per_acc2=[1.0, 2.0, 1.0]), "field", None),
+        ("fix_floor_not_psd", _edited(fix_floor_cov_m2=[1.0, 0.0, -1.0]), "field", None),
         ("fix_bias_negative", _edited(fix_bias_sigma_m=-1.0), "field", None),
         ("fix_length_zero", _edited(fix_bias_length_m=0.0), "field", None),
         ("fix_white_share", _edited(fix_white_share=1.5), "field", None),

@@ -16,7 +16,7 @@ order and word their messages alike, so a file rejected by one is rejected by th
 1. header: size ≥ 24, magic, version, reserved = 0, payload length = file size − 24, CRC-32;
 2. payload: LCM type hash of ``site_t``, then a whole ``site_t`` with no trailing bytes;
 3. fields (:func:`validate_site`): finite map rotation (and geo-reference in range when ``has_geo``;
-   a positive-definite ``fix_cov_per_acc2``, ``fix_bias_sigma_m`` ≥ 0, ``fix_bias_length_m`` > 0 and
+   a positive semi-definite ``fix_floor_cov_m2``, a positive-definite ``fix_cov_per_acc2``, ``fix_bias_sigma_m`` ≥ 0, ``fix_bias_length_m`` > 0 and
    ``fix_white_share`` in 0 … 1 when ``has_fix_model``);
    ``n_floors`` ≥ 1 with finite, strictly increasing heights; BSSIDs in 0 … 2⁴⁸−1, strictly
    ascending; ``cell_size_m`` finite and ≥ 0; reference points with finite positions, a floor in
@@ -111,6 +111,13 @@ def validate_site(site: site_t) -> None:
             raise SiteValidationError(f"origin_lon_deg = {site.origin_lon_deg:g} outside -180..180")
 
     if site.has_fix_model:
+        fxx, fxy, fyy = site.fix_floor_cov_m2
+        if not (
+            all(_finite(v) for v in (fxx, fxy, fyy)) and fxx >= 0 and fyy >= 0 and fxx * fyy >= fxy * fxy
+        ):
+            raise SiteValidationError(
+                f"fix_floor_cov_m2 = [{fxx:g}, {fxy:g}, {fyy:g}] not positive semi-definite"
+            )
         xx, xy, yy = site.fix_cov_per_acc2
         if not (all(_finite(v) for v in (xx, xy, yy)) and xx > 0 and yy > 0 and xx * yy > xy * xy):
             raise SiteValidationError(f"fix_cov_per_acc2 = [{xx:g}, {xy:g}, {yy:g}] not positive definite")
@@ -327,7 +334,7 @@ def new_site(**fields: Any) -> site_t:
     s.ap_bssid, s.cell_size_m = [], 0.0
     s.rp_x_m, s.rp_y_m, s.rp_floor, s.rp_scans = [], [], [], []
     s.entry_ap, s.entry_rp, s.entry_mean_dbm, s.entry_std_db, s.entry_count = [], [], [], [], []
-    s.has_fix_model, s.fix_cov_per_acc2 = False, [1.0, 0.0, 1.0]
+    s.has_fix_model, s.fix_floor_cov_m2, s.fix_cov_per_acc2 = False, [0.0, 0.0, 0.0], [1.0, 0.0, 1.0]
     s.fix_bias_sigma_m, s.fix_bias_length_m, s.fix_white_share = 0.0, 10.0, 1.0
     for name, value in fields.items():
         if not hasattr(s, name):

@@ -8,10 +8,12 @@ The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather tha
   their own block and the held-out block (:func:`.select.block_replays`, the same machinery as the
   matcher's inner cross-validation, with that block's matcher settings), so every residual is out of
   sample and none comes from the walk being scored;
-* per held-out block a, M = mean over the fixes of u·uᵀ, u = e / accuracy (e = fix − truth, per
-  axis: a corridor's error runs along it), pooled over the other blocks' walks; |u| is winsorised at
-  its :data:`WINSOR_QUANTILE` quantile, because a fix outside the training walks' coverage is off by
-  tens of metres and one of them would set M alone (the gate handles those);
+* per held-out block a, one fix's error covariance F + accuracy²·M (e = fix − truth, pooled over the
+  other blocks' walks): a least-squares fit of the per-axis squared error on accuracy², since the error
+  follows the matcher's accuracy only weakly (site1/F2: 3.8 m rms per axis at 2 m, 5.3 m at 6 m), and
+  the axes' shape from the mean e·eᵀ (a corridor's error runs along it); |e| is winsorised at its
+  :data:`WINSOR_QUANTILE` quantile, because a fix outside the training walks' coverage is off by tens of
+  metres and one of them would set the model alone (the gate handles those);
 * consecutive fixes err alike (neighbouring scans match the same wrong reference points; a standing
   walker gets the same wrong fix again), and a filter that takes them as independent follows them. The
   scheme carries that part of the error as a state c (a Gauss–Markov process in the distance walked);
@@ -20,8 +22,8 @@ The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather tha
   r(Δd) = a·exp(−Δd/ℓ) (:func:`correlation`); σ_c² = a times one fix's variance at the median
   accuracy, and every fix keeps at least the white share 1 − a of its own variance.
 
-The result goes into the fold's site file (``site_t.has_fix_model``, ``fix_cov_per_acc2`` — the
-scheme's prior, which it can only raise online — ``fix_bias_sigma_m``, ``fix_bias_length_m``,
+The result goes into the fold's site file (``site_t.has_fix_model``, ``fix_floor_cov_m2``,
+``fix_cov_per_acc2`` — the scheme's prior, which it can only raise online — ``fix_bias_sigma_m``, ``fix_bias_length_m``,
 ``fix_white_share``): the map carries its own error model. A user's ``--set`` of an ``ekf.fix_*`` key
 (:data:`KEYS`) skips the measurement, and the parameters hold.
 """
@@ -46,7 +48,9 @@ from stridefix_analyzer.realbench.progress import Progress
 MIN_WALKS = 3
 #: fewest fixes per block for a model (fewer: the firmware prior for that block)
 MIN_FIXES = 20
-#: |u| (and |e| for the correlation) above this quantile is pulled onto it
+#: the per-accuracy² part is kept at least this (the firmware's model needs it positive definite)
+MIN_PER_ACC2 = 0.01
+#: |e| above this quantile is pulled onto it
 WINSOR_QUANTILE = 0.9
 #: pairs of fixes at most this many fixes apart enter the correlation
 MAX_LAG = 20
@@ -62,6 +66,9 @@ KEYS = (
     "ekf.fix_var_x_per_acc2",
     "ekf.fix_var_y_per_acc2",
     "ekf.fix_cov_xy_per_acc2",
+    "ekf.fix_floor_xx_m2",
+    "ekf.fix_floor_yy_m2",
+    "ekf.fix_floor_xy_m2",
     "ekf.fix_bias_sigma_m",
     "ekf.fix_bias_length_m",
     "ekf.fix_white_share",
@@ -110,34 +117,51 @@ def correlation(rows: Sequence[np.ndarray]) -> tuple[float, float, list[dict[str
     return float(np.exp(intercept)), length, bins
 
 
+def variance_law(e2_m2: np.ndarray, acc2_m2: np.ndarray) -> tuple[float, float]:
+    """(F, M) of E[e²] = F + M·accuracy² by least squares over the fixes (per-axis squared errors
+    e2_m2, accuracy² acc2_m2), both kept ≥ 0 and M > 0 (a fit that wants F < 0 is all M; one that
+    wants M ≤ 0 is all F, with M at :data:`MIN_PER_ACC2`)."""
+    a = np.column_stack([np.ones_like(acc2_m2), acc2_m2])
+    (f, m), *_ = np.linalg.lstsq(a, e2_m2, rcond=None)
+    if f < 0:
+        return 0.0, float(np.sum(e2_m2 * acc2_m2) / np.sum(acc2_m2**2))
+    if m <= MIN_PER_ACC2:
+        return float(np.mean(e2_m2) - MIN_PER_ACC2 * np.mean(acc2_m2)), MIN_PER_ACC2
+    return float(f), float(m)
+
+
 def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
     """The fix-error model from per-walk residual arrays (rows: error x, error y [m], accuracy [m],
     distance walked along the truth [m]; time order), or None with fewer than :data:`MIN_FIXES` fixes:
-    M (one fix's error covariance per accuracy²) and the correlated part σ_c, ℓ (:func:`correlation`)."""
+    one fix's error covariance F + accuracy²·M (:func:`variance_law`, with the axes' shape) and the
+    correlated part σ_c, ℓ (:func:`correlation`)."""
     rows = [np.asarray(r, float).reshape(-1, 4) for r in residuals]
     rows = [r[np.all(np.isfinite(r), axis=1) & (r[:, 2] > 0)] for r in rows]
     rows = [r for r in rows if len(r)]
     n = sum(len(r) for r in rows)
     if n < MIN_FIXES:
         return None
-    u = _winsorise(np.concatenate([r[:, :2] / r[:, 2:3] for r in rows]))  # errors per unit accuracy
-    m_xx, m_yy, m_xy = (
-        float(np.mean(u[:, 0] ** 2)),
-        float(np.mean(u[:, 1] ** 2)),
-        float(np.mean(u[:, 0] * u[:, 1])),
-    )
-    cap = _winsorise(np.concatenate([r[:, :2] for r in rows]))
+    cap = _winsorise(np.concatenate([r[:, :2] for r in rows]))  # errors [m]
+    acc = np.concatenate([r[:, 2] for r in rows])
+    floor_m2, per_acc2 = variance_law(0.5 * np.sum(cap**2, axis=1), acc**2)
+    # the axes' shape (a corridor's error runs along it), applied to both parts
+    iso = float(np.mean(0.5 * np.sum(cap**2, axis=1)))
+    shape = np.array([np.mean(cap[:, 0] ** 2), np.mean(cap[:, 0] * cap[:, 1]), np.mean(cap[:, 1] ** 2)]) / iso
+    f_xx, f_xy, f_yy = (float(v) for v in floor_m2 * shape)
+    m_xx, m_xy, m_yy = (float(v) for v in per_acc2 * shape)
     capped, start = [], 0
     for r in rows:
         capped.append(np.column_stack([cap[start : start + len(r)], r[:, 2:]]))
         start += len(r)
     share, length, bins = correlation(capped)
     share = min(max(share, 0.0), MAX_CORRELATED_SHARE)
-    acc_med = float(np.median(np.concatenate([r[:, 2] for r in rows])))
+    acc_med = float(np.median(acc))
     # c's variance in metres: the correlated share of one fix's variance at the median accuracy
-    sigma_c = math.sqrt(share * acc_med**2 * min(m_xx, m_yy))
+    sigma_c = math.sqrt(share * (floor_m2 + per_acc2 * acc_med**2) * float(min(shape[0], shape[2])))
     return {
         "fixes": n,
+        "floor_m2": floor_m2,
+        "per_acc2": per_acc2,
         "m_xx": m_xx,
         "m_yy": m_yy,
         "m_xy": m_xy,
@@ -148,6 +172,7 @@ def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
         "correlation_bins": bins,
         "site_fields": {
             "has_fix_model": True,
+            "fix_floor_cov_m2": [f_xx, f_xy, f_yy],
             "fix_cov_per_acc2": [m_xx, m_xy, m_yy],
             "fix_bias_sigma_m": sigma_c,
             "fix_bias_length_m": length,

@@ -85,3 +85,14 @@ def test_bias_random_walk_from_segment_offsets():
     rot = [{"sum_cos": 1.0, "sum_sin": 0.0, "n_steps": 5, "n_segments": 6, "segments": s} for s in segs]
     assert priors.bias_rw_rad2_per_m(rot, exclude=0) == pytest.approx(0.001)
     assert math.isnan(priors.bias_rw_rad2_per_m(rot[:1], exclude=0))  # no other walk
+
+
+def test_variance_law_separates_floor_and_accuracy_part():
+    rng = np.random.default_rng(11)
+    acc = rng.uniform(1.5, 6.0, 20000)
+    e = rng.normal(0.0, np.sqrt(9.0 + 0.5 * acc**2))  # F = 9 m², M = 0.5
+    f, m = fixmodel.variance_law(e**2, acc**2)
+    assert f == pytest.approx(9.0, rel=0.1) and m == pytest.approx(0.5, rel=0.1)
+    # an error that ignores the accuracy is all floor
+    f, m = fixmodel.variance_law(rng.normal(0.0, 3.0, 20000) ** 2, acc**2)
+    assert f == pytest.approx(9.0, rel=0.1) and m == fixmodel.MIN_PER_ACC2 or m < 0.05
