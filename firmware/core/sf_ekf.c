@@ -64,16 +64,28 @@ static void clamp_eigen2(double m[3], const double lo, const double hi)
     m[2] = l1 * s * s + l2 * c * c;
 }
 
+/* σ_c²: c's stationary variance per axis. */
+static double c_var(const sf_ekf_t *const e)
+{
+    return e->bias_sigma_m * e->bias_sigma_m;
+}
+
+/* Clears the rows and columns of P from index `first` through `last`. */
+static void clear_rows(sf_ekf_t *const e, const int first, const int last)
+{
+    for (int i = first; i <= last; i++) {
+        for (int j = 0; j < n; j++) {
+            e->P[i][j] = 0.0;
+            e->P[j][i] = 0.0;
+        }
+    }
+}
+
 /* Clears the rows and columns of the position and c, and c itself. */
 static void clear_position_and_bias(sf_ekf_t *const e)
 {
-    const int idx[4] = {ix, iy, icx, icy};
-    for (int a = 0; a < 4; a++) {
-        for (int j = 0; j < n; j++) {
-            e->P[idx[a]][j] = 0.0;
-            e->P[j][idx[a]] = 0.0;
-        }
-    }
+    clear_rows(e, ix, iy);
+    clear_rows(e, icx, icy);
     e->fix_bias_m[0] = e->fix_bias_m[1] = 0.0;
 }
 
@@ -103,7 +115,7 @@ void sf_ekf_start(sf_ekf_t *const e, const sf_params_t *const p)
     const double m[3] = {p->ekf_fix_var_x_per_acc2, p->ekf_fix_cov_xy_per_acc2, p->ekf_fix_var_y_per_acc2};
     const double f[3] = {p->ekf_fix_floor_xx_m2, p->ekf_fix_floor_xy_m2, p->ekf_fix_floor_yy_m2};
     set_model(e, p, f, m, p->ekf_fix_bias_sigma_m, p->ekf_fix_bias_length_m, p->ekf_fix_white_share);
-    e->P[icx][icx] = e->P[icy][icy] = e->bias_sigma_m * e->bias_sigma_m;
+    e->P[icx][icx] = e->P[icy][icy] = c_var(e);
 }
 
 void sf_ekf_use_site_model(sf_ekf_t *const e, const sf_params_t *const p, const sf_fix_model_t *const model)
@@ -114,17 +126,15 @@ void sf_ekf_use_site_model(sf_ekf_t *const e, const sf_params_t *const p, const 
     set_model(e, p, model->floor_cov_m2, model->cov_per_acc2, model->bias_sigma_m, model->bias_length_m,
               model->white_share);
     /* c starts afresh with the site's σ_c, uncorrelated (a start before any fix) */
-    for (int j = 0; j < n; j++) {
-        e->P[icx][j] = e->P[j][icx] = e->P[icy][j] = e->P[j][icy] = 0.0;
-    }
+    clear_rows(e, icx, icy);
     e->fix_bias_m[0] = e->fix_bias_m[1] = 0.0;
-    e->P[icx][icx] = e->P[icy][icy] = e->bias_sigma_m * e->bias_sigma_m;
+    e->P[icx][icx] = e->P[icy][icy] = c_var(e);
 }
 
 void sf_ekf_restart_at_fix(sf_ekf_t *const e, const double r_white_m2[3])
 {
     clear_position_and_bias(e);
-    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
+    const double c2 = c_var(e);
     e->P[ix][ix] = r_white_m2[0] + c2;
     e->P[ix][iy] = e->P[iy][ix] = r_white_m2[1];
     e->P[iy][iy] = r_white_m2[2] + c2;
@@ -136,7 +146,7 @@ void sf_ekf_restart_at_fix(sf_ekf_t *const e, const double r_white_m2[3])
 void sf_ekf_restart_known(sf_ekf_t *const e, const double pos_cov_m2[3])
 {
     clear_position_and_bias(e);
-    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
+    const double c2 = c_var(e);
     e->P[ix][ix] = pos_cov_m2[0];
     e->P[ix][iy] = e->P[iy][ix] = pos_cov_m2[1];
     e->P[iy][iy] = pos_cov_m2[2];
@@ -190,7 +200,7 @@ void sf_ekf_time(sf_ekf_t *const e, const sf_params_t *const p, const double dt_
 void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const double accuracy_m,
                   double r_white_m2[3])
 {
-    const double a2 = accuracy_m * accuracy_m, c2 = e->bias_sigma_m * e->bias_sigma_m;
+    const double a2 = accuracy_m * accuracy_m, c2 = c_var(e);
     double total[3];
     for (int i = 0; i < 3; i++) {
         total[i] = e->fix_floor_m2[i] + a2 * e->fix_model[i];
@@ -203,10 +213,10 @@ void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const dou
     clamp_eigen2(r_white_m2, fmax(p->fusion_var_min_m2, white_min), INFINITY);
 }
 
-void sf_ekf_innovation(const sf_ekf_t *const e, const double z_minus_p_m[2], double nu_m[2])
+void sf_ekf_innovation(const sf_ekf_t *const e, double nu_m[2])
 {
-    nu_m[0] = z_minus_p_m[0] - e->fix_bias_m[0];
-    nu_m[1] = z_minus_p_m[1] - e->fix_bias_m[1];
+    nu_m[0] -= e->fix_bias_m[0];
+    nu_m[1] -= e->fix_bias_m[1];
 }
 
 /* H P Hᵀ, H = [I 0 0 I]: the covariance of p + c [xx, xy, yy]. */
@@ -242,7 +252,7 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
     /* an innovation beyond the gate enters shrunk onto it: evidence that R is too small, bounded */
     const double k = isfinite(nis) && nis > nis_max ? sqrt(nis_max / nis) : 1.0;
     const double vx = k * nu_m[0], vy = k * nu_m[1], a2 = accuracy_m * accuracy_m;
-    const double c2 = e->bias_sigma_m * e->bias_sigma_m;
+    const double c2 = c_var(e);
     hph(e, m);
     /* E[ννᵀ] = H P Hᵀ + F + a²M − σ_c² I, solved for M */
     const double *const f = e->fix_floor_m2;

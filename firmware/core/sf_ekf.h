@@ -108,11 +108,12 @@ void sf_ekf_step(sf_ekf_t *e, const sf_params_t *p, double length_m, double head
 /* dt_s seconds without a step (dt_s ≤ 0 adds nothing). */
 void sf_ekf_time(sf_ekf_t *e, const sf_params_t *p, double dt_s);
 
-/* The white part R_w = accuracy_m² · M − σ_c² I of a fix of that accuracy [xx, xy, yy]. */
+/* The white part R_w = F + accuracy_m² · M − σ_c² I of a fix of that accuracy [xx, xy, yy] (floored as
+ * above). */
 void sf_ekf_fix_r(const sf_ekf_t *e, const sf_params_t *p, double accuracy_m, double r_white_m2[3]);
 
-/* ν = z − p − c from the fix's offset z − p (fix minus the nominal position). */
-void sf_ekf_innovation(const sf_ekf_t *e, const double z_minus_p_m[2], double nu_m[2]);
+/* In place: the fix's offset z − p (fix minus the nominal position) becomes ν = z − p − c. */
+void sf_ekf_innovation(const sf_ekf_t *e, double nu_m[2]);
 
 /* S = H P Hᵀ + R_w [xx, xy, yy] and the NIS νᵀ S⁻¹ ν (+∞ when S is not positive definite). */
 double sf_ekf_nis(const sf_ekf_t *e, const double nu_m[2], const double r_white_m2[3], double s_m2[3]);

@@ -131,6 +131,13 @@ static int16_t scheme_floor(const sf_fusion_t *const f, const int16_t baro_floor
 
 /* ---- fusion: the math ---------------------------------------------------------------------------- */
 
+/* A fresh ekf filter: the parameters' priors, then the site's fix model if it measured one. */
+static void start_ekf(sf_fusion_t *const f, const sf_params_t *const p)
+{
+    sf_ekf_start(&f->ekf, p);
+    sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
+}
+
 /* Time update of the variance up to t_us (Δt < 0 counts as backwards and adds nothing). */
 static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us)
 {
@@ -173,7 +180,7 @@ static void blend(sf_fusion_t *const f, const sf_params_t *const p, const double
 /* position ← fix, variance ← R, floor from the fix: initialisation, recovery, wifi_only. The ekf's
  * position block restarts at its 2×2 R (ekf_r_m2), bias and scale keep what they learnt. */
 static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                         const double r_m2, const double ekf_r_m2[3], const int16_t baro_floor)
+                         const double r_m2, const double ekf_r_m2[3])
 {
     f->initialised = true;
     f->x_m = fix->x_m;
@@ -182,15 +189,14 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
     if (is_ekf(f)) {
         sf_ekf_restart_at_fix(&f->ekf, ekf_r_m2);
     }
-    (void)baro_floor;
     f->floor_offset = predicts(f) ? 0 : (int32_t)fix->floor; /* the caller's floor is the floor */
 }
 
 /* ---- control: which fixes to fuse ---------------------------------------------------------------- */
 
 /* The decision for an initialised scheme, from the named conditions of the header. */
-static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                    const double test_ratio, const int16_t baro_floor, const bool between_floors)
+static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const double test_ratio,
+                    const bool between_floors)
 {
     if (row_of(f)->mode == mode_dead_reckoning) {
         return sf_fix_reason_scheme_ignores;
@@ -201,7 +207,6 @@ static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, cons
     /* The floor: between floors no fix is of the map's floors; on a floor, the fix's floor is one vote
      * on the caller's floor (sf_floor_vote.h) and its position is judged on the gate like any other (a
      * radio map's floor guess fails far more often than its position; sf_fusion.h, Floors). */
-    (void)fix, (void)baro_floor;
     if (between_floors) {
         return sf_fix_reason_floor_mismatch;
     }
@@ -262,8 +267,7 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
     if (is_ekf(f)) {
         double cov_m2[3];
         iso_cov(f->var_m2, cov_m2);
-        sf_ekf_start(&f->ekf, p);
-        sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
+        start_ekf(f, p);
         sf_ekf_restart_known(&f->ekf, cov_m2);
     }
     (void)baro_floor;
@@ -311,6 +315,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
 int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                            const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
+    (void)baro_floor; /* DEVIATION: unused (Floors: the caller's floor rules); the call sites still pass it */
     audit_begin(audit, f, fix);
     f->fixes++;
     if (!fix_usable(fix)) {
@@ -326,15 +331,14 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     double ekf_r_m2[3] = {r_m2, 0.0, r_m2};
     if (is_ekf(f)) {
         if (!f->initialised) {
-            sf_ekf_start(&f->ekf, p); /* the prior fix model, bias and scale */
-            sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
+            start_ekf(f, p);
         }
         sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
     }
 
     /* control: start */
     if (!f->initialised) {
-        reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
+        reset_to_fix(f, p, fix, r_m2, ekf_r_m2);
         f->last_fix_t_us = fix->t_us;
         f->rejections = 0;
         f->initialisations++;
@@ -348,24 +352,24 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     /* fusion: innovation, its variance, the test ratio */
     double nu_m[2] = {fix->x_m - f->x_m, fix->y_m - f->y_m};
     if (is_ekf(f)) { /* the ekf predicts the fix at its position plus the fixes' correlated error */
-        const double z_minus_p_m[2] = {nu_m[0], nu_m[1]};
-        sf_ekf_innovation(&f->ekf, z_minus_p_m, nu_m);
+        sf_ekf_innovation(&f->ekf, nu_m);
     }
     const double nu_x = nu_m[0], nu_y = nu_m[1];
-    const double s_m2 = f->var_m2 + r_m2;
     const double gate = p->fusion_gate_sigma;
     audit->innovation_m[0] = nu_x;
     audit->innovation_m[1] = nu_y;
-    audit->innovation_var_m2 = s_m2;
-    audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
     if (is_ekf(f)) { /* the full 2×2 S: NIS, χ² with 2 dof, on the same gate */
         double s3_m2[3];
         audit->test_ratio = sf_ekf_nis(&f->ekf, nu_m, ekf_r_m2, s3_m2) / (gate * gate);
         audit->innovation_var_m2 = 0.5 * (s3_m2[0] + s3_m2[2]);
+    } else {
+        const double s_m2 = f->var_m2 + r_m2;
+        audit->innovation_var_m2 = s_m2;
+        audit->test_ratio = (nu_x * nu_x + nu_y * nu_y) / (gate * gate * s_m2);
     }
 
     /* control: judge, then apply */
-    const int8_t reason = judge(f, p, fix, audit->test_ratio, baro_floor, between_floors);
+    const int8_t reason = judge(f, p, audit->test_ratio, between_floors);
     audit->reason = reason;
     if (is_ekf(f) && reason == sf_fix_reason_accepted) { /* a rejected fix says nothing about R */
         sf_ekf_learn_fix_model(&f->ekf, p, nu_m, fix->accuracy_m, gate * gate);
@@ -382,13 +386,13 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
             f->y_m += dpos_m[1];
         } else { /* wifi_only */
             audit->alpha = 1.0;
-            reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
+            reset_to_fix(f, p, fix, r_m2, ekf_r_m2);
         }
         f->accepted++;
         break;
     case sf_fix_reason_recovery:
         audit->alpha = 1.0;
-        reset_to_fix(f, p, fix, r_m2, ekf_r_m2, baro_floor);
+        reset_to_fix(f, p, fix, r_m2, ekf_r_m2);
         f->recoveries++;
         break;
     case sf_fix_reason_gate:

@@ -32,6 +32,15 @@ static sf_params_t params(void)
     return p;
 }
 
+/* A fresh filter at a known position of covariance cov [xx, xy, yy]. */
+static sf_ekf_t known_start(const sf_params_t *const p, const double cov[3])
+{
+    sf_ekf_t e;
+    sf_ekf_start(&e, p);
+    sf_ekf_restart_known(&e, cov);
+    return e;
+}
+
 /* Propagating P = diag(0, 0, σb², σs²) through one step equals J diag(σb², σs²) Jᵀ plus the step's
  * noise, J = ∂(displacement)/∂(b, s) by central differences of the displacement itself. */
 static void test_step_jacobian(void **state)
@@ -43,9 +52,7 @@ static void test_step_jacobian(void **state)
     p.ekf_bias_rw_rad2_per_m = 0.0;
     p.ekf_scale_rw_per_m = 0.0;
     const double zero[3] = {0, 0, 0};
-    sf_ekf_t e;
-    sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, zero);
+    sf_ekf_t e = known_start(&p, zero);
     e.heading_bias_rad = 0.3;
     e.stride_scale = 1.1;
     const double vb = e.P[2][2], vs = e.P[3][3], L = 0.7, psi = 1.2;
@@ -81,9 +88,7 @@ static void test_update_is_kalman(void **state)
     (void)state;
     sf_params_t p = params();
     const double cov[3] = {4.0, 0.0, 4.0}, r[3] = {1.0, 0.0, 1.0}, nu[2] = {2.0, -1.0};
-    sf_ekf_t e;
-    sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, cov);
+    sf_ekf_t e = known_start(&p, cov);
     double s[3];
     near(sf_ekf_nis(&e, nu, r, s), (4.0 + 1.0) / 5.0, 1e-12);
     double dpos[2];
@@ -106,9 +111,7 @@ static void test_learns_bias_and_scale(void **state)
     rng_t rng = {.s = 12345};
     const double true_bias = 0.25, true_scale = 1.25, L = 0.6, sigma_fix = 2.0;
     const double cov0[3] = {4.0, 0.0, 4.0};
-    sf_ekf_t e;
-    sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, cov0);
+    sf_ekf_t e = known_start(&p, cov0);
     double x = 0, y = 0, tx = 0, ty = 0, px = 0, py = 0, err_ekf = 0, err_pdr = 0;
     int n = 0;
     for (int k = 0; k < 800; k++) {
@@ -152,9 +155,7 @@ static void test_fix_model_only_grows(void **state)
     p.ekf_fix_var_x_per_acc2 = 2.0;
     p.ekf_fix_var_y_per_acc2 = 2.0;
     const double cov[3] = {1.0, 0.0, 1.0};
-    sf_ekf_t e;
-    sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, cov);
+    sf_ekf_t e = known_start(&p, cov);
     double r[3];
     sf_ekf_fix_r(&e, &p, 3.0, r);
     near(r[0], 18.0, 1e-12);
@@ -190,14 +191,11 @@ static double stuck_fix_run(const double sigma_c_m, sf_ekf_t *const out)
     p.ekf_fix_bias_sigma_m = sigma_c_m;
     p.ekf_r_window = 0;
     const double cov[3] = {1.0, 0.0, 1.0};
-    sf_ekf_t e;
-    sf_ekf_start(&e, &p);
-    sf_ekf_restart_known(&e, cov);
+    sf_ekf_t e = known_start(&p, cov);
     double x = 0.0, y = 0.0;
     for (int i = 0; i < 20; i++) {
-        const double zp[2] = {5.0 - x, 0.0 - y};
-        double nu[2], r[3], dpos[2];
-        sf_ekf_innovation(&e, zp, nu);
+        double nu[2] = {5.0 - x, 0.0 - y}, r[3], dpos[2];
+        sf_ekf_innovation(&e, nu);
         sf_ekf_fix_r(&e, &p, 3.0, r);
         (void)sf_ekf_update(&e, &p, nu, r, dpos);
         x += dpos[0], y += dpos[1];

@@ -48,26 +48,11 @@ DEFAULT_BLOCKS = 4
 MIN_WALKS = 6
 
 
-def fix_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
-    """2-D error [m] of every Wi-Fi fix of a stridefixd log (one per scan) against the truth
-    interpolated linearly between waypoints; fixes outside the truth span are left out."""
-    fix = read_table(fw_log, "FIX")
-    wp_t_us = np.asarray(wp_t_us, np.int64)
-    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
-    if fix is None or not len(fix) or len(wp_t_us) < 2:
-        return np.zeros(0)
-    t, first = np.unique(fix["t_us"], return_index=True)  # one row per scan (schemes repeat it)
-    keep = (t >= wp_t_us[0]) & (t <= wp_t_us[-1]) & (fix["accuracy_m"][first] > 0)
-    t, first = t[keep], first[keep]
-    x = np.interp(t, wp_t_us, wp[:, 0])
-    y = np.interp(t, wp_t_us, wp[:, 1])
-    return np.hypot(fix["x_m"][first] - x, fix["y_m"][first] - y)
-
-
 def fix_residuals_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
-    """Every Wi-Fi fix's error against the truth (interpolated as in :func:`fix_errors_m`), in time
-    order: rows (error x [m], error y [m], the matcher's accuracy_m [m], distance walked along the
-    truth since its first waypoint [m])."""
+    """Every Wi-Fi fix's error against the truth (one row per scan: the schemes repeat it), linear
+    between waypoints, fixes outside the truth span left out, in time order: rows (error x [m],
+    error y [m], the matcher's accuracy_m [m], distance walked along the truth since its first
+    waypoint [m])."""
     fix = read_table(fw_log, "FIX")
     wp_t_us = np.asarray(wp_t_us, np.int64)
     wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
@@ -80,6 +65,13 @@ def fix_residuals_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) 
     ey = fix["y_m"][first] - np.interp(t, wp_t_us, wp[:, 1])
     walked_m = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(wp, axis=0).T))])
     return np.column_stack([ex, ey, fix["accuracy_m"][first], np.interp(t, wp_t_us, walked_m)])
+
+
+def fix_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:
+    """2-D error [m] of every Wi-Fi fix of a stridefixd log (one per scan) against the truth
+    interpolated linearly between waypoints; fixes outside the truth span are left out."""
+    r = fix_residuals_m(fw_log, wp_t_us, wp_xy_m)
+    return np.hypot(r[:, 0], r[:, 1])
 
 
 def pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> np.ndarray:

@@ -10,8 +10,23 @@ import zlib
 
 import numpy as np
 import pytest
+from stridefix import site_t
 from stridefix_analyzer.io import sitefile
 from stridefix_analyzer.io.sitefile import HEADER_SIZE, SiteFileError
+
+#: the ``float`` fields of site_t.lcm (the others are double, integers, booleans or strings)
+_FLOAT32_FIELDS = {
+    "cell_size_m",
+    "rp_x_m",
+    "rp_y_m",
+    "entry_mean_dbm",
+    "entry_std_db",
+    "fix_floor_cov_m2",
+    "fix_cov_per_acc2",
+    "fix_bias_sigma_m",
+    "fix_bias_length_m",
+    "fix_white_share",
+}
 
 
 def _f32(values):
@@ -23,26 +38,16 @@ def test_round_trip_every_value_equal(tmp_path, vector_site):
     size = sitefile.write_site(path, vector_site)
     assert size == path.stat().st_size
     got = sitefile.read_site(path)
-    for name in (
-        "name",
-        "source",
-        "map_rotation_deg",
-        "has_geo",
-        "origin_lat_deg",
-        "origin_lon_deg",
-        "lowest_floor",
-        "n_floors",
-        "n_ap",
-        "n_rp",
-        "n_entries",
-    ):
-        assert getattr(got, name) == getattr(vector_site, name), name
-    for name in ("floor_height_m", "ap_bssid", "rp_floor", "rp_scans", "entry_ap", "entry_rp", "entry_count"):
-        assert list(getattr(got, name)) == list(getattr(vector_site, name)), name
-    # float32 fields come back as the float32 nearest to what was written, exactly
-    for name in ("rp_x_m", "rp_y_m", "entry_mean_dbm", "entry_std_db"):
-        assert np.array_equal(np.asarray(getattr(got, name)), _f32(getattr(vector_site, name))), name
-    assert got.cell_size_m == vector_site.cell_size_m
+    # every field of site_t (a new one cannot be missed); float32 fields come back as the float32
+    # nearest to what was written, exactly, the rest exactly as written
+    for name in site_t.__slots__:
+        want, back = getattr(vector_site, name), getattr(got, name)
+        if name in _FLOAT32_FIELDS:
+            assert np.array_equal(np.asarray(back, float), _f32(want)), name
+        elif isinstance(want, list | tuple):
+            assert list(back) == list(want), name
+        else:
+            assert back == want, name
 
 
 def test_header_layout(tmp_path, vector_site):
