@@ -9,9 +9,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
 BUILD=${BUILD:-build}
-# clang and cppcheck: the quality gates (make check-clang, make check-static).
+# clang and cppcheck: the quality gates (make check-clang, make check-static); libclang-rt-14-dev:
+# the libFuzzer runtime (make check-fuzz, make fuzz).
 DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev python3-dev cmake g++ gcc make pkg-config
-      clang cppcheck)
+      clang cppcheck libclang-rt-14-dev)
 
 missing=()
 for p in "${DEBS[@]}"; do

@@ -70,6 +70,17 @@ static void complain(daemon_t *const d, const int code)
     d->messages_printed++;
 }
 
+/* An input whose framing cannot be trusted any more (sf_input_next SF_ECORRUPT): said even with
+ * --quiet, since the run then fails. */
+static void refuse_rest(const daemon_t *const d)
+{
+    char text[512];
+    if (!sf_input_describe(d->in, SF_ECORRUPT, text, sizeof text)) {
+        snprintf(text, sizeof text, "%s: %s", sf_input_name(d->in), sf_strerror(SF_ECORRUPT));
+    }
+    fprintf(stderr, "stridefixd: %s\n", text);
+}
+
 static void write_health(daemon_t *const d)
 {
     sf_input_counters_t ic;
@@ -201,6 +212,11 @@ static int run(daemon_t *const d)
         }
         if (rc == SF_EIO) {
             fprintf(stderr, "stridefixd: %s: read failed: %s\n", sf_input_name(d->in), strerror(errno));
+            status = 1;
+            break;
+        }
+        if (rc == SF_ECORRUPT) {
+            refuse_rest(d);
             status = 1;
             break;
         }

@@ -52,13 +52,13 @@ static int next_lcm(sf_input_t *const in, sf_input_item_t *const item)
 {
     sf_rx_counters_t *const c = &in->rx.counters;
     const int rc = sf_lcm_input_next(in->lcm, &item->event, &item->log_t_us);
-    if (rc == 0) {
-        return 0;
+    if (rc == 0 || rc == SF_EIO) {
+        return rc;
     }
     c->frames++;
     if (rc < 0) {
         c->decode_errors++;
-        return SF_ESYNTAX;
+        return rc; /* SF_ESYNTAX, or SF_ECORRUPT: the rest of the log refused */
     }
     c->frames_ok++;
     sf_rx_count_sample(c, item->event.kind);
@@ -94,8 +94,7 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
     const sf_can_frame_t *const f = &in->frame;
     switch (code) {
     case SF_ESYNTAX:
-        return in->lcm != NULL ? "a sensor event whose payload does not decode; skipped"
-                               : "not a candump -L line; skipped";
+        return "not a candump -L line; skipped";
     case SF_EUNKNOWN_ID:
         snprintf(buf, size, "CAN id 0x%" PRIX32 "%s is not in board.dbc; skipped", f->id,
                  f->extended ? " (extended)" : f->remote ? " (remote)" : "");
@@ -113,6 +112,10 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
 
 bool sf_input_describe(const sf_input_t *const in, const int code, char *const buf, const size_t size)
 {
+    if (in->lcm != NULL && (code == SF_ESYNTAX || code == SF_ECORRUPT)) {
+        snprintf(buf, size, "%s", sf_lcm_input_error(in->lcm)); /* names the log, the event and the field */
+        return true;
+    }
     char tmp[160];
     const char *const w = what(in, code, tmp, sizeof tmp);
     if (w == NULL) {

@@ -45,7 +45,8 @@ typedef struct {
 int sf_input_open(sf_input_t **in, const char *spec, char *err_text, size_t err_size);
 
 /* Next item: 1 *item filled; 0 end of input; SF_EIO a read error (errno tells); SF_ESYNTAX a line or
- * event that does not parse (counted and skipped, no item: call again). */
+ * event that does not parse (counted and skipped, no item: call again); SF_ECORRUPT an LCM log whose
+ * framing cannot be trusted from here on (counted; the rest is refused: the caller should fail). */
 int sf_input_next(sf_input_t *in, sf_input_item_t *item);
 
 /* The words for a skipped input (an SF_ESYNTAX of sf_input_next, or an item's status) of the latest

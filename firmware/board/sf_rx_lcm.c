@@ -4,18 +4,40 @@
 #include <string.h>
 
 #include "sf_error.h"
+#include "sf_lcm_walk.h"
 #include "stridefix_baro_t.h"
 #include "stridefix_gnss_t.h"
 #include "stridefix_imu_t.h"
 #include "stridefix_mag_t.h"
 #include "stridefix_wifi_scan_t.h"
 
+/* Where a message goes: "<name>: <what>" into err. */
+typedef struct {
+    const char *name;
+    char *err;
+    size_t err_size;
+} where_t;
+
+/* The generated decode's result: SF_OK when it used all size bytes, else SF_ESYNTAX with a message. */
+static int decoded(const int used, const int size, const char *const type, const where_t *const e)
+{
+    if (used < 0) {
+        return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX,
+                            "payload of %d bytes is not a %s (wrong type hash, or too short)", size, type);
+    }
+    if (used != size) {
+        return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX, "payload has %d trailing bytes after the %s",
+                            size - used, type);
+    }
+    return SF_OK;
+}
+
 /* ---- per kind: decode (LCM → event, 1 or SF_ESYNTAX) and encode (event → log) ---------------------- */
 
-static int decode_imu(const void *const data, const int size, sf_rx_event_t *const ev)
+static int decode_imu(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
 {
     stridefix_imu_t m;
-    if (stridefix_imu_t_decode(data, 0, size, &m) < 0) {
+    if (decoded(stridefix_imu_t_decode(data, 0, size, &m), size, "stridefix.imu_t", e) != SF_OK) {
         return SF_ESYNTAX;
     }
     ev->u.imu.t_us = m.t_us;
@@ -35,10 +57,10 @@ static void encode_imu(sf_lcm_out_t *const out, const char *const channel, const
     SF_LCM_WRITE(out, channel, ts_us, stridefix_imu_t, &msg);
 }
 
-static int decode_mag(const void *const data, const int size, sf_rx_event_t *const ev)
+static int decode_mag(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
 {
     stridefix_mag_t m;
-    if (stridefix_mag_t_decode(data, 0, size, &m) < 0) {
+    if (decoded(stridefix_mag_t_decode(data, 0, size, &m), size, "stridefix.mag_t", e) != SF_OK) {
         return SF_ESYNTAX;
     }
     ev->u.mag.t_us = m.t_us;
@@ -56,10 +78,10 @@ static void encode_mag(sf_lcm_out_t *const out, const char *const channel, const
     SF_LCM_WRITE(out, channel, ts_us, stridefix_mag_t, &msg);
 }
 
-static int decode_baro(const void *const data, const int size, sf_rx_event_t *const ev)
+static int decode_baro(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
 {
     stridefix_baro_t m;
-    if (stridefix_baro_t_decode(data, 0, size, &m) < 0) {
+    if (decoded(stridefix_baro_t_decode(data, 0, size, &m), size, "stridefix.baro_t", e) != SF_OK) {
         return SF_ESYNTAX;
     }
     ev->u.baro = (sf_rx_baro_t){m.t_us, m.seq, m.pressure_pa, m.temperature_degc};
@@ -75,11 +97,22 @@ static void encode_baro(sf_lcm_out_t *const out, const char *const channel, cons
     SF_LCM_WRITE(out, channel, ts_us, stridefix_baro_t, &msg);
 }
 
-static int decode_wifi(const void *const data, const int size, sf_rx_event_t *const ev)
+/* wifi_scan_t.lcm field by field (sf_lcm_walk.h says why): the only raw-sensor type with a count. */
+static int walk_wifi(const void *const data, const int size, const where_t *const e)
+{
+    sf_lcm_walk_t w = {data, (size_t)size, 0, e->name, e->err, e->err_size};
+    int rc = sf_lcm_walk_skip(&w, 8, "type hash");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_skip(&w, 8 + 8 + 1, "t_us .. complete");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(&w, "n_ap", 8 + 4 + 4);
+    return rc != SF_OK ? rc : sf_lcm_walk_end(&w, "stridefix.wifi_scan_t");
+}
+
+static int decode_wifi(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
 {
     stridefix_wifi_scan_t m;
-    if (stridefix_wifi_scan_t_decode(data, 0, size, &m) < 0) {
-        return SF_ESYNTAX;
+    if (walk_wifi(data, size, e) != SF_OK ||
+        decoded(stridefix_wifi_scan_t_decode(data, 0, size, &m), size, "stridefix.wifi_scan_t", e) != SF_OK) {
+        return SF_ESYNTAX; /* after the walk, the decode fails only on the type hash: nothing allocated */
     }
     sf_rx_wifi_t *const w = &ev->u.wifi;
     w->t_us = m.t_us;
@@ -110,10 +143,10 @@ static void encode_wifi(sf_lcm_out_t *const out, const char *const channel, cons
     SF_LCM_WRITE(out, channel, ts_us, stridefix_wifi_scan_t, &msg);
 }
 
-static int decode_gnss(const void *const data, const int size, sf_rx_event_t *const ev)
+static int decode_gnss(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
 {
     stridefix_gnss_t m;
-    if (stridefix_gnss_t_decode(data, 0, size, &m) < 0) {
+    if (decoded(stridefix_gnss_t_decode(data, 0, size, &m), size, "stridefix.gnss_t", e) != SF_OK) {
         return SF_ESYNTAX;
     }
     ev->u.gnss = (sf_rx_gnss_t){m.t_us, m.lat_deg, m.lon_deg, m.alt_m, m.accuracy_m};
@@ -134,7 +167,7 @@ static void encode_gnss(sf_lcm_out_t *const out, const char *const channel, cons
 typedef struct {
     sf_rx_kind_t kind;
     const char *channel;
-    int (*decode)(const void *data, int size, sf_rx_event_t *ev);
+    int (*decode)(const void *data, int size, sf_rx_event_t *ev, const where_t *e);
     void (*encode)(sf_lcm_out_t *out, const char *channel, int64_t ts_us, const sf_rx_event_t *ev);
 } kind_row_t;
 
@@ -158,11 +191,15 @@ const char *sf_rx_lcm_channel(const sf_rx_kind_t kind)
 }
 
 int sf_rx_lcm_decode(const char *const channel, const void *const data, const size_t size,
-                     sf_rx_event_t *const ev)
+                     sf_rx_event_t *const ev, const char *const name, char *const err, const size_t err_size)
 {
+    const where_t e = {name != NULL ? name : channel, err, err_size};
     for (size_t i = 0; i < sizeof kind_rows / sizeof kind_rows[0]; i++) {
         if (strcmp(channel, kind_rows[i].channel) == 0) {
-            if (size > (size_t)INT32_MAX || kind_rows[i].decode(data, (int)size, ev) != 1) {
+            if (size > (size_t)INT32_MAX) {
+                return sf_lcm_failf(err, err_size, e.name, SF_ESYNTAX, "payload of %zu bytes is too large", size);
+            }
+            if (kind_rows[i].decode(data, (int)size, ev, &e) != 1) {
                 return SF_ESYNTAX;
             }
             ev->kind = kind_rows[i].kind;

@@ -19,9 +19,13 @@
 const char *sf_rx_lcm_channel(sf_rx_kind_t kind);
 
 /* Decodes one logged message. 1 *event filled, 0 the channel is not a sensor input (event untouched),
- * SF_ESYNTAX a sensor channel whose payload does not decode. A scan longer than SF_WIFI_MAX_AP keeps
- * its first SF_WIFI_MAX_AP access points (the rest cannot be used anyway). */
-int sf_rx_lcm_decode(const char *channel, const void *data, size_t size, sf_rx_event_t *event);
+ * SF_ESYNTAX a sensor channel whose payload does not decode: every count is checked against the
+ * payload before the generated decode runs (sf_lcm_walk.h), and trailing bytes are refused; err (if
+ * err_size > 0) then holds "<name>: <what>", e.g. "payload: n_ap = 536870912 needs 8589934592 bytes
+ * of arrays, 13 left" (name NULL: the channel). A scan longer than SF_WIFI_MAX_AP keeps its first
+ * SF_WIFI_MAX_AP access points (the rest cannot be used anyway). */
+int sf_rx_lcm_decode(const char *channel, const void *data, size_t size, sf_rx_event_t *event, const char *name,
+                     char *err, size_t err_size);
 
 /* Writes the event as its message on its channel with log timestamp ts_us; sf_rx_none writes nothing.
  * Drops are counted by sf_lcm_out. */

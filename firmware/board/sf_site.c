@@ -3,29 +3,14 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "sf_error.h"
+#include "sf_lcm_walk.h"
 
 static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
-
-/* "<name>: <formatted text>" into err; returns rc. */
-static int failf(char *const err, const size_t err_size, const char *const name, const int rc,
-                 const char *const fmt, ...)
-{
-    if (err != NULL && err_size > 0) {
-        char what[400];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(what, sizeof what, fmt, ap);
-        va_end(ap);
-        snprintf(err, err_size, "%s: %s", name, what);
-    }
-    return rc;
-}
 
 uint32_t sf_site_crc32(const void *const data, const size_t n)
 {
@@ -50,93 +35,21 @@ static uint32_t le32(const uint8_t *const p)
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static int32_t be32(const uint8_t *const p)
-{
-    const uint32_t u = ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
-    return (int32_t)u;
-}
+/* --- payload bounds walk (sf_lcm_walk.h says why: the generated decoder trusts the counts) ------- */
 
-/* --- payload bounds walk -------------------------------------------------------------------------
- * DEVIATION: this walks the site_t layout by hand (counts and strings only) before the generated
- * decoder runs, because the LCM C decoder (lcm_coretypes.h, 1.3 and 1.5) computes `int total =
- * sizeof(T) * count` (overflow for count ≥ 2^28 lets it read past the buffer) and does not check that
- * strings end with NUL. It must follow site_t.lcm field by field; the type hash check before it and
- * the round-trip test (tests/c/test_site.c) catch a layout change that is not mirrored here. */
-typedef struct {
-    const uint8_t *p;
-    size_t size;
-    size_t pos;
-    const char *name;
-    char *err;
-    size_t err_size;
-} walk_t;
-
-static int skip(walk_t *const w, const size_t bytes, const char *const field)
+static int walk_site(sf_lcm_walk_t *const w)
 {
-    if (bytes > w->size - w->pos) {
-        return failf(w->err, w->err_size, w->name, SF_ESYNTAX,
-                     "payload ends inside field '%s' (needs %zu bytes at offset %zu, %zu left)", field,
-                     bytes, w->pos, w->size - w->pos);
-    }
-    w->pos += bytes;
-    return SF_OK;
-}
-
-static int walk_string(walk_t *const w, const char *const field)
-{
-    int rc = skip(w, 4, field);
-    if (rc != SF_OK) {
-        return rc;
-    }
-    const int32_t len = be32(w->p + w->pos - 4);
-    if (len < 1) {
-        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: string '%s' has length %d, must be >= 1",
-                     field, (int)len);
-    }
-    rc = skip(w, (size_t)len, field);
-    if (rc == SF_OK && w->p[w->pos - 1] != 0u) {
-        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: string '%s' does not end with NUL",
-                     field);
-    }
-    return rc;
-}
-
-/* A count, then the arrays it sizes (element_bytes = bytes per index over all those arrays). */
-static int walk_count(walk_t *const w, const char *const field, const size_t element_bytes)
-{
-    int rc = skip(w, 4, field);
-    if (rc != SF_OK) {
-        return rc;
-    }
-    const int32_t n = be32(w->p + w->pos - 4);
-    if (n < 0) {
-        return failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload: %s = %d is negative", field, (int)n);
-    }
-    if ((size_t)n > (w->size - w->pos) / element_bytes) {
-        return failf(w->err, w->err_size, w->name, SF_ESYNTAX,
-                     "payload: %s = %d needs %zu bytes of arrays, %zu left", field, (int)n,
-                     (size_t)n * element_bytes, w->size - w->pos);
-    }
-    return skip(w, (size_t)n * element_bytes, field);
-}
-
-static int walk_site(walk_t *const w)
-{
-    int rc = skip(w, 8, "type hash");
-    rc = rc != SF_OK ? rc : walk_string(w, "name");
-    rc = rc != SF_OK ? rc : walk_string(w, "source");
-    rc = rc != SF_OK ? rc : skip(w, 8 + 1 + 8 + 8 + 2, "map_rotation_deg .. lowest_floor");
-    rc = rc != SF_OK ? rc : walk_count(w, "n_floors", 8);
-    rc = rc != SF_OK ? rc : walk_count(w, "n_ap", 8);
-    rc = rc != SF_OK ? rc : skip(w, 4, "cell_size_m");
-    rc = rc != SF_OK ? rc : walk_count(w, "n_rp", 4 + 4 + 2 + 4);
-    rc = rc != SF_OK ? rc : walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
-    rc = rc != SF_OK ? rc : skip(w, 1 + 3 * 4 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
-    if (rc == SF_OK && w->pos != w->size) {
-        rc = failf(w->err, w->err_size, w->name, SF_ESYNTAX, "payload has %zu trailing bytes after the site_t",
-                   w->size - w->pos);
-    }
-    return rc;
+    int rc = sf_lcm_walk_skip(w, 8, "type hash");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_string(w, "name");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_string(w, "source");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_skip(w, 8 + 1 + 8 + 8 + 2, "map_rotation_deg .. lowest_floor");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_floors", 8);
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_ap", 8);
+    rc = rc != SF_OK ? rc : sf_lcm_walk_skip(w, 4, "cell_size_m");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_rp", 4 + 4 + 2 + 4);
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
+    rc = rc != SF_OK ? rc : sf_lcm_walk_skip(w, 1 + 3 * 4 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
+    return rc != SF_OK ? rc : sf_lcm_walk_end(w, "site_t");
 }
 
 /* --- field rules (the same order and words as sitefile.validate_site) -------------------------- */
@@ -144,7 +57,7 @@ static int walk_site(walk_t *const w)
 static int check_fields(const stridefix_site_t *const s, const char *const name, char *const err,
                         const size_t err_size)
 {
-#define BAD(...) failf(err, err_size, name, SF_ERANGE, __VA_ARGS__)
+#define BAD(...) sf_lcm_failf(err, err_size, name, SF_ERANGE, __VA_ARGS__)
     if (!isfinite(s->map_rotation_deg)) {
         return BAD("map_rotation_deg is %g, must be finite", s->map_rotation_deg);
     }
@@ -273,12 +186,12 @@ static int check_header(const uint8_t *const data, const size_t size, const char
                         const size_t err_size)
 {
     if (size < SF_SITE_HEADER_SIZE) {
-        return failf(err, err_size, name, SF_ESYNTAX,
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
                      "file has only %zu bytes; a site file starts with a %d-byte header", size,
                      SF_SITE_HEADER_SIZE);
     }
     if (memcmp(data, magic, sizeof magic) != 0) {
-        return failf(err, err_size, name, SF_ESYNTAX,
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
                      "bad magic %02x %02x %02x %02x %02x %02x %02x %02x, expected 53 46 53 49 54 45 00 01 "
                      "(not a StrideFix site file)",
                      data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]);
@@ -288,26 +201,26 @@ static int check_header(const uint8_t *const data, const size_t size, const char
     const uint32_t crc = le32(data + 16);
     const uint32_t reserved = le32(data + 20);
     if (version != SF_SITE_FORMAT_VERSION) {
-        return failf(err, err_size, name, SF_ESYNTAX, "format version %lu, this reader supports %u",
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "format version %lu, this reader supports %u",
                      (unsigned long)version, SF_SITE_FORMAT_VERSION);
     }
     if (reserved != 0u) {
-        return failf(err, err_size, name, SF_ESYNTAX, "reserved header field is 0x%08lx, must be 0",
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "reserved header field is 0x%08lx, must be 0",
                      (unsigned long)reserved);
     }
     const size_t have = size - SF_SITE_HEADER_SIZE;
     if ((size_t)length != have) {
-        return failf(err, err_size, name, SF_ESYNTAX,
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
                      "length mismatch (%s): header says %lu payload bytes, file has %zu",
                      (size_t)length > have ? "truncated" : "trailing bytes", (unsigned long)length, have);
     }
     if (length > SF_SITE_MAX_PAYLOAD) {
-        return failf(err, err_size, name, SF_ESYNTAX, "payload of %lu bytes exceeds the limit of %u",
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "payload of %lu bytes exceeds the limit of %u",
                      (unsigned long)length, SF_SITE_MAX_PAYLOAD);
     }
     const uint32_t actual = sf_site_crc32(data + SF_SITE_HEADER_SIZE, have);
     if (actual != crc) {
-        return failf(err, err_size, name, SF_ESYNTAX, "CRC-32 mismatch: header says 0x%08lx, payload has 0x%08lx",
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "CRC-32 mismatch: header says 0x%08lx, payload has 0x%08lx",
                      (unsigned long)crc, (unsigned long)actual);
     }
     return SF_OK;
@@ -320,7 +233,7 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     const stridefix_site_t *const s = &store->msg;
     store->ap_first = malloc(sizeof(int32_t) * ((size_t)s->n_ap + 1u));
     if (store->ap_first == NULL) {
-        return failf(err, err_size, name, SF_EIO, "out of memory for the AP index (%d APs)", (int)s->n_ap);
+        return sf_lcm_failf(err, err_size, name, SF_EIO, "out of memory for the AP index (%d APs)", (int)s->n_ap);
     }
     /* entry_ap is sorted (checked): ap_first[a] = first entry whose ap is ≥ a */
     int32_t i = 0;
@@ -358,7 +271,7 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     m->entry_count = s->entry_count;
     const char *what = NULL;
     if (sf_radiomap_check(m, &what) != SF_OK) {
-        return failf(err, err_size, name, SF_ERANGE, "radio map check failed: %s", what != NULL ? what : "?");
+        return sf_lcm_failf(err, err_size, name, SF_ERANGE, "radio map check failed: %s", what != NULL ? what : "?");
     }
     return SF_OK;
 }
@@ -371,7 +284,7 @@ int sf_site_parse(const uint8_t *const data, const size_t size, const char *cons
     }
     const char *const label = name != NULL ? name : "<site>";
     if ((data == NULL && size > 0) || store == NULL || site == NULL) {
-        return failf(err, err_size, label, SF_EINVAL, "sf_site_parse: NULL argument");
+        return sf_lcm_failf(err, err_size, label, SF_EINVAL, "sf_site_parse: NULL argument");
     }
     memset(store, 0, sizeof *store);
     memset(site, 0, sizeof *site);
@@ -383,15 +296,15 @@ int sf_site_parse(const uint8_t *const data, const size_t size, const char *cons
     const size_t length = size - SF_SITE_HEADER_SIZE;
     const int64_t want_hash = __stridefix_site_t_get_hash();
     if (length >= 8) {
-        const int64_t got_hash = (int64_t)(((uint64_t)(uint32_t)be32(payload) << 32) | (uint32_t)be32(payload + 4));
+        const int64_t got_hash = (int64_t)(((uint64_t)(uint32_t)sf_lcm_be32(payload) << 32) | (uint32_t)sf_lcm_be32(payload + 4));
         if (got_hash != want_hash) {
-            return failf(err, err_size, label, SF_ESYNTAX,
+            return sf_lcm_failf(err, err_size, label, SF_ESYNTAX,
                          "payload is not a stridefix.site_t: LCM type hash 0x%016llx, expected 0x%016llx "
                          "(written with another version of site_t?)",
                          (unsigned long long)got_hash, (unsigned long long)want_hash);
         }
     }
-    walk_t w = {payload, length, 0, label, err, err_size};
+    sf_lcm_walk_t w = {payload, length, 0, label, err, err_size};
     rc = walk_site(&w);
     if (rc != SF_OK) {
         return rc;
@@ -400,12 +313,12 @@ int sf_site_parse(const uint8_t *const data, const size_t size, const char *cons
     if (used < 0) {
         stridefix_site_t_decode_cleanup(&store->msg); /* frees what was allocated before the failure */
         memset(store, 0, sizeof *store);
-        return failf(err, err_size, label, SF_ESYNTAX, "LCM decode of site_t failed (code %d)", used);
+        return sf_lcm_failf(err, err_size, label, SF_ESYNTAX, "LCM decode of site_t failed (code %d)", used);
     }
     store->loaded = 1;
     if ((size_t)used != length) {
         sf_site_store_free(store);
-        return failf(err, err_size, label, SF_ESYNTAX, "LCM decode used %d of %zu payload bytes", used, length);
+        return sf_lcm_failf(err, err_size, label, SF_ESYNTAX, "LCM decode used %d of %zu payload bytes", used, length);
     }
     rc = check_fields(&store->msg, label, err, err_size);
     if (rc == SF_OK) {
@@ -425,14 +338,14 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
         err[0] = '\0';
     }
     if (path == NULL || store == NULL || site == NULL) {
-        return failf(err, err_size, path != NULL ? path : "<site>", SF_EINVAL, "sf_site_load: NULL argument");
+        return sf_lcm_failf(err, err_size, path != NULL ? path : "<site>", SF_EINVAL, "sf_site_load: NULL argument");
     }
     memset(store, 0, sizeof *store);
     memset(site, 0, sizeof *site);
     FILE *const f = fopen(path, "rb");
     if (f == NULL) {
         const int e = errno;
-        return failf(err, err_size, path, e == ENOENT ? SF_ENOENT : SF_EIO, "cannot open site file: %s",
+        return sf_lcm_failf(err, err_size, path, e == ENOENT ? SF_ENOENT : SF_EIO, "cannot open site file: %s",
                      strerror(e));
     }
     /* read the whole file, growing the buffer, up to one byte more than the largest valid file */
@@ -444,14 +357,14 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
     for (;;) {
         uint8_t *const bigger = realloc(buf, cap);
         if (bigger == NULL) {
-            rc = failf(err, err_size, path, SF_EIO, "out of memory reading the site file (%zu bytes)", cap);
+            rc = sf_lcm_failf(err, err_size, path, SF_EIO, "out of memory reading the site file (%zu bytes)", cap);
             break;
         }
         buf = bigger;
         size += fread(buf + size, 1, cap - size, f);
         if (ferror(f)) {
             const int e = errno;
-            rc = failf(err, err_size, path, SF_EIO, "cannot read site file: %s", strerror(e));
+            rc = sf_lcm_failf(err, err_size, path, SF_EIO, "cannot read site file: %s", strerror(e));
             break;
         }
         if (size < cap || cap >= limit) {
@@ -462,7 +375,7 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
     fclose(f);
     if (rc == SF_OK) {
         if (size >= limit) {
-            rc = failf(err, err_size, path, SF_ESYNTAX, "file is larger than the %zu-byte limit of a site file",
+            rc = sf_lcm_failf(err, err_size, path, SF_ESYNTAX, "file is larger than the %zu-byte limit of a site file",
                        limit - 1u);
         } else {
             rc = sf_site_parse(buf, size, path, store, site, err, err_size);

@@ -16,6 +16,7 @@ const char *sf_strerror(const int code)
     case SF_ENOENT: return "no such file or interface";
     case SF_EUNSUPPORTED: return "not supported here";
     case SF_EFULL: return "queue full";
+    case SF_ECORRUPT: return "corrupt framing, rest of the file refused";
     default: return "unknown error";
     }
 }

@@ -301,10 +301,10 @@ static void test_every_kind_has_a_channel(void **state)
         const char *const ch = sf_rx_lcm_channel((sf_rx_kind_t)k);
         assert_non_null(ch);
         sf_rx_event_t ev;
-        assert_int_equal(sf_rx_lcm_decode(ch, junk, sizeof junk, &ev), SF_ESYNTAX);
+        assert_int_equal(sf_rx_lcm_decode(ch, junk, sizeof junk, &ev, NULL, NULL, 0), SF_ESYNTAX);
     }
     sf_rx_event_t ev;
-    assert_int_equal(sf_rx_lcm_decode("TRUTH", junk, sizeof junk, &ev), 0);
+    assert_int_equal(sf_rx_lcm_decode("TRUTH", junk, sizeof junk, &ev, NULL, NULL, 0), 0);
 }
 
 int main(void)
