@@ -10,7 +10,7 @@ DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
 .PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
-	gates check-static check-clang check-asan
+	gates check-static check-clang check-asan check-fuzz fuzz
 
 all: build
 
@@ -26,7 +26,9 @@ help:
 	@echo "make check-static - cppcheck on firmware/ (suppressions: tools/cppcheck.supp); fails on a finding"
 	@echo "make check-clang  - the whole tree with clang/clang++ (warnings are errors) into build-clang/, ctest"
 	@echo "make check-asan   - firmware + C tests with ASan+UBSan and SF_ASSERT on into build-asan/, ctest"
-	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/ and out/"
+	@echo "make check-fuzz   - each libFuzzer harness of tests/fuzz for $(FUZZ_CHECK_SECONDS) s (clang, ASan+UBSan) into build-fuzz/"
+	@echo "make fuzz   - the same, $(FUZZ_SECONDS) s per harness (FUZZ_SECONDS=...; FUZZ_HARNESSES=\"site config\")"
+	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/, build-fuzz/ and out/"
 
 deps:
 	@BUILD=$(BUILD) VENV=$(VENV) tools/deps.sh
@@ -91,7 +93,7 @@ bench: build
 
 # Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
 # so it needs the build; the other two are separate build trees with their own compiler and flags.
-gates: check-static check-clang check-asan
+gates: check-static check-clang check-asan check-fuzz
 
 check-static: build
 	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
@@ -110,5 +112,33 @@ check-asan: deps
 	@cmake --build build-asan -j $(JOBS)
 	cd build-asan && ctest --output-on-failure
 
+# libFuzzer (README "Fuzzing"): clang with ASan+UBSan, SF_ASSERT live, -O1. Each harness starts from
+# tests/fuzz/corpus/<h> and crashers/<h> (read only) and grows build-fuzz/corpus/<h>; a finding is
+# written to build-fuzz/artifacts/<h>/ and fails the goal (keep it in tests/fuzz/crashers/<h>/).
+FUZZ_HARNESSES ?= candump board_rx lcm_input site config
+FUZZ_CHECK_SECONDS ?= 30
+FUZZ_SECONDS ?= 600
+FUZZ_FLAGS ?= -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+define run_fuzzers
+	@$(call configure,build-fuzz,-DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_FLAGS=-O1 -DSF_SANITIZE=ON -DSF_FUZZ=ON \
+		-DSF_NATIVE=OFF -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++)
+	@cmake --build build-fuzz -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_HARNESSES))
+	@for h in $(FUZZ_HARNESSES); do \
+		mkdir -p build-fuzz/corpus/$$h build-fuzz/artifacts/$$h; \
+		echo "fuzz: $$h for $(1) s"; \
+		build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(1) $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/artifacts/$$h/ \
+			build-fuzz/corpus/$$h tests/fuzz/corpus/$$h tests/fuzz/crashers/$$h > build-fuzz/fuzz_$$h.log 2>&1 \
+			|| { tail -60 build-fuzz/fuzz_$$h.log; echo "fuzz: $$h FAILED (input in build-fuzz/artifacts/$$h/)"; exit 1; }; \
+		grep -E "stat::number_of_executed_runs|stat::peak_rss_mb" build-fuzz/fuzz_$$h.log | tr '\n' ' '; \
+		grep -o "cov: [0-9]* ft: [0-9]* corp: [0-9/]*[a-zA-Z]*" build-fuzz/fuzz_$$h.log | tail -1; \
+	done
+endef
+
+check-fuzz: deps
+	$(call run_fuzzers,$(FUZZ_CHECK_SECONDS))
+
+fuzz: deps
+	$(call run_fuzzers,$(FUZZ_SECONDS))
+
 clean:
-	rm -rf $(BUILD) build-clang build-asan out
+	rm -rf $(BUILD) build-clang build-asan build-fuzz out

@@ -157,8 +157,7 @@ static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end
         const bool was_open = rx->scan_open;
         rx->counters.decode_errors++;
         if (was_open) {
-            (void)close_scan(rx, false, ev);
-            return 1;
+            return close_scan(rx, false, ev); /* 0 (no event) when the open scan had no board time */
         }
         return SF_ERANGE;
     }
