@@ -122,14 +122,15 @@ FUZZ_FLAGS ?= -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
 define run_fuzzers
 	@$(call configure,build-fuzz,-DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_FLAGS=-O1 -DSF_SANITIZE=ON -DSF_FUZZ=ON \
 		-DSF_NATIVE=OFF -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++)
-	@cmake --build build-fuzz -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_HARNESSES))
+	@cmake --build build-fuzz -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_HARNESSES)) > build-fuzz/build.log 2>&1 \
+		|| { cat build-fuzz/build.log; exit 1; }
 	@for h in $(FUZZ_HARNESSES); do \
 		mkdir -p build-fuzz/corpus/$$h build-fuzz/artifacts/$$h; \
 		echo "fuzz: $$h for $(1) s"; \
 		build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(1) $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/artifacts/$$h/ \
 			build-fuzz/corpus/$$h tests/fuzz/corpus/$$h tests/fuzz/crashers/$$h > build-fuzz/fuzz_$$h.log 2>&1 \
 			|| { tail -60 build-fuzz/fuzz_$$h.log; echo "fuzz: $$h FAILED (input in build-fuzz/artifacts/$$h/)"; exit 1; }; \
-		grep -E "stat::number_of_executed_runs|stat::peak_rss_mb" build-fuzz/fuzz_$$h.log | tr '\n' ' '; \
+		grep -E "stat::(number_of_executed_units|peak_rss_mb)" build-fuzz/fuzz_$$h.log | tr -s ' \n' ' '; \
 		grep -o "cov: [0-9]* ft: [0-9]* corp: [0-9/]*[a-zA-Z]*" build-fuzz/fuzz_$$h.log | tail -1; \
 	done
 endef
