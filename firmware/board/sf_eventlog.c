@@ -42,21 +42,31 @@ static int fail(sf_eventlog_t *const log, const sf_eventlog_event_t *const ev, c
     return sf_lcm_failf(err, err_size, where, rc, "%s", what);
 }
 
-/* Reads exactly n bytes into buf (NULL: read and discard): SF_OK, SF_ELENGTH (end of file first) or
- * SF_EIO. */
-static int read_exact(sf_eventlog_t *const log, void *const buf, const size_t n)
+/* Reads exactly n bytes into buf: SF_OK, SF_ELENGTH (end of file first) or SF_EIO. */
+static int read_exact(sf_eventlog_t *const log, uint8_t *const buf, const size_t n)
 {
-    uint8_t sink[4096];
-    size_t left = n;
-    while (left > 0) {
-        const size_t chunk = buf != NULL ? left : (left < sizeof sink ? left : sizeof sink);
-        uint8_t *const to = buf != NULL ? (uint8_t *)buf + (n - left) : sink;
-        const size_t got = fread(to, 1, chunk, log->f);
-        log->offset += got;
-        left -= got;
-        if (got < chunk) {
-            return ferror(log->f) ? SF_EIO : SF_ELENGTH;
+    if (n == 0) {
+        return SF_OK; /* buf may be NULL (an empty event before any data buffer) */
+    }
+    const size_t got = fread(buf, 1, n, log->f);
+    log->offset += got;
+    if (got < n) {
+        return ferror(log->f) ? SF_EIO : SF_ELENGTH;
+    }
+    return SF_OK;
+}
+
+/* Reads and drops n bytes (an oversized event's data, never held whole): as read_exact. */
+static int discard(sf_eventlog_t *const log, size_t n)
+{
+    uint8_t sink[4096] = {0};
+    while (n > 0) {
+        const size_t chunk = n < sizeof sink ? n : sizeof sink;
+        const int rc = read_exact(log, sink, chunk);
+        if (rc != SF_OK) {
+            return rc;
         }
+        n -= chunk;
     }
     return SF_OK;
 }
@@ -113,14 +123,14 @@ int sf_eventlog_next(sf_eventlog_t *const log, sf_eventlog_event_t *const ev, ch
         snprintf(what, sizeof what, "negative data length %" PRId32 ": the rest of the log is refused", data_len);
         return fail(log, ev, SF_ECORRUPT, err, err_size, what);
     }
-    rc = read_exact(log, log->channel, (size_t)channel_len);
+    rc = read_exact(log, (uint8_t *)log->channel, (size_t)channel_len);
     if (rc != SF_OK) {
         return short_read(log, ev, rc, "channel", err, err_size);
     }
     log->channel[channel_len] = '\0';
     const size_t size = (size_t)data_len;
     if (size > SF_EVENTLOG_MAX_DATA_BYTES) {
-        rc = read_exact(log, NULL, size);
+        rc = discard(log, size);
         if (rc != SF_OK) {
             return short_read(log, ev, rc, "data", err, err_size);
         }
