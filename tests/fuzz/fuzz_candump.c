@@ -2,7 +2,6 @@
  * bytes: the input is a candump file read line by line, as `stridefixd --input FILE` reads it.
  * Reference check: every line that parses formats back (sf_candump_format) to a line that parses to
  * the same frame. */
-#define _GNU_SOURCE /* fmemopen */
 #include <string.h>
 
 #include "sf_can_input.h"
@@ -18,10 +17,7 @@ static int same_frame(const sf_can_frame_t *const a, const sf_can_frame_t *const
 
 int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
 {
-    if (size == 0) {
-        return 0;
-    }
-    FILE *const f = fmemopen((void *)(uintptr_t)data, size, "rb");
+    FILE *const f = sf_fuzz_stream(data, size);
     if (f == NULL) {
         return 0;
     }

@@ -2,7 +2,6 @@
  * file (sf_config_load reads a path: the input is written to a private temporary file), once as a
  * --set assignment (up to the first NUL or newline). Reference checks: only the documented codes,
  * a message on every failure, and every parameter stays inside its row's range (sf_param_table). */
-#define _POSIX_C_SOURCE 200809L
 #include <string.h>
 #include <unistd.h>
 

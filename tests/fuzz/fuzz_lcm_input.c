@@ -2,7 +2,6 @@
  * the bounds-checked decode) on a whole log file taken from the input, read to its end as
  * `stridefixd --replay` reads it. Reference checks: only the documented codes, every bad event has a
  * message, the counters add up (events = used + other channels + bad events). */
-#define _GNU_SOURCE /* fmemopen */
 #include <string.h>
 
 #include "sf_error.h"
@@ -11,10 +10,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
 {
-    if (size == 0) {
-        return 0;
-    }
-    FILE *const f = fmemopen((void *)(uintptr_t)data, size, "rb");
+    FILE *const f = sf_fuzz_stream(data, size);
     if (f == NULL) {
         return 0;
     }

@@ -2,7 +2,6 @@
  * line (a directory: each regular file in it, dot files skipped) to LLVMFuzzerTestOneInput, so the
  * corpus and every kept crasher are a plain ctest in each build (gcc, clang, ASan). A missing
  * directory is fine (no crashers yet); exit 1 when a file cannot be read. */
-#define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <string.h>
 #include <sys/stat.h>

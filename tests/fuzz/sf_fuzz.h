@@ -12,6 +12,13 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
+/* The input as a read-only stream (fmemopen; CMake builds the harnesses with _GNU_SOURCE), or NULL for an
+ * empty input (nothing to read) or when no stream can be made. */
+static inline FILE *sf_fuzz_stream(const uint8_t *const data, const size_t size)
+{
+    return size > 0 ? fmemopen((void *)(uintptr_t)data, size, "rb") : NULL;
+}
+
 /* A reference check that failed: says which and aborts, so the fuzzer keeps the input. */
 #define SF_FUZZ_CHECK(cond)                                                                      \
     do {                                                                                         \
