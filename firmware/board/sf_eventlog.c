@@ -30,12 +30,18 @@ static int64_t be64(const uint8_t *const p)
     return (int64_t)((hi << 32) | lo);
 }
 
-/* "<name>: event N at offset X: <what>"; ends the log unless rc only skips an event. */
+#define NUMBER_UNREAD INT64_MIN /* ev->number before the header is read whole */
+
+/* "<name>: event N at offset X: <what>" ("<name>: at offset X: <what>" in a cut-off header); ends the log unless rc only skips an event. */
 static int fail(sf_eventlog_t *const log, const sf_eventlog_event_t *const ev, const int rc, char *const err,
                 const size_t err_size, const char *const what)
 {
     char where[300];
-    snprintf(where, sizeof where, "%s: event %" PRId64 " at offset %" PRIu64, log->name, ev->number, ev->offset);
+    if (ev->number == NUMBER_UNREAD) {
+        snprintf(where, sizeof where, "%s: at offset %" PRIu64, log->name, ev->offset);
+    } else {
+        snprintf(where, sizeof where, "%s: event %" PRId64 " at offset %" PRIu64, log->name, ev->number, ev->offset);
+    }
     if (rc != SF_ERANGE && rc != SF_ESYNTAX) {
         log->done = 1;
     }
@@ -91,7 +97,7 @@ int sf_eventlog_next(sf_eventlog_t *const log, sf_eventlog_event_t *const ev, ch
         return 0;
     }
     ev->offset = log->offset;
-    ev->number = -1;
+    ev->number = NUMBER_UNREAD;
     uint8_t h[SF_EVENTLOG_HEADER_SIZE];
     const size_t got = fread(h, 1, 1, log->f);
     log->offset += got;

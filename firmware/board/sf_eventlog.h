@@ -62,7 +62,8 @@ void sf_eventlog_init(sf_eventlog_t *log, FILE *f, const char *name);
 
 /* Next event: 1 *event filled; 0 end of log; SF_ERANGE, SF_ESYNTAX (event skipped: call again),
  * SF_ELENGTH, SF_EIO (end of log) or SF_ECORRUPT (rest refused), each with a message in err. On a
- * negative code event->number and ->offset name the bad event (the others are unset). */
+ * negative code event->number and ->offset name the bad event (number INT64_MIN when the log ends
+ * inside its header; the other fields are unset). */
 int sf_eventlog_next(sf_eventlog_t *log, sf_eventlog_event_t *event, char *err, size_t err_size);
 
 /* Frees the data buffer (not the FILE). */
