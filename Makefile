@@ -116,7 +116,7 @@ check-asan: deps
 # tests/fuzz/corpus/<h> and crashers/<h> (read only) and grows build-fuzz/corpus/<h>; a finding is
 # written to build-fuzz/artifacts/<h>/ and fails the goal (keep it in tests/fuzz/crashers/<h>/).
 FUZZ_HARNESSES ?= candump board_rx lcm_input site config
-FUZZ_CHECK_SECONDS ?= 30
+FUZZ_CHECK_SECONDS ?= 28
 FUZZ_SECONDS ?= 600
 FUZZ_FLAGS ?= -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
 define run_fuzzers
