@@ -13,6 +13,8 @@
 #define IMU_PERIOD_MS 10.0
 #define MAG_PERIOD_MS 20.0
 #define BARO_PERIOD_MS 50.0
+/* No frame for this long is a silence of the bus (the board sends at least 100 IMU frames a second). */
+#define SILENCE_US 1000000
 
 void sf_board_rx_init(sf_board_rx_t *const rx)
 {
@@ -37,23 +39,45 @@ int32_t sf_wifi_channel_to_mhz(const unsigned channel)
     return 0;
 }
 
-/* Gives a sample its time; counts gaps and sync/duplicate problems. */
+/* A new epoch (the board restarted): what was in flight belongs to the old boot. */
+static void on_new_epoch(sf_board_rx_t *const rx)
+{
+    rx->counters.board_restarts++;
+    rx->accel.valid = rx->gyro.valid = false;
+    if (rx->scan_open && rx->scan_timed) {
+        rx->counters.wifi_incomplete++;
+    }
+    rx->scan_open = false;
+    rx->gnss_info_valid = false;
+    rx->last_scan_valid = false;
+}
+
+/* Output time [µs] of a board time of the current epoch. */
+static int64_t output_us(const sf_board_rx_t *const rx, const int64_t board_ms)
+{
+    return (board_ms + rx->clock.offset_ms) * 1000;
+}
+
+/* Gives a sample its time; counts gaps and sync, duplicate, late and corrupt-seq problems. */
 static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const uint8_t seq, const uint8_t t_lo,
                    int64_t *const t_us, int64_t *const useq)
 {
     int64_t t_ms;
     uint32_t lost;
-    const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, &t_ms, useq, &lost);
-    if (rc == SF_ENOTSYNC) {
-        rx->counters.unsynced++;
-        return rc;
+    const uint32_t epoch = rx->clock.epoch;
+    const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, rx->host_t_us, &t_ms, useq, &lost);
+    if (rx->clock.epoch != epoch) {
+        on_new_epoch(rx); /* this sample confirmed a held BOARD_TIME of a new boot */
     }
-    if (rc == SF_EDUPLICATE) {
-        rx->counters.duplicates++;
-        return rc;
+    switch (rc) {
+    case SF_OK: break;
+    case SF_ENOTSYNC: rx->counters.unsynced++; return rc;
+    case SF_EDUPLICATE: rx->counters.duplicates++; return rc;
+    case SF_ELATE: rx->counters.late++; return rc;
+    default: rx->counters.seq_rejected++; return rc;
     }
     rx->counters.seq_gaps += lost;
-    *t_us = t_ms * 1000;
+    *t_us = output_us(rx, t_ms);
     return SF_OK;
 }
 
@@ -62,6 +86,13 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
 {
     sf_imu_half_t *const mine = is_accel ? &rx->accel : &rx->gyro;
     sf_imu_half_t *const other = is_accel ? &rx->gyro : &rx->accel;
+    const bool repeats_waiting = mine->valid && mine->seq == half->seq && mine->t_lo_ms == half->t_lo_ms;
+    const bool repeats_sample =
+        rx->imu_time.started && rx->imu_time.epoch == rx->clock.epoch && rx->imu_time.last_seq == half->seq;
+    if (repeats_waiting || repeats_sample) {
+        rx->counters.duplicates++; /* the same half again (the bus repeated a frame) */
+        return SF_EDUPLICATE;
+    }
     if (other->valid && other->seq == half->seq) {
         other->valid = false;
         if (mine->valid) { /* a stale half of ours is left over: its partner was lost */
@@ -98,6 +129,9 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
 static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_t *const ev)
 {
     rx->scan_open = false;
+    rx->last_scan_valid = true;
+    rx->last_scan_raw_id = rx->scan_raw_id;
+    rx->last_scan_time_ms = rx->scan_time_ms;
     if (!rx->scan_timed) {
         return 0; /* started before the first BOARD_TIME: already counted as unsynced */
     }
@@ -110,24 +144,59 @@ static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_
     return 1;
 }
 
+/* A full board time carried by a frame (scan start, GNSS fix), unwrapped; SF_ERANGE (counted as a
+ * decode error) when it lies more than TIME_AGE_MAX_MS before the newest board time or more than
+ * TIME_AHEAD_MAX_MS after it plus the host time since: a corrupt time. Scans and fixes report when
+ * they started, seconds back; a flip of any bit above bit 13 is caught, lower ones cannot be told
+ * from a true time. */
+#define TIME_AGE_MAX_MS 60000
+#define TIME_AHEAD_MAX_MS 10000
+static int carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
+{
+    if (sf_board_clock_unwrap(&rx->clock, time_ms, t_ms) != SF_OK) {
+        rx->counters.unsynced++;
+        return SF_ENOTSYNC;
+    }
+    const sf_board_clock_t *const c = &rx->clock;
+    const int64_t since_ms = rx->host_t_us > c->latest_host_us ? (rx->host_t_us - c->latest_host_us) / 1000 : 0;
+    if (*t_ms < c->latest_ms - TIME_AGE_MAX_MS || *t_ms > c->latest_ms + since_ms + TIME_AHEAD_MAX_MS) {
+        rx->counters.decode_errors++;
+        return SF_ERANGE;
+    }
+    return SF_OK;
+}
+
 static int on_scan_begin(sf_board_rx_t *const rx, const struct board_wifi_scan_begin_t *const m,
                          sf_rx_event_t *const ev)
 {
+    const bool repeats = rx->scan_open ? rx->scan_raw_id == m->scan_id && rx->scan_time_ms == m->time_ms
+                                       : rx->last_scan_valid && rx->last_scan_raw_id == m->scan_id &&
+                                             rx->last_scan_time_ms == m->time_ms;
+    if (repeats) {
+        rx->counters.duplicates++; /* a scan repeated: its frames are dropped until the next scan */
+        rx->scan_repeat = !rx->scan_open;
+        return SF_EDUPLICATE;
+    }
+    rx->scan_repeat = false;
     int result = 0;
     if (rx->scan_open) {
         result = close_scan(rx, false, ev); /* SCAN_END was lost */
     }
+    int64_t t_ms;
+    const int rc = carried_time(rx, m->time_ms, &t_ms);
+    if (rc == SF_ERANGE) {
+        return result != 0 ? result : rc; /* no scan opens: its APs count as orphans */
+    }
     rx->scan_open = true;
     rx->scan_raw_id = m->scan_id;
-    int64_t t_ms;
-    rx->scan_timed = sf_board_clock_unwrap(&rx->clock, m->time_ms, &t_ms) == SF_OK;
+    rx->scan_time_ms = m->time_ms;
+    rx->scan_timed = rc == SF_OK;
     if (!rx->scan_timed) {
-        rx->counters.unsynced++;
         return result != 0 ? result : SF_ENOTSYNC;
     }
     rx->scan_id = rx->scan_id_started ? rx->scan_id + (uint8_t)(m->scan_id - (uint8_t)rx->scan_id) : m->scan_id;
     rx->scan_id_started = true;
-    rx->scan.t_us = t_ms * 1000;
+    rx->scan.t_us = output_us(rx, t_ms);
     rx->scan.scan_id = rx->scan_id;
     rx->scan.n_ap = 0;
     return result;
@@ -135,6 +204,15 @@ static int on_scan_begin(sf_board_rx_t *const rx, const struct board_wifi_scan_b
 
 static int on_scan_ap(sf_board_rx_t *const rx, const struct board_wifi_ap_t *const m)
 {
+    if (rx->scan_repeat) {
+        return SF_EDUPLICATE; /* counted once, at its SCAN_BEGIN */
+    }
+    for (int32_t i = 0; rx->scan_open && i < rx->scan.n_ap; i++) {
+        if (rx->scan.bssid[i] == (int64_t)m->bssid) {
+            rx->counters.duplicates++; /* a scan lists each BSSID once */
+            return SF_EDUPLICATE;
+        }
+    }
     const int32_t mhz = sf_wifi_channel_to_mhz(m->channel);
     if (!rx->scan_open || mhz == 0 || m->rssi >= 0 || rx->scan.n_ap >= SF_WIFI_MAX_AP) {
         rx->counters.decode_errors++;
@@ -153,6 +231,13 @@ static int on_scan_ap(sf_board_rx_t *const rx, const struct board_wifi_ap_t *con
 static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end_t *const m,
                        sf_rx_event_t *const ev)
 {
+    if (!rx->scan_open && rx->last_scan_valid && m->scan_id == rx->last_scan_raw_id) {
+        if (!rx->scan_repeat) {
+            rx->counters.duplicates++; /* the SCAN_END again */
+        }
+        rx->scan_repeat = false;
+        return SF_EDUPLICATE;
+    }
     if (!rx->scan_open || m->scan_id != rx->scan_raw_id) {
         const bool was_open = rx->scan_open;
         rx->counters.decode_errors++;
@@ -172,12 +257,12 @@ static int on_board_time(sf_board_rx_t *const rx, const sf_can_frame_t *const f,
     (void)ev;
     struct board_board_time_t m;
     (void)board_board_time_unpack(&m, f->data, f->dlc);
-    const uint32_t restarts = rx->clock.restarts;
-    sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id);
-    if (rx->clock.restarts != restarts) {
-        rx->counters.board_restarts++;
-        rx->accel.valid = rx->gyro.valid = false;
+    if (sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us) == sf_board_time_restart) {
+        on_new_epoch(rx);
     }
+    /* a held BOARD_TIME is counted in board_time_rejected when it is never confirmed */
+    rx->counters.board_time_rejected = rx->clock.time_rejected;
+    rx->counters.board_time_jumps = rx->clock.time_jumps;
     return 0;
 }
 
@@ -264,9 +349,9 @@ static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, 
     struct board_gnss_info_t m;
     (void)board_gnss_info_unpack(&m, f->data, f->dlc);
     int64_t t_ms;
-    if (sf_board_clock_unwrap(&rx->clock, m.time_ms, &t_ms) != SF_OK) {
-        rx->counters.unsynced++;
-        return SF_ENOTSYNC;
+    const int rc = carried_time(rx, m.time_ms, &t_ms);
+    if (rc != SF_OK) {
+        return rc;
     }
     rx->gnss_info_valid = true;
     rx->gnss_t_ms = t_ms;
@@ -287,7 +372,7 @@ static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const
     }
     rx->gnss_info_valid = false;
     sf_rx_gnss_t *const out = &ev->u.gnss;
-    out->t_us = rx->gnss_t_ms * 1000;
+    out->t_us = output_us(rx, rx->gnss_t_ms);
     out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
     out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
     out->alt_m = rx->gnss_alt_m;
@@ -358,6 +443,10 @@ int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
 {
     rx->counters.frames++;
     ev->kind = sf_rx_none;
+    if (rx->counters.frames > 1 && f->host_t_us - rx->host_t_us > SILENCE_US) {
+        rx->counters.silences++;
+    }
+    rx->host_t_us = f->host_t_us;
     const frame_row_t *const row = find_row(f);
     if (row == NULL) {
         rx->counters.unknown_id++;

@@ -107,6 +107,11 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
     case SF_ERANGE:
         snprintf(buf, size, "CAN id 0x%03" PRIX32 ": signal out of range or out of sequence; skipped", f->id);
         return buf;
+    case SF_ELATE:
+    case SF_ESEQ:
+    case SF_EIMPLAUSIBLE:
+        snprintf(buf, size, "CAN id 0x%03" PRIX32 ": %s; skipped", f->id, sf_strerror(code));
+        return buf;
     default: return NULL; /* unsynced / duplicate samples: counted only, they are expected at start-up */
     }
 }
