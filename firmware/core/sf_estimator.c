@@ -122,9 +122,29 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
     step->floor = sf_floor_current(&e->floor);
 }
 
+/* Whether a sample passes its stream's gate (sf_sample_gate.h); a refused one is counted by verdict. */
+static bool admit(sf_estimator_t *const e, sf_sample_gate_t *const gate, const sf_sample_limits_t *const limits,
+                  const int64_t t_us, const double *const value, const int n_axes)
+{
+    const sf_gate_verdict_t v = sf_sample_gate_check(gate, limits, t_us, value, n_axes);
+    if (v != sf_gate_accepted) {
+        e->samples_refused[v]++;
+        return false;
+    }
+    return true;
+}
+
 int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
+    const sf_sample_limits_t accel = {-p->gate_accel_full_scale_mps2, p->gate_accel_full_scale_mps2,
+                                      p->gate_accel_jump_floor_mps2, p->gate_accel_rate_max_mps3};
+    const sf_sample_limits_t gyro = {-p->gate_gyro_full_scale_radps, p->gate_gyro_full_scale_radps,
+                                     p->gate_gyro_jump_floor_radps, p->gate_gyro_rate_max_radps2};
+    if (!admit(e, &e->accel_gate, &accel, s->t_us, s->accel_mps2, 3) ||
+        !admit(e, &e->gyro_gate, &gyro, s->t_us, s->gyro_radps, 3)) {
+        return 0;
+    }
     sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
     double f_nav[3];
     sf_attitude_body_to_nav(&e->attitude, s->accel_mps2, f_nav);
@@ -170,6 +190,11 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
+    const sf_sample_limits_t mag = {-p->gate_mag_full_scale_ut, p->gate_mag_full_scale_ut, p->gate_mag_jump_floor_ut,
+                                    p->gate_mag_rate_max_ut_s};
+    if (!admit(e, &e->mag_gate, &mag, t_us, field_ut, 3)) {
+        return;
+    }
     sf_magcal_update(&e->magcal, p, t_us, field_ut);
     double corrected_ut[3];
     sf_magcal_apply(&e->magcal, field_ut, corrected_ut);
@@ -179,6 +204,11 @@ void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const
 void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                        const double pressure_pa)
 {
+    const sf_sample_limits_t baro = {p->gate_baro_min_pa, p->gate_baro_max_pa, p->gate_baro_jump_floor_pa,
+                                     p->gate_baro_rate_max_pa_s};
+    if (!admit(e, &e->baro_gate, &baro, t_us, &pressure_pa, 1)) {
+        return;
+    }
     sf_floor_update(&e->floor, p, t_us, pressure_pa);
     if (e->floor_vote_active) {
         bool rereference;
@@ -289,5 +319,8 @@ void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *c
                                       .has_site = e->site != NULL,
                                       .mag_rejected = e->attitude.mag_rejected,
                                       .steps_refused = e->steps_refused,
-                                      .stride_calibrations = e->stride_calibrations};
+                                      .stride_calibrations = e->stride_calibrations,
+                                      .samples_out_of_range = e->samples_refused[sf_gate_out_of_range],
+                                      .samples_jumped = e->samples_refused[sf_gate_jump],
+                                      .samples_out_of_order = e->samples_refused[sf_gate_out_of_order]};
 }
