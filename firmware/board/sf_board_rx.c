@@ -43,7 +43,8 @@ int32_t sf_wifi_channel_to_mhz(const unsigned channel)
 static void on_new_epoch(sf_board_rx_t *const rx)
 {
     rx->counters.board_restarts++;
-    rx->accel.valid = rx->gyro.valid = false;
+    memset(rx->accel, 0, sizeof rx->accel);
+    memset(rx->gyro, 0, sizeof rx->gyro);
     if (rx->scan_open && rx->scan_timed) {
         rx->counters.wifi_incomplete++;
     }
@@ -81,26 +82,43 @@ static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const ui
     return SF_OK;
 }
 
+/* Drops the halves of buf older than seq: their partners can no longer come in time. */
+static void drop_older(sf_board_rx_t *const rx, sf_imu_half_t buf[SF_IMU_HALVES], const uint8_t seq)
+{
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        if (buf[i].valid && (int8_t)(uint8_t)(seq - buf[i].seq) > 0) {
+            buf[i].valid = false;
+            rx->counters.imu_unpaired++;
+        }
+    }
+}
+
+/* Pairs IMU_ACCEL with IMU_GYRO by seq. Each half waits in a buffer of SF_IMU_HALVES, so two
+ * swapped frames (ACCEL n, ACCEL n+1, GYRO n, GYRO n+1) still pair. */
 static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_imu_half_t *const half,
                        sf_rx_event_t *const ev)
 {
-    sf_imu_half_t *const mine = is_accel ? &rx->accel : &rx->gyro;
-    sf_imu_half_t *const other = is_accel ? &rx->gyro : &rx->accel;
-    const bool repeats_waiting = mine->valid && mine->seq == half->seq && mine->t_lo_ms == half->t_lo_ms;
-    const bool repeats_sample =
-        rx->imu_time.started && rx->imu_time.epoch == rx->clock.epoch && rx->imu_time.last_seq == half->seq;
-    if (repeats_waiting || repeats_sample) {
+    sf_imu_half_t *const mine = is_accel ? rx->accel : rx->gyro;
+    sf_imu_half_t *const other = is_accel ? rx->gyro : rx->accel;
+    bool repeats = rx->imu_time.started && rx->imu_time.epoch == rx->clock.epoch && rx->imu_time.last_seq == half->seq;
+    int match = -1;
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        repeats = repeats || (mine[i].valid && mine[i].seq == half->seq && mine[i].t_lo_ms == half->t_lo_ms);
+        if (other[i].valid && other[i].seq == half->seq) {
+            match = i;
+        }
+    }
+    if (repeats) {
         rx->counters.duplicates++; /* the same half again (the bus repeated a frame) */
         return SF_EDUPLICATE;
     }
-    if (other->valid && other->seq == half->seq) {
-        other->valid = false;
-        if (mine->valid) { /* a stale half of ours is left over: its partner was lost */
-            mine->valid = false;
-            rx->counters.imu_unpaired++;
-        }
-        const sf_imu_half_t *const acc = is_accel ? half : other;
-        const sf_imu_half_t *const gyr = is_accel ? other : half;
+    if (match >= 0) {
+        const sf_imu_half_t partner = other[match];
+        other[match].valid = false;
+        drop_older(rx, mine, half->seq);
+        drop_older(rx, other, half->seq);
+        const sf_imu_half_t *const acc = is_accel ? half : &partner;
+        const sf_imu_half_t *const gyr = is_accel ? &partner : half;
         sf_rx_imu_t *const out = &ev->u.imu;
         const int rc = resolve(rx, &rx->imu_time, half->seq, half->t_lo_ms, &out->t_us, &out->seq);
         if (rc != SF_OK) {
@@ -113,15 +131,21 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
         ev->kind = sf_rx_imu;
         return 1;
     }
-    if (other->valid) { /* the other half waits for a sample we will never complete */
-        other->valid = false;
+    int slot = 0; /* a free slot, else the oldest half (its partner was lost) */
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        if (!mine[i].valid) {
+            slot = i;
+            break;
+        }
+        if ((int8_t)(uint8_t)(mine[slot].seq - mine[i].seq) > 0) {
+            slot = i;
+        }
+    }
+    if (mine[slot].valid) {
         rx->counters.imu_unpaired++;
     }
-    if (mine->valid) {
-        rx->counters.imu_unpaired++;
-    }
-    *mine = *half;
-    mine->valid = true;
+    mine[slot] = *half;
+    mine[slot].valid = true;
     return 0;
 }
 

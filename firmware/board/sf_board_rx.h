@@ -53,13 +53,15 @@ typedef struct {
     double xyz[3];
 } sf_imu_half_t;
 
+#define SF_IMU_HALVES 2
+
 typedef struct {
     sf_board_clock_t clock;
     sf_stream_time_t imu_time;
     sf_stream_time_t mag_time;
     sf_stream_time_t baro_time;
-    sf_imu_half_t accel;
-    sf_imu_half_t gyro;
+    sf_imu_half_t accel[SF_IMU_HALVES]; /* halves waiting for their partner */
+    sf_imu_half_t gyro[SF_IMU_HALVES];
     int64_t host_t_us;    /* host receive time of the latest frame */
     bool scan_open;       /* between SCAN_BEGIN and SCAN_END */
     bool scan_repeat;     /* frames of a repeated scan are being dropped */

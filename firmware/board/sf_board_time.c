@@ -22,6 +22,10 @@
 #define FIT_MAX_SAMPLES 16u
 #define RESTART_SEQ_MAX 16u
 #define FIRST_SAMPLE_MS 160
+/* After LOCK_SAMPLES samples in a row within FIT_MS of the prediction, a t_lo more than STRAY_MS from
+ * it is corrupt (sampling jitter of a board is a millisecond or two). */
+#define LOCK_SAMPLES 8u
+#define STRAY_MS 16
 
 /* The value ≡ low (mod 2^bits) nearest to predicted. */
 static int64_t snap(const int64_t predicted, const uint64_t low, const unsigned bits)
@@ -193,7 +197,17 @@ int sf_stream_time_resolve(sf_stream_time_t *const s, sf_board_clock_t *const cl
         /* The advance ≡ Δseq (mod 256) nearest to the host time that passed: exact past the wrap. */
         const double wraps = (double)llround((host_ms / s->period_ms - (double)dseq) / 256.0);
         const double advance = (double)dseq + 256.0 * (wraps > 0 ? wraps : 0);
-        const int64_t by_seq = snap(s->last_t_ms + (int64_t)llround(advance * s->period_ms), t_lo_ms, 8);
+        const int64_t predicted = s->last_t_ms + (int64_t)llround(advance * s->period_ms);
+        const int64_t by_seq = snap(predicted, t_lo_ms, 8);
+        /* A locked stream's t_lo that strays from the prediction is corrupt, not the board's timing:
+         * skipped once; a second in a row is believed (the timing really changed). */
+        const int64_t stray_ms = llabs(by_seq - predicted);
+        if (s->fits >= LOCK_SAMPLES && stray_ms > STRAY_MS && !s->strayed) {
+            s->strayed = true;
+            return SF_ESEQ;
+        }
+        s->strayed = false;
+        s->fits = stray_ms <= FIT_MS ? (s->fits < LOCK_SAMPLES ? s->fits + 1 : s->fits) : 0;
         /* Trust the sequence unless a newer BOARD_TIME proves it wrong: a sample is never sent
          * long before the BOARD_TIME that precedes it on the bus. */
         const bool new_anchor = s->generation != clock->generation;

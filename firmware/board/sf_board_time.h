@@ -14,7 +14,9 @@
  *     falls more than 128 ms before a BOARD_TIME that arrived since the previous sample.
  * A sample whose Δseq claims more time than the host saw pass is not believed: within 32 samples
  * behind it arrived late (reordered, SF_ELATE), else its seq is corrupt (SF_ESEQ); either way it is
- * skipped and the stream's state is untouched.
+ * skipped and the stream's state is untouched. Once eight samples in a row have matched the
+ * prediction, a t_lo more than 16 ms from it is corrupt and skipped (SF_ESEQ); a second in a row is
+ * believed.
  *
  * The clock believes a BOARD_TIME that agrees with what it knows (the same boot id, and a time
  * between 500 ms before the newest board time seen and the host time elapsed since, +10 %, +1 s).
@@ -65,6 +67,8 @@ typedef struct {
     int64_t seq;            /* unwrapped sequence number of the last sample */
     uint32_t generation;    /* clock generation seen at the last sample */
     uint32_t epoch;         /* clock epoch of the last sample */
+    uint32_t fits;          /* samples in a row whose t_lo matched the prediction (to LOCK) */
+    bool strayed;           /* the previous sample's t_lo strayed from a locked stream */
     double period_ms;       /* learnt sample period */
     double nominal_period_ms;
 } sf_stream_time_t;

@@ -486,6 +486,47 @@ static void test_rx_unsynced_duplicate_and_restart(void **state)
     free(rx);
 }
 
+static void test_rx_swapped_halves_still_pair(void **state)
+{
+    (void)state;
+    sf_board_rx_t *const rx = malloc(sizeof *rx);
+    assert_non_null(rx);
+    sf_board_rx_init(rx);
+    sf_rx_event_t ev;
+    const sf_can_frame_t bt = tf_board_time(5000, 1);
+    assert_int_equal(sf_board_rx_frame(rx, &bt, &ev), 0);
+    /* ACCEL 0, ACCEL 1, GYRO 0, GYRO 1: the bus swapped GYRO 0 and ACCEL 1 */
+    sf_can_frame_t f = tf_accel(0, (uint8_t)5000, 0, 0, 9.81);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 0);
+    f = tf_accel(1, (uint8_t)5010, 0, 0, 9.81);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 0);
+    f = tf_gyro(0, (uint8_t)5000, 0, 0, 0);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 1);
+    assert_int_equal(ev.u.imu.t_us, 5000000);
+    f = tf_gyro(1, (uint8_t)5010, 0, 0, 0);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 1);
+    assert_int_equal(ev.u.imu.t_us, 5010000);
+    assert_int_equal(rx->counters.imu_unpaired, 0);
+    free(rx);
+}
+
+static void test_corrupt_t_lo_of_a_locked_stream_is_skipped(void **state)
+{
+    (void)state;
+    sf_board_clock_t clock;
+    sf_stream_time_t st;
+    sf_board_clock_init(&clock);
+    sf_stream_time_init(&st, PERIOD_MS);
+    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
+    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 50);
+    int64_t t, useq;
+    uint32_t lost;
+    /* sample 50 at 50 500 ms with t_lo bit 6 flipped: 64 ms off the prediction, inside ±128 ms */
+    assert_int_equal(
+        sf_stream_time_resolve(&st, &clock, 50, (uint8_t)(50500 ^ 64), HOST_US(50500), &t, &useq, &lost), SF_ESEQ);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 51, 200);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -505,6 +546,8 @@ int main(void)
         cmocka_unit_test(test_outage_longer_than_the_seq_wrap_is_exact_by_host_time),
         cmocka_unit_test(test_rx_imu_pairs_times_and_counters),
         cmocka_unit_test(test_rx_unsynced_duplicate_and_restart),
+        cmocka_unit_test(test_rx_swapped_halves_still_pair),
+        cmocka_unit_test(test_corrupt_t_lo_of_a_locked_stream_is_skipped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
