@@ -55,6 +55,11 @@ bool sf_input_describe(const sf_input_t *in, int code, char *buf, size_t size);
 
 void sf_input_counters(const sf_input_t *in, sf_input_counters_t *counters);
 
+/* After the input ended: true, with the words in buf ("NAME: nothing valid in the input: ..."), when
+ * not one frame (CAN) or sensor event (LCM replay) was valid: a PNG given as a candump, an empty file,
+ * a log without sensor channels. The daemon then exits SF_EXIT_NOTHING_VALID. */
+bool sf_input_nothing_valid(const sf_input_t *in, char *buf, size_t size);
+
 /* The spec as given ("<stdin>" for "-"), for messages. */
 const char *sf_input_name(const sf_input_t *in);
 
