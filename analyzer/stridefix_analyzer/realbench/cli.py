@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer import datasets
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.realbench import tuning
@@ -126,7 +127,7 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
         )
     except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     print(format_table(doc))
     print(
         f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
@@ -231,7 +232,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
         doc = run_fusion(cfg)
     except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     print(format_tables(doc, tuning.axes(args.param_sets)))
     extra = f" and {doc['report']}" if doc.get("report") else ""
     print(

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,
@@ -207,7 +208,7 @@ def run(args: argparse.Namespace) -> int:
         )
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     for note in summary["warnings"]:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))
