@@ -36,7 +36,7 @@ int sf_file_check(const char *const path, const char *const what, const bool all
     const char *const kind = refused_kind(st.st_mode, allow_fifo);
     if (kind != NULL) {
         snprintf(err, err_size, "%s: %s is %s, not a file", path, what, kind);
-        return SF_EINVAL;
+        return SF_EIO; /* cannot be read as a file: the callers' "unreadable" */
     }
     return SF_OK;
 }

@@ -11,8 +11,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-/* SF_OK, SF_ENOENT (no such file), SF_EIO (cannot stat: errno's text in err) or SF_EINVAL (not a
- * file: "PATH: is a directory, not a file"); what names the role ("config", "site file", ...). */
+/* SF_OK, SF_ENOENT (no such file) or SF_EIO (cannot stat, or not a file: "PATH: config is a
+ * directory, not a file"), the "cannot read" of every loader's contract; what names the role
+ * ("config", "site file", ...) in the message. */
 int sf_file_check(const char *path, const char *what, bool allow_fifo, char *err_text, size_t err_size);
 
 #endif

@@ -267,9 +267,9 @@ static void test_device_and_directory_are_refused(void **state)
     sf_params_t p;
     sf_params_default(&p);
     char err[256] = "";
-    assert_int_equal(sf_config_load("/dev/zero", &p, err, sizeof err), SF_EINVAL);
+    assert_int_equal(sf_config_load("/dev/zero", &p, err, sizeof err), SF_EIO);
     assert_non_null(strstr(err, "/dev/zero: config is a character device"));
-    assert_int_equal(sf_config_load("/tmp", &p, err, sizeof err), SF_EINVAL);
+    assert_int_equal(sf_config_load("/tmp", &p, err, sizeof err), SF_EIO);
     assert_non_null(strstr(err, "/tmp: config is a directory"));
 }
 
