@@ -24,6 +24,7 @@ from __future__ import annotations
 import abc
 import argparse
 import dataclasses
+import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -208,11 +209,22 @@ class Dataset(abc.ABC):
         return {"max_wifi_age_s": args.max_wifi_age_s}
 
 
+def seconds_arg(text: str) -> float:
+    """An argparse type: a finite number of seconds >= 0 (``float`` alone takes ``nan`` and ``-1``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number of seconds >= 0")
+    return value
+
+
 def add_max_wifi_age_argument(parser: argparse.ArgumentParser, defaults: Defaults) -> None:
     """``--max-wifi-age-s S`` with the set's default."""
     parser.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=defaults.max_wifi_age_s,
         metavar="S",
         help="drop Wi-Fi entries last seen more than S before the scan time "

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer import datasets
+from stridefix_analyzer.datasets.protocol import seconds_arg
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
@@ -91,7 +92,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=DEFAULT_MAX_WIFI_AGE_S,
         metavar="S",
         help=f"importer: drop cached Wi-Fi entries older than S (default {DEFAULT_MAX_WIFI_AGE_S:g})",
@@ -188,7 +189,7 @@ def add_fusion_parser(sub: Any) -> None:
     )
     d.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=None,
         help="importer: drop cached Wi-Fi entries older than this [s] (default: the importer's)",
     )

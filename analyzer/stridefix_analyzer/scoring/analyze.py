@@ -10,8 +10,9 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
-Exit status: 0 success; 1 nothing could be scored (every truth sample precedes the first POSE);
-2 missing or unreadable input, or no TRUTH / no POSE in the logs.
+Exit status (:mod:`stridefix_analyzer.exits`): 0 success; 1 nothing could be scored (every truth
+sample precedes the first POSE); 2 missing or unreadable input, or no TRUTH / no POSE in the logs;
+3 nothing valid in them (not an LCM log, or neither TRUTH nor POSE in any).
 """
 
 from __future__ import annotations

@@ -54,3 +54,33 @@ def test_worst_status_of_several_inputs():
     assert exits.worst([0, 3, 0]) == exits.EXIT_NOTHING_VALID
     assert exits.worst([3, 2, 0]) == exits.EXIT_USAGE
     assert exits.worst([2, 1, 3]) == exits.EXIT_FAILURE
+
+
+# --- the same pattern in the other commands --------------------------------------------------------
+
+
+def test_analyze_of_junk_or_empty_logs_is_nothing_valid(write_log, tmp_path, cli_main, capsys):
+    """Regression (issue 12): a PNG given as a log exited 2 like a missing file; two logs without one
+    event exited 2 as if one channel were missing. Both hold nothing valid: 3."""
+    png = tmp_path / "photo.png"
+    png.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
+    assert cli_main(["analyze", str(png), "--out", str(tmp_path / "o")]) == exits.EXIT_NOTHING_VALID
+    assert "nothing valid in the input: not an LCM event log" in capsys.readouterr().err
+    empty = write_log("empty.lcmlog", [])
+    assert cli_main(["analyze", str(empty), "--out", str(tmp_path / "o")]) == exits.EXIT_NOTHING_VALID
+    assert cli_main(["radiomap", "build", str(png), "--out", str(tmp_path / "s.sfsite")]) == (
+        exits.EXIT_NOTHING_VALID
+    )
+
+
+@pytest.mark.parametrize("path", ["/dev/zero", "/tmp"])
+def test_site_file_that_is_not_a_file_is_refused(path, cli_main, capsys):
+    assert cli_main(["radiomap", "show", path]) == exits.EXIT_USAGE
+    assert "not a regular file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-1", "x"])
+def test_import_seconds_are_parsed_strictly(value, tmp_path, cli_main):
+    with pytest.raises(SystemExit) as exc:
+        cli_main(["import", "gsd", "x.txt", "-o", str(tmp_path / "x"), "--max-wifi-age-s", value])
+    assert exc.value.code == exits.EXIT_USAGE
