@@ -317,6 +317,11 @@ static int serve(daemon_t *const d)
         status = 1;
     }
     summary(d, &oc, (monotonic_us() - t0) * 1e-6);
+    char why[512];
+    if (status == 0 && sf_input_nothing_valid(d->in, why, sizeof why)) {
+        fprintf(stderr, "stridefixd: %s\n", why);
+        status = SF_EXIT_NOTHING_VALID;
+    }
     return status;
 }
 

@@ -9,6 +9,7 @@
 
 #include "sf_candump.h"
 #include "sf_error.h"
+#include "sf_file_kind.h"
 
 #ifdef __linux__
 #include <linux/can.h>
@@ -32,6 +33,11 @@ static int open_socketcan(sf_can_input_t *const in, const char *const iface, cha
     }
     struct ifreq ifr;
     memset(&ifr, 0, sizeof ifr);
+    if (strlen(iface) >= sizeof ifr.ifr_name) { /* cut short, it could name another interface */
+        snprintf(err, n, "%s: interface name longer than %zu characters", in->name, sizeof ifr.ifr_name - 1);
+        close(fd);
+        return SF_EINVAL;
+    }
     snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", iface);
     if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
         snprintf(err, n, "%s: no CAN interface '%s': %s", in->name, iface, strerror(errno));
@@ -80,6 +86,11 @@ int sf_can_input_open(sf_can_input_t *const in, const char *const spec, char *er
         in->file = stdin;
         snprintf(in->name, sizeof in->name, "<stdin>");
         return SF_OK;
+    }
+    /* a FIFO is a stream like stdin; a device (/dev/zero never ends) or a directory is refused */
+    const int kind_rc = sf_file_check(spec, "input", true, err_text, err_size);
+    if (kind_rc != SF_OK) {
+        return kind_rc;
     }
     in->file = fopen(spec, "r");
     if (in->file == NULL) {

@@ -138,6 +138,28 @@ void sf_input_counters(const sf_input_t *const in, sf_input_counters_t *const co
     counters->frames_total = in->rx.counters.frames + in->bad_syntax;
 }
 
+bool sf_input_nothing_valid(const sf_input_t *const in, char *const buf, const size_t size)
+{
+    const sf_rx_counters_t *const c = &in->rx.counters;
+    if (c->frames_ok > 0) {
+        return false;
+    }
+    if (in->lcm != NULL) {
+        if (c->frames == 0) {
+            snprintf(buf, size, "%s: nothing valid in the input: no sensor event (IMU MAG BARO WIFI GNSS)", in->name);
+        } else {
+            snprintf(buf, size, "%s: nothing valid in the input: %" PRIu64 " sensor events, none decodes",
+                     in->name, c->frames);
+        }
+    } else {
+        snprintf(buf, size,
+                 "%s: nothing valid in the input: %" PRIu64 " lines or frames read (%" PRIu64
+                 " not candump -L), not one a valid board.dbc frame",
+                 in->name, c->frames + in->bad_syntax, in->bad_syntax);
+    }
+    return true;
+}
+
 const char *sf_input_name(const sf_input_t *const in)
 {
     return in->name;

@@ -7,7 +7,8 @@
  * not an error: it is counted in one set of counters (sf_input_counters_t, never decreasing, what
  * HEALTH reports) and skipped; sf_input_describe words it, naming the file and line.
  *
- * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable),
+ * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable, or a
+ * directory or device: sf_file_kind.h; a FIFO is read like stdin),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
  * sf_input_next: see below. Memory: one heap block per open input (≈ 5.5 KiB on x86-64, asserted
  * ≤ 6 KiB: the decoder with its scan in progress, the candump line buffer), allocated by
@@ -54,6 +55,11 @@ int sf_input_next(sf_input_t *in, sf_input_item_t *item);
 bool sf_input_describe(const sf_input_t *in, int code, char *buf, size_t size);
 
 void sf_input_counters(const sf_input_t *in, sf_input_counters_t *counters);
+
+/* After the input ended: true, with the words in buf ("NAME: nothing valid in the input: ..."), when
+ * not one frame (CAN) or sensor event (LCM replay) was valid: a PNG given as a candump, an empty file,
+ * a log without sensor channels. The daemon then exits SF_EXIT_NOTHING_VALID. */
+bool sf_input_nothing_valid(const sf_input_t *in, char *buf, size_t size);
 
 /* The spec as given ("<stdin>" for "-"), for messages. */
 const char *sf_input_name(const sf_input_t *in);

@@ -10,6 +10,7 @@
 #include <lcm/eventlog.h>
 
 #include "sf_error.h"
+#include "sf_file_kind.h"
 #include "sf_rx_lcm.h"
 
 struct sf_lcm_input {
@@ -23,6 +24,11 @@ int sf_lcm_input_open(sf_lcm_input_t **const result, const char *const path, cha
     if (in == NULL) {
         snprintf(err, err_size, "out of memory");
         return SF_EIO;
+    }
+    const int kind_rc = sf_file_check(path, "LCM log", true, err, err_size);
+    if (kind_rc != SF_OK) {
+        free(in);
+        return kind_rc;
     }
     FILE *const probe = fopen(path, "rb");
     if (probe == NULL) {

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "sf_error.h"
+#include "sf_file_kind.h"
 
 static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
 
@@ -429,6 +430,10 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
     }
     memset(store, 0, sizeof *store);
     memset(site, 0, sizeof *site);
+    const int kind_rc = sf_file_check(path, "site file", true, err, err != NULL ? err_size : 0);
+    if (kind_rc != SF_OK) {
+        return kind_rc;
+    }
     FILE *const f = fopen(path, "rb");
     if (f == NULL) {
         const int e = errno;
