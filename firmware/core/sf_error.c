@@ -16,6 +16,7 @@ const char *sf_strerror(const int code)
     case SF_ENOENT: return "no such file or interface";
     case SF_EUNSUPPORTED: return "not supported here";
     case SF_EFULL: return "queue full";
+    case SF_EINTR: return "interrupted by a signal";
     default: return "unknown error";
     }
 }

@@ -18,6 +18,7 @@
 #define SF_ENOENT (-9)       /* a named file or interface does not exist */
 #define SF_EUNSUPPORTED (-10) /* not available on this platform/kernel (e.g. no AF_CAN) */
 #define SF_EFULL (-11)       /* a bounded queue or table is full; the item was dropped */
+#define SF_EINTR (-12)       /* a blocking read was interrupted by a signal; nothing was lost, call again */
 
 /* Short English text for a code; never NULL. */
 const char *sf_strerror(int code);
