@@ -52,7 +52,10 @@ struct sf_lcm_out {
     size_t head; /* next to write */
     size_t count;
     bool closing;
-    bool rotate_asked;
+    uint64_t n_queued;   /* items ever queued */
+    uint64_t n_taken;    /* items ever taken by the writer */
+    bool rotate_asked;   /* by sf_lcm_out_rotate: after the item n_queued counted then */
+    uint64_t rotate_after;
     bool write_failed;
     sf_lcm_out_counters_t counters;
 };
@@ -247,7 +250,7 @@ static void *writer_main(void *arg)
     pthread_mutex_lock(&out->lock);
     for (;;) {
         while (out->count == 0 && !out->closing) {
-            const bool rotate = out->rotate_asked;
+            const bool rotate = out->rotate_asked; /* the queue is empty: every item before it is written */
             out->rotate_asked = false;
             pthread_mutex_unlock(&out->lock);
             housekeeping(out, rotate);
@@ -262,8 +265,9 @@ static void *writer_main(void *arg)
         const item_t it = out->ring[out->head];
         out->head = (out->head + 1) % out->capacity;
         out->count--;
-        const bool rotate = out->rotate_asked;
-        out->rotate_asked = false;
+        out->n_taken++;
+        const bool rotate = out->rotate_asked && out->n_taken >= out->rotate_after;
+        out->rotate_asked &= !rotate;
         pthread_cond_signal(&out->not_full);
         pthread_mutex_unlock(&out->lock);
 
@@ -405,6 +409,7 @@ static int enqueue(sf_lcm_out_t *const out, const char *const channel, const int
     memcpy(it.data, data, size);
     out->ring[(out->head + out->count) % out->capacity] = it;
     out->count++;
+    out->n_queued++;
     pthread_cond_signal(&out->not_empty);
     pthread_mutex_unlock(&out->lock);
     return SF_OK;
@@ -429,6 +434,7 @@ void sf_lcm_out_rotate(sf_lcm_out_t *const out)
     }
     pthread_mutex_lock(&out->lock);
     out->rotate_asked = true;
+    out->rotate_after = out->n_queued;
     pthread_cond_signal(&out->not_empty);
     pthread_mutex_unlock(&out->lock);
 }
