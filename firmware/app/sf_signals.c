@@ -11,18 +11,21 @@
 _Static_assert(ATOMIC_INT_LOCK_FREE == 2, "signal handlers need lock-free atomics");
 
 static atomic_int stop_signal;
+static atomic_int stop_seen; /* the main loop has left its reads: no more alarms */
 static atomic_uint rotate_requests;
 
 static void on_stop(const int sig)
 {
     atomic_store(&stop_signal, sig);
-    alarm(1);
+    if (atomic_load(&stop_seen) == 0) {
+        alarm(1);
+    }
 }
 
 static void on_alarm(const int sig)
 {
     (void)sig;
-    if (atomic_load(&stop_signal) != 0) {
+    if (atomic_load(&stop_signal) != 0 && atomic_load(&stop_seen) == 0) {
         alarm(1); /* the main loop has not stopped yet: interrupt its read again */
     }
 }
@@ -55,6 +58,12 @@ int sf_signals_install(void)
 int sf_signals_stop_requested(void)
 {
     return atomic_load(&stop_signal);
+}
+
+void sf_signals_input_done(void)
+{
+    atomic_store(&stop_seen, 1);
+    alarm(0);
 }
 
 const atomic_uint *sf_signals_rotate_requests(void)

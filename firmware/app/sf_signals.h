@@ -19,6 +19,9 @@ int sf_signals_install(void);
 /* The stop signal received (SIGTERM or SIGINT), or 0. */
 int sf_signals_stop_requested(void);
 
+/* The main loop reads no more input: the alarms stop (so they interrupt nothing during the close). */
+void sf_signals_input_done(void);
+
 /* Incremented by every SIGHUP. */
 const atomic_uint *sf_signals_rotate_requests(void);
 

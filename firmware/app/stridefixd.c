@@ -224,6 +224,7 @@ static int run(daemon_t *const d)
         }
         handle(d, &d->item);
     }
+    sf_signals_input_done();
     if (!d->config_written) {
         sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
         d->config_written = true;

@@ -186,7 +186,11 @@ static void keep_header(sf_lcm_out_t *const out, const item_t *const it)
     memcpy(data, it->data, it->size);
     free(out->header.channel);
     free(out->header.data);
-    out->header = (item_t){channel, data, it->size, it->timestamp_us, true};
+    out->header.channel = channel;
+    out->header.data = data;
+    out->header.size = it->size;
+    out->header.timestamp_us = it->timestamp_us;
+    out->header.is_header = true;
 }
 
 static void write_item(sf_lcm_out_t *const out, const item_t *const it)
