@@ -221,3 +221,22 @@ def test_sigkill_loses_no_record_older_than_the_fsync_interval(stridefixd, candu
     newest_wall = feeder.t0_wall + (imu_t_s.max() - imu_t_s.min())
     age_s = kill_wall - newest_wall
     assert age_s <= interval_s, f"the newest record in the log is {age_s:.3f} s older than the kill"
+
+
+def test_time_rotation_closes_files_by_age(stridefixd, candump, tmp_path, log_detail):
+    """WHEN output.log_rotate_s=1 and a live-paced feed runs for 2.5 s, THEN at least three files,
+    every one but the last renamed while the feed ran, each starting with CONFIG."""
+    log = tmp_path / "walk.lcmlog"
+    proc = start_on_stdin(stridefixd, log, "--set", "output.log_rotate_s=1")
+    feeder = Feeder(proc, candump.read_text().splitlines(keepends=True))
+    time.sleep(2.5)
+    assert log.exists() and (tmp_path / "walk.001.lcmlog").exists()  # closed by age, not by the stop
+    proc.send_signal(signal.SIGTERM)
+    stderr = proc.stderr.read()
+    proc.wait(timeout=10)
+    feeder.stop.set()
+    feeder.thread.join(timeout=10)
+    assert proc.returncode == 0, stderr
+    files = sorted(tmp_path.glob("*.lcmlog"))
+    assert len(files) == log_detail(stderr)["files"] >= 3 and not list(tmp_path.glob("*.part"))
+    assert all(channels(p)[0] == "CONFIG" for p in files)
