@@ -33,6 +33,8 @@ typedef struct {
     int n_sets;
     bool quiet;
     long max_messages;
+    bool force;      /* --force: an existing log file may be replaced */
+    bool allow_root; /* --allow-root: a live input as root */
 } sf_options_t;
 
 /* 0 to run, or the exit status (SF_EXIT_USAGE, with a message on stderr). */

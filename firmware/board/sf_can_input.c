@@ -19,8 +19,6 @@
 #include <sys/socket.h>
 #endif
 
-#define SOCKETCAN_PREFIX "socketcan:"
-
 static int open_socketcan(sf_can_input_t *const in, const char *const iface, char *const err, const size_t n)
 {
 #ifdef __linux__
@@ -78,8 +76,8 @@ int sf_can_input_open(sf_can_input_t *const in, const char *const spec, char *er
     memset(in, 0, sizeof *in);
     in->fd = -1;
     snprintf(in->name, sizeof in->name, "%s", spec);
-    if (strncmp(spec, SOCKETCAN_PREFIX, strlen(SOCKETCAN_PREFIX)) == 0) {
-        return open_socketcan(in, spec + strlen(SOCKETCAN_PREFIX), err_text, err_size);
+    if (strncmp(spec, SF_CAN_INPUT_SOCKETCAN_PREFIX, strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX)) == 0) {
+        return open_socketcan(in, spec + strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX), err_text, err_size);
     }
     in->kind = sf_can_input_file;
     if (strcmp(spec, "-") == 0) {
@@ -108,7 +106,7 @@ static int next_socketcan(sf_can_input_t *const in, sf_can_frame_t *const frame)
     for (;;) {
         const ssize_t n = read(in->fd, &cf, sizeof cf);
         if (n < 0 && errno == EINTR) {
-            continue;
+            return SF_EINTR; /* a signal: the caller decides whether to stop */
         }
         if (n < 0) {
             return SF_EIO;
@@ -145,6 +143,10 @@ int sf_can_input_next(sf_can_input_t *const in, sf_can_frame_t *const frame)
     }
     for (;;) {
         if (fgets(in->line, sizeof in->line, in->file) == NULL) {
+            if (ferror(in->file) && errno == EINTR) {
+                clearerr(in->file);
+                return SF_EINTR; /* a signal: the caller decides whether to stop */
+            }
             return ferror(in->file) ? SF_EIO : 0;
         }
         in->line_no++;

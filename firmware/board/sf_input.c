@@ -170,6 +170,12 @@ bool sf_input_is_live(const sf_input_t *const in)
     return in->lcm == NULL && in->can.kind == sf_can_input_socketcan;
 }
 
+bool sf_input_spec_is_live(const char *const spec)
+{
+    const char *const prefix = SF_CAN_INPUT_SOCKETCAN_PREFIX;
+    return spec != NULL && strncmp(spec, prefix, strlen(prefix)) == 0;
+}
+
 void sf_input_close(sf_input_t *const in)
 {
     if (in == NULL) {

@@ -46,7 +46,8 @@ typedef struct {
 int sf_input_open(sf_input_t **in, const char *spec, char *err_text, size_t err_size);
 
 /* Next item: 1 *item filled; 0 end of input; SF_EIO a read error (errno tells); SF_ESYNTAX a line or
- * event that does not parse (counted and skipped, no item: call again). */
+ * event that does not parse (counted and skipped, no item: call again); SF_EINTR a blocking read
+ * (stdin, SocketCAN) interrupted by a signal (no item: call again, or stop). */
 int sf_input_next(sf_input_t *in, sf_input_item_t *item);
 
 /* The words for a skipped input (an SF_ESYNTAX of sf_input_next, or an item's status) of the latest
@@ -67,6 +68,9 @@ const char *sf_input_name(const sf_input_t *in);
 /* True for a live source (SocketCAN), where the logger must never wait on the disk; false for files,
  * stdin and logs, whose replay may wait rather than drop. */
 bool sf_input_is_live(const sf_input_t *in);
+
+/* True for a spec that names a live source (socketcan:IFACE), before anything is opened. */
+bool sf_input_spec_is_live(const char *spec);
 
 /* Closes what sf_input_open opened, and only that (never a descriptor it did not open, such as
  * standard input for an LCM replay); in may be NULL. */

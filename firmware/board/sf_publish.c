@@ -104,6 +104,7 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .log_events = (int64_t)oc.events,
         .log_bytes = (int64_t)oc.bytes,
         .log_drops = (int64_t)oc.drops,
+        .log_drop_bytes = (int64_t)oc.drop_bytes,
         .loop_mean_us = loop->n > 0 ? (float)(loop->sum_us / (double)loop->n) : 0.0f,
         .loop_max_us = (float)loop->max_us,
     };
@@ -136,5 +137,6 @@ void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const in
                               .n = (int32_t)sf_param_count,
                               .key = key_ptrs,
                               .value = value_ptrs};
-    SF_LCM_WRITE(out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
+    /* the header: every rotated log file starts with a copy, so each reads alone */
+    SF_LCM_WRITE_WITH(sf_lcm_out_write_header, out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
 }

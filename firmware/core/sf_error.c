@@ -19,6 +19,7 @@ const char *sf_strerror(const int code)
     case SF_ELATE: return "sample arrived late (reordered)";
     case SF_ESEQ: return "sequence number implausible for the time elapsed (corrupt)";
     case SF_EIMPLAUSIBLE: return "sample beyond full scale or a physically impossible jump";
+    case SF_EINTR: return "interrupted by a signal";
     default: return "unknown error";
     }
 }

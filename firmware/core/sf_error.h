@@ -21,6 +21,7 @@
 #define SF_ELATE (-12)       /* a sample arrived after a newer one of its stream (reordered) */
 #define SF_ESEQ (-13)        /* a sequence number that claims more time than passed (corrupt) */
 #define SF_EIMPLAUSIBLE (-14) /* a sample beyond full scale or a physically impossible jump */
+#define SF_EINTR (-15)       /* a blocking read was interrupted by a signal; nothing was lost, call again */
 
 /* Short English text for a code; never NULL. */
 const char *sf_strerror(int code);

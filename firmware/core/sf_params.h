@@ -140,7 +140,10 @@
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
-    X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
+    X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)") \
+    X(output, fsync_interval_ms,   int32_t, 1000,    0,       60000,   "ms",    "the log writer fdatasyncs at least this often (0: after every event, one disk sync each: slow): what power loss may cost") \
+    X(output, log_rotate_mb,       int32_t, 0,       0,       1000000, "MB",    "start a new log file before one would exceed this size (0: no size rotation)") \
+    X(output, log_rotate_s,        int32_t, 0,       0,       604800,  "s",     "start a new log file when one is this old (0: no time rotation; SIGHUP rotates too)")
 
 /* sf_fingerprint.h */
 #define SF_PARAMS_FINGERPRINT(X)                                                                       \

@@ -182,6 +182,7 @@ static void test_candump_and_lcm_replay_give_the_same_events(void **state)
 
     sf_lcm_out_t *out = NULL;
     char err[256];
+    unlink(lcmlog); /* the log is created O_EXCL: the name only, not the file */
     assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 16, true, err, sizeof err), SF_OK);
     for (int i = 0; i < can.n; i++) {
         sf_rx_lcm_write(out, can.log_t_us[i], &can.ev[i]);
@@ -256,6 +257,7 @@ static void test_replay_close_does_not_close_stdin(void **state)
     char lcmlog[64], spec[80];
     temp_path(lcmlog, sizeof lcmlog, "stdin");
     sf_lcm_out_t *out = NULL;
+    unlink(lcmlog); /* the log is created O_EXCL: the name only, not the file */
     assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 4, true, NULL, 0), SF_OK);
     sf_rx_event_t ev = {.kind = sf_rx_mag, .u.mag = {.t_us = 1000, .seq = 1, .field_ut = {1.0, 2.0, 3.0}}};
     sf_rx_lcm_write(out, 5, &ev);
