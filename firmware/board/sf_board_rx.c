@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "board.h"
+#include "sf_board_scan.h"
 #include "sf_error.h"
 
 #define DEG_TO_RAD (3.14159265358979323846 / 180.0)
@@ -53,12 +54,6 @@ static void on_new_epoch(sf_board_rx_t *const rx)
     rx->last_scan_valid = false;
 }
 
-/* Output time [µs] of a board time of the current epoch. */
-static int64_t output_us(const sf_board_rx_t *const rx, const int64_t board_ms)
-{
-    return (board_ms + rx->clock.offset_ms) * 1000;
-}
-
 /* Gives a sample its time; counts gaps and sync, duplicate, late and corrupt-seq problems. */
 static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const uint8_t seq, const uint8_t t_lo,
                    int64_t *const t_us, int64_t *const useq)
@@ -78,7 +73,7 @@ static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const ui
     default: rx->counters.seq_rejected++; return rc;
     }
     rx->counters.seq_gaps += lost;
-    *t_us = output_us(rx, t_ms);
+    *t_us = sf_board_clock_output_us(&rx->clock, t_ms);
     return SF_OK;
 }
 
@@ -149,129 +144,17 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
     return 0;
 }
 
-/* Closes the open scan into *ev. */
-static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_t *const ev)
+/* A full board time carried by a frame (scan start, GNSS fix), unwrapped (sf_board_clock_carried);
+ * a corrupt one is counted as a decode error. */
+int sf_board_rx_carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
 {
-    rx->scan_open = false;
-    rx->last_scan_valid = true;
-    rx->last_scan_raw_id = rx->scan_raw_id;
-    rx->last_scan_time_ms = rx->scan_time_ms;
-    if (!rx->scan_timed) {
-        return 0; /* started before the first BOARD_TIME: already counted as unsynced */
-    }
-    rx->scan.complete = complete;
-    if (!complete) {
-        rx->counters.wifi_incomplete++;
-    }
-    ev->kind = sf_rx_wifi;
-    ev->u.wifi = rx->scan;
-    return 1;
-}
-
-/* A full board time carried by a frame (scan start, GNSS fix), unwrapped; SF_ERANGE (counted as a
- * decode error) when it lies more than TIME_AGE_MAX_MS before the newest board time or more than
- * TIME_AHEAD_MAX_MS after it plus the host time since: a corrupt time. Scans and fixes report when
- * they started, seconds back; a flip of any bit above bit 13 is caught, lower ones cannot be told
- * from a true time. */
-#define TIME_AGE_MAX_MS 60000
-#define TIME_AHEAD_MAX_MS 10000
-static int carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
-{
-    if (sf_board_clock_unwrap(&rx->clock, time_ms, t_ms) != SF_OK) {
+    const int rc = sf_board_clock_carried(&rx->clock, time_ms, rx->host_t_us, t_ms);
+    if (rc == SF_ENOTSYNC) {
         rx->counters.unsynced++;
-        return SF_ENOTSYNC;
-    }
-    const sf_board_clock_t *const c = &rx->clock;
-    const int64_t since_ms = rx->host_t_us > c->latest_host_us ? (rx->host_t_us - c->latest_host_us) / 1000 : 0;
-    if (*t_ms < c->latest_ms - TIME_AGE_MAX_MS || *t_ms > c->latest_ms + since_ms + TIME_AHEAD_MAX_MS) {
+    } else if (rc == SF_ERANGE) {
         rx->counters.decode_errors++;
-        return SF_ERANGE;
     }
-    return SF_OK;
-}
-
-static int on_scan_begin(sf_board_rx_t *const rx, const struct board_wifi_scan_begin_t *const m,
-                         sf_rx_event_t *const ev)
-{
-    const bool repeats = rx->scan_open ? rx->scan_raw_id == m->scan_id && rx->scan_time_ms == m->time_ms
-                                       : rx->last_scan_valid && rx->last_scan_raw_id == m->scan_id &&
-                                             rx->last_scan_time_ms == m->time_ms;
-    if (repeats) {
-        rx->counters.duplicates++; /* a scan repeated: its frames are dropped until the next scan */
-        rx->scan_repeat = !rx->scan_open;
-        return SF_EDUPLICATE;
-    }
-    rx->scan_repeat = false;
-    int result = 0;
-    if (rx->scan_open) {
-        result = close_scan(rx, false, ev); /* SCAN_END was lost */
-    }
-    int64_t t_ms;
-    const int rc = carried_time(rx, m->time_ms, &t_ms);
-    if (rc == SF_ERANGE) {
-        return result != 0 ? result : rc; /* no scan opens: its APs count as orphans */
-    }
-    rx->scan_open = true;
-    rx->scan_raw_id = m->scan_id;
-    rx->scan_time_ms = m->time_ms;
-    rx->scan_timed = rc == SF_OK;
-    if (!rx->scan_timed) {
-        return result != 0 ? result : SF_ENOTSYNC;
-    }
-    rx->scan_id = rx->scan_id_started ? rx->scan_id + (uint8_t)(m->scan_id - (uint8_t)rx->scan_id) : m->scan_id;
-    rx->scan_id_started = true;
-    rx->scan.t_us = output_us(rx, t_ms);
-    rx->scan.scan_id = rx->scan_id;
-    rx->scan.n_ap = 0;
-    return result;
-}
-
-static int on_scan_ap(sf_board_rx_t *const rx, const struct board_wifi_ap_t *const m)
-{
-    if (rx->scan_repeat) {
-        return SF_EDUPLICATE; /* counted once, at its SCAN_BEGIN */
-    }
-    for (int32_t i = 0; rx->scan_open && i < rx->scan.n_ap; i++) {
-        if (rx->scan.bssid[i] == (int64_t)m->bssid) {
-            rx->counters.duplicates++; /* a scan lists each BSSID once */
-            return SF_EDUPLICATE;
-        }
-    }
-    const int32_t mhz = sf_wifi_channel_to_mhz(m->channel);
-    if (!rx->scan_open || mhz == 0 || m->rssi >= 0 || rx->scan.n_ap >= SF_WIFI_MAX_AP) {
-        rx->counters.decode_errors++;
-        return SF_ERANGE;
-    }
-    if (!rx->scan_timed) {
-        return 0;
-    }
-    const int32_t i = rx->scan.n_ap++;
-    rx->scan.bssid[i] = (int64_t)m->bssid;
-    rx->scan.rssi_dbm[i] = (float)m->rssi;
-    rx->scan.freq_mhz[i] = mhz;
-    return 0;
-}
-
-static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end_t *const m,
-                       sf_rx_event_t *const ev)
-{
-    if (!rx->scan_open && rx->last_scan_valid && m->scan_id == rx->last_scan_raw_id) {
-        if (!rx->scan_repeat) {
-            rx->counters.duplicates++; /* the SCAN_END again */
-        }
-        rx->scan_repeat = false;
-        return SF_EDUPLICATE;
-    }
-    if (!rx->scan_open || m->scan_id != rx->scan_raw_id) {
-        const bool was_open = rx->scan_open;
-        rx->counters.decode_errors++;
-        if (was_open) {
-            (void)close_scan(rx, false, ev);
-            return 1;
-        }
-        return SF_ERANGE;
-    }
-    return close_scan(rx, rx->scan.n_ap == (int32_t)m->n_ap, ev);
+    return rc;
 }
 
 /* ---- one handler per board.dbc frame ------------------------------------------------------------ */
@@ -349,7 +232,7 @@ static int on_wifi_scan_begin(sf_board_rx_t *const rx, const sf_can_frame_t *con
 {
     struct board_wifi_scan_begin_t m;
     (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
-    return on_scan_begin(rx, &m, ev);
+    return sf_board_scan_begin(rx, &m, ev);
 }
 
 static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -357,14 +240,14 @@ static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
     (void)ev;
     struct board_wifi_ap_t m;
     (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
-    return on_scan_ap(rx, &m);
+    return sf_board_scan_ap(rx, &m);
 }
 
 static int on_wifi_scan_end(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
     struct board_wifi_scan_end_t m;
     (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
-    return on_scan_end(rx, &m, ev);
+    return sf_board_scan_end(rx, &m, ev);
 }
 
 static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -373,7 +256,7 @@ static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, 
     struct board_gnss_info_t m;
     (void)board_gnss_info_unpack(&m, f->data, f->dlc);
     int64_t t_ms;
-    const int rc = carried_time(rx, m.time_ms, &t_ms);
+    const int rc = sf_board_rx_carried_time(rx, m.time_ms, &t_ms);
     if (rc != SF_OK) {
         return rc;
     }
@@ -396,7 +279,7 @@ static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const
     }
     rx->gnss_info_valid = false;
     sf_rx_gnss_t *const out = &ev->u.gnss;
-    out->t_us = output_us(rx, rx->gnss_t_ms);
+    out->t_us = sf_board_clock_output_us(&rx->clock, rx->gnss_t_ms);
     out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
     out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
     out->alt_m = rx->gnss_alt_m;

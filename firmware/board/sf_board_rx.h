@@ -2,7 +2,8 @@
  *
  * Decodes each frame with the pack/unpack code that cantools generates from firmware/board.dbc,
  * gives every sample its board time (sf_board_time.h), pairs IMU_ACCEL with IMU_GYRO by seq,
- * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END, and pairs GNSS_INFO with GNSS_POSITION.
+ * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END (sf_board_scan.c), and pairs GNSS_INFO with
+ * GNSS_POSITION.
  * One frame yields at most one event (sf_rx_event.h). Frames are dispatched through one table in
  * sf_board_rx.c (id, DBC length, handler): adding a frame is its DBC entry plus one row. Bad frames
  * are counted in sf_rx_counters_t and skipped: the return code says which counter moved, so the

@@ -141,6 +141,28 @@ int sf_board_clock_unwrap(const sf_board_clock_t *const clock, const uint32_t ti
     return SF_OK;
 }
 
+#define CARRIED_AGE_MAX_MS 60000
+#define CARRIED_AHEAD_MAX_MS 10000
+
+int sf_board_clock_carried(const sf_board_clock_t *const c, const uint32_t time_ms, const int64_t host_t_us,
+                           int64_t *const t_ms)
+{
+    const int rc = sf_board_clock_unwrap(c, time_ms, t_ms);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    const int64_t since_ms = elapsed_ms(c->latest_host_us, host_t_us);
+    if (*t_ms < c->latest_ms - CARRIED_AGE_MAX_MS || *t_ms > c->latest_ms + since_ms + CARRIED_AHEAD_MAX_MS) {
+        return SF_ERANGE;
+    }
+    return SF_OK;
+}
+
+int64_t sf_board_clock_output_us(const sf_board_clock_t *const clock, const int64_t board_ms)
+{
+    return (board_ms + clock->offset_ms) * 1000;
+}
+
 void sf_stream_time_init(sf_stream_time_t *const stream, const double nominal_period_ms)
 {
     *stream = (sf_stream_time_t){0};

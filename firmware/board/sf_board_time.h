@@ -91,6 +91,16 @@ sf_board_time_verdict_t sf_board_clock_on_time(sf_board_clock_t *clock, uint32_t
  * BOARD_TIME. */
 int sf_board_clock_unwrap(const sf_board_clock_t *clock, uint32_t time_ms, int64_t *t_ms);
 
+/* A full 32-bit board time carried by another frame, received at host_t_us, checked: SF_ERANGE when
+ * it lies more than 60 s before the newest board time or more than 10 s after it plus the host time
+ * since (a corrupt time: scans and fixes report when they started, seconds back; a flip of any bit
+ * above bit 13 is caught, lower ones cannot be told from a true time). SF_ENOTSYNC before the first
+ * BOARD_TIME. */
+int sf_board_clock_carried(const sf_board_clock_t *clock, uint32_t time_ms, int64_t host_t_us, int64_t *t_ms);
+
+/* Output time [µs] of a board time of the clock's current epoch. */
+int64_t sf_board_clock_output_us(const sf_board_clock_t *clock, int64_t board_ms);
+
 void sf_stream_time_init(sf_stream_time_t *stream, double nominal_period_ms);
 
 /* Resolves one sample received at host_t_us. On SF_OK fills *t_ms (board time of the clock's
