@@ -268,11 +268,15 @@ def write_init_ini(result: SimResult, path: Path) -> None:
 def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | None = None) -> dict:
     """Write the run's files into ``out_dir``; candump lines go to ``candump_stream`` when given."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    text = "\n".join(result.board.lines) + "\n"
+    lines = result.board.lines or [""]  # (no frame: one empty line, as before)
+    step = 100_000  # in pieces: an 8-hour walk's text would be another 400 MB at once
     if candump_stream is None:
-        (out_dir / "board.candump").write_text(text, encoding="ascii")
+        with open(out_dir / "board.candump", "w", encoding="ascii") as f:
+            for i in range(0, len(lines), step):
+                f.write("\n".join(lines[i : i + step]) + "\n")
     else:
-        candump_stream.write(text)
+        for i in range(0, len(lines), step):
+            candump_stream.write("\n".join(lines[i : i + step]) + "\n")
         candump_stream.flush()
     write_truth_log(result, out_dir / "truth.lcmlog")
     write_init_ini(result, out_dir / "init_truth.ini")

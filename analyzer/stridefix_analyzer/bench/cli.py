@@ -19,7 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import fusion, realdata, reliability, sil_pdr
+from stridefix_analyzer.bench import fusion, realdata, reliability, sil_pdr, soak
 from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
@@ -84,6 +84,16 @@ def _run_reliability(args: argparse.Namespace, firmware: Firmware, seeds: list[i
     return reliability.missed_targets(doc)
 
 
+def _run_soak(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del seeds  # one walk (soak.SEED)
+    if not 0 < args.checkpoint_h < args.hours:
+        raise BenchUsageError(f"--checkpoint-h {args.checkpoint_h}: must be in 0..--hours ({args.hours})")
+    doc = soak.run_soak(firmware, out, hours=args.hours, checkpoint_h=args.checkpoint_h, sets=args.sets)
+    print(soak.format_table(doc))
+    print(f"wrote {out / 'soak.json'}")
+    return soak.missed_targets(doc)
+
+
 Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
 #: sub-bench name → (runner, default seeds)
 BENCHES: dict[str, tuple[Runner, str]] = {
@@ -92,6 +102,7 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "office-wifi": (_run_office, "1,2,3"),
     "real-targets": (_run_real_targets, "1"),
     "reliability": (_run_reliability, "1"),
+    "soak": (_run_soak, "1"),
 }
 
 
@@ -120,7 +131,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "experiment (fusion schemes at the reference points); office-wifi: the fusion "
         "schemes on the default office walk with a surveyed radio map; real-targets: issue 11's "
         "targets on realbench results.json files (--results); reliability: the default walk with each bus "
-        "and board fault vs clean (make reliability)",
+        "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
+        "accounting (make soak)",
     )
     p.add_argument(
         "--paces",
@@ -169,6 +181,16 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--no-site",
         action="store_true",
         help="reliability: replay without the office site (PDR only; faster, no fused scheme)",
+    )
+    p.add_argument(
+        "--hours", type=float, default=8.0, metavar="H", help="soak: length of the walk [h] (default: 8)"
+    )
+    p.add_argument(
+        "--checkpoint-h",
+        type=float,
+        default=1.0,
+        metavar="H",
+        help="soak: read the first peak RSS after this much input [h] (default: 1)",
     )
     p.add_argument(
         "--no-calibration",
