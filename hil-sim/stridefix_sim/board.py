@@ -16,7 +16,10 @@ Host timestamp = 1700000000 s + (unwrapped) board time + latency; the bus is ser
 arrives at least one frame time after the previous one (timestamps never decrease). Frame loss
 (``can.loss_rate``, seeded) models frames lost between board and logger: the board sent them (n_ap
 counts every AP frame sent), the log lacks them, the counters report what the log holds. The very first
-BOARD_TIME frame is never dropped so that a log always starts with the time reference.
+BOARD_TIME frame is never dropped so that a log always starts with the time reference. The
+``[faults]`` table adds board resets, implausible samples and bus faults (``faults.py``): resets
+through the board clock that ``_events`` uses for every time and counter, the rest on the ordered
+frames; with every fault off none of it runs.
 
 Values are clamped into each signal's DBC range, then encoded per message type at once with numpy
 (``pack``: the DBC's scale, offset, start bit and length, the same bytes as cantools'
