@@ -331,13 +331,13 @@ def emulate_board(
 
     if on:
         assert fault_rng is not None, "faults need their own random stream"
-        flt.implausible(db, t, name, word, fc, fault_rng, rec)
         lost = flt.lost_on_bus(t, lost, fc, fault_rng, rec)
         acc_sent = np.where(last_acc >= 0, ~lost[np.maximum(last_acc, 0)], False)
         imu_samples = int(np.sum(is_gyr & ~lost & acc_sent))
     keep = ~lost
     host_kept, name_kept, word_kept = host[keep], name[keep], word[keep]
-    if on:
+    if on:  # (implausible samples on frames that arrive: each one counted reaches the logger)
+        flt.implausible(db, t[keep], name_kept, word_kept, fc, fault_rng, rec)
         n_bits = np.array([8 * m.length for m in db.messages], dtype=np.int64)[name_kept]
         flt.corrupt(word_kept, n_bits, fc, fault_rng, rec)
         (name_kept, word_kept), host_kept = flt.duplicate_and_reorder(

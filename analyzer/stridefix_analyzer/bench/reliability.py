@@ -273,7 +273,7 @@ def format_table(doc: dict[str, Any]) -> str:
             f"{'yes' if r['checks']['recovered'] else 'NO':<10} {moved}"
         )
     lines.append(
-        f"(lost = board frames the daemon did not use; affected = frames the simulator damaged; tail = "
+        f"(lost = board frames the daemon did not use, negative when it used duplicates; affected = frames the simulator damaged; tail = "
         f"steps in the last {TAIL_S:g} s; errors = mean 2-D error [m]; recovered = steps within "
         f"{100 * STEPS_TOL:g} % of clean when < {100 * LOST_MAX:g} % lost, both errors within "
         f"{ERR_FACTOR:g} x clean + {ERR_MARGIN_M:g} m, steps in the tail; counters moved = HEALTH "
