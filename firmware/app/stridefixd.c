@@ -250,9 +250,9 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
             "stridefixd: faults: %" PRIu64 " duplicates, %" PRIu64 " late, %" PRIu64 " corrupt seq, %" PRIu64
             " silences, %" PRIu64 " board restarts, %" PRIu64 " BOARD_TIME not believed, %" PRIu64
             " board time jumps; samples refused: %" PRIu32 " out of range, %" PRIu32 " jumps, %" PRIu32
-            " out of order\n",
+            " out of order; %" PRIu32 " IMU gaps bridged\n",
             c->duplicates, c->late, c->seq_rejected, c->silences, c->board_restarts, c->board_time_rejected,
-            c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order);
+            c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order, st.gaps_bridged);
     fprintf(stderr,
             "stridefixd: %" PRIu64 " IMU, %" PRIu64 " MAG, %" PRIu64 " BARO, %" PRIu64 " WIFI, %" PRIu64
             " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",

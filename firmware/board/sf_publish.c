@@ -94,6 +94,7 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .samples_out_of_range = est->samples_out_of_range,
         .samples_jumped = est->samples_jumped,
         .samples_out_of_order = est->samples_out_of_order,
+        .gaps_bridged = est->gaps_bridged,
         .imu_samples = (int64_t)c->imu,
         .mag_samples = (int64_t)c->mag,
         .baro_samples = (int64_t)c->baro,

@@ -84,7 +84,21 @@ static double walk_heading(const sf_estimator_t *const e, const sf_params_t *con
     return wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
 }
 
-/* Moves the position by one credited step and fills its STEP record. */
+/* Moves the PDR track and every fusion scheme by one displacement. */
+static void advance(sf_estimator_t *const e, const sf_params_t *const p, const int64_t now_us, const double dx_m,
+                    const double dy_m, const double length_m)
+{
+    e->x_m += dx_m;
+    e->y_m += dy_m;
+    e->distance_m += length_m;
+    e->sigma_m += p->estimator_sigma_per_m * length_m;
+    for (int s = 0; s < sf_scheme_count; s++) {
+        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
+    }
+}
+
+/* Moves the position by one credited step (and first by the walk a gap hid, sf_gap_bridge.h) and
+ * fills its STEP record. */
 static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_step_event_t *const ev,
                  const int64_t now_us, sf_step_t *const step)
 {
@@ -99,18 +113,16 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
                               ? fabs(sf_floor_vertical_speed_mps(&e->floor)) * ev->period_s
                               : 0.0;
     const double length_m = fmax(level_m - 2.0 * rise_m, 0.0);
+    double bridge_m, bridge_heading_rad;
+    if (sf_gap_bridge_on_step(&e->gap, p, ev->t_us, e->heading_rad, &bridge_m, &bridge_heading_rad)) {
+        advance(e, p, now_us, bridge_m * cos(bridge_heading_rad), bridge_m * sin(bridge_heading_rad), bridge_m);
+        e->calib_anchor_valid = false; /* a guessed distance must not calibrate the stride */
+    }
+    sf_gap_bridge_note_step(&e->gap, ev->t_us, ev->period_s, length_m, e->heading_rad);
     e->step_count++;
-    e->x_m += length_m * cos(e->heading_rad);
-    e->y_m += length_m * sin(e->heading_rad);
-    /* (the fusion schemes move by the same displacement below) */
-    e->distance_m += length_m;
-    e->sigma_m += p->estimator_sigma_per_m * length_m;
     /* the calibration sum scaled like the length, so K·sum stays the distance moved */
     e->weinberg_sum += level_m > 0.0 ? sf_stride_weinberg_term(ev) * (length_m / level_m) : 0.0;
-    const double dx_m = length_m * cos(e->heading_rad), dy_m = length_m * sin(e->heading_rad);
-    for (int s = 0; s < sf_scheme_count; s++) {
-        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
-    }
+    advance(e, p, now_us, length_m * cos(e->heading_rad), length_m * sin(e->heading_rad), length_m);
 
     step->t_us = now_us; /* published when known (causal); ev->t_us is the extremum, earlier */
     step->index = e->step_count;
@@ -145,6 +157,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
         !admit(e, &e->gyro_gate, &gyro, s->t_us, s->gyro_radps, 3)) {
         return 0;
     }
+    sf_gap_bridge_on_imu(&e->gap, p, e->started ? e->t_us : 0, s->t_us);
     sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
     double f_nav[3];
     sf_attitude_body_to_nav(&e->attitude, s->accel_mps2, f_nav);
@@ -322,5 +335,6 @@ void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *c
                                       .stride_calibrations = e->stride_calibrations,
                                       .samples_out_of_range = e->samples_refused[sf_gate_out_of_range],
                                       .samples_jumped = e->samples_refused[sf_gate_jump],
-                                      .samples_out_of_order = e->samples_refused[sf_gate_out_of_order]};
+                                      .samples_out_of_order = e->samples_refused[sf_gate_out_of_order],
+                                      .gaps_bridged = e->gap.bridged};
 }

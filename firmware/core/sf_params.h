@@ -42,6 +42,13 @@
     X(gate, baro_jump_floor_pa,    double, 20.0,    0.0,     1e5,     "Pa",    "pressure change always allowed (noise, door and ventilation transients)") \
     X(gate, baro_rate_max_pa_s,    double, 1000.0,  0.0,     1e7,     "Pa/s",  "fastest pressure change accepted (8x a fast elevator)")
 
+/* sf_gap_bridge.h */
+#define SF_PARAMS_GAP(X)                                                                               \
+    X(gap,  bridge,                int32_t, 1,       0,       1,       "",      "1 = dead-reckon across an IMU gap the walk went through (bus silence, board reset)") \
+    X(gap,  min_s,                 double,  1.0,     0.1,     60.0,    "s",     "IMU gaps at least this long are bridged (shorter ones lose less than two steps)") \
+    X(gap,  max_s,                 double,  30.0,    0.0,     600.0,   "s",     "longer gaps are not guessed") \
+    X(gap,  walking_s,             double,  2.0,     0.1,     10.0,    "s",     "a step this close before the gap and after it: the walk went on through it")
+
 /* sf_estimator.h */
 #define SF_PARAMS_ESTIMATOR(X)                                                                         \
     X(estimator, gravity_tau_s,    double,  2.0,     0.1,     60.0,    "s",     "time constant of the gravity magnitude low-pass (a_v = f_up - g)") \
@@ -216,7 +223,7 @@
     X(ekf,    r_max,               double,  100.0,   1e-3,    1e4,     "",      "largest eigenvalue of the learnt fix-error model (per accuracy_m^2)")
 
 #define SF_PARAM_LIST(X) \
-    SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
+    SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
     SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
