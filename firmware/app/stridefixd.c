@@ -250,7 +250,7 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
             "stridefixd: faults: %" PRIu64 " duplicates, %" PRIu64 " late, %" PRIu64 " corrupt seq, %" PRIu64
             " silences, %" PRIu64 " board restarts, %" PRIu64 " BOARD_TIME not believed, %" PRIu64
             " board time jumps; samples refused: %" PRIu32 " out of range, %" PRIu32 " jumps, %" PRIu32
-            " out of order; %" PRIu32 " IMU gaps bridged\n",
+            " out of order; %" PRIu32 " walk gaps bridged\n",
             c->duplicates, c->late, c->seq_rejected, c->silences, c->board_restarts, c->board_time_rejected,
             c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order, st.gaps_bridged);
     fprintf(stderr,
