@@ -10,7 +10,7 @@ DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
 .PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
-	gates check-static check-clang check-asan check-fuzz fuzz
+	gates check-static check-clang check-asan reliability soak check-fuzz fuzz
 
 all: build
 
@@ -19,6 +19,8 @@ help:
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
 	@echo "make lint   - ruff (lint + format check) on all Python, mypy on the analyzer (strict on io, datasets)"
 	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance); writes out/bench/*.json"
+	@echo "make reliability - the default SIL walk with each bus/board fault vs clean; out/bench/reliability.json"
+	@echo "make soak   - an 8-hour SIL walk with faults through stridefixd: RSS at 1 h and 8 h, events accounted"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
@@ -90,6 +92,13 @@ bench: build
 	$(PY) -m stridefix_analyzer.cli bench real-targets --stridefixd $(STRIDEFIXD) --results $$results || status=1; \
 	if [ $$status -ne 0 ]; then echo "bench: FAILED: a target was missed or a bench failed (TARGET MISSED lines above)"; fi; \
 	exit $$status
+
+# Issue 12: bus and board faults (exit 1 when a fault is not recovered) and the 8-hour soak; not in make test.
+reliability: build
+	$(PY) -m stridefix_analyzer.cli bench reliability --stridefixd $(STRIDEFIXD) --out out/bench
+
+soak: build
+	$(PY) -m stridefix_analyzer.cli bench soak --stridefixd $(STRIDEFIXD) --out out/bench
 
 # Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
 # so it needs the build; the other two are separate build trees with their own compiler and flags.

@@ -6,7 +6,8 @@ A sub-command may also rewrite its own argument list before parsing (e.g. to sup
 sub-sub-command): :data:`ARGV_REWRITES` names that hook as ``"module:function"``, ``function(argv) ->
 argv``, applied only when that sub-command is the one given. This module registers and dispatches
 and nothing else; nothing imports from it.
-Exit status: 0 success, 1 the work failed, 2 bad usage or unreadable input.
+Exit status: the one contract of :mod:`stridefix_analyzer.exits` (0 ok, 1 failed while running, 2 bad
+usage or unreadable input, 3 nothing valid in the input), stated in every sub-command's ``--help``.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import argparse
 import importlib
 import sys
 from collections.abc import Callable
+
+from stridefix_analyzer.exits import EXIT_FAILURE, HELP
 
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
@@ -39,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="stridefix",
         description="StrideFix tools: simulate a walk, analyze LCM logs, render reports.",
+        epilog=HELP,
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, module_name in SUBCOMMANDS.items():
@@ -50,14 +54,24 @@ def build_parser() -> argparse.ArgumentParser:
             p.set_defaults(_run=_unavailable(name, exc))
             continue
         p = module.add_parser(sub)
+        _add_exit_help(p)
         p.set_defaults(_run=module.run)
     return parser
+
+
+def _add_exit_help(parser: argparse.ArgumentParser) -> None:
+    """The exit-status paragraph at the end of ``parser``'s help and of its sub-commands' (if any)."""
+    parser.epilog = HELP if not parser.epilog else f"{parser.epilog}\n\n{HELP}"
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in set(action.choices.values()):
+                _add_exit_help(child)
 
 
 def _unavailable(name: str, exc: ImportError) -> Callable[[argparse.Namespace], int]:
     def run(_args: argparse.Namespace) -> int:
         print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
-        return 1
+        return EXIT_FAILURE
 
     return run
 

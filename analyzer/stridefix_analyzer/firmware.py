@@ -144,7 +144,8 @@ class Firmware:
             raise FirmwareError("Firmware.run: give exactly one of input= and replay=")
         cmd = [str(self.path)]
         cmd += ["--input", str(input)] if input is not None else ["--replay", str(replay)]
-        cmd += ["--log", str(log)]
+        # --force: the log is this run's output, replaced on a re-run (stridefixd refuses otherwise)
+        cmd += ["--log", str(log), "--force"]
         if site is not None:
             cmd += ["--site", str(site)]
         if fusion is not None:

@@ -1,7 +1,9 @@
 /* sf_options.c — getopt_long over stridefixd's options (see sf_options.h). */
 #include "sf_options.h"
 
+#include <errno.h>
 #include <getopt.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,10 +34,18 @@ static void usage(FILE *const f)
             "                         LCM log (IMU MAG BARO WIFI GNSS channels) as `stridefix import` writes\n"
             "      --replay FILE      same as --input lcmlog:FILE: replay a raw-sensor log as fast as possible\n"
             "Outputs\n"
-            "  -l, --log FILE         LCM event log to write (default: DIR/stridefixd-YYYYmmdd-HHMMSS.lcmlog)\n"
+            "  -l, --log FILE         LCM event log to write (default:\n"
+            "                         DIR/stridefixd-YYYYmmdd-HHMMSS-MICROS-PID.lcmlog, UTC); written as\n"
+            "                         FILE.part and renamed to FILE when closed; rotated files are\n"
+            "                         FILE.001.lcmlog, ... (output.log_rotate_mb, output.log_rotate_s, SIGHUP)\n"
             "  -d, --log-dir DIR      directory for the default log name (default: .)\n"
+            "      --force            replace an existing log file (never through a symlink); without it an\n"
+            "                         existing FILE or FILE.part is refused (exit 1)\n"
             "      --no-log           write no log (live publishing only)\n"
-            "  -u, --lcm-url URL      also publish live to this LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0\n"
+            "  -u, --lcm-url URL      also publish live to this LCM URL (default: none, nothing leaves the\n"
+            "                         process), e.g. udpm://239.255.76.67:7667?ttl=0 (ttl=0: this host only)\n"
+            "Privilege\n"
+            "      --allow-root       read a live input (socketcan:) as root; refused without it\n"
             "Site\n"
             "      --site FILE        site file (floors, map rotation, radio map) from `stridefix radiomap build`:\n"
             "                         enables Wi-Fi fixes and the fusion schemes; without it PDR starts at\n"
@@ -61,9 +71,68 @@ static void usage(FILE *const f)
             "\n"
             "Channels written: IMU MAG BARO WIFI GNSS (inputs), STEP, POSE (one per fusion scheme),\n"
             "FIX (with a site: every scheme's verdict on every Wi-Fi fix), HEALTH (every\n"
-            "output.health_period_ms of board time, and at exit), CONFIG (once, first).\n"
-            "Exit status: 0 done (bad frames are counted and skipped, not fatal); 1 the log could not be\n"
-            "written; 2 bad usage, or an input or config that cannot be read.\n");
+            "output.health_period_ms of board time, and at exit), CONFIG (first in every log file).\n"
+            "Log durability: the writer fdatasyncs every output.fsync_interval_ms (default 1000); on a full\n"
+            "disk events are dropped and counted (events and bytes, in HEALTH and the summary), the reason\n"
+            "is printed once, and logging resumes when space returns.\n"
+            "Signals: SIGTERM, SIGINT stop reading, write a last HEALTH, close and rename the log, print\n"
+            "the summary and exit as if the input had ended; SIGHUP closes the log file and starts the next.\n"
+            "\n"
+            "Exit status (the same for every `stridefix` command):\n"
+            "  0  the input was read and held valid frames (bad ones are counted and skipped, not fatal);\n"
+            "     also when stopped by SIGTERM or SIGINT\n"
+            "  1  a failure while running: the log could not be created, lost events to a failed write\n"
+            "     (disk full) or could not be renamed, or reading the input failed\n"
+            "  2  bad usage (also a live input as root without --allow-root), or an input, config or site\n"
+            "     that cannot be read (missing, or a directory or device where a file is expected)\n"
+            "  3  nothing valid in the input: read to its end without one valid frame or sensor event\n");
+}
+
+/* A whole-string integer in [min, max] (strtol with the end checked): 0, or SF_EXIT_USAGE with a
+ * message naming the option. */
+static int parse_long(const char *const option, const char *const text, const long min, const long max,
+                      long *const value)
+{
+    char *end = NULL;
+    errno = 0;
+    const long v = strtol(text, &end, 10);
+    if (end == text || *end != '\0' || errno != 0 || v < min || v > max) {
+        fprintf(stderr, "stridefixd: %s '%s': expected an integer in [%ld, %ld]\n", option, text, min, max);
+        return SF_EXIT_USAGE;
+    }
+    *value = v;
+    return 0;
+}
+
+/* A path option that fits the daemon's buffers (room_left: what the daemon appends to it). */
+static int check_path(const char *const option, const char *const path, const size_t room_left)
+{
+    if (strlen(path) + room_left >= SF_OPTIONS_PATH_MAX) {
+        fprintf(stderr, "stridefixd: %s: a path of %zu characters is longer than the %d this accepts\n", option,
+                strlen(path), SF_OPTIONS_PATH_MAX - 1 - (int)room_left);
+        return SF_EXIT_USAGE;
+    }
+    return 0;
+}
+
+/* Every path option checked against SF_OPTIONS_PATH_MAX. */
+static int check_paths(const sf_options_t *const o)
+{
+    int rc = 0;
+    if (o->input != NULL && o->input != o->replay_spec) {
+        rc |= check_path("--input", o->input, 0);
+    }
+    if (o->log_path != NULL) {
+        rc |= check_path("--log", o->log_path, 0);
+    }
+    rc |= check_path("--log-dir", o->log_dir, 64); /* "/" and the default file name */
+    if (o->site_path != NULL) {
+        rc |= check_path("--site", o->site_path, 0);
+    }
+    for (int i = 0; i < o->n_configs; i++) {
+        rc |= check_path("--config", o->config_paths[i], 0);
+    }
+    return rc != 0 ? SF_EXIT_USAGE : 0;
 }
 
 /* Applies --config files, --set overrides and --fusion on top of the defaults. */
@@ -99,7 +168,17 @@ static int effective_params(const sf_options_t *const o, sf_params_t *const para
 int sf_options_parse(const int argc, char **const argv, const char *const version, const char *const dbc_sha256,
                      sf_options_t *const o, sf_params_t *const params)
 {
-    enum { opt_no_log = 1000, opt_print_config, opt_max_messages, opt_site, opt_fusion, opt_replay, opt_json };
+    enum {
+        opt_no_log = 1000,
+        opt_print_config,
+        opt_max_messages,
+        opt_site,
+        opt_fusion,
+        opt_replay,
+        opt_json,
+        opt_force,
+        opt_allow_root
+    };
     static const struct option longs[] = {
         {"input", required_argument, NULL, 'i'},   {"log", required_argument, NULL, 'l'},
         {"log-dir", required_argument, NULL, 'd'}, {"no-log", no_argument, NULL, opt_no_log},
@@ -111,6 +190,8 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         {"fusion", required_argument, NULL, opt_fusion},
         {"replay", required_argument, NULL, opt_replay},
         {"json", no_argument, NULL, opt_json},
+        {"force", no_argument, NULL, opt_force},
+        {"allow-root", no_argument, NULL, opt_allow_root},
         {NULL, 0, NULL, 0}};
     *o = (sf_options_t){.log_dir = ".", .max_messages = 20};
     bool want_print_config = false;
@@ -126,6 +207,9 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         case opt_site: o->site_path = optarg; break;
         case opt_fusion: o->fusion = optarg; break;
         case opt_replay: /* the raw-sensor log replay, spelled as the issue asked for it */
+            if (check_path("--replay", optarg, strlen(SF_INPUT_LCMLOG_PREFIX)) != 0) {
+                return SF_EXIT_USAGE;
+            }
             snprintf(o->replay_spec, sizeof o->replay_spec, "%s%s", SF_INPUT_LCMLOG_PREFIX, optarg);
             o->input = o->replay_spec;
             break;
@@ -145,8 +229,14 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
             break;
         case opt_print_config: want_print_config = true; break;
         case opt_json: want_json = true; break;
+        case opt_force: o->force = true; break;
+        case opt_allow_root: o->allow_root = true; break;
         case 'q': o->quiet = true; break;
-        case opt_max_messages: o->max_messages = strtol(optarg, NULL, 10); break;
+        case opt_max_messages:
+            if (parse_long("--max-messages", optarg, 0, LONG_MAX, &o->max_messages) != 0) {
+                return SF_EXIT_USAGE;
+            }
+            break;
         case 'h': usage(stdout); exit(0);
         case 'V': printf("stridefixd %s (board.dbc sha256 %s)\n", version, dbc_sha256); exit(0);
         default: usage(stderr); return SF_EXIT_USAGE;
@@ -154,6 +244,9 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
     }
     if (optind < argc) {
         fprintf(stderr, "stridefixd: unexpected argument '%s' (see --help)\n", argv[optind]);
+        return SF_EXIT_USAGE;
+    }
+    if (check_paths(o) != 0) {
         return SF_EXIT_USAGE;
     }
     if (want_json && !want_print_config) {

@@ -4,7 +4,10 @@
  * timed samples; each is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch
  * (feed()); the core's steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
  * optionally, live LCM. Bad input is counted and skipped, never fatal; counts go into HEALTH and the
- * exit summary. The scheme names come from pose_t.SCHEME_* through the core's registry. */
+ * exit summary. The scheme names come from pose_t.SCHEME_* through the core's registry.
+ * Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h) and the run closes as at the end of
+ * the input; a live input is refused as root (sf_privilege.h); the log file's naming, rotation and
+ * durability are sf_lcm_out's and sf_log_file's. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <inttypes.h>
@@ -12,15 +15,19 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "sf_error.h"
 #include "sf_estimator.h"
 #include "sf_input.h"
 #include "sf_lcm_out.h"
+#include "sf_log_file.h"
 #include "sf_options.h"
 #include "sf_params.h"
+#include "sf_privilege.h"
 #include "sf_publish.h"
 #include "sf_rx_lcm.h"
+#include "sf_signals.h"
 #include "sf_site.h"
 #include "sf_workspace.h"
 
@@ -32,6 +39,7 @@
 #endif
 
 #define LOG_QUEUE_MESSAGES 8192
+#define LOG_NAME_ATTEMPTS 100 /* default names tried before giving up (each one EEXIST) */
 
 typedef struct {
     sf_options_t opt;
@@ -44,7 +52,7 @@ typedef struct {
     sf_site_t site;
     sf_fingerprint_workspace_t ws;
     void *ws_memory;
-    char log_path[4096];
+    char log_path[SF_LOG_FILE_PATH_MAX];
     long messages_printed;
     int64_t host_t_us;  /* log timestamp of the item being handled: every message's */
     int64_t board_t_us; /* latest board time seen */
@@ -206,9 +214,15 @@ static int run(daemon_t *const d)
 {
     int status = 0;
     for (;;) {
+        if (sf_signals_stop_requested() != 0) {
+            break;
+        }
         const int rc = sf_input_next(d->in, &d->item);
         if (rc == 0) {
             break;
+        }
+        if (rc == SF_EINTR) {
+            continue; /* a stop signal is seen at the top */
         }
         if (rc == SF_EIO) {
             fprintf(stderr, "stridefixd: %s: read failed: %s\n", sf_input_name(d->in), strerror(errno));
@@ -217,7 +231,7 @@ static int run(daemon_t *const d)
         }
         if (rc == SF_ECORRUPT) {
             refuse_rest(d);
-            status = 1;
+            status = sf_input_nothing_valid(d->in, NULL, 0) ? 0 : 1; /* 0: not a log at all, exit 3 below */
             break;
         }
         if (rc < 0) {
@@ -226,6 +240,7 @@ static int run(daemon_t *const d)
         }
         handle(d, &d->item);
     }
+    sf_signals_input_done();
     if (!d->config_written) {
         sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
         d->config_written = true;
@@ -248,24 +263,58 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
             ic.frames_total, c->frames_ok, ic.bad_syntax, c->unknown_id, c->bad_length, c->decode_errors,
             c->seq_gaps, c->unsynced, c->imu_unpaired, c->wifi_incomplete);
     fprintf(stderr,
+            "stridefixd: faults: %" PRIu64 " duplicates, %" PRIu64 " late, %" PRIu64 " corrupt seq, %" PRIu64
+            " silences, %" PRIu64 " board restarts, %" PRIu64 " BOARD_TIME not believed, %" PRIu64
+            " board time jumps; samples refused: %" PRIu32 " out of range, %" PRIu32 " jumps, %" PRIu32
+            " out of order; %" PRIu32 " walk gaps bridged\n",
+            c->duplicates, c->late, c->seq_rejected, c->silences, c->board_restarts, c->board_time_rejected,
+            c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order, st.gaps_bridged);
+    fprintf(stderr,
             "stridefixd: %" PRIu64 " IMU, %" PRIu64 " MAG, %" PRIu64 " BARO, %" PRIu64 " WIFI, %" PRIu64
             " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
             c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)st.step_count, d->opt.no_log ? "(none)" : d->log_path,
             oc->events, (double)oc->bytes / 1e6, oc->drops, wall_s);
+    if (!d->opt.no_log) {
+        fprintf(stderr,
+                "stridefixd: log detail: %" PRIu64 " files, %" PRIu64 " events written (%" PRIu64
+                " of them CONFIG copies heading a rotated file), %" PRIu64 " bytes written; %" PRIu64
+                " events dropped, %" PRIu64 " bytes\n",
+                oc->files, oc->events, oc->header_copies, oc->bytes, oc->drops, oc->drop_bytes);
+    }
 }
 
-static void default_log_path(daemon_t *const d)
+/* Opens the log and the live LCM: --log as given, or the first default name in --log-dir that is
+ * free (sf_log_file_default_name; a taken name is EEXIST from the O_EXCL open). */
+static int open_output(daemon_t *const d, char *const err, const size_t err_size)
 {
+    sf_lcm_out_config_t cfg = {.log_path = d->opt.no_log ? NULL : d->log_path,
+                               .lcm_url = d->opt.lcm_url,
+                               .queue_capacity = LOG_QUEUE_MESSAGES,
+                               /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
+                               .block_when_full = !sf_input_is_live(d->in),
+                               .force = d->opt.force,
+                               .fsync_interval_ms = d->params.output_fsync_interval_ms,
+                               .rotate_bytes = (uint64_t)d->params.output_log_rotate_mb * 1000000u,
+                               .rotate_s = d->params.output_log_rotate_s,
+                               .rotate_requests = sf_signals_rotate_requests(),
+                               .report = stderr};
     if (d->opt.log_path != NULL) {
         snprintf(d->log_path, sizeof d->log_path, "%s", d->opt.log_path);
-        return;
+        return sf_lcm_out_open_config(&d->out, &cfg, err, err_size);
     }
-    const time_t now = time(NULL);
-    struct tm tm;
-    gmtime_r(&now, &tm);
-    char name[64];
-    strftime(name, sizeof name, "stridefixd-%Y%m%d-%H%M%S.lcmlog", &tm);
-    snprintf(d->log_path, sizeof d->log_path, "%s/%s", d->opt.log_dir, name);
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    int rc = SF_EIO;
+    for (unsigned attempt = 0; attempt < LOG_NAME_ATTEMPTS; attempt++) {
+        rc = sf_log_file_default_name(d->log_path, sizeof d->log_path, d->opt.log_dir, &now, (long)getpid(), attempt);
+        if (rc == SF_OK) {
+            rc = sf_lcm_out_open_config(&d->out, &cfg, err, err_size);
+        }
+        if (rc == SF_OK || d->opt.no_log || errno != EEXIST) {
+            break;
+        }
+    }
+    return rc;
 }
 
 /* Loads --site and gives it to the estimator: the site's map rotation replaces
@@ -292,15 +341,20 @@ static int load_site(daemon_t *const d)
 /* Everything after the options: open, run, close. The exit status of the run. */
 static int serve(daemon_t *const d)
 {
-    char err[512];
+    char err[SF_LOG_FILE_PATH_MAX + 256];
+    if (sf_privilege_check(d->opt.input, d->opt.allow_root, err, sizeof err) != SF_OK) {
+        fprintf(stderr, "stridefixd: %s\n", err);
+        return SF_EXIT_USAGE;
+    }
+    if (sf_signals_install() != SF_OK) {
+        fprintf(stderr, "stridefixd: cannot install the signal handlers: %s\n", strerror(errno));
+        return 1;
+    }
     if (sf_input_open(&d->in, d->opt.input, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return SF_EXIT_USAGE;
     }
-    default_log_path(d);
-    /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
-    if (sf_lcm_out_open(&d->out, d->opt.no_log ? NULL : d->log_path, d->opt.lcm_url, LOG_QUEUE_MESSAGES,
-                        !sf_input_is_live(d->in), err, sizeof err) != SF_OK) {
+    if (open_output(d, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return 1;
     }
@@ -322,10 +376,22 @@ static int serve(daemon_t *const d)
     const int close_rc = sf_lcm_out_close(d->out, &oc);
     d->out = NULL;
     if (close_rc != SF_OK) {
-        fprintf(stderr, "stridefixd: %s: writing the log failed\n", d->log_path);
+        fprintf(stderr, "stridefixd: %s: the log is incomplete: %" PRIu64 " events (%" PRIu64
+                " bytes) dropped by failed writes or a file not finished (reasons above)\n",
+                d->log_path, oc.drops, oc.drop_bytes);
         status = 1;
     }
+    const int stop_signal = sf_signals_stop_requested();
+    if (stop_signal != 0) {
+        fprintf(stderr, "stridefixd: stopped by signal %d (%s); the log is closed\n", stop_signal,
+                strsignal(stop_signal));
+    }
     summary(d, &oc, (monotonic_us() - t0) * 1e-6);
+    char why[512];
+    if (status == 0 && sf_input_nothing_valid(d->in, why, sizeof why)) {
+        fprintf(stderr, "stridefixd: %s\n", why);
+        status = SF_EXIT_NOTHING_VALID;
+    }
     return status;
 }
 

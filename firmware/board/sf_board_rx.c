@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "board.h"
+#include "sf_board_scan.h"
 #include "sf_error.h"
 
 #define DEG_TO_RAD (3.14159265358979323846 / 180.0)
@@ -13,6 +14,8 @@
 #define IMU_PERIOD_MS 10.0
 #define MAG_PERIOD_MS 20.0
 #define BARO_PERIOD_MS 50.0
+/* No frame for this long is a silence of the bus (the board sends at least 100 IMU frames a second). */
+#define SILENCE_US 1000000
 
 void sf_board_rx_init(sf_board_rx_t *const rx)
 {
@@ -37,39 +40,80 @@ int32_t sf_wifi_channel_to_mhz(const unsigned channel)
     return 0;
 }
 
-/* Gives a sample its time; counts gaps and sync/duplicate problems. */
+/* A new epoch (the board restarted): what was in flight belongs to the old boot. */
+static void on_new_epoch(sf_board_rx_t *const rx)
+{
+    rx->counters.board_restarts++;
+    memset(rx->accel, 0, sizeof rx->accel);
+    memset(rx->gyro, 0, sizeof rx->gyro);
+    if (rx->scan_open && rx->scan_timed) {
+        rx->counters.wifi_incomplete++;
+    }
+    rx->scan_open = false;
+    rx->gnss_info_valid = false;
+    rx->last_scan_valid = false;
+}
+
+/* Gives a sample its time; counts gaps and sync, duplicate, late and corrupt-seq problems. */
 static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const uint8_t seq, const uint8_t t_lo,
                    int64_t *const t_us, int64_t *const useq)
 {
     int64_t t_ms;
     uint32_t lost;
-    const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, &t_ms, useq, &lost);
-    if (rc == SF_ENOTSYNC) {
-        rx->counters.unsynced++;
-        return rc;
+    const uint32_t epoch = rx->clock.epoch;
+    const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, rx->host_t_us, &t_ms, useq, &lost);
+    if (rx->clock.epoch != epoch) {
+        on_new_epoch(rx); /* this sample confirmed a held BOARD_TIME of a new boot */
     }
-    if (rc == SF_EDUPLICATE) {
-        rx->counters.duplicates++;
-        return rc;
+    switch (rc) {
+    case SF_OK: break;
+    case SF_ENOTSYNC: rx->counters.unsynced++; return rc;
+    case SF_EDUPLICATE: rx->counters.duplicates++; return rc;
+    case SF_ELATE: rx->counters.late++; return rc;
+    default: rx->counters.seq_rejected++; return rc;
     }
     rx->counters.seq_gaps += lost;
-    *t_us = t_ms * 1000;
+    *t_us = sf_board_clock_output_us(&rx->clock, t_ms);
     return SF_OK;
 }
 
+/* Drops the halves of buf older than seq: their partners can no longer come in time. */
+static void drop_older(sf_board_rx_t *const rx, sf_imu_half_t buf[SF_IMU_HALVES], const uint8_t seq)
+{
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        if (buf[i].valid && (int8_t)(uint8_t)(seq - buf[i].seq) > 0) {
+            buf[i].valid = false;
+            rx->counters.imu_unpaired++;
+        }
+    }
+}
+
+/* Pairs IMU_ACCEL with IMU_GYRO by seq. Each half waits in a buffer of SF_IMU_HALVES, so two
+ * swapped frames (ACCEL n, ACCEL n+1, GYRO n, GYRO n+1) still pair. */
 static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_imu_half_t *const half,
                        sf_rx_event_t *const ev)
 {
-    sf_imu_half_t *const mine = is_accel ? &rx->accel : &rx->gyro;
-    sf_imu_half_t *const other = is_accel ? &rx->gyro : &rx->accel;
-    if (other->valid && other->seq == half->seq) {
-        other->valid = false;
-        if (mine->valid) { /* a stale half of ours is left over: its partner was lost */
-            mine->valid = false;
-            rx->counters.imu_unpaired++;
+    sf_imu_half_t *const mine = is_accel ? rx->accel : rx->gyro;
+    sf_imu_half_t *const other = is_accel ? rx->gyro : rx->accel;
+    bool repeats = rx->imu_time.started && rx->imu_time.epoch == rx->clock.epoch && rx->imu_time.last_seq == half->seq;
+    int match = -1;
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        repeats = repeats || (mine[i].valid && mine[i].seq == half->seq && mine[i].t_lo_ms == half->t_lo_ms);
+        if (other[i].valid && other[i].seq == half->seq) {
+            match = i;
         }
-        const sf_imu_half_t *const acc = is_accel ? half : other;
-        const sf_imu_half_t *const gyr = is_accel ? other : half;
+    }
+    if (repeats) {
+        rx->counters.duplicates++; /* the same half again (the bus repeated a frame) */
+        return SF_EDUPLICATE;
+    }
+    if (match >= 0) {
+        const sf_imu_half_t partner = other[match];
+        other[match].valid = false;
+        drop_older(rx, mine, half->seq);
+        drop_older(rx, other, half->seq);
+        const sf_imu_half_t *const acc = is_accel ? half : &partner;
+        const sf_imu_half_t *const gyr = is_accel ? &partner : half;
         sf_rx_imu_t *const out = &ev->u.imu;
         const int rc = resolve(rx, &rx->imu_time, half->seq, half->t_lo_ms, &out->t_us, &out->seq);
         if (rc != SF_OK) {
@@ -82,86 +126,35 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
         ev->kind = sf_rx_imu;
         return 1;
     }
-    if (other->valid) { /* the other half waits for a sample we will never complete */
-        other->valid = false;
-        rx->counters.imu_unpaired++;
-    }
-    if (mine->valid) {
-        rx->counters.imu_unpaired++;
-    }
-    *mine = *half;
-    mine->valid = true;
-    return 0;
-}
-
-/* Closes the open scan into *ev. */
-static int close_scan(sf_board_rx_t *const rx, const bool complete, sf_rx_event_t *const ev)
-{
-    rx->scan_open = false;
-    if (!rx->scan_timed) {
-        return 0; /* started before the first BOARD_TIME: already counted as unsynced */
-    }
-    rx->scan.complete = complete;
-    if (!complete) {
-        rx->counters.wifi_incomplete++;
-    }
-    ev->kind = sf_rx_wifi;
-    ev->u.wifi = rx->scan;
-    return 1;
-}
-
-static int on_scan_begin(sf_board_rx_t *const rx, const struct board_wifi_scan_begin_t *const m,
-                         sf_rx_event_t *const ev)
-{
-    int result = 0;
-    if (rx->scan_open) {
-        result = close_scan(rx, false, ev); /* SCAN_END was lost */
-    }
-    rx->scan_open = true;
-    rx->scan_raw_id = m->scan_id;
-    int64_t t_ms;
-    rx->scan_timed = sf_board_clock_unwrap(&rx->clock, m->time_ms, &t_ms) == SF_OK;
-    if (!rx->scan_timed) {
-        rx->counters.unsynced++;
-        return result != 0 ? result : SF_ENOTSYNC;
-    }
-    rx->scan_id = rx->scan_id_started ? rx->scan_id + (uint8_t)(m->scan_id - (uint8_t)rx->scan_id) : m->scan_id;
-    rx->scan_id_started = true;
-    rx->scan.t_us = t_ms * 1000;
-    rx->scan.scan_id = rx->scan_id;
-    rx->scan.n_ap = 0;
-    return result;
-}
-
-static int on_scan_ap(sf_board_rx_t *const rx, const struct board_wifi_ap_t *const m)
-{
-    const int32_t mhz = sf_wifi_channel_to_mhz(m->channel);
-    if (!rx->scan_open || mhz == 0 || m->rssi >= 0 || rx->scan.n_ap >= SF_WIFI_MAX_AP) {
-        rx->counters.decode_errors++;
-        return SF_ERANGE;
-    }
-    if (!rx->scan_timed) {
-        return 0;
-    }
-    const int32_t i = rx->scan.n_ap++;
-    rx->scan.bssid[i] = (int64_t)m->bssid;
-    rx->scan.rssi_dbm[i] = (float)m->rssi;
-    rx->scan.freq_mhz[i] = mhz;
-    return 0;
-}
-
-static int on_scan_end(sf_board_rx_t *const rx, const struct board_wifi_scan_end_t *const m,
-                       sf_rx_event_t *const ev)
-{
-    if (!rx->scan_open || m->scan_id != rx->scan_raw_id) {
-        const bool was_open = rx->scan_open;
-        rx->counters.decode_errors++;
-        if (was_open) {
-            return close_scan(rx, false, ev); /* 0 (no event) when the open scan had no board time */
+    int slot = 0; /* a free slot, else the oldest half (its partner was lost) */
+    for (int i = 0; i < SF_IMU_HALVES; i++) {
+        if (!mine[i].valid) {
+            slot = i;
+            break;
         }
-        return SF_ERANGE;
+        if ((int8_t)(uint8_t)(mine[slot].seq - mine[i].seq) > 0) {
+            slot = i;
+        }
     }
-    return close_scan(rx, rx->scan.n_ap == (int32_t)m->n_ap, ev);
+    if (mine[slot].valid) {
+        rx->counters.imu_unpaired++;
+    }
+    mine[slot] = *half;
+    mine[slot].valid = true;
+    return 0;
+}
+
+/* A full board time carried by a frame (scan start, GNSS fix), unwrapped (sf_board_clock_carried);
+ * a corrupt one is counted as a decode error. */
+int sf_board_rx_carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
+{
+    const int rc = sf_board_clock_carried(&rx->clock, time_ms, rx->host_t_us, t_ms);
+    if (rc == SF_ENOTSYNC) {
+        rx->counters.unsynced++;
+    } else if (rc == SF_ERANGE) {
+        rx->counters.decode_errors++;
+    }
+    return rc;
 }
 
 /* ---- one handler per board.dbc frame ------------------------------------------------------------ */
@@ -171,12 +164,12 @@ static int on_board_time(sf_board_rx_t *const rx, const sf_can_frame_t *const f,
     (void)ev;
     struct board_board_time_t m;
     (void)board_board_time_unpack(&m, f->data, f->dlc);
-    const uint32_t restarts = rx->clock.restarts;
-    sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id);
-    if (rx->clock.restarts != restarts) {
-        rx->counters.board_restarts++;
-        rx->accel.valid = rx->gyro.valid = false;
+    if (sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us) == sf_board_time_restart) {
+        on_new_epoch(rx);
     }
+    /* a held BOARD_TIME is counted in board_time_rejected when it is never confirmed */
+    rx->counters.board_time_rejected = rx->clock.time_rejected;
+    rx->counters.board_time_jumps = rx->clock.time_jumps;
     return 0;
 }
 
@@ -239,7 +232,7 @@ static int on_wifi_scan_begin(sf_board_rx_t *const rx, const sf_can_frame_t *con
 {
     struct board_wifi_scan_begin_t m;
     (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
-    return on_scan_begin(rx, &m, ev);
+    return sf_board_scan_begin(rx, &m, ev);
 }
 
 static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -247,14 +240,14 @@ static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
     (void)ev;
     struct board_wifi_ap_t m;
     (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
-    return on_scan_ap(rx, &m);
+    return sf_board_scan_ap(rx, &m);
 }
 
 static int on_wifi_scan_end(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
     struct board_wifi_scan_end_t m;
     (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
-    return on_scan_end(rx, &m, ev);
+    return sf_board_scan_end(rx, &m, ev);
 }
 
 static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -263,9 +256,9 @@ static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, 
     struct board_gnss_info_t m;
     (void)board_gnss_info_unpack(&m, f->data, f->dlc);
     int64_t t_ms;
-    if (sf_board_clock_unwrap(&rx->clock, m.time_ms, &t_ms) != SF_OK) {
-        rx->counters.unsynced++;
-        return SF_ENOTSYNC;
+    const int rc = sf_board_rx_carried_time(rx, m.time_ms, &t_ms);
+    if (rc != SF_OK) {
+        return rc;
     }
     rx->gnss_info_valid = true;
     rx->gnss_t_ms = t_ms;
@@ -286,7 +279,7 @@ static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const
     }
     rx->gnss_info_valid = false;
     sf_rx_gnss_t *const out = &ev->u.gnss;
-    out->t_us = rx->gnss_t_ms * 1000;
+    out->t_us = sf_board_clock_output_us(&rx->clock, rx->gnss_t_ms);
     out->lat_deg = board_gnss_position_latitude_decode(m.latitude);
     out->lon_deg = board_gnss_position_longitude_decode(m.longitude);
     out->alt_m = rx->gnss_alt_m;
@@ -357,6 +350,10 @@ int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
 {
     rx->counters.frames++;
     ev->kind = sf_rx_none;
+    if (rx->counters.frames > 1 && f->host_t_us - rx->host_t_us > SILENCE_US) {
+        rx->counters.silences++;
+    }
+    rx->host_t_us = f->host_t_us;
     const frame_row_t *const row = find_row(f);
     if (row == NULL) {
         rx->counters.unknown_id++;

@@ -2,13 +2,14 @@
  *
  * Decodes each frame with the pack/unpack code that cantools generates from firmware/board.dbc,
  * gives every sample its board time (sf_board_time.h), pairs IMU_ACCEL with IMU_GYRO by seq,
- * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END, and pairs GNSS_INFO with GNSS_POSITION.
+ * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END (sf_board_scan.c), and pairs GNSS_INFO with
+ * GNSS_POSITION.
  * One frame yields at most one event (sf_rx_event.h). Frames are dispatched through one table in
  * sf_board_rx.c (id, DBC length, handler): adding a frame is its DBC entry plus one row. Bad frames
  * are counted in sf_rx_counters_t and skipped: the return code says which counter moved, so the
  * caller can print a message naming the line.
  *
- * Memory: sizeof(sf_board_rx_t) = 4560 B on x86-64 (one scan in progress; asserted ≤ 4.5 KiB); no heap. */
+ * Memory: sizeof(sf_board_rx_t) = 4688 B on x86-64 (one scan in progress; asserted ≤ 4.75 KiB); no heap. */
 #ifndef SF_BOARD_RX_H
 #define SF_BOARD_RX_H
 
@@ -36,8 +37,13 @@ typedef struct {
     uint64_t baro;
     uint64_t wifi;
     uint64_t gnss;
+    uint64_t late;            /* samples that arrived after a newer one (reordered), skipped */
+    uint64_t seq_rejected;    /* samples whose seq claims more time than passed (corrupt), skipped */
+    uint64_t silences;        /* gaps of more than 1 s without any frame */
+    uint64_t board_time_rejected; /* BOARD_TIME frames not believed (never confirmed) */
+    uint64_t board_time_jumps;    /* same boot, board time jumped forwards (confirmed) */
     uint64_t board_status;
-    uint64_t board_restarts;
+    uint64_t board_restarts;  /* board restarts: new boot id or time gone back (confirmed) */
     uint64_t board_tx_overflows; /* last value the board reported */
 } sf_rx_counters_t;
 
@@ -48,14 +54,22 @@ typedef struct {
     double xyz[3];
 } sf_imu_half_t;
 
+#define SF_IMU_HALVES 2
+
 typedef struct {
     sf_board_clock_t clock;
     sf_stream_time_t imu_time;
     sf_stream_time_t mag_time;
     sf_stream_time_t baro_time;
-    sf_imu_half_t accel;
-    sf_imu_half_t gyro;
+    sf_imu_half_t accel[SF_IMU_HALVES]; /* halves waiting for their partner */
+    sf_imu_half_t gyro[SF_IMU_HALVES];
+    int64_t host_t_us;    /* host receive time of the latest frame */
     bool scan_open;       /* between SCAN_BEGIN and SCAN_END */
+    bool scan_repeat;     /* frames of a repeated scan are being dropped */
+    uint32_t scan_time_ms; /* SCAN_BEGIN time of the open scan, as sent */
+    bool last_scan_valid; /* the last closed scan, to recognise a repeat */
+    uint8_t last_scan_raw_id;
+    uint32_t last_scan_time_ms;
     bool scan_timed;      /* the open scan has a board time */
     uint8_t scan_raw_id;
     bool scan_id_started;
@@ -68,14 +82,16 @@ typedef struct {
     sf_rx_counters_t counters;
 } sf_board_rx_t;
 
-_Static_assert(sizeof(sf_board_rx_t) <= 4608, "sf_board_rx.h promises at most 4.5 KiB");
+_Static_assert(sizeof(sf_board_rx_t) <= 4864, "sf_board_rx.h promises at most 4.75 KiB");
 
 void sf_board_rx_init(sf_board_rx_t *rx);
 
 /* Consumes one frame. Returns 1 when *event was filled (a SCAN_BEGIN that finds a scan still open
  * returns that scan, marked incomplete), 0 when the frame was used without an event, or a negative
- * code when the frame was skipped and counted: SF_EUNKNOWN_ID, SF_ELENGTH, SF_ERANGE (decode error),
- * SF_ENOTSYNC (no board time yet), SF_EDUPLICATE. */
+ * code when the frame was skipped and counted: SF_EUNKNOWN_ID, SF_ELENGTH, SF_ERANGE (decode error,
+ * or a carried time far from the clock), SF_ENOTSYNC (no board time yet), SF_EDUPLICATE (a repeated
+ * frame: IMU half, sample, scan, AP or SCAN_END), SF_ELATE (reordered), SF_ESEQ (corrupt seq).
+ * Sample times are output times (sf_board_time.h): continuous across board restarts. */
 int sf_board_rx_frame(sf_board_rx_t *rx, const sf_can_frame_t *frame, sf_rx_event_t *event);
 
 /* Counts one sample of a kind in its counter (imu .. gnss; sf_rx_none counts nothing): the one place

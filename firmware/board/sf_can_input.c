@@ -9,6 +9,7 @@
 
 #include "sf_candump.h"
 #include "sf_error.h"
+#include "sf_file_kind.h"
 
 #ifdef __linux__
 #include <linux/can.h>
@@ -17,8 +18,6 @@
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #endif
-
-#define SOCKETCAN_PREFIX "socketcan:"
 
 static int open_socketcan(sf_can_input_t *const in, const char *const iface, char *const err, const size_t n)
 {
@@ -32,6 +31,11 @@ static int open_socketcan(sf_can_input_t *const in, const char *const iface, cha
     }
     struct ifreq ifr;
     memset(&ifr, 0, sizeof ifr);
+    if (strlen(iface) >= sizeof ifr.ifr_name) { /* cut short, it could name another interface */
+        snprintf(err, n, "%s: interface name longer than %zu characters", in->name, sizeof ifr.ifr_name - 1);
+        close(fd);
+        return SF_EINVAL;
+    }
     snprintf(ifr.ifr_name, sizeof ifr.ifr_name, "%s", iface);
     if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
         snprintf(err, n, "%s: no CAN interface '%s': %s", in->name, iface, strerror(errno));
@@ -72,14 +76,19 @@ int sf_can_input_open(sf_can_input_t *const in, const char *const spec, char *er
     memset(in, 0, sizeof *in);
     in->fd = -1;
     snprintf(in->name, sizeof in->name, "%s", spec);
-    if (strncmp(spec, SOCKETCAN_PREFIX, strlen(SOCKETCAN_PREFIX)) == 0) {
-        return open_socketcan(in, spec + strlen(SOCKETCAN_PREFIX), err_text, err_size);
+    if (strncmp(spec, SF_CAN_INPUT_SOCKETCAN_PREFIX, strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX)) == 0) {
+        return open_socketcan(in, spec + strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX), err_text, err_size);
     }
     in->kind = sf_can_input_file;
     if (strcmp(spec, "-") == 0) {
         in->file = stdin;
         snprintf(in->name, sizeof in->name, "<stdin>");
         return SF_OK;
+    }
+    /* a FIFO is a stream like stdin; a device (/dev/zero never ends) or a directory is refused */
+    const int kind_rc = sf_file_check(spec, "input", true, err_text, err_size);
+    if (kind_rc != SF_OK) {
+        return kind_rc;
     }
     in->file = fopen(spec, "r");
     if (in->file == NULL) {
@@ -97,7 +106,7 @@ static int next_socketcan(sf_can_input_t *const in, sf_can_frame_t *const frame)
     for (;;) {
         const ssize_t n = read(in->fd, &cf, sizeof cf);
         if (n < 0 && errno == EINTR) {
-            continue;
+            return SF_EINTR; /* a signal: the caller decides whether to stop */
         }
         if (n < 0) {
             return SF_EIO;
@@ -134,6 +143,10 @@ int sf_can_input_next(sf_can_input_t *const in, sf_can_frame_t *const frame)
     }
     for (;;) {
         if (fgets(in->line, sizeof in->line, in->file) == NULL) {
+            if (ferror(in->file) && errno == EINTR) {
+                clearerr(in->file);
+                return SF_EINTR; /* a signal: the caller decides whether to stop */
+            }
             return ferror(in->file) ? SF_EIO : 0;
         }
         in->line_no++;

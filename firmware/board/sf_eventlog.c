@@ -32,7 +32,8 @@ static int64_t be64(const uint8_t *const p)
 
 #define NUMBER_UNREAD INT64_MIN /* ev->number before the header is read whole */
 
-/* "<name>: event N at offset X: <what>" ("<name>: at offset X: <what>" in a cut-off header); ends the log unless rc only skips an event. */
+/* "<name>: event N at offset X: <what>" ("<name>: at offset X: <what>" in a cut-off header); ends
+ * the log unless rc only skips an event. */
 static int fail(sf_eventlog_t *const log, const sf_eventlog_event_t *const ev, const int rc, char *const err,
                 const size_t err_size, const char *const what)
 {

@@ -106,6 +106,11 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
     case SF_ERANGE:
         snprintf(buf, size, "CAN id 0x%03" PRIX32 ": signal out of range or out of sequence; skipped", f->id);
         return buf;
+    case SF_ELATE:
+    case SF_ESEQ:
+    case SF_EIMPLAUSIBLE:
+        snprintf(buf, size, "CAN id 0x%03" PRIX32 ": %s; skipped", f->id, sf_strerror(code));
+        return buf;
     default: return NULL; /* unsynced / duplicate samples: counted only, they are expected at start-up */
     }
 }
@@ -136,6 +141,28 @@ void sf_input_counters(const sf_input_t *const in, sf_input_counters_t *const co
     counters->frames_total = in->rx.counters.frames + in->bad_syntax;
 }
 
+bool sf_input_nothing_valid(const sf_input_t *const in, char *const buf, const size_t size)
+{
+    const sf_rx_counters_t *const c = &in->rx.counters;
+    if (c->frames_ok > 0) {
+        return false;
+    }
+    if (in->lcm != NULL) {
+        if (c->frames == 0) {
+            snprintf(buf, size, "%s: nothing valid in the input: no sensor event (IMU MAG BARO WIFI GNSS)", in->name);
+        } else {
+            snprintf(buf, size, "%s: nothing valid in the input: %" PRIu64 " sensor events, none decodes",
+                     in->name, c->frames);
+        }
+    } else {
+        snprintf(buf, size,
+                 "%s: nothing valid in the input: %" PRIu64 " lines or frames read (%" PRIu64
+                 " not candump -L), not one a valid board.dbc frame",
+                 in->name, c->frames + in->bad_syntax, in->bad_syntax);
+    }
+    return true;
+}
+
 const char *sf_input_name(const sf_input_t *const in)
 {
     return in->name;
@@ -144,6 +171,12 @@ const char *sf_input_name(const sf_input_t *const in)
 bool sf_input_is_live(const sf_input_t *const in)
 {
     return in->lcm == NULL && in->can.kind == sf_can_input_socketcan;
+}
+
+bool sf_input_spec_is_live(const char *const spec)
+{
+    const char *const prefix = SF_CAN_INPUT_SOCKETCAN_PREFIX;
+    return spec != NULL && strncmp(spec, prefix, strlen(prefix)) == 0;
 }
 
 void sf_input_close(sf_input_t *const in)

@@ -7,7 +7,8 @@
  * not an error: it is counted in one set of counters (sf_input_counters_t, never decreasing, what
  * HEALTH reports) and skipped; sf_input_describe words it, naming the file and line.
  *
- * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable),
+ * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable, or a
+ * directory or device: sf_file_kind.h; a FIFO is read like stdin),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
  * sf_input_next: see below. Memory: one heap block per open input (≈ 5.5 KiB on x86-64, asserted
  * ≤ 6 KiB: the decoder with its scan in progress, the candump line buffer), allocated by
@@ -45,8 +46,9 @@ typedef struct {
 int sf_input_open(sf_input_t **in, const char *spec, char *err_text, size_t err_size);
 
 /* Next item: 1 *item filled; 0 end of input; SF_EIO a read error (errno tells); SF_ESYNTAX a line or
- * event that does not parse (counted and skipped, no item: call again); SF_ECORRUPT an LCM log whose
- * framing cannot be trusted from here on (counted; the rest is refused: the caller should fail). */
+ * event that does not parse (counted and skipped, no item: call again); SF_EINTR a blocking read
+ * (stdin, SocketCAN) interrupted by a signal (no item: call again, or stop); SF_ECORRUPT an LCM log
+ * whose framing cannot be trusted from here on (counted; the rest is refused: the caller should fail). */
 int sf_input_next(sf_input_t *in, sf_input_item_t *item);
 
 /* The words for a skipped input (an SF_ESYNTAX of sf_input_next, or an item's status) of the latest
@@ -56,12 +58,20 @@ bool sf_input_describe(const sf_input_t *in, int code, char *buf, size_t size);
 
 void sf_input_counters(const sf_input_t *in, sf_input_counters_t *counters);
 
+/* After the input ended: true, with the words in buf ("NAME: nothing valid in the input: ..."), when
+ * not one frame (CAN) or sensor event (LCM replay) was valid: a PNG given as a candump, an empty file,
+ * a log without sensor channels. The daemon then exits SF_EXIT_NOTHING_VALID. */
+bool sf_input_nothing_valid(const sf_input_t *in, char *buf, size_t size);
+
 /* The spec as given ("<stdin>" for "-"), for messages. */
 const char *sf_input_name(const sf_input_t *in);
 
 /* True for a live source (SocketCAN), where the logger must never wait on the disk; false for files,
  * stdin and logs, whose replay may wait rather than drop. */
 bool sf_input_is_live(const sf_input_t *in);
+
+/* True for a spec that names a live source (socketcan:IFACE), before anything is opened. */
+bool sf_input_spec_is_live(const char *spec);
 
 /* Closes what sf_input_open opened, and only that (never a descriptor it did not open, such as
  * standard input for an LCM replay); in may be NULL. */

@@ -10,6 +10,7 @@
 
 #include "sf_error.h"
 #include "sf_eventlog.h"
+#include "sf_file_kind.h"
 #include "sf_rx_lcm.h"
 
 struct sf_lcm_input {
@@ -38,6 +39,10 @@ int sf_lcm_input_open_stream(sf_lcm_input_t **const result, FILE *const f, const
 
 int sf_lcm_input_open(sf_lcm_input_t **const result, const char *const path, char *const err, const size_t err_size)
 {
+    const int kind_rc = sf_file_check(path, "LCM log", true, err, err_size);
+    if (kind_rc != SF_OK) {
+        return kind_rc;
+    }
     FILE *const f = fopen(path, "rb");
     if (f == NULL) {
         const int e = errno;

@@ -84,6 +84,17 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .unsynced = (int64_t)c->unsynced,
         .imu_unpaired = (int64_t)c->imu_unpaired,
         .wifi_incomplete = (int64_t)c->wifi_incomplete,
+        .duplicates = (int64_t)c->duplicates,
+        .late_samples = (int64_t)c->late,
+        .seq_rejected = (int64_t)c->seq_rejected,
+        .silences = (int64_t)c->silences,
+        .board_restarts = (int64_t)c->board_restarts,
+        .board_time_rejected = (int64_t)c->board_time_rejected,
+        .board_time_jumps = (int64_t)c->board_time_jumps,
+        .samples_out_of_range = est->samples_out_of_range,
+        .samples_jumped = est->samples_jumped,
+        .samples_out_of_order = est->samples_out_of_order,
+        .gaps_bridged = est->gaps_bridged,
         .imu_samples = (int64_t)c->imu,
         .mag_samples = (int64_t)c->mag,
         .baro_samples = (int64_t)c->baro,
@@ -94,6 +105,7 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .log_events = (int64_t)oc.events,
         .log_bytes = (int64_t)oc.bytes,
         .log_drops = (int64_t)oc.drops,
+        .log_drop_bytes = (int64_t)oc.drop_bytes,
         .loop_mean_us = loop->n > 0 ? (float)(loop->sum_us / (double)loop->n) : 0.0f,
         .loop_max_us = (float)loop->max_us,
     };
@@ -126,5 +138,6 @@ void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const in
                               .n = (int32_t)sf_param_count,
                               .key = key_ptrs,
                               .value = value_ptrs};
-    SF_LCM_WRITE(out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
+    /* the header: every rotated log file starts with a copy, so each reads alone */
+    SF_LCM_WRITE_WITH(sf_lcm_out_write_header, out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "sf_error.h"
+#include "sf_file_kind.h"
 #include "sf_lcm_walk.h"
 
 static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
@@ -187,14 +188,14 @@ static int check_header(const uint8_t *const data, const size_t size, const char
 {
     if (size < SF_SITE_HEADER_SIZE) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
-                     "file has only %zu bytes; a site file starts with a %d-byte header", size,
-                     SF_SITE_HEADER_SIZE);
+                            "file has only %zu bytes; a site file starts with a %d-byte header", size,
+                            SF_SITE_HEADER_SIZE);
     }
     if (memcmp(data, magic, sizeof magic) != 0) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
-                     "bad magic %02x %02x %02x %02x %02x %02x %02x %02x, expected 53 46 53 49 54 45 00 01 "
-                     "(not a StrideFix site file)",
-                     data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]);
+                            "bad magic %02x %02x %02x %02x %02x %02x %02x %02x, expected 53 46 53 49 54 45 00 01 "
+                            "(not a StrideFix site file)",
+                            data[0], data[1], data[2], data[3], data[4], data[5], data[6], data[7]);
     }
     const uint32_t version = le32(data + 8);
     const uint32_t length = le32(data + 12);
@@ -202,26 +203,27 @@ static int check_header(const uint8_t *const data, const size_t size, const char
     const uint32_t reserved = le32(data + 20);
     if (version != SF_SITE_FORMAT_VERSION) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "format version %lu, this reader supports %u",
-                     (unsigned long)version, SF_SITE_FORMAT_VERSION);
+                            (unsigned long)version, SF_SITE_FORMAT_VERSION);
     }
     if (reserved != 0u) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "reserved header field is 0x%08lx, must be 0",
-                     (unsigned long)reserved);
+                            (unsigned long)reserved);
     }
     const size_t have = size - SF_SITE_HEADER_SIZE;
     if ((size_t)length != have) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
-                     "length mismatch (%s): header says %lu payload bytes, file has %zu",
-                     (size_t)length > have ? "truncated" : "trailing bytes", (unsigned long)length, have);
+                            "length mismatch (%s): header says %lu payload bytes, file has %zu",
+                            (size_t)length > have ? "truncated" : "trailing bytes", (unsigned long)length, have);
     }
     if (length > SF_SITE_MAX_PAYLOAD) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "payload of %lu bytes exceeds the limit of %u",
-                     (unsigned long)length, SF_SITE_MAX_PAYLOAD);
+                            (unsigned long)length, SF_SITE_MAX_PAYLOAD);
     }
     const uint32_t actual = sf_site_crc32(data + SF_SITE_HEADER_SIZE, have);
     if (actual != crc) {
-        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "CRC-32 mismatch: header says 0x%08lx, payload has 0x%08lx",
-                     (unsigned long)crc, (unsigned long)actual);
+        return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
+                            "CRC-32 mismatch: header says 0x%08lx, payload has 0x%08lx", (unsigned long)crc,
+                            (unsigned long)actual);
     }
     return SF_OK;
 }
@@ -296,12 +298,13 @@ int sf_site_parse(const uint8_t *const data, const size_t size, const char *cons
     const size_t length = size - SF_SITE_HEADER_SIZE;
     const int64_t want_hash = __stridefix_site_t_get_hash();
     if (length >= 8) {
-        const int64_t got_hash = (int64_t)(((uint64_t)(uint32_t)sf_lcm_be32(payload) << 32) | (uint32_t)sf_lcm_be32(payload + 4));
+        const uint64_t hi = (uint32_t)sf_lcm_be32(payload);
+        const int64_t got_hash = (int64_t)((hi << 32) | (uint32_t)sf_lcm_be32(payload + 4));
         if (got_hash != want_hash) {
             return sf_lcm_failf(err, err_size, label, SF_ESYNTAX,
-                         "payload is not a stridefix.site_t: LCM type hash 0x%016llx, expected 0x%016llx "
-                         "(written with another version of site_t?)",
-                         (unsigned long long)got_hash, (unsigned long long)want_hash);
+                                "payload is not a stridefix.site_t: LCM type hash 0x%016llx, expected 0x%016llx "
+                                "(written with another version of site_t?)",
+                                (unsigned long long)got_hash, (unsigned long long)want_hash);
         }
     }
     sf_lcm_walk_t w = {payload, length, 0, label, err, err_size};
@@ -342,11 +345,15 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
     }
     memset(store, 0, sizeof *store);
     memset(site, 0, sizeof *site);
+    const int kind_rc = sf_file_check(path, "site file", true, err, err != NULL ? err_size : 0);
+    if (kind_rc != SF_OK) {
+        return kind_rc;
+    }
     FILE *const f = fopen(path, "rb");
     if (f == NULL) {
         const int e = errno;
         return sf_lcm_failf(err, err_size, path, e == ENOENT ? SF_ENOENT : SF_EIO, "cannot open site file: %s",
-                     strerror(e));
+                            strerror(e));
     }
     /* read the whole file, growing the buffer, up to one byte more than the largest valid file */
     const size_t limit = (size_t)SF_SITE_HEADER_SIZE + SF_SITE_MAX_PAYLOAD + 1u;
@@ -376,7 +383,7 @@ int sf_site_load(const char *const path, sf_site_store_t *const store, sf_site_t
     if (rc == SF_OK) {
         if (size >= limit) {
             rc = sf_lcm_failf(err, err_size, path, SF_ESYNTAX, "file is larger than the %zu-byte limit of a site file",
-                       limit - 1u);
+                              limit - 1u);
         } else {
             rc = sf_site_parse(buf, size, path, store, site, err, err_size);
         }

@@ -16,6 +16,10 @@ const char *sf_strerror(const int code)
     case SF_ENOENT: return "no such file or interface";
     case SF_EUNSUPPORTED: return "not supported here";
     case SF_EFULL: return "queue full";
+    case SF_ELATE: return "sample arrived late (reordered)";
+    case SF_ESEQ: return "sequence number implausible for the time elapsed (corrupt)";
+    case SF_EIMPLAUSIBLE: return "sample beyond full scale or a physically impossible jump";
+    case SF_EINTR: return "interrupted by a signal";
     case SF_ECORRUPT: return "corrupt framing, rest of the file refused";
     default: return "unknown error";
     }

@@ -18,7 +18,11 @@
 #define SF_ENOENT (-9)       /* a named file or interface does not exist */
 #define SF_EUNSUPPORTED (-10) /* not available on this platform/kernel (e.g. no AF_CAN) */
 #define SF_EFULL (-11)       /* a bounded queue or table is full; the item was dropped */
-#define SF_ECORRUPT (-12)    /* a file's framing cannot be trusted: the rest of it is refused */
+#define SF_ELATE (-12)       /* a sample arrived after a newer one of its stream (reordered) */
+#define SF_ESEQ (-13)        /* a sequence number that claims more time than passed (corrupt) */
+#define SF_EIMPLAUSIBLE (-14) /* a sample beyond full scale or a physically impossible jump */
+#define SF_EINTR (-15)       /* a blocking read was interrupted by a signal; nothing was lost, call again */
+#define SF_ECORRUPT (-16)    /* a file's framing cannot be trusted: the rest of it is refused */
 
 /* Short English text for a code; never NULL. */
 const char *sf_strerror(int code);

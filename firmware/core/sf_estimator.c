@@ -84,7 +84,21 @@ static double walk_heading(const sf_estimator_t *const e, const sf_params_t *con
     return wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
 }
 
-/* Moves the position by one credited step and fills its STEP record. */
+/* Moves the PDR track and every fusion scheme by one displacement. */
+static void advance(sf_estimator_t *const e, const sf_params_t *const p, const int64_t now_us, const double dx_m,
+                    const double dy_m, const double length_m)
+{
+    e->x_m += dx_m;
+    e->y_m += dy_m;
+    e->distance_m += length_m;
+    e->sigma_m += p->estimator_sigma_per_m * length_m;
+    for (int s = 0; s < sf_scheme_count; s++) {
+        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
+    }
+}
+
+/* Moves the position by one credited step (and first by the walk a gap hid, sf_gap_bridge.h) and
+ * fills its STEP record. */
 static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_step_event_t *const ev,
                  const int64_t now_us, sf_step_t *const step)
 {
@@ -99,18 +113,16 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
                               ? fabs(sf_floor_vertical_speed_mps(&e->floor)) * ev->period_s
                               : 0.0;
     const double length_m = fmax(level_m - 2.0 * rise_m, 0.0);
+    double bridge_m, bridge_heading_rad;
+    if (sf_gap_bridge_on_step(&e->gap, p, ev->t_us, e->heading_rad, &bridge_m, &bridge_heading_rad)) {
+        advance(e, p, now_us, bridge_m * cos(bridge_heading_rad), bridge_m * sin(bridge_heading_rad), bridge_m);
+        e->calib_anchor_valid = false; /* a guessed distance must not calibrate the stride */
+    }
+    sf_gap_bridge_note_step(&e->gap, ev->t_us, ev->period_s, length_m, e->heading_rad);
     e->step_count++;
-    e->x_m += length_m * cos(e->heading_rad);
-    e->y_m += length_m * sin(e->heading_rad);
-    /* (the fusion schemes move by the same displacement below) */
-    e->distance_m += length_m;
-    e->sigma_m += p->estimator_sigma_per_m * length_m;
     /* the calibration sum scaled like the length, so K·sum stays the distance moved */
     e->weinberg_sum += level_m > 0.0 ? sf_stride_weinberg_term(ev) * (length_m / level_m) : 0.0;
-    const double dx_m = length_m * cos(e->heading_rad), dy_m = length_m * sin(e->heading_rad);
-    for (int s = 0; s < sf_scheme_count; s++) {
-        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
-    }
+    advance(e, p, now_us, length_m * cos(e->heading_rad), length_m * sin(e->heading_rad), length_m);
 
     step->t_us = now_us; /* published when known (causal); ev->t_us is the extremum, earlier */
     step->index = e->step_count;
@@ -122,9 +134,30 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
     step->floor = sf_floor_current(&e->floor);
 }
 
+/* Whether a sample passes its stream's gate (sf_sample_gate.h); a refused one is counted by verdict. */
+static bool admit(sf_estimator_t *const e, sf_sample_gate_t *const gate, const sf_sample_limits_t *const limits,
+                  const int64_t t_us, const double *const value, const int n_axes)
+{
+    const sf_gate_verdict_t v = sf_sample_gate_check(gate, limits, t_us, value, n_axes);
+    if (v != sf_gate_accepted) {
+        e->samples_refused[v]++;
+        return false;
+    }
+    return true;
+}
+
 int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
+    const sf_sample_limits_t accel = {-p->gate_accel_full_scale_mps2, p->gate_accel_full_scale_mps2,
+                                      p->gate_accel_jump_floor_mps2, p->gate_accel_rate_max_mps3};
+    const sf_sample_limits_t gyro = {-p->gate_gyro_full_scale_radps, p->gate_gyro_full_scale_radps,
+                                     p->gate_gyro_jump_floor_radps, p->gate_gyro_rate_max_radps2};
+    if (!admit(e, &e->accel_gate, &accel, s->t_us, s->accel_mps2, 3) ||
+        !admit(e, &e->gyro_gate, &gyro, s->t_us, s->gyro_radps, 3)) {
+        return 0;
+    }
+    sf_gap_bridge_on_imu(&e->gap, p, e->started ? e->t_us : 0, s->t_us);
     sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
     double f_nav[3];
     sf_attitude_body_to_nav(&e->attitude, s->accel_mps2, f_nav);
@@ -170,6 +203,11 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
+    const sf_sample_limits_t mag = {-p->gate_mag_full_scale_ut, p->gate_mag_full_scale_ut, p->gate_mag_jump_floor_ut,
+                                    p->gate_mag_rate_max_ut_s};
+    if (!admit(e, &e->mag_gate, &mag, t_us, field_ut, 3)) {
+        return;
+    }
     sf_magcal_update(&e->magcal, p, t_us, field_ut);
     double corrected_ut[3];
     sf_magcal_apply(&e->magcal, field_ut, corrected_ut);
@@ -179,6 +217,11 @@ void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const
 void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                        const double pressure_pa)
 {
+    const sf_sample_limits_t baro = {p->gate_baro_min_pa, p->gate_baro_max_pa, p->gate_baro_jump_floor_pa,
+                                     p->gate_baro_rate_max_pa_s};
+    if (!admit(e, &e->baro_gate, &baro, t_us, &pressure_pa, 1)) {
+        return;
+    }
     sf_floor_update(&e->floor, p, t_us, pressure_pa);
     if (e->floor_vote_active) {
         bool rereference;
@@ -289,5 +332,9 @@ void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *c
                                       .has_site = e->site != NULL,
                                       .mag_rejected = e->attitude.mag_rejected,
                                       .steps_refused = e->steps_refused,
-                                      .stride_calibrations = e->stride_calibrations};
+                                      .stride_calibrations = e->stride_calibrations,
+                                      .samples_out_of_range = e->samples_refused[sf_gate_out_of_range],
+                                      .samples_jumped = e->samples_refused[sf_gate_jump],
+                                      .samples_out_of_order = e->samples_refused[sf_gate_out_of_order],
+                                      .gaps_bridged = e->gap.bridged};
 }

@@ -55,10 +55,12 @@
 #include "sf_floor.h"
 #include "sf_floor_vote.h"
 #include "sf_fusion.h"
+#include "sf_gap_bridge.h"
 #include "sf_heading.h"
 #include "sf_magcal.h"
 #include "sf_params.h"
 #include "sf_radiomap.h"
+#include "sf_sample_gate.h"
 #include "sf_steps.h"
 #include "sf_stride.h"
 #include "sf_types.h"
@@ -85,6 +87,9 @@ typedef struct {
     double weinberg_sum; /* Σ range^¼ since the last stride calibration (for absolute fixes) */
     int32_t step_count;
     uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
+    sf_sample_gate_t accel_gate, gyro_gate, mag_gate, baro_gate;
+    sf_gap_bridge_t gap;
+    uint32_t samples_refused[4]; /* by sf_gate_verdict_t (index 0 unused) */
     sf_step_event_t held_events[SF_ACTIVITY_BOUT_MAX]; /* the held detections of a bout (sf_activity.h) */
     /* absolute fixes (issue 4): the site and the matcher's workspace are the caller's */
     const sf_site_t *site;          /* NULL: no site, no Wi-Fi fixes */
@@ -148,6 +153,10 @@ typedef struct {
     uint32_t mag_rejected; /* magnetometer samples the attitude refused (disturbed field) */
     uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
     uint32_t stride_calibrations;
+    uint32_t samples_out_of_range; /* samples refused by sf_sample_gate: not finite or beyond full scale */
+    uint32_t samples_jumped;       /* ... faster than a body moves */
+    uint32_t samples_out_of_order; /* ... not later than their stream's last accepted sample */
+    uint32_t gaps_bridged;         /* IMU gaps the walk went through, dead-reckoned (sf_gap_bridge) */
 } sf_estimator_status_t;
 
 /* Fills *status; cannot fail. */

@@ -23,6 +23,32 @@
     X(init,   use_config_pose,     int32_t, 0,       0,       1,       "",      "1 = every scheme starts at init.x_m/y_m (truth-initialised); 0 = from the first fix (always 1 without a site)") \
     X(init,   sigma_m,             double,  1.0,     0.0,     1e3,     "m",     "position sigma of a config start")
 
+/* sf_sample_gate.h: full scales are the board's sensors' (docs/DESIGN.md: int16, ±16 g, ±2000 °/s);
+ * rates are what a human body produces, with a wide margin: walking and running jerk at the trunk
+ * stays below ~2500 m/s3, fast wrist rotation below ~400 rad/s2, an elevator changes pressure by
+ * ~120 Pa/s; the floors cover sensor noise and irregular sample timing. */
+#define SF_PARAMS_GATE(X)                                                                              \
+    X(gate, accel_full_scale_mps2, double, 156.9,   1.0,     2000.0,  "m/s2",  "accelerometer full scale: a sample at or beyond it per axis is refused") \
+    X(gate, accel_jump_floor_mps2, double, 20.0,    0.0,     4000.0,  "m/s2",  "accelerometer change always allowed between accepted samples") \
+    X(gate, accel_rate_max_mps3,   double, 5000.0,  0.0,     1e7,     "m/s3",  "fastest accelerometer change a body produces (jerk), per axis") \
+    X(gate, gyro_full_scale_radps, double, 34.9,    0.1,     200.0,   "rad/s", "gyroscope full scale (2000 deg/s)") \
+    X(gate, gyro_jump_floor_radps, double, 1.0,     0.0,     400.0,   "rad/s", "gyroscope change always allowed between accepted samples") \
+    X(gate, gyro_rate_max_radps2,  double, 1000.0,  0.0,     1e7,     "rad/s2", "fastest angular acceleration a body produces, per axis") \
+    X(gate, mag_full_scale_ut,     double, 4900.0,  1.0,     1e5,     "uT",    "magnetometer full scale") \
+    X(gate, mag_jump_floor_ut,     double, 100.0,   0.0,     1e5,     "uT",    "magnetometer change always allowed (indoor disturbances are the attitude's to reject)") \
+    X(gate, mag_rate_max_ut_s,     double, 10000.0, 0.0,     1e8,     "uT/s",  "fastest magnetometer change accepted, per axis") \
+    X(gate, baro_min_pa,           double, 30000.0, 0.0,     2e5,     "Pa",    "lowest plausible pressure (above Everest's summit)") \
+    X(gate, baro_max_pa,           double, 120000.0, 0.0,    2e5,     "Pa",    "highest plausible pressure (below any mine's depth)") \
+    X(gate, baro_jump_floor_pa,    double, 20.0,    0.0,     1e5,     "Pa",    "pressure change always allowed (noise, door and ventilation transients)") \
+    X(gate, baro_rate_max_pa_s,    double, 1000.0,  0.0,     1e7,     "Pa/s",  "fastest pressure change accepted (8x a fast elevator)")
+
+/* sf_gap_bridge.h */
+#define SF_PARAMS_GAP(X)                                                                               \
+    X(gap,  bridge,                int32_t, 1,       0,       1,       "",      "1 = dead-reckon across an IMU gap the walk went through (bus silence, board reset)") \
+    X(gap,  min_s,                 double,  1.0,     0.1,     60.0,    "s",     "IMU gaps at least this long are bridged (shorter ones lose less than two steps)") \
+    X(gap,  max_s,                 double,  30.0,    0.0,     600.0,   "s",     "longer gaps are not guessed") \
+    X(gap,  walking_s,             double,  2.0,     0.1,     10.0,    "s",     "a step this close before the gap and after it: the walk went on through it")
+
 /* sf_estimator.h */
 #define SF_PARAMS_ESTIMATOR(X)                                                                         \
     X(estimator, gravity_tau_s,    double,  2.0,     0.1,     60.0,    "s",     "time constant of the gravity magnitude low-pass (a_v = f_up - g)") \
@@ -121,7 +147,10 @@
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
-    X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)")
+    X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)") \
+    X(output, fsync_interval_ms,   int32_t, 1000,    0,       60000,   "ms",    "the log writer fdatasyncs at least this often (0: after every event, one disk sync each: slow): what power loss may cost") \
+    X(output, log_rotate_mb,       int32_t, 0,       0,       1000000, "MB",    "start a new log file before one would exceed this size (0: no size rotation)") \
+    X(output, log_rotate_s,        int32_t, 0,       0,       604800,  "s",     "start a new log file when one is this old (0: no time rotation; SIGHUP rotates too)")
 
 /* sf_fingerprint.h */
 #define SF_PARAMS_FINGERPRINT(X)                                                                       \
@@ -194,7 +223,7 @@
     X(ekf,    r_max,               double,  100.0,   1e-3,    1e4,     "",      "largest eigenvalue of the learnt fix-error model (per accuracy_m^2)")
 
 #define SF_PARAM_LIST(X) \
-    SF_PARAMS_INIT(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
+    SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
     SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {

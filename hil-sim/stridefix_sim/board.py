@@ -16,7 +16,10 @@ Host timestamp = 1700000000 s + (unwrapped) board time + latency; the bus is ser
 arrives at least one frame time after the previous one (timestamps never decrease). Frame loss
 (``can.loss_rate``, seeded) models frames lost between board and logger: the board sent them (n_ap
 counts every AP frame sent), the log lacks them, the counters report what the log holds. The very first
-BOARD_TIME frame is never dropped so that a log always starts with the time reference.
+BOARD_TIME frame is never dropped so that a log always starts with the time reference. The
+``[faults]`` table adds board resets, implausible samples and bus faults (``faults.py``): resets
+through the board clock that ``_events`` uses for every time and counter, the rest on the ordered
+frames; with every fault off none of it runs.
 
 Values are clamped into each signal's DBC range, then encoded per message type at once with numpy
 (``pack``: the DBC's scale, offset, start bit and length, the same bytes as cantools'
@@ -32,6 +35,7 @@ from pathlib import Path
 import cantools
 import numpy as np
 
+from . import faults as flt
 from .radio import Scan
 from .sensors import SensorData
 
@@ -106,12 +110,19 @@ def pack(msg, fields: dict) -> np.ndarray:
     return word
 
 
-def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) -> _Frames:
-    """Every frame the board sends, unsorted (``emulate_board`` orders them by board ms, then priority,
-    then the order they are added here)."""
+def _events(
+    db,
+    sensors: SensorData,
+    scans: list[Scan],
+    n_imu: int,
+    sc: dict,
+    clock: flt.BoardClock,
+    rec: flt.FaultRecord,
+) -> _Frames:
+    """Every frame the board sends, unsorted (``emulate_board`` orders them by simulated ms, then
+    priority, then the order they are added here). ``clock`` gives board time and counter restarts
+    (board resets); frames while the board reboots are not sent (counted in ``rec``)."""
     msgs = {m.name: m for m in db.messages}
-    start_ms = int(sc["can"]["board_time_start_ms"])
-    boot_id = int(sc["can"]["boot_id"])
     acc = _clip_signal(db, "IMU_ACCEL", "accel_x", sensors.accel_mps2)
     gyr = _clip_signal(db, "IMU_GYRO", "gyro_x", sensors.gyro_dps)
     mag = _clip_signal(db, "MAG", "mag_x", sensors.mag_ut)
@@ -120,24 +131,31 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
     duration_ms = (n_imu - 1) * IMU_PERIOD_MS
     ev = _Frames()
 
-    t = np.arange(0, duration_ms + 1, 1000, dtype=np.int64)
-    ev.add(
-        "BOARD_TIME",
-        t,
-        P_TIME,
-        pack(msgs["BOARD_TIME"], {"time_ms": (start_ms + t) % 2**32, "boot_id": boot_id}),
-    )
-    i = np.arange(n_imu, dtype=np.int64)
-    t = i * IMU_PERIOD_MS
-    lo = (start_ms + t) % 256
-    base = ev.reserve(2 * n_imu)  # ACCEL and GYRO of a sample alternate
+    t, seg = clock.periodic(0, 1000, duration_ms)
+    boot = np.asarray(clock.boot_ids, dtype=np.int64)[seg] if clock.resets else clock.boot_ids[0]
+    ev.add("BOARD_TIME", t, P_TIME, pack(msgs["BOARD_TIME"], {"time_ms": clock.board_ms(t), "boot_id": boot}))
+
+    def sent(t: np.ndarray, *cols: np.ndarray, frames: int = 1) -> tuple:
+        """(t, seq, t_lo_ms, cols) of the samples a sending boot took (all of them without resets);
+        ``frames``: frames per sample."""
+        if not clock.resets:
+            return (t, np.arange(len(t), dtype=np.int64) % 256, clock.board_ms(t) % 256, *cols)
+        seg = clock.segment(t)
+        ok = seg >= 0
+        rec.unsent_reset += int(np.sum(~ok)) * frames
+        t, seg = t[ok], seg[ok]
+        return (t, clock.counter(seg) % 256, clock.board_ms(t, seg) % 256, *(c[ok] for c in cols))
+
+    t, seq, lo, acc, gyr = sent(np.arange(n_imu, dtype=np.int64) * IMU_PERIOD_MS, acc, gyr, frames=2)
+    i = np.arange(len(t), dtype=np.int64)
+    base = ev.reserve(2 * len(t))  # ACCEL and GYRO of a sample alternate
     ev.add(
         "IMU_ACCEL",
         t,
         P_IMU,
         pack(
             msgs["IMU_ACCEL"],
-            {"accel_x": acc[:, 0], "accel_y": acc[:, 1], "accel_z": acc[:, 2], "seq": i % 256, "t_lo_ms": lo},
+            {"accel_x": acc[:, 0], "accel_y": acc[:, 1], "accel_z": acc[:, 2], "seq": seq, "t_lo_ms": lo},
         ),
         ins=base + 2 * i,
     )
@@ -147,51 +165,48 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
         P_IMU,
         pack(
             msgs["IMU_GYRO"],
-            {"gyro_x": gyr[:, 0], "gyro_y": gyr[:, 1], "gyro_z": gyr[:, 2], "seq": i % 256, "t_lo_ms": lo},
+            {"gyro_x": gyr[:, 0], "gyro_y": gyr[:, 1], "gyro_z": gyr[:, 2], "seq": seq, "t_lo_ms": lo},
         ),
         ins=base + 2 * i + 1,
     )
-    j = np.arange(len(sensors.mag_idx), dtype=np.int64)
-    t = sensors.mag_idx.astype(np.int64) * IMU_PERIOD_MS
+    t, seq, lo, mag = sent(sensors.mag_idx.astype(np.int64) * IMU_PERIOD_MS, mag)
     ev.add(
         "MAG",
         t,
         P_MAG,
         pack(
             msgs["MAG"],
-            {
-                "mag_x": mag[:, 0],
-                "mag_y": mag[:, 1],
-                "mag_z": mag[:, 2],
-                "seq": j % 256,
-                "t_lo_ms": (start_ms + t) % 256,
-            },
+            {"mag_x": mag[:, 0], "mag_y": mag[:, 1], "mag_z": mag[:, 2], "seq": seq, "t_lo_ms": lo},
         ),
     )
-    j = np.arange(len(sensors.baro_idx), dtype=np.int64)
-    t = sensors.baro_idx.astype(np.int64) * IMU_PERIOD_MS
+    baro_t = sensors.baro_idx.astype(np.int64) * IMU_PERIOD_MS
+    t, seq, lo, prs_sent, tmp_sent = sent(baro_t, prs, tmp)
     ev.add(
         "BARO",
         t,
         P_BARO,
-        pack(
-            msgs["BARO"],
-            {"pressure": prs, "temperature": tmp, "seq": j % 256, "t_lo_ms": (start_ms + t) % 256},
-        ),
+        pack(msgs["BARO"], {"pressure": prs_sent, "temperature": tmp_sent, "seq": seq, "t_lo_ms": lo}),
     )
     # Wi-Fi: BEGIN, one AP frame per access point, END; in scan order
     wifi = {"WIFI_SCAN_BEGIN": [], "WIFI_AP": [], "WIFI_SCAN_END": []}
     k_ins = 0
-    for k, scan in enumerate(scans):
+    scan_ids = [0] * len(clock.boot_ids)  # scan_id restarts at each boot
+    for scan in scans:
         t_res = scan.t_ms + int(sc["radio"]["scan_duration_ms"])
         if t_res > duration_ms:
             continue
-        wifi["WIFI_SCAN_BEGIN"].append((t_res, k_ins, k % 256, (start_ms + scan.t_ms) % 2**32, 0))
+        k = int(clock.segment(np.array([scan.t_ms]))[0])
+        if clock.resets and (k < 0 or int(clock.segment(np.array([t_res]))[0]) != k):
+            rec.scans_lost_reset += 1  # a reset interrupted it: the board never sends it
+            continue
+        sid = scan_ids[k] % 256
+        scan_ids[k] += 1
+        wifi["WIFI_SCAN_BEGIN"].append((t_res, k_ins, sid, int(clock.board_ms(np.array([scan.t_ms]))[0]), 0))
         k_ins += 1
         for bssid, rssi, ch in scan.aps:
             wifi["WIFI_AP"].append((t_res, k_ins, bssid, max(-128, min(127, rssi)), ch))
             k_ins += 1
-        wifi["WIFI_SCAN_END"].append((t_res, k_ins, k % 256, min(255, len(scan.aps)), 0))
+        wifi["WIFI_SCAN_END"].append((t_res, k_ins, sid, min(255, len(scan.aps)), 0))
         k_ins += 1
     base = ev.reserve(k_ins)
     names = {
@@ -210,8 +225,7 @@ def _events(db, sensors: SensorData, scans: list[Scan], n_imu: int, sc: dict) ->
             pack(msgs[name], {f: a[:, 2 + c] for c, f in enumerate(names[name])}),
             ins=base + a[:, 1],
         )
-    t = np.arange(500, duration_ms + 1, 1000, dtype=np.int64)
-    baro_t = sensors.baro_idx.astype(np.int64) * IMU_PERIOD_MS
+    t, _ = clock.periodic(500, 1000, duration_ms)
     j = np.minimum(np.searchsorted(baro_t, t), len(tmp) - 1)
     ev.add(
         "BOARD_STATUS",
@@ -278,12 +292,20 @@ def emulate_board(
     sc: dict,
     rng: np.random.Generator,
     dbc_path: Path | str = DBC_PATH,
+    fault_rng: np.random.Generator | None = None,
 ) -> BoardOutput:
+    """The board's frames as candump lines; ``rng`` draws the random loss, ``fault_rng`` the
+    ``[faults]`` (faults.py; needed only when one is on)."""
     db = load_dbc(dbc_path)
     can = sc["can"]
+    fc = sc.get("faults")
+    on = fc is not None and flt.faults_on(fc)
     start_ms = int(can["board_time_start_ms"])
     latency_us, frame_us = int(can["latency_us"]), int(can["frame_time_us"])
-    ev = _events(db, sensors, scans, n_imu, sc)
+    rec = flt.FaultRecord()
+    clock = flt.BoardClock(start_ms, int(can["boot_id"]), fc if on else None)
+    rec.resets = clock.resets
+    ev = _events(db, sensors, scans, n_imu, sc, clock, rec)
     names = [m.name for m in db.messages]
     code = {name: c for c, name in enumerate(names)}
     t = np.concatenate([p[0] for p in ev.parts])
@@ -307,8 +329,21 @@ def emulate_board(
     acc_sent = np.where(last_acc >= 0, ~lost[np.maximum(last_acc, 0)], False)
     imu_samples = int(np.sum(is_gyr & ~lost & acc_sent))
 
+    if on:
+        assert fault_rng is not None, "faults need their own random stream"
+        lost = flt.lost_on_bus(t, lost, fc, fault_rng, rec)
+        acc_sent = np.where(last_acc >= 0, ~lost[np.maximum(last_acc, 0)], False)
+        imu_samples = int(np.sum(is_gyr & ~lost & acc_sent))
     keep = ~lost
-    lines = _candump_lines(host[keep], name[keep], word[keep], db)
+    host_kept, name_kept, word_kept = host[keep], name[keep], word[keep]
+    if on:  # (implausible samples on frames that arrive: each one counted reaches the logger)
+        flt.implausible(db, t[keep], name_kept, word_kept, fc, fault_rng, rec)
+        n_bits = np.array([8 * m.length for m in db.messages], dtype=np.int64)[name_kept]
+        flt.corrupt(word_kept, n_bits, fc, fault_rng, rec)
+        (name_kept, word_kept), host_kept = flt.duplicate_and_reorder(
+            (name_kept, word_kept), host_kept, frame_us, fc, fault_rng, rec
+        )
+    lines = _candump_lines(host_kept, name_kept, word_kept, db)
     sent = np.bincount(name[keep], minlength=len(names))
     dropped = np.bincount(name[lost], minlength=len(names))
     sent_by_name = {nm: int(sent[c]) for c, nm in enumerate(names)}
@@ -323,4 +358,6 @@ def emulate_board(
         "frames_by_name": {nm: v for nm, v in sent_by_name.items() if v},
         "dropped_by_name": {nm: int(dropped[c]) for c, nm in enumerate(names) if dropped[c]},
     }
+    if on:  # ground truth of the faults (absent from clean runs, whose output stays as it was)
+        counts["faults"] = {**rec.as_dict(), "frames_sent_by_board": n, "boot_ids": clock.boot_ids}
     return BoardOutput(lines=lines, counts=counts)

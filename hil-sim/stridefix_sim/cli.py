@@ -1,7 +1,8 @@
 """``stridefix sim``: run one software-in-the-loop scenario and write the board's CAN log plus truth.
 
-Exit status: 0 success, 1 the simulation failed, 2 bad usage or unreadable input (scenario file missing,
-bad TOML, unknown key, value out of range).
+Exit status (:mod:`stridefix_analyzer.exits`, the contract of every ``stridefix`` command): 0 success,
+1 the simulation failed or its output could not be written, 2 bad usage or unreadable input (scenario
+file missing, bad TOML, unknown key, value out of range).
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ import argparse
 import sys
 import time
 from pathlib import Path
+
+from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE
 
 from .pipeline import simulate, write_outputs
 from .scenario import BUILTIN, ScenarioError, resolve_scenario
@@ -65,14 +68,14 @@ def run(args) -> int:
         )
     except ScenarioError as e:
         print(f"stridefix sim: error: {e}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     try:
         result = simulate(scenario)
         out_dir = Path(args.out)
         summary = write_outputs(result, out_dir, candump_stream=sys.stdout if args.stdout else None)
     except OSError as e:
         print(f"stridefix sim: error: cannot write output: {e}", file=sys.stderr)
-        return 2
+        return EXIT_FAILURE
     elapsed = time.perf_counter() - t_start
     where = "stdout" if args.stdout else str(out_dir / "board.candump")
     print(
@@ -90,4 +93,4 @@ def run(args) -> int:
         f"outputs in {out_dir}; {elapsed:.2f} s",
         file=sys.stderr,
     )
-    return 0
+    return EXIT_OK

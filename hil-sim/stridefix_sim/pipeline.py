@@ -1,7 +1,8 @@
 """One simulated run: scenario → world → walker → sensors + radio → board emulator → output files.
 
 Seeding: one ``numpy.random.SeedSequence(seed)`` spawns independent streams for the walker, the sensors,
-the radio, the CAN link and the person (body: stride and cadence scales, Weinberg K), so e.g. changing
+the radio, the CAN link, the person (body: stride and cadence scales, Weinberg K) and the bus and board
+faults (faults.py), so e.g. changing
 the loss rate does not change the sensor noise, and changing the pace does not change the person. The
 same scenario and seed give byte-identical outputs.
 
@@ -136,6 +137,11 @@ class SimResult:
             extra["reference_points"] = [
                 {k: r[k] for k in ("index", "x_m", "y_m", "floor", "s_m", "t_s")} for r in refs
             ]
+        scenario = self.scenario.data
+        if "faults" in c:  # the ground truth of what the faults damaged (faults.FaultRecord)
+            extra["faults"] = c["faults"]
+        else:  # faults off: the summary of a clean run stays as it was before faults existed
+            scenario = {k: v for k, v in scenario.items() if k != "faults"}
         if self.world.name != "default":
             extra["world"] = {
                 "name": self.world.name,
@@ -173,7 +179,7 @@ class SimResult:
             "activity_s": self.activity_s(),
             "elevator_rides": len([r for r in self.walk.rides if r[0] <= self.duration_s]),
             "init": self.init_pose(),
-            "scenario": self.scenario.data,
+            "scenario": scenario,
             **extra,
         }
 
@@ -186,7 +192,8 @@ def simulate(scenario: Scenario) -> SimResult:
     sc = scenario.data
     world = load_world(sc["world"]["name"], sc["world"]["map_rotation_deg"])
     ss = np.random.SeedSequence(scenario.seed)
-    r_walk, r_sens, r_radio, r_can, r_person = (np.random.default_rng(s) for s in ss.spawn(5))
+    # (a sixth stream for the faults leaves the first five as they were: child i has spawn key (i,))
+    r_walk, r_sens, r_radio, r_can, r_person, r_faults = (np.random.default_rng(s) for s in ss.spawn(6))
     duration = float(sc["duration_s"])
     duration = math.ceil(duration * 10 - 1e-9) / 10 if duration > 0 else None  # whole truth periods
     person = make_person(sc, r_person)
@@ -194,7 +201,7 @@ def simulate(scenario: Scenario) -> SimResult:
     duration_s = float(walk.t_s[-1])
     sensors = simulate_sensors(sc, world, walk, r_sens)
     scans = simulate_scans(sc, world, walk, r_radio)
-    board = emulate_board(sensors, scans, len(walk.t_s), sc, r_can)
+    board = emulate_board(sensors, scans, len(walk.t_s), sc, r_can, fault_rng=r_faults)
     return SimResult(
         scenario=scenario,
         world=world,
@@ -261,11 +268,15 @@ def write_init_ini(result: SimResult, path: Path) -> None:
 def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | None = None) -> dict:
     """Write the run's files into ``out_dir``; candump lines go to ``candump_stream`` when given."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    text = "\n".join(result.board.lines) + "\n"
+    lines = result.board.lines or [""]  # (no frame: one empty line, as before)
+    step = 100_000  # in pieces: an 8-hour walk's text would be another 400 MB at once
     if candump_stream is None:
-        (out_dir / "board.candump").write_text(text, encoding="ascii")
+        with open(out_dir / "board.candump", "w", encoding="ascii") as f:
+            for i in range(0, len(lines), step):
+                f.write("\n".join(lines[i : i + step]) + "\n")
     else:
-        candump_stream.write(text)
+        for i in range(0, len(lines), step):
+            candump_stream.write("\n".join(lines[i : i + step]) + "\n")
         candump_stream.flush()
     write_truth_log(result, out_dir / "truth.lcmlog")
     write_init_ini(result, out_dir / "init_truth.ini")

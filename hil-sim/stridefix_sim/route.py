@@ -123,10 +123,14 @@ class Polyline:
         hd = np.empty_like(d)
         k = np.zeros_like(d)
         idx = np.clip(np.searchsorted(self._starts, d, side="right") - 1, 0, len(self.pieces) - 1)
+        # the samples of each piece, in their order (a stable sort: O(n log n) however many pieces a
+        # long walk has, and the same arrays as the mask idx == i gave, so the same numbers)
+        order = np.argsort(idx, kind="stable")
+        bounds = np.searchsorted(idx[order], np.arange(len(self.pieces) + 1), side="left")
         for i, pc in enumerate(self.pieces):
-            m = idx == i
-            if not m.any():
+            if bounds[i] == bounds[i + 1]:
                 continue
+            m = order[bounds[i] : bounds[i + 1]]
             e = d[m] - pc[1]
             if pc[0] == "L":
                 _, _, _, x0, y0, h = pc

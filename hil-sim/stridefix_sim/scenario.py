@@ -2,8 +2,10 @@
 
 A scenario names the world, the walk (route, pace, pauses), the person, stairs and elevator, the sensor
 imperfections (noise, biases and their drift, scale errors, board mounting rotation, magnetic
-disturbances, weather), the radio model, the CAN link (frame loss, board time start), the seed and the
-duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: the two-floor tour —
+disturbances, weather), the radio model, the CAN link (frame loss, board time start; a board time start
+near 2**32 makes the 32-bit time wrap during the walk), bus and board faults (``[faults]``, faults.py:
+loss bursts, silence, duplicates, reordering, corruption, board resets, implausible samples), the seed
+and the duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: the two-floor tour —
 a lap of floor 0, the stairs up, a lap of floor 1, the elevator down, a partial lap — at normal pace
 with 3 pauses, about 5 minutes). A file only needs the keys it changes. An unknown key, a wrong type or
 an out-of-range value raises :class:`ScenarioError` naming the file and the key.
@@ -132,6 +134,24 @@ DEFAULTS: dict[str, Any] = {
         "latency_us": 300,  # board-to-host latency of the first frame of a burst
         "frame_time_us": 130,  # bus time per frame (8-byte classic frame at 1 Mbit/s)
     },
+    "faults": {  # bus and board faults (faults.py), all off; their own random stream; times = walk time
+        "burst_rate": 0.0,  # probability per frame that a loss burst starts there
+        "burst_frames": 20,  # frames lost per burst, 1..10000
+        "silence_at_s": [],  # starts of windows in which no frame arrives
+        "silence_s": 5.0,  # length of each silence window
+        "duplicate_rate": 0.0,  # probability that a frame arrives twice
+        "reorder_rate": 0.0,  # probability that a frame arrives after the next reorder_frames frames
+        "reorder_frames": 1,  # 1..100
+        "corrupt_rate": 0.0,  # probability that a frame's payload has corrupt_bits bits flipped
+        "corrupt_bits": 1,  # distinct random bits flipped per corrupted frame, 1..64
+        "reset_at_s": [],  # board resets: new boot_id, BOARD_TIME first, board time and counters restart
+        "reset_down_ms": 200,  # the board sends nothing for this long after a reset
+        "reset_time_start_ms": 0,  # board time of the first frame after a reset, 0..2**32-1
+        "implausible_at_s": [],  # one implausible IMU sample (implausible_signal) at each of these times
+        "implausible_rate": 0.0,  # probability per frame of implausible_signal's message
+        "implausible_signal": "accel_z",  # accel_x..z, gyro_x..z
+        "implausible_mode": "bitflip",  # "bitflip": sign bit flipped (9.8 -> -147 m/s2); "full_scale"
+    },
 }
 
 
@@ -200,6 +220,12 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
                         raise ScenarioError(source, f"key '{name}[{i}].{k}' must be a number")
                 pauses.append({"at_m": float(p["at_m"]), "duration_s": float(p["duration_s"])})
             out[key] = pauses
+        elif isinstance(dflt, list) and not dflt:  # an empty default: a list of any length (times)
+            if not isinstance(value, list) or any(
+                isinstance(v, bool) or not isinstance(v, (int, float)) for v in value
+            ):
+                raise ScenarioError(source, f"key '{name}' must be a list of numbers")
+            out[key] = [float(v) for v in value]
         elif isinstance(dflt, list):
             if (
                 not isinstance(value, list)
@@ -316,6 +342,7 @@ def _validate_values(d: dict, source: str) -> None:
     check(0 <= c["loss_rate"] < 1, "can.loss_rate", "must be in 0..1")
     check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
     check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
+    _validate_faults(d["faults"], check)
     check(
         0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
         "radio.scan_interval_min_s",
@@ -325,6 +352,37 @@ def _validate_values(d: dict, source: str) -> None:
         0 <= r["scan_duration_ms"] < 1000 * r["scan_interval_min_s"],
         "radio.scan_duration_ms",
         "must be >= 0 and shorter than the scan interval",
+    )
+
+
+def _validate_faults(f: dict, check) -> None:
+    from .faults import IMPLAUSIBLE_MODES, IMPLAUSIBLE_SIGNALS
+
+    for key in ("burst_rate", "duplicate_rate", "reorder_rate", "corrupt_rate", "implausible_rate"):
+        check(0 <= f[key] < 1, f"faults.{key}", "must be in 0..1")
+    check(1 <= f["burst_frames"] <= 10_000, "faults.burst_frames", "must be in 1..10000")
+    check(1 <= f["reorder_frames"] <= 100, "faults.reorder_frames", "must be in 1..100")
+    check(1 <= f["corrupt_bits"] <= 64, "faults.corrupt_bits", "must be in 1..64")
+    check(0 < f["silence_s"] <= 3600, "faults.silence_s", "must be in 0..3600 (> 0)")
+    check(0 <= f["reset_down_ms"] <= 60_000, "faults.reset_down_ms", "must be in 0..60000")
+    check(0 <= f["reset_time_start_ms"] < 2**32, "faults.reset_time_start_ms", "must be in 0..2**32-1")
+    for key in ("silence_at_s", "reset_at_s", "implausible_at_s"):
+        check(all(v >= 0 for v in f[key]), f"faults.{key}", "must hold times >= 0")
+    resets = sorted(f["reset_at_s"])
+    check(
+        all(b - a > f["reset_down_ms"] / 1000 for a, b in zip(resets, resets[1:])),
+        "faults.reset_at_s",
+        "must be further apart than faults.reset_down_ms",
+    )
+    check(
+        f["implausible_signal"] in IMPLAUSIBLE_SIGNALS,
+        "faults.implausible_signal",
+        f"must be one of {', '.join(IMPLAUSIBLE_SIGNALS)}",
+    )
+    check(
+        f["implausible_mode"] in IMPLAUSIBLE_MODES,
+        "faults.implausible_mode",
+        f"must be one of {', '.join(IMPLAUSIBLE_MODES)}",
     )
 
 

@@ -22,6 +22,8 @@
 #include "sf_test_frames.h"
 
 #define PERIOD_MS 10
+/* Host receive time of a frame sent at board time t_ms: the board sends as it samples. */
+#define HOST_US(t_ms) (1700000000000000LL + (int64_t)(t_ms) * 1000)
 #define MAX_SAMPLES 2000
 
 typedef struct {
@@ -77,7 +79,7 @@ static totals_t run_direct(const scenario_t *const s)
     for (int k = 0; k < s->n; k++) {
         const int64_t t = s->t0_ms + (int64_t)k * PERIOD_MS;
         if (is_time_frame(k) && !s->drop_time[k]) {
-            sf_board_clock_on_time(&clock, (uint32_t)t, 7);
+            sf_board_clock_on_time(&clock, (uint32_t)t, 7, HOST_US(t));
         }
         if (s->drop[k]) {
             if (last_k >= 0) {
@@ -88,7 +90,7 @@ static totals_t run_direct(const scenario_t *const s)
         int64_t t_ms = -1;
         int64_t useq = -1;
         uint32_t lost = 12345;
-        const int rc = sf_stream_time_resolve(&st, &clock, (uint8_t)k, (uint8_t)t, &t_ms, &useq, &lost);
+        const int rc = sf_stream_time_resolve(&st, &clock, (uint8_t)k, (uint8_t)t, HOST_US(t), &t_ms, &useq, &lost);
         assert_int_equal(rc, SF_OK);
         if (first_k < 0) {
             first_k = k;
@@ -215,9 +217,9 @@ static void test_32bit_board_time_wrap(void **state)
 
     sf_board_clock_t clock;
     sf_board_clock_init(&clock);
-    sf_board_clock_on_time(&clock, (uint32_t)t0, 1);
+    sf_board_clock_on_time(&clock, (uint32_t)t0, 1, HOST_US(t0));
     assert_int_equal(clock.board_ms, t0);
-    sf_board_clock_on_time(&clock, 1000, 1); /* 2^32 + 1000 */
+    sf_board_clock_on_time(&clock, 1000, 1, HOST_US(4294967296LL + 1000)); /* 2^32 + 1000 */
     assert_int_equal(clock.board_ms, 4294967296LL + 1000);
     int64_t t_ms = 0;
     assert_int_equal(sf_board_clock_unwrap(&clock, 4294967000u, &t_ms), SF_OK);
@@ -234,13 +236,13 @@ static void test_duplicate_seq(void **state)
     sf_stream_time_t st;
     sf_board_clock_init(&clock);
     sf_stream_time_init(&st, PERIOD_MS);
-    sf_board_clock_on_time(&clock, 1000, 1);
+    sf_board_clock_on_time(&clock, 1000, 1, HOST_US(1000));
     int64_t t, useq;
     uint32_t lost;
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 5, (uint8_t)1000, &t, &useq, &lost), SF_OK);
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 5, (uint8_t)1000, HOST_US(1000), &t, &useq, &lost), SF_OK);
     assert_int_equal(t, 1000);
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 5, (uint8_t)1000, &t, &useq, &lost), SF_EDUPLICATE);
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 6, (uint8_t)1010, &t, &useq, &lost), SF_OK);
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 5, (uint8_t)1000, HOST_US(1000), &t, &useq, &lost), SF_EDUPLICATE);
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 6, (uint8_t)1010, HOST_US(1010), &t, &useq, &lost), SF_OK);
     assert_int_equal(t, 1010);
     assert_int_equal(useq, 6);
     assert_int_equal(lost, 0);
@@ -255,44 +257,139 @@ static void test_not_synced_before_first_board_time(void **state)
     sf_stream_time_init(&st, PERIOD_MS);
     int64_t t = -1, useq = -1;
     uint32_t lost = 0;
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 0, 0, &t, &useq, &lost), SF_ENOTSYNC);
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 0, 0, 0, &t, &useq, &lost), SF_ENOTSYNC);
     assert_int_equal(sf_board_clock_unwrap(&clock, 1234, &t), SF_ENOTSYNC);
-    sf_board_clock_on_time(&clock, 20000, 3);
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 1, (uint8_t)20005, &t, &useq, &lost), SF_OK);
+    sf_board_clock_on_time(&clock, 20000, 3, HOST_US(20000));
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 1, (uint8_t)20005, HOST_US(20005), &t, &useq, &lost), SF_OK);
     assert_int_equal(t, 20005);
 }
 
-static void test_boot_id_change_resets(void **state)
+/* 100 Hz samples k = from..to-1 of a stream starting at t0_ms (seq = k mod 256), each checked to
+ * resolve at board time t0 + 10 k and output time out0 + 10 k. */
+static void stream_exact(sf_stream_time_t *const st, sf_board_clock_t *const clock, const int64_t t0_ms,
+                         const int64_t out0_ms, const int64_t host0_ms, const int from, const int to)
+{
+    for (int k = from; k < to; k++) {
+        const int64_t want = t0_ms + 10 * k;
+        int64_t t, useq;
+        uint32_t lost;
+        const int rc = sf_stream_time_resolve(st, clock, (uint8_t)k, (uint8_t)want, HOST_US(host0_ms + 10 * k), &t,
+                                              &useq, &lost);
+        if (rc != SF_OK || t != want || t + clock->offset_ms != out0_ms + 10 * k) {
+            fail_msg("sample %d: rc %d, time %lld (want %lld), output %lld (want %lld)", k, rc, (long long)t,
+                     (long long)want, (long long)(t + clock->offset_ms), (long long)(out0_ms + 10 * k));
+        }
+    }
+}
+
+static void test_boot_id_change_restarts_and_reanchors(void **state)
 {
     (void)state;
     sf_board_clock_t clock;
     sf_stream_time_t st;
     sf_board_clock_init(&clock);
     sf_stream_time_init(&st, PERIOD_MS);
+    assert_int_equal(sf_board_clock_on_time(&clock, 3000000, 1, HOST_US(3000000)), sf_board_time_believed);
+    stream_exact(&st, &clock, 3000000, 3000000, 3000000, 0, 300); /* last sample at 3 002 990 */
+    /* The board restarts 510 ms after its last sample: clock near 0, new boot id, seq from 0. The
+     * BOARD_TIME alone is held; the first sample, which restarts its sequence at that time and does not
+     * fit the old stream, confirms it. Output time goes on by the host time that passed. */
+    assert_int_equal(sf_board_clock_on_time(&clock, 500, 2, HOST_US(3003500)), sf_board_time_held);
+    assert_int_equal(clock.restarts, 0);
+    stream_exact(&st, &clock, 500, 3003500, 3003500 - 500, 0, 200);
+    assert_int_equal(clock.restarts, 1);
+    assert_int_equal(clock.boot_id, 2);
+    assert_int_equal(clock.time_rejected, 0);
+    /* The same boot id again is believed and no restart. */
+    assert_int_equal(sf_board_clock_on_time(&clock, 2500, 2, HOST_US(3005500)), sf_board_time_believed);
+    assert_int_equal(clock.restarts, 1);
+}
+
+static void test_restart_confirmed_by_the_next_board_time(void **state)
+{
+    (void)state;
+    /* Board time restarts under the same boot id (no sample can tell: same-boot jumps wait for the
+     * next BOARD_TIME, which confirms it). Samples in between are not believed. */
+    sf_board_clock_t clock;
+    sf_stream_time_t st;
+    sf_board_clock_init(&clock);
+    sf_stream_time_init(&st, PERIOD_MS);
+    sf_board_clock_on_time(&clock, 70000, 4, HOST_US(70000));
+    stream_exact(&st, &clock, 70000, 70000, 70000, 0, 100); /* last sample 70 990 at host 70 990 */
+    assert_int_equal(sf_board_clock_on_time(&clock, 1000, 4, HOST_US(71000)), sf_board_time_held);
+    int rejected = 0;
+    for (int k = 0; k < 100; k++) { /* 1 s of samples of the restarted board, before its next BOARD_TIME */
+        int64_t t, useq;
+        uint32_t lost;
+        const int rc = sf_stream_time_resolve(&st, &clock, (uint8_t)k, (uint8_t)(1000 + 10 * k),
+                                              HOST_US(71000 + 10 * k), &t, &useq, &lost);
+        rejected += rc != SF_OK;
+        assert_true(rc == SF_OK || rc == SF_ESEQ || rc == SF_ELATE || rc == SF_EDUPLICATE);
+    }
+    assert_true(rejected > 0);
+    assert_int_equal(sf_board_clock_on_time(&clock, 2000, 4, HOST_US(72000)), sf_board_time_restart);
+    assert_int_equal(clock.restarts, 1);
+    assert_int_equal(clock.board_ms, 2000);
+    stream_exact(&st, &clock, 1000, 71000, 71000, 100, 300); /* board 1000 = output 71 000 */
+}
+
+static void test_corrupt_board_time_is_not_believed(void **state)
+{
+    (void)state;
+    /* One BOARD_TIME with a flipped bit (time bit 30), and one with a flipped boot id bit: neither
+     * moves the stream; both are counted when the next good BOARD_TIME contradicts them. */
+    sf_board_clock_t clock;
+    sf_stream_time_t st;
+    sf_board_clock_init(&clock);
+    sf_stream_time_init(&st, PERIOD_MS);
+    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
+    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 100);
+    assert_int_equal(sf_board_clock_on_time(&clock, 51000u ^ (1u << 30), 9, HOST_US(51000)), sf_board_time_held);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 100, 200);
+    assert_int_equal(sf_board_clock_on_time(&clock, 52000, 9, HOST_US(52000)), sf_board_time_believed);
+    assert_int_equal(clock.time_rejected, 1);
+    assert_int_equal(sf_board_clock_on_time(&clock, 53000, 9 ^ 4, HOST_US(53000)), sf_board_time_held);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 200, 300); /* seq 44.. go on: they fit the old stream */
+    assert_int_equal(sf_board_clock_on_time(&clock, 53000, 9, HOST_US(53000)), sf_board_time_believed);
+    assert_int_equal(clock.time_rejected, 2);
+    assert_int_equal(clock.restarts, 0);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 300, 400);
+}
+
+static void test_late_and_corrupt_seq_are_skipped(void **state)
+{
+    (void)state;
+    sf_board_clock_t clock;
+    sf_stream_time_t st;
+    sf_board_clock_init(&clock);
+    sf_stream_time_init(&st, PERIOD_MS);
+    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
+    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 50);
     int64_t t, useq;
     uint32_t lost;
-    sf_board_clock_on_time(&clock, 3000000, 1);
-    for (int k = 0; k < 300; k++) {
-        const int64_t want = 3000000 + 10 * k;
-        assert_int_equal(sf_stream_time_resolve(&st, &clock, (uint8_t)k, (uint8_t)want, &t, &useq, &lost), SF_OK);
-        assert_int_equal(t, want);
-    }
-    assert_int_equal(useq, 299);
-    /* The board restarts: its clock starts again near 0 with a new boot_id. */
-    sf_board_clock_on_time(&clock, 500, 2);
-    assert_int_equal(clock.restarts, 1);
-    assert_int_equal(clock.board_ms, 500);
-    assert_int_equal(clock.boot_id, 2);
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 0, (uint8_t)500, &t, &useq, &lost), SF_OK);
-    assert_int_equal(t, 500);
-    assert_int_equal(useq, 0);
-    assert_int_equal(lost, 0);
-    assert_int_equal(sf_stream_time_resolve(&st, &clock, 1, (uint8_t)510, &t, &useq, &lost), SF_OK);
-    assert_int_equal(t, 510);
-    assert_int_equal(useq, 1);
-    /* The same boot_id again is not a restart. */
-    sf_board_clock_on_time(&clock, 1000, 2);
-    assert_int_equal(clock.restarts, 1);
+    /* sample 51 before 50 (reordered): 51 is taken, 50 arrives late */
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 51, (uint8_t)50510, HOST_US(50510), &t, &useq, &lost), SF_OK);
+    assert_int_equal(t, 50510);
+    assert_int_equal(lost, 1);
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 50, (uint8_t)50500, HOST_US(50511), &t, &useq, &lost),
+                     SF_ELATE);
+    /* sample 52 with a flipped seq bit (52 ^ 64 = 116): 64 samples in 10 ms cannot be */
+    assert_int_equal(sf_stream_time_resolve(&st, &clock, 52 ^ 64, (uint8_t)50520, HOST_US(50520), &t, &useq, &lost),
+                     SF_ESEQ);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 53, 300);
+}
+
+static void test_outage_longer_than_the_seq_wrap_is_exact_by_host_time(void **state)
+{
+    (void)state;
+    /* 300 samples and every BOARD_TIME among them lost (Δseq = 44 mod 256): the host time that
+     * passed (3 s) tells 300 from 44, so the samples before the next BOARD_TIME are exact too. */
+    scenario_t *const s = new_scenario(50000, 1500);
+    lose(s, 650, 300, true);
+    const totals_t tot = run_direct(s);
+    assert_int_equal(tot.dropped, 300);
+    assert_int_equal(tot.lost_total, 300);
+    free(s);
 }
 
 /* ---- through sf_board_rx_frame, IMU_ACCEL + IMU_GYRO pairs ---- */
@@ -366,24 +463,68 @@ static void test_rx_unsynced_duplicate_and_restart(void **state)
     assert_int_equal(sf_board_rx_frame(rx, &a, &ev), 0);
     assert_int_equal(sf_board_rx_frame(rx, &g, &ev), 1);
     assert_int_equal(ev.u.imu.t_us, 1000000);
-    /* the same sample again */
-    assert_int_equal(sf_board_rx_frame(rx, &a, &ev), 0);
+    /* the same sample again (the bus repeated both frames) */
+    assert_int_equal(sf_board_rx_frame(rx, &a, &ev), SF_EDUPLICATE);
     assert_int_equal(sf_board_rx_frame(rx, &g, &ev), SF_EDUPLICATE);
-    assert_int_equal(rx->counters.duplicates, 1);
+    assert_int_equal(rx->counters.duplicates, 2);
+    assert_int_equal(rx->counters.imu_unpaired, 0);
 
-    /* the board restarts mid-sample: the accel half waiting is dropped with the old boot */
+    /* the board restarts mid-sample: the accel half waiting is dropped with the old boot; the new
+     * boot's first sample confirms the restart and goes on in output time */
     a = tf_accel(3, (uint8_t)1010, 0, 0, 9.81);
     assert_int_equal(sf_board_rx_frame(rx, &a, &ev), 0);
     bt = tf_board_time(200, 2);
     assert_int_equal(sf_board_rx_frame(rx, &bt, &ev), 0);
-    assert_int_equal(rx->counters.board_restarts, 1);
+    assert_int_equal(rx->counters.board_restarts, 0); /* held: one frame is not believed */
     a = tf_accel(0, 200, 0, 0, 9.81);
     g = tf_gyro(0, 200, 0, 0, 0);
     assert_int_equal(sf_board_rx_frame(rx, &a, &ev), 0);
     assert_int_equal(sf_board_rx_frame(rx, &g, &ev), 1);
-    assert_int_equal(ev.u.imu.t_us, 200000);
+    assert_int_equal(rx->counters.board_restarts, 1);
+    assert_true(ev.u.imu.t_us > 1000000); /* after the old boot's last sample, not back at 200 ms */
     assert_int_equal(ev.u.imu.seq, 0);
     free(rx);
+}
+
+static void test_rx_swapped_halves_still_pair(void **state)
+{
+    (void)state;
+    sf_board_rx_t *const rx = malloc(sizeof *rx);
+    assert_non_null(rx);
+    sf_board_rx_init(rx);
+    sf_rx_event_t ev;
+    const sf_can_frame_t bt = tf_board_time(5000, 1);
+    assert_int_equal(sf_board_rx_frame(rx, &bt, &ev), 0);
+    /* ACCEL 0, ACCEL 1, GYRO 0, GYRO 1: the bus swapped GYRO 0 and ACCEL 1 */
+    sf_can_frame_t f = tf_accel(0, (uint8_t)5000, 0, 0, 9.81);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 0);
+    f = tf_accel(1, (uint8_t)5010, 0, 0, 9.81);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 0);
+    f = tf_gyro(0, (uint8_t)5000, 0, 0, 0);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 1);
+    assert_int_equal(ev.u.imu.t_us, 5000000);
+    f = tf_gyro(1, (uint8_t)5010, 0, 0, 0);
+    assert_int_equal(sf_board_rx_frame(rx, &f, &ev), 1);
+    assert_int_equal(ev.u.imu.t_us, 5010000);
+    assert_int_equal(rx->counters.imu_unpaired, 0);
+    free(rx);
+}
+
+static void test_corrupt_t_lo_of_a_locked_stream_is_skipped(void **state)
+{
+    (void)state;
+    sf_board_clock_t clock;
+    sf_stream_time_t st;
+    sf_board_clock_init(&clock);
+    sf_stream_time_init(&st, PERIOD_MS);
+    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
+    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 50);
+    int64_t t, useq;
+    uint32_t lost;
+    /* sample 50 at 50 500 ms with t_lo bit 6 flipped: 64 ms off the prediction, inside ±128 ms */
+    assert_int_equal(
+        sf_stream_time_resolve(&st, &clock, 50, (uint8_t)(50500 ^ 64), HOST_US(50500), &t, &useq, &lost), SF_ESEQ);
+    stream_exact(&st, &clock, 50000, 50000, 50000, 51, 200);
 }
 
 int main(void)
@@ -398,9 +539,15 @@ int main(void)
         cmocka_unit_test(test_32bit_board_time_wrap),
         cmocka_unit_test(test_duplicate_seq),
         cmocka_unit_test(test_not_synced_before_first_board_time),
-        cmocka_unit_test(test_boot_id_change_resets),
+        cmocka_unit_test(test_boot_id_change_restarts_and_reanchors),
+        cmocka_unit_test(test_restart_confirmed_by_the_next_board_time),
+        cmocka_unit_test(test_corrupt_board_time_is_not_believed),
+        cmocka_unit_test(test_late_and_corrupt_seq_are_skipped),
+        cmocka_unit_test(test_outage_longer_than_the_seq_wrap_is_exact_by_host_time),
         cmocka_unit_test(test_rx_imu_pairs_times_and_counters),
         cmocka_unit_test(test_rx_unsynced_duplicate_and_restart),
+        cmocka_unit_test(test_rx_swapped_halves_still_pair),
+        cmocka_unit_test(test_corrupt_t_lo_of_a_locked_stream_is_skipped),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

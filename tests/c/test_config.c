@@ -205,6 +205,74 @@ static void test_set(void **state)
     assert_true(strlen(err) > 0);
 }
 
+/* Regression (issue 12): a --set longer than 255 characters was cut short silently; the value is
+ * now read in place (no limit) and an over-long key is refused. */
+static void test_set_is_never_cut_short(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    char err[256] = "";
+    char long_value[600];
+    snprintf(long_value, sizeof long_value, "stride.weinberg_k=0.5%0500d", 0); /* 0.5000...0 */
+    assert_int_equal(sf_config_set(long_value, &p, err, sizeof err), SF_OK);
+    assert_true(p.stride_weinberg_k == 0.5);
+    snprintf(long_value, sizeof long_value, "stride.weinberg_k=0.5%0300dx", 0); /* the tail counts */
+    assert_int_equal(sf_config_set(long_value, &p, err, sizeof err), SF_ESYNTAX);
+    char long_key[400];
+    memset(long_key, 'a', 300);
+    strcpy(long_key + 300, ".b=1");
+    assert_int_equal(sf_config_set(long_key, &p, err, sizeof err), SF_ESYNTAX);
+    assert_non_null(strstr(err, "characters"));
+}
+
+/* Regression (issue 12): a line longer than inih's INI_MAX_LINE was split, and the error named a
+ * later line and a key made of the line's tail. It is now refused with its own line number. */
+static void test_over_long_line_names_its_line(void **state)
+{
+    (void)state;
+    char text[1024];
+    char comment[400];
+    memset(comment, 'x', 300);
+    comment[300] = '\0';
+    snprintf(text, sizeof text, "[stride]\nweinberg_k = 0.5\n# %s\nweinberg_k = 0.6\n", comment);
+    load(text, SF_ESYNTAX, 3, "longer than");
+    snprintf(text, sizeof text, "[stride]\nweinberg_k = 0.5%s\n", comment);
+    load(text, SF_ESYNTAX, 2, "longer than");
+    /* 199 characters fit exactly (inih's 200-byte buffer less its NUL) */
+    snprintf(text, sizeof text, "[stride]\n# %.197s\nweinberg_k = 0.6", comment);
+    const sf_params_t p = load(text, SF_OK, 0, NULL);
+    assert_true(p.stride_weinberg_k == 0.6);
+}
+
+static void test_nul_byte_is_refused(void **state)
+{
+    (void)state;
+    write_config("");
+    FILE *const f = fopen(g_path, "w");
+    assert_non_null(f);
+    fwrite("[stride]\nweinberg_k = 0.5\0\n", 1, 28, f);
+    fclose(f);
+    sf_params_t p;
+    sf_params_default(&p);
+    char err[512] = "";
+    assert_int_equal(sf_config_load(g_path, &p, err, sizeof err), SF_ESYNTAX);
+    assert_non_null(strstr(err, ":2: a NUL byte"));
+}
+
+/* Regression (issue 12): --config /dev/zero hung in inih, --config DIR was accepted. */
+static void test_device_and_directory_are_refused(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    char err[256] = "";
+    assert_int_equal(sf_config_load("/dev/zero", &p, err, sizeof err), SF_EIO);
+    assert_non_null(strstr(err, "/dev/zero: config is a character device"));
+    assert_int_equal(sf_config_load("/tmp", &p, err, sizeof err), SF_EIO);
+    assert_non_null(strstr(err, "/tmp: config is a directory"));
+}
+
 static void test_param_table_matches_struct(void **state)
 {
     (void)state;
@@ -236,6 +304,10 @@ int main(void)
         CFG_TEST(test_error_is_kept_when_good_lines_follow),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_set),
+        cmocka_unit_test(test_set_is_never_cut_short),
+        CFG_TEST(test_over_long_line_names_its_line),
+        CFG_TEST(test_nul_byte_is_refused),
+        cmocka_unit_test(test_device_and_directory_are_refused),
         cmocka_unit_test(test_param_table_matches_struct),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

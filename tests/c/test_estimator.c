@@ -9,6 +9,7 @@
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -46,6 +47,14 @@ static void nav_to_body(const double v[3], double yaw, double out[3])
     out[2] = v[2];
 }
 
+/* Sample index whose accelerometer z and, 300 samples later, gyroscope z carry a flipped int16 sign bit
+ * (a corrupt frame), or -1. */
+static int g_corrupt_k = -1;
+/* Samples [g_gap_k, g_gap_k + 500) never arrive (a 5 s bus silence), or -1; g_no_bridge turns the
+ * gap bridge off. */
+static int g_gap_k = -1;
+static bool g_no_bridge = false;
+
 /* climb_mps: the walker rises at this speed while walking (stairs; the barometer at 10 Hz sees it,
  * the IMU does not: the same gait as on level ground) */
 static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offset_rad, double step_hz,
@@ -53,6 +62,7 @@ static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offs
 {
     sf_params_t p;
     sf_params_default(&p);
+    p.gap_bridge = g_no_bridge ? 0 : 1;
     sf_estimator_t est;
     sf_estimator_init(&est, &p);
     run_result_t r = {0};
@@ -71,6 +81,9 @@ static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offs
     for (int k = 0; k < (int)(total_s * rate_hz); k++) {
         const double t = k / rate_hz;
         const double tw = t - still0_s;
+        if (g_gap_k >= 0 && k >= g_gap_k && k < g_gap_k + 500) {
+            continue;
+        }
         const bool walking = tw >= 0.0 && tw < walk_s;
         /* vertical: a_z = A sin(ωt); v_z = −A/ω cos(ωt); forward a_f = −c·v_z (inverted pendulum) */
         const double az = walking ? a_v * sin(w * tw) : 0.0;
@@ -82,6 +95,12 @@ static run_result_t run_walk(int n_steps, double walk_dir_rad, double mount_offs
                                  af * sin(walk_dir_rad) + al * cos(walk_dir_rad), G + az + noise};
         sf_imu_sample_t s = {.t_us = (int64_t)llround(t * 1e6)};
         nav_to_body(f_nav, device_yaw, s.accel_mps2);
+        if (k == g_corrupt_k) {
+            s.accel_mps2[2] -= 156.9; /* the sign bit of the DBC's int16 at 16 g full scale */
+        }
+        if (k == g_corrupt_k + 300) {
+            s.gyro_radps[2] += 34.9; /* the sign bit at 2000 deg/s */
+        }
         if (k % 2 == 0) {
             double m_body[3];
             nav_to_body(m_nav, device_yaw, m_body);
@@ -134,6 +153,39 @@ static void test_counts_steps_and_walks_straight(void **state)
     assert_true(angle_deg(atan2(r.y_m, r.x_m) - dir) < 3.0);
     assert_true(angle_deg(r.last_step.heading_rad - dir) < 3.0);
     assert_true(r.last_step.accel_range_mps2 > 3.0 && r.last_step.accel_range_mps2 < 6.0);
+}
+
+static void test_one_corrupt_sample_changes_nothing(void **state)
+{
+    (void)state;
+    const double dir = 30.0 * PI / 180.0;
+    const run_result_t clean = run_walk(100, dir, 0.0, 1.8, 0.0);
+    g_corrupt_k = 2000; /* mid-walk */
+    const run_result_t bad = run_walk(100, dir, 0.0, 1.8, 0.0);
+    g_corrupt_k = -1;
+    assert_int_equal(bad.steps, clean.steps);
+    assert_true(hypot(bad.x_m - clean.x_m, bad.y_m - clean.y_m) < 0.2);
+}
+
+static void test_a_silence_mid_walk_is_bridged(void **state)
+{
+    (void)state;
+    const double dir = 30.0 * PI / 180.0;
+    const run_result_t clean = run_walk(100, dir, 0.0, 1.8, 0.0);
+    g_gap_k = 2000; /* 15 s into the walk: 5 s, 9 steps, never arrive */
+    g_no_bridge = true;
+    const run_result_t lost = run_walk(100, dir, 0.0, 1.8, 0.0);
+    g_no_bridge = false;
+    const run_result_t bridged = run_walk(100, dir, 0.0, 1.8, 0.0);
+    g_gap_k = -1;
+    const double d_clean = hypot(clean.x_m, clean.y_m);
+    const double d_lost = hypot(lost.x_m, lost.y_m);
+    const double d_bridged = hypot(bridged.x_m, bridged.y_m);
+    assert_true(lost.steps <= clean.steps - 8);
+    assert_int_equal(bridged.steps, lost.steps); /* bridging credits distance, not steps */
+    assert_true(d_clean - d_lost > 0.08 * d_clean);
+    assert_true(fabs(d_bridged - d_clean) < 0.03 * d_clean);
+    assert_true(angle_deg(atan2(bridged.y_m, bridged.x_m) - dir) < 3.0);
 }
 
 static void test_still_does_not_drift(void **state)
@@ -232,6 +284,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_counts_steps_and_walks_straight),
+        cmocka_unit_test(test_one_corrupt_sample_changes_nothing),
+        cmocka_unit_test(test_a_silence_mid_walk_is_bridged),
         cmocka_unit_test(test_still_does_not_drift),
         cmocka_unit_test(test_mounting_offset_is_learnt),
         cmocka_unit_test(test_paces),

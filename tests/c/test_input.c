@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -181,6 +182,7 @@ static void test_candump_and_lcm_replay_give_the_same_events(void **state)
 
     sf_lcm_out_t *out = NULL;
     char err[256];
+    unlink(lcmlog); /* the log is created O_EXCL: the name only, not the file */
     assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 16, true, err, sizeof err), SF_OK);
     for (int i = 0; i < can.n; i++) {
         sf_rx_lcm_write(out, can.log_t_us[i], &can.ev[i]);
@@ -255,6 +257,7 @@ static void test_replay_close_does_not_close_stdin(void **state)
     char lcmlog[64], spec[80];
     temp_path(lcmlog, sizeof lcmlog, "stdin");
     sf_lcm_out_t *out = NULL;
+    unlink(lcmlog); /* the log is created O_EXCL: the name only, not the file */
     assert_int_equal(sf_lcm_out_open(&out, lcmlog, NULL, 4, true, NULL, 0), SF_OK);
     sf_rx_event_t ev = {.kind = sf_rx_mag, .u.mag = {.t_us = 1000, .seq = 1, .field_ut = {1.0, 2.0, 3.0}}};
     sf_rx_lcm_write(out, 5, &ev);
@@ -290,6 +293,68 @@ static void test_missing_inputs_fail_with_a_message(void **state)
     assert_int_equal(sf_input_open(&in, "", err, sizeof err), SF_EINVAL);
 }
 
+/* Regression (issue 12): --input /dev/zero hung and a directory was accepted. Devices and
+ * directories are refused for candump and LCM inputs alike; a FIFO (a stream, as stdin) is not. */
+static void test_devices_and_directories_are_refused(void **state)
+{
+    (void)state;
+    static const char *const specs[] = {"/dev/zero", "/tmp", "lcmlog:/dev/zero", "lcmlog:/tmp"};
+    for (size_t i = 0; i < sizeof specs / sizeof specs[0]; i++) {
+        sf_input_t *in = NULL;
+        char err[256] = "";
+        assert_int_equal(sf_input_open(&in, specs[i], err, sizeof err), SF_EIO);
+        assert_null(in);
+        assert_non_null(strstr(err, "not a file"));
+    }
+    char fifo[64];
+    temp_path(fifo, sizeof fifo, "fifo");
+    unlink(fifo);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    const int writer = open(fifo, O_RDWR); /* keeps the FIFO's open from blocking */
+    assert_true(writer >= 0);
+    sf_input_t *in = NULL;
+    char err[256] = "";
+    assert_int_equal(sf_input_open(&in, fifo, err, sizeof err), SF_OK);
+    sf_input_close(in);
+    close(writer);
+    unlink(fifo);
+}
+
+/* Regression (issue 12): a PNG given as a candump was 508 bad lines and exit 0. An input without one
+ * valid frame says so; one valid frame among bad lines is enough. */
+static void test_nothing_valid_is_told(void **state)
+{
+    (void)state;
+    char path[64];
+    temp_path(path, sizeof path, "junk");
+    FILE *const f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs("\x89PNG\r\n\x1a\nnot a frame\n(1.0) can0 7FF#00\n", f);
+    fclose(f);
+    sf_input_t *in = NULL;
+    char err[256];
+    char why[256] = "";
+    assert_int_equal(sf_input_open(&in, path, err, sizeof err), SF_OK);
+    sf_input_item_t *const item = malloc(sizeof *item);
+    assert_non_null(item);
+    while (sf_input_next(in, item) != 0) {
+    }
+    assert_true(sf_input_nothing_valid(in, why, sizeof why));
+    assert_non_null(strstr(why, "nothing valid"));
+    assert_non_null(strstr(why, path));
+    sf_input_close(in);
+
+    const int n_lines = write_candump(path);
+    assert_true(n_lines > 1);
+    assert_int_equal(sf_input_open(&in, path, err, sizeof err), SF_OK);
+    while (sf_input_next(in, item) != 0) {
+    }
+    assert_false(sf_input_nothing_valid(in, why, sizeof why));
+    sf_input_close(in);
+    free(item);
+    unlink(path);
+}
+
 /* The kind table: every kind has a channel that decodes back to it; other channels are not inputs,
  * and a payload that does not decode is SF_ESYNTAX. */
 static void test_every_kind_has_a_channel(void **state)
@@ -315,6 +380,8 @@ int main(void)
         cmocka_unit_test(test_replay_close_does_not_close_stdin),
         cmocka_unit_test(test_missing_inputs_fail_with_a_message),
         cmocka_unit_test(test_every_kind_has_a_channel),
+        cmocka_unit_test(test_devices_and_directories_are_refused),
+        cmocka_unit_test(test_nothing_valid_is_told),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

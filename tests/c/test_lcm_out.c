@@ -31,6 +31,7 @@ static void temp_path(char *const path, const size_t size)
     const int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
+    unlink(path); /* the log is created O_EXCL: the name only, not the file */
 }
 
 static stridefix_imu_t imu_sample(const int i)

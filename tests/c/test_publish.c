@@ -31,6 +31,7 @@ static void test_every_output_round_trips(void **state)
     const int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
+    unlink(path); /* the log is created O_EXCL: the name only, not the file */
     sf_lcm_out_t *out = NULL;
     assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
 

@@ -39,7 +39,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
         SF_FUZZ_CHECK(c->frames == before.frames + 1);
         SF_FUZZ_CHECK(c->frames_ok >= before.frames_ok && c->decode_errors >= before.decode_errors);
         SF_FUZZ_CHECK(rc == 0 || rc == 1 || rc == SF_EUNKNOWN_ID || rc == SF_ELENGTH || rc == SF_ERANGE ||
-                      rc == SF_ENOTSYNC || rc == SF_EDUPLICATE);
+                      rc == SF_ENOTSYNC || rc == SF_EDUPLICATE || rc == SF_ELATE || rc == SF_ESEQ);
         skipped += rc < 0;
         if (rc == 1) {
             SF_FUZZ_CHECK(ev.kind > sf_rx_none && (int)ev.kind <= SF_RX_KIND_COUNT);

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import fusion, realdata, sil_pdr
+from stridefix_analyzer.bench import fusion, realdata, reliability, sil_pdr, soak
 from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
@@ -69,6 +69,31 @@ def _run_real_targets(args: argparse.Namespace, firmware: Firmware, seeds: list[
     return missed
 
 
+def _run_reliability(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del seeds  # one walk (reliability.SEED): every case is the same walk with one fault
+    wanted = {f for f in args.faults.split(",") if f}
+    known = {c[0] for c in reliability.CASES}
+    if wanted - known:
+        raise BenchUsageError(
+            f"--faults: unknown {sorted(wanted - known)}; known: {', '.join(sorted(known))}"
+        )
+    cases = [c for c in reliability.CASES if not c[2] or not wanted or c[0] in wanted]
+    doc = reliability.run_reliability(firmware, out, cases, site=not args.no_site, sets=args.sets)
+    print(reliability.format_table(doc))
+    print(f"wrote {out / 'reliability.json'} ({doc['run_s']:.0f} s)")
+    return reliability.missed_targets(doc)
+
+
+def _run_soak(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del seeds  # one walk (soak.SEED)
+    if not 0 < args.checkpoint_h < args.hours:
+        raise BenchUsageError(f"--checkpoint-h {args.checkpoint_h}: must be in 0..--hours ({args.hours})")
+    doc = soak.run_soak(firmware, out, hours=args.hours, checkpoint_h=args.checkpoint_h, sets=args.sets)
+    print(soak.format_table(doc))
+    print(f"wrote {out / 'soak.json'}")
+    return soak.missed_targets(doc)
+
+
 Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
 #: sub-bench name → (runner, default seeds)
 BENCHES: dict[str, tuple[Runner, str]] = {
@@ -76,7 +101,13 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "aadr2015": (_run_aadr2015, "1,2,3,4,5"),
     "office-wifi": (_run_office, "1,2,3"),
     "real-targets": (_run_real_targets, "1"),
+    "reliability": (_run_reliability, "1"),
+    "soak": (_run_soak, "1"),
 }
+
+
+class BenchUsageError(ValueError):
+    """A bench option holds a value the bench does not know (exit 2)."""
 
 
 def exit_status(missed: list[str]) -> int:
@@ -99,7 +130,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="sil-pdr: PDR targets at each pace; aadr2015: the auto-adaptive DR paper's "
         "experiment (fusion schemes at the reference points); office-wifi: the fusion "
         "schemes on the default office walk with a surveyed radio map; real-targets: issue 11's "
-        "targets on realbench results.json files (--results)",
+        "targets on realbench results.json files (--results); reliability: the default walk with each bus "
+        "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
+        "accounting (make soak)",
     )
     p.add_argument(
         "--paces",
@@ -139,6 +172,27 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="passed to stridefixd (e.g. attitude.mode=1), to compare variants; repeatable",
     )
     p.add_argument(
+        "--faults",
+        default="",
+        metavar="LIST",
+        help="reliability: comma-separated fault kinds to run beside the clean run (default: all)",
+    )
+    p.add_argument(
+        "--no-site",
+        action="store_true",
+        help="reliability: replay without the office site (PDR only; faster, no fused scheme)",
+    )
+    p.add_argument(
+        "--hours", type=float, default=8.0, metavar="H", help="soak: length of the walk [h] (default: 8)"
+    )
+    p.add_argument(
+        "--checkpoint-h",
+        type=float,
+        default=1.0,
+        metavar="H",
+        help="soak: read the first peak RSS after this much input [h] (default: 1)",
+    )
+    p.add_argument(
         "--no-calibration",
         action="store_true",
         help="skip the per-person stride calibration walk (use the configured default K)",
@@ -165,4 +219,7 @@ def run(args: argparse.Namespace) -> int:
     except StageError as exc:
         print(f"stridefix bench: error: {exc}", file=sys.stderr)
         return 1
+    except BenchUsageError as exc:
+        print(f"stridefix bench: error: {exc}", file=sys.stderr)
+        return 2
     return exit_status(missed)

@@ -32,6 +32,7 @@ from stridefix_analyzer.crowd.positions import run_solve
 from stridefix_analyzer.crowd.sites import run_radiomap
 from stridefix_analyzer.crowd.solve import RANGES, SOLVERS
 from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.logread import LogReadError
 
 # action -> its command (experiment returns its own exit status)
@@ -170,5 +171,5 @@ def run(args: argparse.Namespace) -> int:
         ACTIONS[args.crowd_command](args)
     except (LogReadError, CrowdInputError) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     return 0

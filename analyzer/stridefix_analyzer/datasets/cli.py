@@ -6,7 +6,9 @@ every format shares, then the set's own options (:meth:`~.protocol.Dataset.add_a
 ``--json``. Every format writes either one log per input into a directory (``--out DIR``:
 ``DIR/<input-stem>.lcmlog``) or, for a single input, one named file (``-o/--output FILE``):
 :func:`add_output_arguments`, :func:`output_paths`.
-Exit status: 0 success, 1 the import failed, 2 bad usage or a missing/unreadable input.
+Exit status (:mod:`stridefix_analyzer.exits`): 0 every input imported, 1 an output could not be
+written, 2 bad usage or a missing/unreadable input, 3 an input held no valid sensor record (nothing
+written for it); with several inputs the worst of theirs.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from typing import Any, TextIO
 from stridefix_analyzer import datasets
 from stridefix_analyzer.datasets.lines import MalformedLineWarning
 from stridefix_analyzer.datasets.protocol import Dataset, DatasetReadError
+from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, input_error_status, worst
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
@@ -48,8 +51,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Import every input of the chosen data set; exit 0, or 2 when an input was missing/unreadable
-    or its output failed."""
+    """Import every input of the chosen data set; the exit status (see the module docstring)."""
     ds: Dataset = args._dataset
     options = ds.options(args)
     return run_imports(
@@ -98,12 +100,13 @@ def run_imports(
     """The import loop: one input at a time, malformed-line warnings on stderr, a progress line and a
     JSON summary line per input, ``--json`` with all summaries.
 
-    ``do_import(input, out) -> summary dict``. Returns 0, or 2 when an input was missing/unreadable
-    (:class:`~.protocol.DatasetReadError`) or its output failed.
+    ``do_import(input, out) -> summary dict``. Returns the worst status of the inputs: 0, 3 for an
+    input without a valid record (:class:`~.protocol.NothingValidError`), 2 for a missing/unreadable
+    one (:class:`~.protocol.DatasetReadError`), 1 when an output could not be written.
     """
     outs = output_paths(inputs, args, prog)
     if outs is None:
-        return 2
+        return EXIT_USAGE
 
     def show(
         message: Warning | str,
@@ -115,7 +118,7 @@ def run_imports(
     ) -> None:
         print(f"{prog}: warning: {message}", file=sys.stderr)
 
-    status, summaries = 0, []
+    statuses, summaries = [EXIT_OK], []
     for i, (item, out) in enumerate(zip(inputs, outs), 1):
         t0 = time.perf_counter()
         try:
@@ -125,11 +128,11 @@ def run_imports(
                 s = do_import(item, out)
         except DatasetReadError as exc:
             print(f"{prog}: error: {exc}", file=sys.stderr)
-            status = 2
+            statuses.append(input_error_status(exc))
             continue
         except OSError as exc:
             print(f"{prog}: error: cannot write {out}: {exc}", file=sys.stderr)
-            status = 2
+            statuses.append(EXIT_FAILURE)
             continue
         summaries.append(s)
         print(
@@ -141,4 +144,4 @@ def run_imports(
         Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
     where = args.output if args.output else args.out
     print(f"{prog}: {len(summaries)}/{len(inputs)} {noun}(s) imported into {where}", file=sys.stderr)
-    return status
+    return worst(statuses)

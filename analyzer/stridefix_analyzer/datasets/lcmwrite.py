@@ -93,6 +93,9 @@ def _makers(raw: RawWalk) -> tuple[Callable[[int], _Encodable], ...]:
 def write_lcmlog(raw: RawWalk, out_path: str | os.PathLike[str]) -> int:
     """Write ``raw`` as an LCM event log (overwriting ``out_path``); returns the events written.
 
+    The log is written as ``out_path.part`` and renamed when whole; on any failure the part is removed
+    and ``out_path`` is left as it was.
+
     Raises
     ------
     OSError
@@ -110,10 +113,16 @@ def write_lcmlog(raw: RawWalk, out_path: str | os.PathLike[str]) -> int:
     index = np.concatenate([np.arange(len(t)) for t in times])
     order = np.lexsort((index, rank, t_all))
     makers = _makers(raw)
-    log = lcm.EventLog(out, "w", overwrite=True)
+    part = out + ".part"  # the log appears under its name whole, or not at all
+    log = lcm.EventLog(part, "w", overwrite=True)
     try:
-        for r, i, t in zip(rank[order].tolist(), index[order].tolist(), t_all[order].tolist()):
-            log.write_event(t, CHANNELS[r], makers[r](i).encode())
-    finally:
-        log.close()
+        try:
+            for r, i, t in zip(rank[order].tolist(), index[order].tolist(), t_all[order].tolist()):
+                log.write_event(t, CHANNELS[r], makers[r](i).encode())
+        finally:
+            log.close()
+        os.replace(part, out)
+    except BaseException:
+        Path(part).unlink(missing_ok=True)
+        raise
     return len(order)

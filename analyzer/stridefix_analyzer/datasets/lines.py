@@ -13,6 +13,29 @@ import os
 import warnings
 from collections.abc import Iterator
 
+#: bytes of a file's head looked at by :func:`not_text_hint`
+SNIFF_BYTES = 4096
+_BOMS = {b"\xff\xfe": "UTF-16 (little-endian)", b"\xfe\xff": "UTF-16 (big-endian)"}
+
+
+def not_text_hint(path: str | os.PathLike[str]) -> str | None:
+    """Why a file that gave no valid line is probably not UTF-8 text: a UTF-16 byte-order mark, NUL
+    bytes (binary data) or no byte at all; None when its head looks like text (or cannot be read)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(SNIFF_BYTES)
+    except OSError:
+        return None
+    if not head:
+        return "the file is empty"
+    for bom, name in _BOMS.items():
+        if head.startswith(bom):
+            return f"it starts with a {name} byte-order mark: convert it to UTF-8"
+    nul = head.find(b"\0")
+    if nul >= 0:
+        return f"it holds NUL bytes (the first at byte {nul}): binary data, not a text log"
+    return None
+
 
 class MalformedLineWarning(UserWarning):
     """A line of a trace was skipped; the message names the file and line."""

@@ -24,13 +24,16 @@ from __future__ import annotations
 import abc
 import argparse
 import dataclasses
+import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, ClassVar
 
 from stridefix_analyzer.datasets.lcmwrite import write_lcmlog
+from stridefix_analyzer.datasets.lines import not_text_hint
 from stridefix_analyzer.datasets.rawwalk import RawWalk
+from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import Table
 
 PathLike = str | os.PathLike[str]
@@ -47,6 +50,30 @@ class DatasetReadError(DatasetError):
         super().__init__(f"{os.fspath(path)}: {reason}")
         self.path = os.fspath(path)
         self.reason = reason
+
+
+class NothingValidError(DatasetReadError, NothingValid):
+    """A walk's file was read but held not one valid sensor record (empty, binary, UTF-16, a header
+    only): nothing is written, ``stridefix import`` exits
+    :data:`~stridefix_analyzer.exits.EXIT_NOTHING_VALID`. The message names the file, what was read,
+    and the first malformed line."""
+
+
+def check_has_records(raw: RawWalk) -> None:
+    """Raise :class:`NothingValidError` when ``raw`` has no sensor record (see the class)."""
+    if raw.n_sensor_records() > 0:
+        return
+    lines = raw.stats.get("lines")
+    parts = [f"{lines} line(s) read" if lines is not None else "read"]
+    if raw.skipped:
+        line_no, reason = raw.skipped[0]
+        parts.append(f"{len(raw.skipped)} malformed (the first: line {line_no}, {reason[:80]})")
+    hint = not_text_hint(raw.path)
+    if hint:
+        parts.append(hint)
+    raise NothingValidError(
+        raw.path, f"nothing valid in the input: no sensor record (IMU MAG BARO GNSS WIFI); {', '.join(parts)}"
+    )
 
 
 class WalkDiscoveryError(DatasetError):
@@ -152,8 +179,10 @@ class Dataset(abc.ABC):
 
     def import_walk(self, path: PathLike, out_path: PathLike, **options: Any) -> dict[str, Any]:
         """Read one walk and write its raw-sensor LCM log; returns :meth:`summary` plus ``out``,
-        ``events`` and ``importer_version``. Raises :class:`DatasetReadError` or OSError."""
+        ``events`` and ``importer_version``. Raises :class:`DatasetReadError` (:class:`NothingValidError`
+        for a walk without one sensor record: nothing is written) or OSError."""
         raw = self.read(path, **options)
+        check_has_records(raw)
         events = write_lcmlog(raw, out_path)
         summary = self.summary(raw)
         summary.update(out=os.fspath(out_path), events=events, importer_version=self.version)
@@ -180,11 +209,22 @@ class Dataset(abc.ABC):
         return {"max_wifi_age_s": args.max_wifi_age_s}
 
 
+def seconds_arg(text: str) -> float:
+    """An argparse type: a finite number of seconds >= 0 (``float`` alone takes ``nan`` and ``-1``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number of seconds >= 0")
+    return value
+
+
 def add_max_wifi_age_argument(parser: argparse.ArgumentParser, defaults: Defaults) -> None:
     """``--max-wifi-age-s S`` with the set's default."""
     parser.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=defaults.max_wifi_age_s,
         metavar="S",
         help="drop Wi-Fi entries last seen more than S before the scan time "

@@ -115,6 +115,11 @@ class RawWalk:
             "notes": list(self.notes),
         }
 
+    def n_sensor_records(self) -> int:
+        """Samples and scans of the sensor streams (imu, mag, baro, gnss, wifi; not truth): what a
+        replay feeds ``stridefixd``. 0 means the walk holds nothing valid to import."""
+        return len(self.imu) + len(self.mag) + len(self.baro) + len(self.gnss) + self.n_scans
+
     def time_span_us(self) -> tuple[int, int] | None:
         """(first, last) time of any sample [µs], or None for a walk without samples."""
         ts = [s["t_us"] for s in (self.imu, self.mag, self.baro, self.gnss, self.wifi, self.truth) if len(s)]

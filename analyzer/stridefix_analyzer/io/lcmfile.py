@@ -13,6 +13,8 @@ from typing import Any, BinaryIO
 
 import lcm
 
+from stridefix_analyzer.exits import NothingValid
+
 
 class LogReadError(Exception):
     """A log file could not be opened or is not an LCM event log. The message names the file."""
@@ -26,6 +28,10 @@ class LogReadError(Exception):
         # a realbench worker's error must reach the parent process whole (pickling rebuilds an exception
         # from self.args, which is the one formatted message here)
         return (type(self), (self.path, self.reason))
+
+
+class NotALogError(LogReadError, NothingValid):
+    """The file was read but holds no LCM record (no sync word): nothing valid in it."""
 
 
 class LogTruncatedWarning(UserWarning):
@@ -149,7 +155,9 @@ def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[s
         with open(path, "rb") as f:
             head = f.read(4)
         if head != _SYNC_WORD:
-            raise LogReadError(path, f"not an LCM event log (no LCM sync word; {size} bytes)")
+            raise NotALogError(
+                path, f"nothing valid in the input: not an LCM event log (no LCM sync word; {size} bytes)"
+            )
     notes: list[str] = []
     if trailing:
         notes.append(

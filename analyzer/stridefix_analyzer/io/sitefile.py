@@ -33,6 +33,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import stat
 import struct
 import tempfile
 import zlib
@@ -316,6 +317,8 @@ def read_site(path: str | os.PathLike[str]) -> site_t:
         0x…"``.
     """
     path = os.fspath(path)
+    if os.path.exists(path) and not (os.path.isfile(path) or stat.S_ISFIFO(os.stat(path).st_mode)):
+        raise SiteFileError(path, "io", "cannot read site file: not a regular file (a directory or device)")
     try:
         with open(path, "rb") as f:
             data = f.read(HEADER_SIZE + MAX_PAYLOAD_BYTES + 1)

@@ -12,6 +12,7 @@ import sys
 
 from stridefix import site_t
 
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
@@ -166,5 +167,5 @@ def run(args: argparse.Namespace) -> int:
                 print(f"wrote {args.png}")
     except (LogReadError, RadioMapInputError, SiteFileError) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     return 0

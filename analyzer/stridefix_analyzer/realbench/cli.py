@@ -16,6 +16,8 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer import datasets
+from stridefix_analyzer.datasets.protocol import seconds_arg
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.realbench import tuning
@@ -90,7 +92,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=DEFAULT_MAX_WIFI_AGE_S,
         metavar="S",
         help=f"importer: drop cached Wi-Fi entries older than S (default {DEFAULT_MAX_WIFI_AGE_S:g})",
@@ -126,7 +128,7 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
         )
     except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     print(format_table(doc))
     print(
         f"wrote {os.path.join(doc['out_dir'], JSON_FILE)} and {os.path.join(doc['out_dir'], PNG_FILE)} "
@@ -187,7 +189,7 @@ def add_fusion_parser(sub: Any) -> None:
     )
     d.add_argument(
         "--max-wifi-age-s",
-        type=float,
+        type=seconds_arg,
         default=None,
         help="importer: drop cached Wi-Fi entries older than this [s] (default: the importer's)",
     )
@@ -231,7 +233,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
         doc = run_fusion(cfg)
     except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     print(format_tables(doc, tuning.axes(args.param_sets)))
     extra = f" and {doc['report']}" if doc.get("report") else ""
     print(

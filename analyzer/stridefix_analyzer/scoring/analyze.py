@@ -10,8 +10,9 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
-Exit status: 0 success; 1 nothing could be scored (every truth sample precedes the first POSE);
-2 missing or unreadable input, or no TRUTH / no POSE in the logs.
+Exit status (:mod:`stridefix_analyzer.exits`): 0 success; 1 nothing could be scored (every truth
+sample precedes the first POSE); 2 missing or unreadable input, or no TRUTH / no POSE in the logs;
+3 nothing valid in them (not an LCM log, or neither TRUTH nor POSE in any).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,
@@ -207,7 +209,7 @@ def run(args: argparse.Namespace) -> int:
         )
     except (LogReadError, MetricsInputError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     for note in summary["warnings"]:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))

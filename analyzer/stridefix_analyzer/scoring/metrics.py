@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes as registry
+from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 
@@ -37,6 +38,11 @@ IPIN_FLOOR_PENALTY_M = 15.0
 
 class MetricsInputError(ValueError):
     """The logs lack what scoring needs (no TRUTH, no POSE, unknown scheme); the message says what."""
+
+
+class NothingToScoreError(MetricsInputError, NothingValid):
+    """The logs hold neither TRUTH nor POSE: nothing valid for scoring in them (``stridefix analyze``
+    exits :data:`~stridefix_analyzer.exits.EXIT_NOTHING_VALID`)."""
 
 
 def scheme_code(name: str | int) -> int:
@@ -400,12 +406,14 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     Raises
     ------
     MetricsInputError
-        No TRUTH or no POSE messages (both listed when both are missing), or ``scheme`` absent.
+        No TRUTH or no POSE messages (both listed when both are missing: :class:`NothingToScoreError`),
+        or ``scheme`` absent.
     """
     truth, pose = data.table("TRUTH"), data.table("POSE")
     missing = [ch for ch, t in (("TRUTH", truth), ("POSE", pose)) if t is None or not len(t)]
     if truth is None or pose is None or missing:
-        raise MetricsInputError(
+        error = NothingToScoreError if len(missing) == 2 else MetricsInputError
+        raise error(
             f"no {' and no '.join(missing)} messages in "
             f"{', '.join(i['path'] for i in data.inputs) or 'the input'}"
         )

@@ -4,8 +4,15 @@ from tests/python/conftest.py)."""
 from __future__ import annotations
 
 import json
+import re
+from collections.abc import Callable
 
 import pytest
+
+_LOG_DETAIL = re.compile(
+    r"log detail: (\d+) files, (\d+) events written \((\d+) of them CONFIG copies heading a rotated file\), "
+    r"(\d+) bytes written; (\d+) events dropped, (\d+) bytes"
+)
 
 
 @pytest.fixture(scope="session")
@@ -16,3 +23,17 @@ def default_walk(tmp_path_factory, cli) -> dict:
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((out / "sim_summary.json").read_text())
     return {"dir": out, "summary": summary}
+
+
+@pytest.fixture(scope="session")
+def log_detail() -> Callable[[str], dict[str, int]]:
+    """stridefixd's summary line on its log, from its stderr, as numbers: files, events (written),
+    copies (CONFIG heading rotated files), bytes, drops, drop_bytes."""
+
+    def parse(stderr: str) -> dict[str, int]:
+        m = _LOG_DETAIL.search(stderr)
+        assert m, stderr
+        keys = ("files", "events", "copies", "bytes", "drops", "drop_bytes")
+        return dict(zip(keys, map(int, m.groups()), strict=True))
+
+    return parse

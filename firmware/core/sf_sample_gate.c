@@ -1,0 +1,57 @@
+/* sf_sample_gate.c — see sf_sample_gate.h. */
+#include "sf_sample_gate.h"
+
+#include <math.h>
+#include <string.h>
+
+void sf_sample_gate_init(sf_sample_gate_t *const gate)
+{
+    memset(gate, 0, sizeof *gate);
+}
+
+/* Every axis of b within the jump bound of a over dt_us. */
+static bool within(const sf_sample_limits_t *const lim, const double *const a, const double *const b,
+                   const int64_t dt_us, const int n)
+{
+    const double bound = lim->jump_floor + lim->rate_max * (double)dt_us * 1e-6;
+    for (int i = 0; i < n; i++) {
+        if (fabs(b[i] - a[i]) > bound) {
+            return false;
+        }
+    }
+    return true;
+}
+
+static void accept(sf_sample_gate_t *const g, const int64_t t_us, const double *const v, const int n)
+{
+    g->started = true;
+    g->last_rejected = false;
+    g->t_us = t_us;
+    memcpy(g->value, v, (size_t)n * sizeof v[0]);
+}
+
+sf_gate_verdict_t sf_sample_gate_check(sf_sample_gate_t *const g, const sf_sample_limits_t *const lim,
+                                       const int64_t t_us, const double *const v, const int n)
+{
+    for (int i = 0; i < n; i++) {
+        if (!isfinite(v[i]) || v[i] < lim->min || v[i] > lim->max) {
+            return sf_gate_out_of_range;
+        }
+    }
+    if (!g->started) {
+        accept(g, t_us, v, n);
+        return sf_gate_accepted;
+    }
+    if (t_us <= g->t_us) {
+        return sf_gate_out_of_order;
+    }
+    if (within(lim, g->value, v, t_us - g->t_us, n) ||
+        (g->last_rejected && t_us > g->rejected_t_us && within(lim, g->rejected, v, t_us - g->rejected_t_us, n))) {
+        accept(g, t_us, v, n);
+        return sf_gate_accepted;
+    }
+    g->last_rejected = true;
+    g->rejected_t_us = t_us;
+    memcpy(g->rejected, v, (size_t)n * sizeof v[0]);
+    return sf_gate_jump;
+}
