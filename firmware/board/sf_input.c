@@ -139,6 +139,13 @@ void sf_input_counters(const sf_input_t *const in, sf_input_counters_t *const co
     counters->rx = in->rx.counters;
     counters->bad_syntax = in->bad_syntax;
     counters->frames_total = in->rx.counters.frames + in->bad_syntax;
+    sf_lcm_input_counters_t lc = {0};
+    if (in->lcm != NULL) {
+        sf_lcm_input_counters(in->lcm, &lc);
+    }
+    counters->replay_oversized = lc.oversized;
+    counters->replay_truncated = lc.truncated;
+    counters->replay_refused = lc.refused;
 }
 
 bool sf_input_nothing_valid(const sf_input_t *const in, char *const buf, const size_t size)

@@ -32,6 +32,9 @@ typedef struct sf_input sf_input_t;
 typedef struct {
     uint64_t frames_total; /* frames, lines or sensor events read, good or bad: rx.frames + bad_syntax */
     uint64_t bad_syntax;   /* candump lines that do not parse, SocketCAN reads that are not a frame */
+    uint64_t replay_oversized; /* LCM replay: events above the size cap, skipped (sf_lcm_input.h) */
+    uint64_t replay_truncated; /* LCM replay: a last event cut short (0 or 1) */
+    uint64_t replay_refused;   /* LCM replay: an untrusted header, the rest of the log refused (0 or 1) */
     sf_rx_counters_t rx;
 } sf_input_counters_t;
 
