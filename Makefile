@@ -136,8 +136,9 @@ define run_fuzzers
 	@for h in $(FUZZ_HARNESSES); do \
 		mkdir -p build-fuzz/corpus/$$h build-fuzz/artifacts/$$h; \
 		echo "fuzz: $$h for $(1) s"; \
+		crashers=$$(test -d tests/fuzz/crashers/$$h && echo tests/fuzz/crashers/$$h); \
 		build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(1) $(FUZZ_FLAGS) -artifact_prefix=build-fuzz/artifacts/$$h/ \
-			build-fuzz/corpus/$$h tests/fuzz/corpus/$$h tests/fuzz/crashers/$$h > build-fuzz/fuzz_$$h.log 2>&1 \
+			build-fuzz/corpus/$$h tests/fuzz/corpus/$$h $$crashers > build-fuzz/fuzz_$$h.log 2>&1 \
 			|| { tail -60 build-fuzz/fuzz_$$h.log; echo "fuzz: $$h FAILED (input in build-fuzz/artifacts/$$h/)"; exit 1; }; \
 		grep -E "stat::(number_of_executed_units|peak_rss_mb)" build-fuzz/fuzz_$$h.log | tr -s ' \n' ' '; \
 		grep -o "cov: [0-9]* ft: [0-9]* corp: [0-9/]*[a-zA-Z]*" build-fuzz/fuzz_$$h.log | tail -1; \
