@@ -2,12 +2,13 @@
 
 Benchmarks and experiments chain ``stridefix sim`` → ``stridefixd`` → ``stridefix radiomap build``.
 :func:`run_stage` runs one ``stridefix`` stage (the console script next to this interpreter) and
-:func:`replay` one firmware replay through :class:`~stridefix_analyzer.firmware.Firmware`; both raise
+:func:`simulate` one simulator run, :func:`replay` one firmware replay through :class:`~stridefix_analyzer.firmware.Firmware`; both raise
 the caller's error type naming the stage, the command and the end of its stderr.
 """
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -43,3 +44,17 @@ def replay(
         return firmware.run(**kw)
     except FirmwareError as exc:
         raise error(f"{what} failed: {exc}") from exc
+
+
+def simulate(
+    scenario: str | Path | None, seed: int, out: Path, what: str, error: type[Exception] = StageError
+) -> dict[str, Any]:
+    """``stridefix sim`` of ``scenario`` (a built-in name or a TOML file; None = the default) into
+    ``out``; returns its ``sim_summary.json``."""
+    out.mkdir(parents=True, exist_ok=True)
+    cmd = [stridefix_exe(), "sim", "--out", str(out), "--seed", str(seed)]
+    if scenario is not None:
+        cmd += ["--scenario", str(scenario)]
+    run_stage(cmd, what, error)
+    summary: dict[str, Any] = json.loads((out / "sim_summary.json").read_text())
+    return summary

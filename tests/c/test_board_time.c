@@ -282,15 +282,23 @@ static void stream_exact(sf_stream_time_t *const st, sf_board_clock_t *const clo
     }
 }
 
+/* A clock synced at t0_ms (boot id boot) and a 100 Hz stream from t0 with its first n samples exact
+ * (board time = output time = host time). */
+static void start_stream(sf_board_clock_t *const clock, sf_stream_time_t *const st, const int64_t t0_ms,
+                         const uint8_t boot, const int n)
+{
+    sf_board_clock_init(clock);
+    sf_stream_time_init(st, PERIOD_MS);
+    assert_int_equal(sf_board_clock_on_time(clock, (uint32_t)t0_ms, boot, HOST_US(t0_ms)), sf_board_time_believed);
+    stream_exact(st, clock, t0_ms, t0_ms, t0_ms, 0, n);
+}
+
 static void test_boot_id_change_restarts_and_reanchors(void **state)
 {
     (void)state;
     sf_board_clock_t clock;
     sf_stream_time_t st;
-    sf_board_clock_init(&clock);
-    sf_stream_time_init(&st, PERIOD_MS);
-    assert_int_equal(sf_board_clock_on_time(&clock, 3000000, 1, HOST_US(3000000)), sf_board_time_believed);
-    stream_exact(&st, &clock, 3000000, 3000000, 3000000, 0, 300); /* last sample at 3 002 990 */
+    start_stream(&clock, &st, 3000000, 1, 300); /* last sample at 3 002 990 */
     /* The board restarts 510 ms after its last sample: clock near 0, new boot id, seq from 0. The
      * BOARD_TIME alone is held; the first sample, which restarts its sequence at that time and does not
      * fit the old stream, confirms it. Output time goes on by the host time that passed. */
@@ -312,10 +320,7 @@ static void test_restart_confirmed_by_the_next_board_time(void **state)
      * next BOARD_TIME, which confirms it). Samples in between are not believed. */
     sf_board_clock_t clock;
     sf_stream_time_t st;
-    sf_board_clock_init(&clock);
-    sf_stream_time_init(&st, PERIOD_MS);
-    sf_board_clock_on_time(&clock, 70000, 4, HOST_US(70000));
-    stream_exact(&st, &clock, 70000, 70000, 70000, 0, 100); /* last sample 70 990 at host 70 990 */
+    start_stream(&clock, &st, 70000, 4, 100); /* last sample 70 990 at host 70 990 */
     assert_int_equal(sf_board_clock_on_time(&clock, 1000, 4, HOST_US(71000)), sf_board_time_held);
     int rejected = 0;
     for (int k = 0; k < 100; k++) { /* 1 s of samples of the restarted board, before its next BOARD_TIME */
@@ -340,10 +345,7 @@ static void test_corrupt_board_time_is_not_believed(void **state)
      * moves the stream; both are counted when the next good BOARD_TIME contradicts them. */
     sf_board_clock_t clock;
     sf_stream_time_t st;
-    sf_board_clock_init(&clock);
-    sf_stream_time_init(&st, PERIOD_MS);
-    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
-    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 100);
+    start_stream(&clock, &st, 50000, 9, 100);
     assert_int_equal(sf_board_clock_on_time(&clock, 51000u ^ (1u << 30), 9, HOST_US(51000)), sf_board_time_held);
     stream_exact(&st, &clock, 50000, 50000, 50000, 100, 200);
     assert_int_equal(sf_board_clock_on_time(&clock, 52000, 9, HOST_US(52000)), sf_board_time_believed);
@@ -361,10 +363,7 @@ static void test_late_and_corrupt_seq_are_skipped(void **state)
     (void)state;
     sf_board_clock_t clock;
     sf_stream_time_t st;
-    sf_board_clock_init(&clock);
-    sf_stream_time_init(&st, PERIOD_MS);
-    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
-    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 50);
+    start_stream(&clock, &st, 50000, 9, 50);
     int64_t t, useq;
     uint32_t lost;
     /* sample 51 before 50 (reordered): 51 is taken, 50 arrives late */
@@ -515,10 +514,7 @@ static void test_corrupt_t_lo_of_a_locked_stream_is_skipped(void **state)
     (void)state;
     sf_board_clock_t clock;
     sf_stream_time_t st;
-    sf_board_clock_init(&clock);
-    sf_stream_time_init(&st, PERIOD_MS);
-    sf_board_clock_on_time(&clock, 50000, 9, HOST_US(50000));
-    stream_exact(&st, &clock, 50000, 50000, 50000, 0, 50);
+    start_stream(&clock, &st, 50000, 9, 50);
     int64_t t, useq;
     uint32_t lost;
     /* sample 50 at 50 500 ms with t_lo bit 6 flipped: 64 ms off the prediction, inside ±128 ms */

@@ -35,7 +35,7 @@ from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.scoring.analyze import run_analyze
 from stridefix_analyzer.scoring.metrics import ipin_score, scored_errors
-from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
+from stridefix_analyzer.stages import replay, run_stage, simulate, stridefix_exe
 
 PAPER = {"wifi_only": (2.94, 3.54), "adaptive": (1.67, 2.29)}
 SURVEY_SEED = 1000  # the survey is its own recording, never one of the scored walks
@@ -58,12 +58,7 @@ def simulate_and_log(
 ) -> dict[str, Any]:
     """sim → candump → stridefixd (with the site, if any) → out/stridefixd.lcmlog; returns the summary."""
     out.mkdir(parents=True, exist_ok=True)
-    run_stage(
-        [stridefix_exe(), "sim", "--scenario", scenario, "--seed", str(seed), "--out", str(out)],
-        f"sim {scenario} seed {seed}",
-        BenchError,
-    )
-    summary: dict[str, Any] = json.loads((out / "sim_summary.json").read_text())
+    summary = simulate(scenario, seed, out, f"sim {scenario} seed {seed}", BenchError)
     # a survey replay (no site): only the WIFI scans matter; the start pose is irrelevant
     survey_sets = (
         [] if site is not None else [f"heading.map_rotation_deg={summary.get('map_rotation_deg', 0.0)}"]

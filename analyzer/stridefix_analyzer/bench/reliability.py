@@ -39,7 +39,7 @@ from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.scoring.analyze import run_analyze
-from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
+from stridefix_analyzer.stages import replay, simulate
 
 #: (name, rate shown in the table, scenario overrides {table: {key: value}})
 CASES: list[tuple[str, str, dict[str, dict[str, Any]]]] = [
@@ -122,12 +122,7 @@ def run_case(
     t0 = time.perf_counter()
     scenario = out / "scenario.toml"
     scenario.write_text(scenario_toml(overrides, duration_s))
-    run_stage(
-        [stridefix_exe(), "sim", "--scenario", str(scenario), "--seed", str(SEED), "--out", str(out)],
-        f"sim {case_label(name, rate)}",
-        BenchError,
-    )
-    summary = json.loads((out / "sim_summary.json").read_text())
+    summary = simulate(scenario, SEED, out, f"sim {case_label(name, rate)}", BenchError)
     log = out / "stridefixd.lcmlog"
     replay(
         firmware,

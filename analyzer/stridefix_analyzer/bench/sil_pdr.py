@@ -31,7 +31,7 @@ from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.scoring.analyze import run_analyze
-from stridefix_analyzer.stages import StageError, replay, run_stage, stridefix_exe
+from stridefix_analyzer.stages import StageError, replay, simulate
 
 CALIBRATION_SCENARIO = """# one lap of the floor-0 loop at normal pace, no pauses: the stride calibration walk
 [walk]
@@ -59,12 +59,7 @@ def calibrate_k(seed: int, firmware: Firmware, out_dir: Path, sets: Sequence[str
     out_dir.mkdir(parents=True, exist_ok=True)
     scenario = out_dir / "calibration.toml"
     scenario.write_text(CALIBRATION_SCENARIO)
-    run_stage(
-        [stridefix_exe(), "sim", "--out", str(out_dir), "--seed", str(seed), "--scenario", str(scenario)],
-        f"calibration sim seed {seed}",
-        BenchError,
-    )
-    summary = json.loads((out_dir / "sim_summary.json").read_text())
+    summary = simulate(scenario, seed, out_dir, f"calibration sim seed {seed}", BenchError)
     log = out_dir / "stridefixd.lcmlog"
     replay(
         firmware,
@@ -93,11 +88,9 @@ def run_one(
     """Simulate one walk, replay it through stridefixd, score it; return the row of numbers."""
     out_dir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
-    sim = [stridefix_exe(), "sim", "--out", str(out_dir), "--seed", str(seed)]
-    if scenario != "default":
-        sim += ["--scenario", scenario]
-    run_stage(sim, f"sim {scenario} seed {seed}", BenchError)
-    summary = json.loads((out_dir / "sim_summary.json").read_text())
+    summary = simulate(
+        None if scenario == "default" else scenario, seed, out_dir, f"sim {scenario} seed {seed}", BenchError
+    )
     log = out_dir / "stridefixd.lcmlog"
     fw_sets = []
     if "map_rotation_deg" in summary:
