@@ -43,7 +43,6 @@ int32_t sf_wifi_channel_to_mhz(const unsigned channel)
 /* A new epoch (the board restarted): what was in flight belongs to the old boot. */
 static void on_new_epoch(sf_board_rx_t *const rx)
 {
-    rx->counters.board_restarts++;
     memset(rx->accel, 0, sizeof rx->accel);
     memset(rx->gyro, 0, sizeof rx->gyro);
     if (rx->scan_open && rx->scan_timed) {
@@ -60,11 +59,7 @@ static int resolve(sf_board_rx_t *const rx, sf_stream_time_t *const st, const ui
 {
     int64_t t_ms;
     uint32_t lost;
-    const uint32_t epoch = rx->clock.epoch;
     const int rc = sf_stream_time_resolve(st, &rx->clock, seq, t_lo, rx->host_t_us, &t_ms, useq, &lost);
-    if (rx->clock.epoch != epoch) {
-        on_new_epoch(rx); /* this sample confirmed a held BOARD_TIME of a new boot */
-    }
     switch (rc) {
     case SF_OK: break;
     case SF_ENOTSYNC: rx->counters.unsynced++; return rc;
@@ -95,7 +90,7 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
 {
     sf_imu_half_t *const mine = is_accel ? rx->accel : rx->gyro;
     sf_imu_half_t *const other = is_accel ? rx->gyro : rx->accel;
-    bool repeats = rx->imu_time.started && rx->imu_time.epoch == rx->clock.epoch && rx->imu_time.last_seq == half->seq;
+    bool repeats = rx->imu_time.started && rx->imu_time.epoch == rx->clock.restarts && rx->imu_time.last_seq == half->seq;
     int match = -1;
     for (int i = 0; i < SF_IMU_HALVES; i++) {
         repeats = repeats || (mine[i].valid && mine[i].seq == half->seq && mine[i].t_lo_ms == half->t_lo_ms);
@@ -164,12 +159,7 @@ static int on_board_time(sf_board_rx_t *const rx, const sf_can_frame_t *const f,
     (void)ev;
     struct board_board_time_t m;
     (void)board_board_time_unpack(&m, f->data, f->dlc);
-    if (sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us) == sf_board_time_restart) {
-        on_new_epoch(rx);
-    }
-    /* a held BOARD_TIME is counted in board_time_rejected when it is never confirmed */
-    rx->counters.board_time_rejected = rx->clock.time_rejected;
-    rx->counters.board_time_jumps = rx->clock.time_jumps;
+    (void)sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us); /* a restart: see below */
     return 0;
 }
 
@@ -364,6 +354,13 @@ int sf_board_rx_frame(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
         return SF_ELENGTH;
     }
     const int rc = row->on_frame(rx, f, ev);
+    if (rx->counters.board_restarts != rx->clock.restarts) {
+        on_new_epoch(rx); /* a BOARD_TIME, or a restarted stream's first sample, confirmed a restart */
+        rx->counters.board_restarts = rx->clock.restarts;
+    }
+    /* the clock's own counts (a held BOARD_TIME is rejected when it is never confirmed) */
+    rx->counters.board_time_rejected = rx->clock.time_rejected;
+    rx->counters.board_time_jumps = rx->clock.time_jumps;
     if (rc >= 0) {
         rx->counters.frames_ok++;
     }

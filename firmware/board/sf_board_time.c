@@ -62,6 +62,14 @@ static void note(sf_board_clock_t *const c, const int64_t t_ms, const int64_t ho
     }
 }
 
+/* A BOARD_TIME believed: the new anchor of every stream. */
+static void anchor(sf_board_clock_t *const c, const int64_t t_ms, const int64_t host_us)
+{
+    c->board_ms = t_ms;
+    note(c, t_ms, host_us);
+    c->generation++;
+}
+
 void sf_board_clock_init(sf_board_clock_t *const clock)
 {
     *clock = (sf_board_clock_t){0};
@@ -76,9 +84,7 @@ static sf_board_time_verdict_t believe_held(sf_board_clock_t *const c)
     const int64_t t_same = snap(c->latest_ms, h.time_ms, 32);
     if (h.boot_id == c->boot_id && t_same > c->latest_ms) {
         c->time_jumps++; /* same board, later time: an outage the host clock did not see */
-        c->board_ms = t_same;
-        note(c, t_same, h.host_t_us);
-        c->generation++;
+        anchor(c, t_same, h.host_t_us);
         return sf_board_time_believed;
     }
     const int64_t gap_ms = elapsed_ms(c->latest_host_us, h.host_t_us);
@@ -89,7 +95,6 @@ static sf_board_time_verdict_t believe_held(sf_board_clock_t *const c)
     c->latest_host_us = h.host_t_us;
     c->boot_id = h.boot_id;
     c->restarts++;
-    c->epoch++;
     c->generation++;
     return sf_board_time_restart;
 }
@@ -112,17 +117,13 @@ sf_board_time_verdict_t sf_board_clock_on_time(sf_board_clock_t *const c, const 
             c->held.valid = false;
             c->time_rejected++;
         }
-        c->board_ms = t;
-        note(c, t, host_t_us);
-        c->generation++;
+        anchor(c, t, host_t_us);
         return sf_board_time_believed;
     }
     if (c->held.valid && boot_id == c->held.boot_id &&
         agrees((int64_t)c->held.time_ms, c->held.host_t_us, time_ms, host_t_us, &t)) {
         const sf_board_time_verdict_t v = believe_held(c);
-        /* and this frame, which agrees with it */
-        c->board_ms = v == sf_board_time_restart ? t : snap(c->latest_ms, time_ms, 32);
-        note(c, c->board_ms, host_t_us);
+        anchor(c, v == sf_board_time_restart ? t : snap(c->latest_ms, time_ms, 32), host_t_us); /* and this frame */
         return v;
     }
     if (c->held.valid) {
@@ -199,13 +200,12 @@ int sf_stream_time_resolve(sf_stream_time_t *const s, sf_board_clock_t *const cl
     if (!clock->synced) {
         return SF_ENOTSYNC;
     }
-    unsigned dseq = (unsigned)(uint8_t)(seq - s->last_seq);
-    if (s->epoch == clock->epoch && starts_at_held(clock, seq, t_lo_ms) && !fits_stream(s, dseq, t_lo_ms)) {
+    const unsigned dseq = (unsigned)(uint8_t)(seq - s->last_seq);
+    if (s->epoch == clock->restarts && starts_at_held(clock, seq, t_lo_ms) && !fits_stream(s, dseq, t_lo_ms)) {
         (void)believe_held(clock);
     }
-    if (s->started && s->epoch != clock->epoch) {
+    if (s->started && s->epoch != clock->restarts) {
         sf_stream_time_init(s, s->nominal_period_ms); /* the board restarted: old times mean nothing */
-        dseq = (unsigned)seq;
     }
     if (s->started && dseq == 0) {
         return SF_EDUPLICATE;
@@ -260,7 +260,7 @@ int sf_stream_time_resolve(sf_stream_time_t *const s, sf_board_clock_t *const cl
     s->last_host_us = host_t_us;
     s->seq = useq;
     s->generation = clock->generation;
-    s->epoch = clock->epoch;
+    s->epoch = clock->restarts;
     note(clock, t, host_t_us);
     *t_ms = t;
     *seq_unwrapped = useq;

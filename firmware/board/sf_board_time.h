@@ -49,12 +49,12 @@ typedef struct {
     int64_t board_ms;       /* latest believed BOARD_TIME, unwrapped, in this epoch's board time */
     uint32_t generation;    /* increments with every believed BOARD_TIME */
     uint8_t boot_id;
-    uint32_t epoch;         /* increments at every restart: streams start again when it changes */
     int64_t offset_ms;      /* output time = board time + offset_ms */
     int64_t latest_ms;      /* newest board time known (BOARD_TIME or sample), this epoch */
     int64_t latest_host_us; /* host receive time of latest_ms */
     sf_board_time_held_t held; /* a BOARD_TIME not believed yet */
-    uint32_t restarts;      /* board restarts believed (new boot id, or time went back) */
+    uint32_t restarts;      /* board restarts believed (new boot id, or time went back): the epoch,
+                             * streams start again when it changes */
     uint32_t time_jumps;    /* same boot id, time jumped forwards (believed after confirmation) */
     uint32_t time_rejected; /* BOARD_TIME frames held and never confirmed */
 } sf_board_clock_t;
@@ -66,7 +66,7 @@ typedef struct {
     int64_t last_host_us;
     int64_t seq;            /* unwrapped sequence number of the last sample */
     uint32_t generation;    /* clock generation seen at the last sample */
-    uint32_t epoch;         /* clock epoch of the last sample */
+    uint32_t epoch;         /* clock restarts seen at the last sample */
     uint32_t fits;          /* samples in a row whose t_lo matched the prediction (to LOCK) */
     bool strayed;           /* the previous sample's t_lo strayed from a locked stream */
     double period_ms;       /* learnt sample period */

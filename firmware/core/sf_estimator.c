@@ -15,8 +15,8 @@ static double wrap_pi(const double a)
 static void start_at_config(sf_estimator_t *const e, const sf_params_t *const p)
 {
     for (int s = 0; s < sf_scheme_count; s++) {
-        (void)sf_fusion_init_at(&e->fusion[s], p, SF_FUSION_T_FIRST_INPUT, p->init_x_m, p->init_y_m, (int16_t)p->init_floor,
-                                p->init_sigma_m, (int16_t)p->init_floor);
+        (void)sf_fusion_init_at(&e->fusion[s], p, SF_FUSION_T_FIRST_INPUT, p->init_x_m, p->init_y_m,
+                                (int16_t)p->init_floor, p->init_sigma_m, (int16_t)p->init_floor);
     }
 }
 
@@ -135,10 +135,11 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
 }
 
 /* Whether a sample passes its stream's gate (sf_sample_gate.h); a refused one is counted by verdict. */
-static bool admit(sf_estimator_t *const e, sf_sample_gate_t *const gate, const sf_sample_limits_t *const limits,
+static bool admit(sf_estimator_t *const e, const sf_params_t *const p, const sf_gate_stream_t stream,
                   const int64_t t_us, const double *const value, const int n_axes)
 {
-    const sf_gate_verdict_t v = sf_sample_gate_check(gate, limits, t_us, value, n_axes);
+    const sf_sample_limits_t limits = sf_sample_limits(p, stream);
+    const sf_gate_verdict_t v = sf_sample_gate_check(&e->gates[stream], &limits, t_us, value, n_axes);
     if (v != sf_gate_accepted) {
         e->samples_refused[v]++;
         return false;
@@ -149,12 +150,8 @@ static bool admit(sf_estimator_t *const e, sf_sample_gate_t *const gate, const s
 int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
-    const sf_sample_limits_t accel = {-p->gate_accel_full_scale_mps2, p->gate_accel_full_scale_mps2,
-                                      p->gate_accel_jump_floor_mps2, p->gate_accel_rate_max_mps3};
-    const sf_sample_limits_t gyro = {-p->gate_gyro_full_scale_radps, p->gate_gyro_full_scale_radps,
-                                     p->gate_gyro_jump_floor_radps, p->gate_gyro_rate_max_radps2};
-    if (!admit(e, &e->accel_gate, &accel, s->t_us, s->accel_mps2, 3) ||
-        !admit(e, &e->gyro_gate, &gyro, s->t_us, s->gyro_radps, 3)) {
+    if (!admit(e, p, sf_gate_accel, s->t_us, s->accel_mps2, 3) ||
+        !admit(e, p, sf_gate_gyro, s->t_us, s->gyro_radps, 3)) {
         return 0;
     }
     sf_gap_bridge_on_imu(&e->gap, p, e->started ? e->t_us : 0, s->t_us);
@@ -203,9 +200,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
-    const sf_sample_limits_t mag = {-p->gate_mag_full_scale_ut, p->gate_mag_full_scale_ut, p->gate_mag_jump_floor_ut,
-                                    p->gate_mag_rate_max_ut_s};
-    if (!admit(e, &e->mag_gate, &mag, t_us, field_ut, 3)) {
+    if (!admit(e, p, sf_gate_mag, t_us, field_ut, 3)) {
         return;
     }
     sf_magcal_update(&e->magcal, p, t_us, field_ut);
@@ -217,9 +212,7 @@ void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const
 void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                        const double pressure_pa)
 {
-    const sf_sample_limits_t baro = {p->gate_baro_min_pa, p->gate_baro_max_pa, p->gate_baro_jump_floor_pa,
-                                     p->gate_baro_rate_max_pa_s};
-    if (!admit(e, &e->baro_gate, &baro, t_us, &pressure_pa, 1)) {
+    if (!admit(e, p, sf_gate_baro, t_us, &pressure_pa, 1)) {
         return;
     }
     sf_floor_update(&e->floor, p, t_us, pressure_pa);

@@ -87,7 +87,7 @@ typedef struct {
     double weinberg_sum; /* Σ range^¼ since the last stride calibration (for absolute fixes) */
     int32_t step_count;
     uint32_t steps_refused; /* detector steps the activity refused (quiet body) */
-    sf_sample_gate_t accel_gate, gyro_gate, mag_gate, baro_gate;
+    sf_sample_gate_t gates[sf_gate_stream_count];
     sf_gap_bridge_t gap;
     uint32_t samples_refused[4]; /* by sf_gate_verdict_t (index 0 unused) */
     sf_step_event_t held_events[SF_ACTIVITY_BOUT_MAX]; /* the held detections of a bout (sf_activity.h) */

@@ -18,6 +18,7 @@ void sf_gap_bridge_on_imu(sf_gap_bridge_t *const gb, const sf_params_t *const p,
     }
     const bool walking_before =
         gb->last_step_t_us != 0 && (double)(prev_t_us - gb->last_step_t_us) * 1e-6 <= p->gap_walking_s;
+    /* a second gap before any step: what happened in the first is unknown, nothing is guessed */
     gb->pending = walking_before && gap_s <= p->gap_max_s && !gb->pending;
     gb->gap_end_us = t_us;
 }
@@ -40,18 +41,22 @@ bool sf_gap_bridge_on_step(sf_gap_bridge_t *const gb, const sf_params_t *const p
     *distance_m = missing * gb->length_m;
     *bridge_heading_rad = atan2(sin(gb->heading_rad) + sin(heading_rad), cos(gb->heading_rad) + cos(heading_rad));
     gb->bridged++;
-    gb->bridged_m += *distance_m;
     return true;
+}
+
+/* A recent mean with x added (x itself for the first). */
+static double recent(const double mean, const double x, const bool first)
+{
+    return first ? x : mean + RECENT_WEIGHT * (x - mean);
 }
 
 void sf_gap_bridge_note_step(sf_gap_bridge_t *const gb, const int64_t t_us, const double period_s,
                              const double length_m, const double heading_rad)
 {
-    const bool first = gb->last_step_t_us == 0;
     if (period_s >= PERIOD_MIN_S && period_s <= PERIOD_MAX_S) {
-        gb->period_s = gb->period_s <= 0.0 ? period_s : gb->period_s + RECENT_WEIGHT * (period_s - gb->period_s);
+        gb->period_s = recent(gb->period_s, period_s, gb->period_s <= 0.0);
     }
-    gb->length_m = first ? length_m : gb->length_m + RECENT_WEIGHT * (length_m - gb->length_m);
+    gb->length_m = recent(gb->length_m, length_m, gb->last_step_t_us == 0);
     gb->last_step_t_us = t_us;
     gb->heading_rad = heading_rad;
 }

@@ -11,7 +11,7 @@
  * (steps are what was detected). A gap of more than gap.max_s is not guessed; nor is a gap when the
  * walker stood before it or after it. The assumption is a constant velocity through the gap, the same
  * a Kalman filter's prediction makes; the gaps bridged are counted in HEALTH.
- * Cost: O(1) per sample and per step; no heap. Memory: sizeof(sf_gap_bridge_t) = 64 B. */
+ * Cost: O(1) per sample and per step; no heap. Memory: sizeof(sf_gap_bridge_t) = 56 B. */
 #ifndef SF_GAP_BRIDGE_H
 #define SF_GAP_BRIDGE_H
 
@@ -28,10 +28,9 @@ typedef struct {
     bool pending;           /* a gap while walking waits for the next step */
     int64_t gap_end_us;
     uint32_t bridged;       /* gaps bridged */
-    double bridged_m;       /* distance credited across them */
 } sf_gap_bridge_t;
 
-_Static_assert(sizeof(sf_gap_bridge_t) <= 64, "sf_gap_bridge.h promises 64 B");
+_Static_assert(sizeof(sf_gap_bridge_t) <= 56, "sf_gap_bridge.h promises 56 B");
 
 /* An IMU sample at t_us whose predecessor came at prev_t_us (0: none). */
 void sf_gap_bridge_on_imu(sf_gap_bridge_t *gb, const sf_params_t *p, int64_t prev_t_us, int64_t t_us);

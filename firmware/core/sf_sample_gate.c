@@ -9,6 +9,26 @@ void sf_sample_gate_init(sf_sample_gate_t *const gate)
     memset(gate, 0, sizeof *gate);
 }
 
+sf_sample_limits_t sf_sample_limits(const sf_params_t *const p, const sf_gate_stream_t stream)
+{
+    switch (stream) { /* no default: a new stream needs its limits (-Wswitch) */
+    case sf_gate_accel:
+        return (sf_sample_limits_t){-p->gate_accel_full_scale_mps2, p->gate_accel_full_scale_mps2,
+                                    p->gate_accel_jump_floor_mps2, p->gate_accel_rate_max_mps3};
+    case sf_gate_gyro:
+        return (sf_sample_limits_t){-p->gate_gyro_full_scale_radps, p->gate_gyro_full_scale_radps,
+                                    p->gate_gyro_jump_floor_radps, p->gate_gyro_rate_max_radps2};
+    case sf_gate_mag:
+        return (sf_sample_limits_t){-p->gate_mag_full_scale_ut, p->gate_mag_full_scale_ut, p->gate_mag_jump_floor_ut,
+                                    p->gate_mag_rate_max_ut_s};
+    case sf_gate_baro:
+        return (sf_sample_limits_t){p->gate_baro_min_pa, p->gate_baro_max_pa, p->gate_baro_jump_floor_pa,
+                                    p->gate_baro_rate_max_pa_s};
+    case sf_gate_stream_count: break;
+    }
+    return (sf_sample_limits_t){0.0, -1.0, 0.0, 0.0}; /* an empty range: nothing passes */
+}
+
 /* Every axis of b within the jump bound of a over dt_us. */
 static bool within(const sf_sample_limits_t *const lim, const double *const a, const double *const b,
                    const int64_t dt_us, const int n)

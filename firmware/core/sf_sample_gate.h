@@ -16,6 +16,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_params.h"
+
 #define SF_SAMPLE_GATE_MAX_AXES 3
 
 typedef enum {
@@ -32,6 +34,9 @@ typedef struct {
     double rate_max;     /* fastest change a body produces [unit/s] */
 } sf_sample_limits_t;
 
+/* The streams a gate guards, each with its limits in the params table (section gate). */
+typedef enum { sf_gate_accel, sf_gate_gyro, sf_gate_mag, sf_gate_baro, sf_gate_stream_count } sf_gate_stream_t;
+
 typedef struct {
     bool started;
     bool last_rejected; /* the previous sample was a jump */
@@ -44,6 +49,9 @@ typedef struct {
 _Static_assert(sizeof(sf_sample_gate_t) <= 72, "sf_sample_gate.h promises 72 B");
 
 void sf_sample_gate_init(sf_sample_gate_t *gate);
+
+/* A stream's limits from the params table. */
+sf_sample_limits_t sf_sample_limits(const sf_params_t *p, sf_gate_stream_t stream);
 
 /* Judges one sample of n_axes (1..SF_SAMPLE_GATE_MAX_AXES) values at t_us; an accepted one becomes
  * the reference. */

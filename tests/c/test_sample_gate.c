@@ -16,8 +16,7 @@ static sf_sample_limits_t accel_limits(void)
 {
     sf_params_t p;
     sf_params_default(&p);
-    return (sf_sample_limits_t){-p.gate_accel_full_scale_mps2, p.gate_accel_full_scale_mps2,
-                                p.gate_accel_jump_floor_mps2, p.gate_accel_rate_max_mps3};
+    return sf_sample_limits(&p, sf_gate_accel);
 }
 
 static sf_gate_verdict_t feed(sf_sample_gate_t *const g, const int64_t t_us, const double z)
