@@ -13,7 +13,6 @@
 
 #include "sf_error.h"
 
-#define LCM_SYNC_WORD 0xEDA1DA01u
 #define LCMLOG_SUFFIX ".lcmlog"
 
 static void put_be(unsigned char *const p, const uint64_t v, const int n_bytes)
@@ -83,7 +82,7 @@ int sf_log_file_write(sf_log_file_t *const f, const char *const channel, const i
     }
     const size_t channel_len = strlen(channel);
     unsigned char head[SF_LOG_FILE_EVENT_OVERHEAD];
-    put_be(head, LCM_SYNC_WORD, 4);
+    put_be(head, SF_EVENTLOG_MAGIC, 4);
     put_be(head + 4, (uint64_t)f->next_event, 8);
     put_be(head + 12, (uint64_t)timestamp_us, 8);
     put_be(head + 20, (uint64_t)channel_len, 4);

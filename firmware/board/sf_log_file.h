@@ -30,8 +30,10 @@
 #include <stdint.h>
 #include <time.h>
 
+#include "sf_eventlog.h" /* the format: one definition for the reader and this writer */
+
 #define SF_LOG_FILE_PATH_MAX 4096
-#define SF_LOG_FILE_EVENT_OVERHEAD 28u /* bytes of header per event */
+#define SF_LOG_FILE_EVENT_OVERHEAD ((unsigned)SF_EVENTLOG_HEADER_SIZE) /* bytes of header per event */
 #define SF_LOG_FILE_PART_SUFFIX ".part"
 
 typedef struct {
