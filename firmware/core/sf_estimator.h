@@ -140,6 +140,20 @@ int sf_estimator_attach_site(sf_estimator_t *est, const sf_params_t *p, const sf
 int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_scan_t *scan, sf_fix_t *fix,
                       bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
 
+/* The other absolute sources (issue 13), each with its own measurement model, offered to every scheme
+ * like a Wi-Fi fix, with the same outputs and return value as sf_estimator_wifi (0 without a site):
+ *   GNSS      mapped into the site frame by the site's geo-reference (sf_geo.h); accuracy = the
+ *             receiver's; no fix without a valid geo-reference or with a bad accuracy.
+ *   BLE       ranges to the site's known beacons (sf_ble.h: log-distance path loss) → a position and
+ *             accuracy; no fix with fewer beacons of the site heard than ble_min_beacons.
+ *   landmark  the landmark's own position and accuracy (α = 1 in the blending schemes, sf_fusion.h). */
+int sf_estimator_gnss(sf_estimator_t *est, const sf_params_t *p, const sf_gnss_t *gnss, sf_fix_t *fix,
+                      bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
+int sf_estimator_ble(sf_estimator_t *est, const sf_params_t *p, const sf_ble_scan_t *scan, sf_fix_t *fix,
+                     bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
+int sf_estimator_landmark(sf_estimator_t *est, const sf_params_t *p, const sf_landmark_t *landmark,
+                          sf_fix_t *fix, bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
+
 /* The pose of one scheme; false while that scheme has no position yet (waiting for its first fix). */
 bool sf_estimator_scheme_pose(const sf_estimator_t *est, const sf_params_t *p, int scheme, sf_pose_t *pose);
 

@@ -222,7 +222,8 @@ static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, cons
 static bool fix_usable(const sf_fix_t *const fix)
 {
     const bool method_ok =
-        fix->method == sf_fix_wifi || fix->method == sf_fix_gnss || fix->method == sf_fix_landmark;
+        fix->method == sf_fix_wifi || fix->method == sf_fix_gnss || fix->method == sf_fix_landmark ||
+        fix->method == sf_fix_ble;
     return method_ok && isfinite(fix->x_m) && isfinite(fix->y_m) && isfinite(fix->accuracy_m) &&
            fix->accuracy_m >= 0.0;
 }

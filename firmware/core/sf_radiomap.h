@@ -42,6 +42,58 @@ typedef struct {
     double white_share;
 } sf_fix_model_t;
 
+/* Geo-reference (site file v2): the map frame's origin on WGS-84 and its rotation, so GNSS fixes and
+ * geo-located beacons map into the site frame (sf_geo.h: a local tangent plane with the WGS-84 radii
+ * at the origin, the same projection as the analyzer's gsd_convert.project). */
+typedef struct {
+    bool valid;
+    double origin_lat_deg;
+    double origin_lon_deg;
+    double origin_alt_m;
+    double rotation_deg; /* map frame = local east-north frame turned counter-clockwise by this [deg] */
+} sf_geo_ref_t;
+
+/* Floor plan (site file v2): wall segments per floor, map frame [m]. A walker never crosses one; a
+ * site without walls (n_walls = 0) constrains nothing. Segments are in any order. */
+typedef struct {
+    int32_t n_walls;
+    const float *x0_m;    /* [n_walls] */
+    const float *y0_m;    /* [n_walls] */
+    const float *x1_m;    /* [n_walls] */
+    const float *y1_m;    /* [n_walls] */
+    const int16_t *floor; /* [n_walls] */
+} sf_floor_plan_t;
+
+/* Port kinds, identical to site_t.PORT_*. */
+enum { sf_port_door = 1, sf_port_stairs = 2, sf_port_elevator = 3 };
+
+/* Ports (site file v2): where a walker may change floor (stairs, elevator) or context (door): a disc
+ * of radius_m about (x_m, y_m) that joins floors floor_lo .. floor_hi (a door: floor_lo = floor_hi). */
+typedef struct {
+    int32_t n_ports;
+    const int8_t *kind;      /* [n_ports], sf_port_* */
+    const float *x_m;        /* [n_ports] */
+    const float *y_m;        /* [n_ports] */
+    const float *radius_m;   /* [n_ports], > 0 */
+    const int16_t *floor_lo; /* [n_ports] */
+    const int16_t *floor_hi; /* [n_ports], ≥ floor_lo */
+} sf_ports_t;
+
+/* BLE beacons (site file v2), ids (48-bit MAC) strictly ascending so a reading's beacon is found by
+ * binary search, with the site's log-distance path-loss model RSSI(d) = rssi_1m_dbm − 10·n·log10(d)
+ * (n = path_loss_exponent; a beacon's own rssi_1m_dbm when finite, else the site's). */
+typedef struct {
+    int32_t n_beacons;
+    const int64_t *id;          /* [n_beacons], strictly ascending, 0 … 2^48 − 1 */
+    const float *x_m;           /* [n_beacons] */
+    const float *y_m;           /* [n_beacons] */
+    const int16_t *floor;       /* [n_beacons] */
+    const float *rssi_1m_dbm;   /* [n_beacons], NaN: the site's */
+    double site_rssi_1m_dbm;    /* the site's RSSI at 1 m [dBm] */
+    double path_loss_exponent;  /* n, > 0 */
+    double range_sigma_db;      /* RSSI spread about the model [dB], > 0 */
+} sf_beacons_t;
+
 /* Floors and frame of the site. */
 typedef struct {
     double map_rotation_deg;
@@ -50,6 +102,10 @@ typedef struct {
     const double *floor_height_m; /* [n_floors], strictly increasing */
     sf_fix_model_t fix_model;     /* measured fix errors, if the builder had held-out walks */
     sf_radiomap_t radiomap;       /* n_rp = 0: no radio map */
+    sf_geo_ref_t geo;             /* not valid: GNSS fixes are not used */
+    sf_floor_plan_t plan;         /* n_walls = 0: no walls */
+    sf_ports_t ports;             /* n_ports = 0: floors change anywhere */
+    sf_beacons_t beacons;         /* n_beacons = 0: BLE readings are not used */
 } sf_site_t;
 
 /* Checks every structural invariant above (sizes, orderings, index ranges, finite values).

@@ -45,8 +45,36 @@ typedef struct {
     const float *rssi_dbm;  /* [n_ap] */
 } sf_wifi_scan_t;
 
-/* Fix methods, identical to fix_t.METHOD_*. */
-enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3 };
+/* One GNSS receiver fix (gnss_t): WGS-84 position, the receiver's own horizontal accuracy (1σ). The
+ * core maps it into the site frame with the site's geo-reference (sf_geo.h). */
+typedef struct {
+    int64_t t_us;
+    double lat_deg;
+    double lon_deg;
+    double alt_m;      /* above the ellipsoid */
+    double accuracy_m; /* 1σ horizontal, as reported */
+} sf_gnss_t;
+
+/* One BLE scan window (ble_scan_t; views into the caller's arrays): beacons by 48-bit MAC. */
+typedef struct {
+    int64_t t_us;
+    int32_t n;
+    const int64_t *beacon_id; /* [n] */
+    const float *rssi_dbm;    /* [n] */
+} sf_ble_scan_t;
+
+/* A landmark event (landmark_t): the user is at this known position. */
+typedef struct {
+    int64_t t_us;
+    int32_t landmark_id;
+    double x_m;
+    double y_m;
+    int16_t floor;
+    double accuracy_m; /* 1σ */
+} sf_landmark_t;
+
+/* Fix methods (the fix's source), identical to fix_t.METHOD_*. */
+enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3, sf_fix_ble = 4 };
 
 /* An absolute position fix offered to the fusion. */
 typedef struct {
@@ -56,7 +84,7 @@ typedef struct {
     double y_m;
     int16_t floor;
     double accuracy_m; /* 1σ, horizontal */
-    int16_t n_ap_used; /* Wi-Fi: APs of the scan found in the map */
+    int16_t n_ap_used; /* Wi-Fi: APs of the scan found in the map; BLE: beacons used; else 0 */
 } sf_fix_t;
 
 /* One detected step. */
