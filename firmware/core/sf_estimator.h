@@ -97,6 +97,7 @@ typedef struct {
     sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
     sf_fingerprint_t fingerprint;
     sf_ble_t ble; /* the BLE ranging's counters (sf_ble.h) */
+    uint32_t ble_floor_votes; /* loud beacons that voted for their floor */
     uint32_t gnss_offered, gnss_refused, landmarks_refused; /* GNSS fixes seen / refused (no geo-reference
                                                              * counts as offered only), bad landmarks */
     sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
@@ -153,7 +154,8 @@ int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_s
  *             with reason INACCURATE and no fix for an accuracy beyond gnss_max_accuracy_m or a
  *             position off the plane (sf_geo_to_map's SF_ERANGE).
  *   BLE       ranges to the site's known beacons (sf_ble.h: log-distance path loss) → a position and
- *             accuracy on the caller's floor, no floor vote; 0 audits without beacons in the site;
+ *             accuracy on the caller's floor; first, the loudest known beacon, when at least
+ *             ble_floor_vote_min_dbm, votes for its own floor; 0 audits without beacons in the site;
  *             TOO_FEW_APS audits when fewer than ble_min_beacons usable beacons were heard.
  *   landmark  the landmark's own position, floor and accuracy (needs no site); it votes on the floor;
  *             every fusing scheme takes it whatever its gate (α = 1 in the fixed-gain blends,

@@ -121,6 +121,17 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     if (e->site == NULL || e->site->beacons.n_beacons == 0) {
         return 0;
     }
+    /* the loudest known beacon, if loud enough, votes for its floor before the fix (which uses only
+     * the beacons of the caller's floor) */
+    sf_fix_t vote;
+    if (e->floor_vote_active && p->ble_floor_vote_min_dbm < 0.0 &&
+        sf_ble_loudest(&e->site->beacons, scan, p->ble_floor_vote_min_dbm, &vote) == SF_OK) {
+        vote.n_ap_used = (int16_t)p->fingerprint_accuracy_ref_aps; /* a full-weight vote (sf_floor_vote.h) */
+        const int16_t baro_floor = sf_floor_current(&e->floor);
+        sf_floor_shift(&e->floor,
+                       sf_floor_vote_fix(&e->floor_vote, p, &vote, baro_floor, sf_floor_settled(&e->floor, p)), false);
+        e->ble_floor_votes++;
+    }
     int32_t n_used = 0;
     if (sf_ble_fix(&e->ble, p, &e->site->beacons, scan, sf_floor_current(&e->floor), fix, &n_used) != SF_OK) {
         return refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);

@@ -111,7 +111,7 @@ int32_t sf_floor_vote_fix(sf_floor_vote_t *const v, const sf_params_t *const p, 
                           const int16_t baro_floor, const bool settled)
 {
     SF_ASSERT(v != NULL && p != NULL && fix != NULL);
-    if (fix->method != sf_fix_wifi || !settled) {
+    if (fix->method == sf_fix_gnss || !settled) { /* a GNSS fix knows no floor */
         return 0;
     }
     const int32_t s = (int32_t)fix->floor - ((int32_t)baro_floor - v->start);
@@ -119,7 +119,9 @@ int32_t sf_floor_vote_fix(sf_floor_vote_t *const v, const sf_params_t *const p, 
         return 0; /* the fix's floor and the barometer agree on no start in the building */
     }
     const double ref = (double)p->fingerprint_accuracy_ref_aps;
-    v->score[s - v->lowest_floor] += fmin(1.0, (double)fix->n_ap_used / ref);
+    /* a landmark's floor is known, not guessed: it alone decides (a full margin) */
+    const double w = fix->method == sf_fix_landmark ? p->floor_vote_margin : fmin(1.0, (double)fix->n_ap_used / ref);
+    v->score[s - v->lowest_floor] += w;
     v->votes++;
     if (v->pinned) {
         return 0;

@@ -1,5 +1,6 @@
-/* sf_floor_vote.h — which floor number the walk started on: a vote of the Wi-Fi fixes' floors, held
- * against what the barometer says the walk did since.
+/* sf_floor_vote.h — which floor number the walk started on: a vote of the fixes' floors (Wi-Fi fixes,
+ * landmarks, loud BLE beacons; GNSS knows no floor), held against what the barometer says the walk did
+ * since.
  *
  * The barometer (sf_floor.h) owns floor *changes*: it counts floors up and down from the start, d(t) =
  * its floor − s, where s is the start floor in use. The fixes own the floor *number*, but a fix's floor
@@ -8,8 +9,9 @@
  * table) has
  *   - a score: Σ of the weights of the settled fixes that agree with it, i.e. whose floor g = s + d at
  *     their time (w = min(1, n_ap_used / fingerprint_accuracy_ref_aps): a fix from few APs is the weaker
- *     guess, as for its accuracy); fixes while the altimeter is not settled (on stairs, in a moving lift,
- *     a change pending) do not vote, d is then unsure;
+ *     guess, as for its accuracy; a landmark w = floor_vote_margin: its floor is known, it decides);
+ *     fixes while the altimeter is not settled (on stairs, in a moving lift, a change pending) do not
+ *     vote, d is then unsure;
  *   - feasibility: s + d stayed inside the building's floors the whole time, s + d_min ≥ lowest and
  *     s + d_max ≤ highest. A walk that went two floors down from s cannot have started on the lowest
  *     floor, whatever the fixes say. This is a proof, the score only a vote.

@@ -277,6 +277,42 @@ static void test_landmark_puts_every_scheme_on_it(void **state)
     assert_int_equal(audits[sf_scheme_ekf].reason, sf_fix_reason_inaccurate);
 }
 
+/* A loud beacon of floor 1 heard again and again while the barometer is flat on the start floor 0:
+ * its floor wins the start-floor vote, and every scheme is on floor 1. */
+static void test_loud_beacon_votes_for_its_floor(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    static sf_estimator_t est;
+    static sf_fingerprint_workspace_t ws;
+    static const double two_floors[] = {0.0, 4.0};
+    const sf_site_t site = {.lowest_floor = 0, .n_floors = 2, .floor_height_m = two_floors, .geo = gsd_geo(),
+                            .beacons = beacons()};
+    sf_estimator_init(&est, &p);
+    assert_int_equal(sf_estimator_attach_site(&est, &p, &site, &ws), SF_OK);
+    sf_fix_audit_t audits[sf_scheme_count];
+    sf_fix_t fix;
+    bool has_fix = false;
+    const int64_t id[] = {ids[5], ids[0]};
+    const float rssi[] = {-62.0f, -80.0f}; /* beacon 6 (floor 1) loud, beacon 1 (floor 0) faint */
+    for (int i = 0; i < 250; i++) { /* 25 Hz barometer, flat; a BLE window every second */
+        sf_estimator_baro(&est, &p, S_US + (int64_t)i * 40000, 100000.0);
+        if (i % 25 == 24) {
+            const sf_ble_scan_t scan = {.t_us = S_US + (int64_t)i * 40000, .n = 2, .beacon_id = id, .rssi_dbm = rssi};
+            (void)sf_estimator_ble(&est, &p, &scan, &fix, &has_fix, audits);
+        }
+    }
+    sf_estimator_status_t st;
+    sf_estimator_status(&est, &st);
+    assert_true(est.ble_floor_votes >= 5);
+    assert_int_equal(st.floor, 1);
+    /* once on floor 1 the fix uses beacon 6, the floor's own */
+    assert_true(has_fix);
+    assert_int_equal(fix.floor, 1);
+    assert_true(hypot(fix.x_m - 10.0, fix.y_m - 7.0) < 1e-6);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -287,6 +323,7 @@ int main(void)
         cmocka_unit_test(test_ble_one_beacon_other_floor_unknown),
         cmocka_unit_test(test_gnss_fix_through_every_scheme),
         cmocka_unit_test(test_landmark_puts_every_scheme_on_it),
+        cmocka_unit_test(test_loud_beacon_votes_for_its_floor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
