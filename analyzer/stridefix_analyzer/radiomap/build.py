@@ -185,5 +185,5 @@ def build_site(
             setattr(site, k, v)
         set_counts(site)
     summary["ble"] = ble["report"]
-    summary.update(n_beacons=site.n_beacons)
+    summary.update(n_beacons=site.n_beacons, ble_model=site_summary(site)["ble_model"])
     return site, summary
