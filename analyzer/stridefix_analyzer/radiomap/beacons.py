@@ -243,7 +243,7 @@ def site_beacons(
     known: dict[int, tuple[float, float, int]] = {}
     if table:
         check = mac_check(placed, table)
-        matches = {}
+        matches: dict[str, str | None] = {}
         for name, c in check.items():
             med = sorted(c["median_dbm"].values(), reverse=True)
             decisive = c["loudest"] is not None and c["readings"] >= MATCH_MIN_READINGS

@@ -133,14 +133,14 @@ def plot_site(site: site_t, png_path: str) -> None:
                 xytext=(3, 3),
                 textcoords="offset points",
             )
-        for i in range(site.n_ports):
-            if site.port_floor_lo[i] <= f <= site.port_floor_hi[i]:
+        for k in range(site.n_ports):
+            if site.port_floor_lo[k] <= f <= site.port_floor_hi[k]:
                 ax.add_patch(
                     Circle(
-                        (site.port_x_m[i], site.port_y_m[i]),
-                        site.port_radius_m[i],
+                        (site.port_x_m[k], site.port_y_m[k]),
+                        site.port_radius_m[k],
                         fill=False,
-                        color=port_colours.get(site.port_kind[i], "k"),
+                        color=port_colours.get(site.port_kind[k], "k"),
                         lw=1.5,
                         zorder=3,
                     )
