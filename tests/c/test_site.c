@@ -384,10 +384,17 @@ static void test_index_out_of_range(void **state)
     load_dump(&d);
     size_t size = 0;
     uint8_t *const buf = read_all(SF_SITE_VECTORS_DIR "/site.sfsite", &size);
-    /* the payload ends with the five entry arrays of n_entries int32/float each (rp is the second),
-     * then the fix model: has_fix_model (1 B) and nine floats */
+    /* the payload has the five entry arrays of n_entries int32/float each (rp is the second), then
+     * the fix model: has_fix_model (1 B) and nine floats, then the version-2 fields (their sizes
+     * from the file as loaded) */
+    sf_site_store_t loaded;
+    sf_site_t view;
+    assert_int_equal(sf_site_parse(buf, size, "site.sfsite", &loaded, &view, NULL, 0), SF_OK);
+    const size_t v2_bytes = 8u + 8u + 4u + 18u * (size_t)loaded.msg.n_walls + 4u + 17u * (size_t)loaded.msg.n_ports +
+                            4u + 22u * (size_t)loaded.msg.n_beacons + 3u * 4u;
+    sf_site_store_free(&loaded);
     const size_t fix_model_bytes = 1u + 9u * 4u;
-    const size_t entry_rp_at = size - fix_model_bytes - 4u * (size_t)d.n_entries * 4u;
+    const size_t entry_rp_at = size - v2_bytes - fix_model_bytes - 4u * (size_t)d.n_entries * 4u;
     put_be32(buf + entry_rp_at + 4u * 2u, 300);
     put_le32(buf + 16, sf_site_crc32(buf + SF_SITE_HEADER_SIZE, size - SF_SITE_HEADER_SIZE));
     sf_site_store_t store;
@@ -433,7 +440,7 @@ static void test_empty_radiomap_from_c_encoder(void **state)
     assert_non_null(buf);
     assert_int_equal(stridefix_site_t_encode(buf + SF_SITE_HEADER_SIZE, 0, payload_size, &m), payload_size);
     memcpy(buf, "SFSITE\0\x01", 8);
-    put_le32(buf + 8, 1u);
+    put_le32(buf + 8, SF_SITE_FORMAT_VERSION);
     put_le32(buf + 12, (uint32_t)payload_size);
     put_le32(buf + 16, sf_site_crc32(buf + SF_SITE_HEADER_SIZE, (size_t)payload_size));
     sf_site_store_t store;
@@ -452,6 +459,10 @@ static void test_empty_radiomap_from_c_encoder(void **state)
     assert_int_equal(site.radiomap.ap_first[0], 0);
     assert_int_equal(sf_radiomap_find_ap(&site.radiomap, 42), -1);
     assert_string_equal(store.msg.name, "empty");
+    assert_false(site.geo.valid); /* no version-2 content: every view empty */
+    assert_int_equal(site.plan.n_walls, 0);
+    assert_int_equal(site.ports.n_ports, 0);
+    assert_int_equal(site.beacons.n_beacons, 0);
     sf_site_store_free(&store);
     free(buf);
 }

@@ -9,7 +9,8 @@ script runs from a fresh build without an installed package. Writes into OUT_DIR
 * ``site.sfsite`` — the small known site of :func:`vector_site`, written by ``sitefile.write_site``;
 * ``site.txt`` — its values as read back by ``sitefile.read_site``, one field per line:
   ``<field> <value> [<value> ...]`` (strings: the rest of the line; floats by repr(), which round-trips
-  a double, and float32 values are exact doubles);
+  a double, and float32 values are exact doubles); ``site_v2.txt`` the same for the version-2 fields
+  (geo altitude and rotation, walls, ports, beacons; NaN as ``nan``), read by tests/c/test_site_v2.c;
 * ``variants/<name>.sfsite`` — corrupted or invalid files, and ``variants.txt`` with one line each:
   ``<name>\\t<kind>\\t<exact|contains>\\t<text>``: the reader must reject the file with the ``kind``
   (``field`` → SF_ERANGE, any other → SF_ESYNTAX) and a message equal to (``exact``) or containing
@@ -47,6 +48,31 @@ _SCALAR_FIELDS = (
     "fix_bias_length_m",
     "fix_white_share",
 )
+_V2_SCALAR_FIELDS = (
+    "origin_alt_m",
+    "geo_rotation_deg",
+    "ble_rssi_1m_dbm",
+    "ble_path_loss_exponent",
+    "ble_range_sigma_db",
+)
+_V2_ARRAY_FIELDS = (
+    "wall_x0_m",
+    "wall_y0_m",
+    "wall_x1_m",
+    "wall_y1_m",
+    "wall_floor",
+    "port_kind",
+    "port_x_m",
+    "port_y_m",
+    "port_radius_m",
+    "port_floor_lo",
+    "port_floor_hi",
+    "beacon_id",
+    "beacon_x_m",
+    "beacon_y_m",
+    "beacon_floor",
+    "beacon_rssi_1m_dbm",
+)
 _ARRAY_FIELDS = (
     "floor_height_m",
     "ap_bssid",
@@ -66,7 +92,9 @@ _ARRAY_FIELDS = (
 
 def vector_site() -> site_t:
     """A small site touching every corner: a negative lowest floor, geo-reference, BSSIDs at both
-    ends of the 48-bit range, an AP with no entry (AP 2) and an RP with none (RP 5)."""
+    ends of the 48-bit range, an AP with no entry (AP 2) and an RP with none (RP 5); walls on two
+    floors, a door and stairs over three floors, beacons at both ends of the id range, one with its
+    own RSSI at 1 m and the others NaN (the site's)."""
     return sitefile.new_site(
         name="vector site \u00fc",
         source="tests/vectors/gen_site_vectors.py",
@@ -93,6 +121,27 @@ def vector_site() -> site_t:
         fix_bias_sigma_m=3.5,
         fix_bias_length_m=20.0,
         fix_white_share=0.25,
+        origin_alt_m=408.5,
+        geo_rotation_deg=-7.25,
+        wall_x0_m=[0.0, 10.0, -2.5],
+        wall_y0_m=[0.0, 0.0, 1.5],
+        wall_x1_m=[10.0, 10.0, -2.5],
+        wall_y1_m=[0.0, 5.0, 8.0],
+        wall_floor=[0, 0, 1],
+        port_kind=[site_t.PORT_DOOR, site_t.PORT_STAIRS],
+        port_x_m=[5.0, 3.0],
+        port_y_m=[0.0, 4.0],
+        port_radius_m=[0.75, 1.5],
+        port_floor_lo=[0, -1],
+        port_floor_hi=[0, 1],
+        beacon_id=[0x000000000000, 0xBEAC20230001, 0xFFFFFFFFFFFF],
+        beacon_x_m=[1.0, 2.5, -3.0],
+        beacon_y_m=[2.0, -1.25, 6.0],
+        beacon_floor=[-1, 0, 1],
+        beacon_rssi_1m_dbm=[float("nan"), -61.5, float("nan")],
+        ble_rssi_1m_dbm=-59.0,
+        ble_path_loss_exponent=2.25,
+        ble_range_sigma_db=5.5,
     )
 
 
@@ -155,7 +204,8 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
     out = [
         ("magic", frame(payload, magic=b"SFSITX\0\x01"), "magic", None),
         ("magic_zero", frame(payload, magic=bytes(8)), "magic", None),
-        ("version", frame(payload, version=2), "version", None),
+        ("version", frame(payload, version=3), "version", None),
+        ("version_1", frame(payload, version=1), "version", None),
         ("reserved", frame(payload, reserved=7), "reserved", None),
         ("length_long", frame(payload, length=len(payload) + 1), "length", None),
         ("length_short", frame(payload, length=len(payload) - 3), "length", None),
@@ -195,8 +245,42 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("fix_bias_negative", _edited(fix_bias_sigma_m=-1.0), "field", None),
         ("fix_length_zero", _edited(fix_bias_length_m=0.0), "field", None),
         ("fix_white_share", _edited(fix_white_share=1.5), "field", None),
+        *v2_variants(),
     ]
     return out
+
+
+def v2_variants() -> list[tuple[str, bytes, str, str | None]]:
+    """One invalid file per version-2 rule (io/site_v2.py's order)."""
+    nan, inf = float("nan"), float("inf")
+    return [
+        ("altitude_nan", _edited(origin_alt_m=nan), "field", None),
+        ("geo_rotation_inf", _edited(geo_rotation_deg=-inf), "field", None),
+        ("wall_inf", _edited(wall_y1_m=[0.0, inf, 8.0]), "field", None),
+        ("wall_floor", _edited(wall_floor=[0, 2, 1]), "field", None),
+        ("wall_zero_length", _edited(wall_x1_m=[10.0, 10.0, -2.5], wall_y1_m=[0.0, 5.0, 1.5]), "field", None),
+        ("port_kind", _edited(port_kind=[1, 4]), "field", None),
+        ("port_position_nan", _edited(port_x_m=[nan, 3.0]), "field", None),
+        ("port_radius_zero", _edited(port_radius_m=[0.75, 0.0]), "field", None),
+        ("port_floors_order", _edited(port_floor_lo=[0, 1], port_floor_hi=[0, 0]), "field", None),
+        ("port_floors_range", _edited(port_floor_lo=[0, -2]), "field", None),
+        ("beacon_id_range", _edited(beacon_id=[0, 0xBEAC20230001, 1 << 48]), "field", None),
+        ("beacon_id_negative", _edited(beacon_id=[-1, 0xBEAC20230001, 0xFFFFFFFFFFFF]), "field", None),
+        ("beacon_order", _edited(beacon_id=[0, 0xBEAC20230001, 0xBEAC20230001]), "field", None),
+        ("beacon_position_inf", _edited(beacon_y_m=[2.0, inf, 6.0]), "field", None),
+        ("beacon_floor", _edited(beacon_floor=[-2, 0, 1]), "field", None),
+        ("beacon_rssi_inf", _edited(beacon_rssi_1m_dbm=[nan, inf, nan]), "field", None),
+        ("ble_rssi_nan", _edited(ble_rssi_1m_dbm=nan), "field", None),
+        ("ble_exponent_zero", _edited(ble_path_loss_exponent=0.0), "field", None),
+        ("ble_sigma_negative", _edited(ble_range_sigma_db=-1.0), "field", None),
+    ]
+
+
+def dump_v2(site: site_t) -> str:
+    lines = [f"{name} {getattr(site, name)!r}" for name in _V2_SCALAR_FIELDS]
+    for name in _V2_ARRAY_FIELDS:
+        lines.append(" ".join([name, *(repr(v) for v in getattr(site, name))]))
+    return "\n".join(lines) + "\n"
 
 
 def dump(site: site_t) -> str:
@@ -217,6 +301,8 @@ def main(out_dir: str) -> int:
     sitefile.write_site(path, vector_site())
     with open(os.path.join(out_dir, "site.txt"), "w", encoding="utf-8") as f:
         f.write(dump(sitefile.read_site(path)))
+    with open(os.path.join(out_dir, "site_v2.txt"), "w", encoding="utf-8") as f:
+        f.write(dump_v2(sitefile.read_site(path)))
     rows = []
     for name, data, kind, c_text in variants():
         vpath = os.path.join(out_dir, "variants", name + ".sfsite")

@@ -16,11 +16,13 @@ BARO     baro_t       ``PRES``, converted to Pa from the unit the header declare
 GNSS     gnss_t       ``GNSS``: latitude, longitude, altitude, accuracy; repeated fixes dropped (counted)
 WIFI     wifi_scan_t  one scan = the ``WIFI`` records within :data:`~.gsd_convert.WIFI_GROUP_S` of the
                       scan's first one; cached entries (older than ``max_wifi_age_s``) dropped
+BLE      ble_scan_t   ``BLE4`` (iBeacon, Eddystone): MAC → beacon id, RSSI; windows of
+                      ``rawwalk.BLE_WINDOW_S`` on the app clock
 TRUTH    truth_t      ``POSI``: latitude/longitude → local metres, x east and y north, about an origin;
                       floor = the floor id; heading NaN, step_count −1, source SOURCE_WAYPOINT
 =======  ===========  =====================================================================================
 
-Events in time order (ties: IMU, MAG, BARO, GNSS, WIFI, TRUTH). A missing or unreadable file raises
+Events in time order (ties: IMU, MAG, BARO, GNSS, WIFI, BLE, TRUTH). A missing or unreadable file raises
 :class:`~.gsd_parse.LogReadError` naming it; an unknown pressure unit
 :class:`~.gsd_parse.LogHeaderError`.
 """
@@ -183,6 +185,7 @@ class Gsd(Dataset):
                 "BARO": len(raw.baro),
                 "GNSS": len(raw.gnss),
                 "WIFI": raw.n_scans,
+                "BLE": raw.n_ble_scans,
                 "TRUTH": len(raw.truth),
             },
             "waypoints": len(raw.truth),
@@ -212,7 +215,9 @@ class Gsd(Dataset):
             f"{s['building_id'] or ','.join(s['building_ids']) or '-'}, floor(s) {floors}, "
             f"IMU {m['IMU']} ({rate}), MAG {m['MAG']}, BARO {m['BARO']}, GNSS {m['GNSS']}, "
             f"WIFI {m['WIFI']} scans / {s['wifi_aps_written']} APs "
-            f"({s['wifi_aps_stale_dropped']} cached dropped), TRUTH {m['TRUTH']} POSI, "
+            f"({s['wifi_aps_stale_dropped']} cached dropped), "
+            f"BLE {m['BLE']} scans / {s['ble_readings']} readings of {s['ble_beacons']} beacons, "
+            f"TRUTH {m['TRUTH']} POSI, "
             f"origin {origin}, {s['skipped_lines']} malformed line(s) skipped"
         )
 

@@ -15,6 +15,9 @@ kept, the calibration minute included; the truth starts at the first POSI.
   first one; an entry last seen (its SensorTimestamp, on the inertial clock) more than
   ``max_wifi_age_s`` before the scan is a cached result, dropped; a BSSID heard twice keeps its
   freshest entry.
+* ``ble``: BLE4 records (iBeacon and Eddystone; the MAC is the beacon id) on the app clock, grouped
+  into windows of :data:`~.rawwalk.BLE_WINDOW_S` (:func:`~.rawwalk.ble_scans`: the app logs one
+  record per advertisement, with no scan grouping of its own).
 * ``truth``: POSI latitude/longitude → local metres, x east and y north, by a local tangent plane about
   an origin (:func:`project`); floor = the floor id. The building ids go into ``meta``.
 """
@@ -26,7 +29,7 @@ import math
 import numpy as np
 
 from stridefix_analyzer.datasets.gsd_parse import INERTIAL, GsdRecords
-from stridefix_analyzer.datasets.rawwalk import RawWalk, dedupe_sorted, gyro_at, wifi_scans
+from stridefix_analyzer.datasets.rawwalk import RawWalk, ble_scans, dedupe_sorted, gyro_at, wifi_scans
 from stridefix_analyzer.io.logread import Table
 
 #: WIFI records whose AppTimestamps lie within this of a scan's first record belong to that scan [s].
@@ -196,6 +199,7 @@ def to_rawwalk(rec: GsdRecords, origin: tuple[float, float] | None, max_wifi_age
     imu, mag, offset = _inertial(rec, stats, notes)
     baro, gnss = _baro_gnss(rec, stats)
     wifi = _wifi(rec, offset, max_wifi_age_s, stats, notes)
+    ble = ble_scans([(int(round(t * 1e6)), mac, rssi) for t, mac, rssi in rec.ble], stats)
 
     posi, origin_source = rec.posi, None
     if origin is not None:
@@ -221,6 +225,7 @@ def to_rawwalk(rec: GsdRecords, origin: tuple[float, float] | None, max_wifi_age
         baro=baro,
         gnss=gnss,
         wifi=wifi,
+        ble=ble,
         truth=Table({"t_us": truth_t, "x_m": x, "y_m": y, "floor": floor}),
         meta={
             "header": rec.header,

@@ -7,7 +7,8 @@ nothing is aligned, grouped or projected here.
 
 Bad data is not an error: a malformed line (wrong field count, a field that is not a number, an
 unknown record tag) is counted, skipped and reported with a :class:`~.lines.MalformedLineWarning`
-naming file and line. Record types not imported (AHRS, LIGH, SOUN, BLE4, ...) are counted per type. A
+naming file and line. BLE4 records (iBeacon and Eddystone: app time, MAC, RSSI) are kept. Record types not
+imported (AHRS, LIGH, SOUN, ...) are counted per type. A
 missing or unreadable file raises :class:`LogReadError` naming it; a pressure unit the importer does
 not know raises :class:`LogHeaderError`.
 
@@ -28,7 +29,9 @@ from stridefix_analyzer.datasets.rawwalk import bssid_to_int, finite
 MAX_LINE_WARNINGS = 20
 
 # record type -> number of ';'-separated fields, the tag included (WIFI: at least; an SSID may hold ';')
-_FIELDS = {"ACCE": 7, "GYRO": 7, "MAGN": 7, "PRES": 5, "GNSS": 11, "WIFI": 7, "POSI": 7}
+_FIELDS = {"ACCE": 7, "GYRO": 7, "MAGN": 7, "PRES": 5, "GNSS": 11, "WIFI": 7, "POSI": 7, "BLE4": 5}
+#: BLE4 frame kinds (the header's two BLE4 formats); BLE4 has at least _FIELDS["BLE4"] fields
+BLE4_KINDS = ("iBeacon", "Eddystone")
 INERTIAL = ("ACCE", "GYRO", "MAGN")
 _TAG_RE = re.compile(r"^[A-Z][A-Z0-9]{3}$")
 _PRESSURE_TO_PA = {"mbar": 100.0, "hpa": 100.0, "pa": 1.0, "kpa": 1000.0}
@@ -54,6 +57,7 @@ class GsdRecords:
     gnss : rows (app time, fix time, lat [deg], lon [deg], alt [m], accuracy [m])
     wifi : rows (app time, sensor time, bssid, rssi [dBm], freq [MHz])
     posi : rows (app time, lat [deg], lon [deg], floor id, building id)
+    ble : rows (app time, MAC as 48-bit int, rssi [dBm]) of BLE4 (iBeacon and Eddystone)
     header : device lines of the ``%`` header (Manufacturer, Model, ...)
     pa_per_unit, pressure_unit : the header's pressure unit (None: no PRES format line; mbar assumed)
     """
@@ -64,6 +68,7 @@ class GsdRecords:
     gnss: list[tuple[float, float, float, float, float, float]]
     wifi: list[tuple[float, float, int, float, int]]
     posi: list[tuple[float, float, float, int, str]]
+    ble: list[tuple[float, int, float]]
     header: dict[str, str]
     pa_per_unit: float
     pressure_unit: str | None
@@ -108,6 +113,7 @@ def parse_log(path: str | os.PathLike[str], max_line_warnings: int = MAX_LINE_WA
     gnss: list[tuple[float, float, float, float, float, float]] = []
     wifi: list[tuple[float, float, int, float, int]] = []
     posi: list[tuple[float, float, float, int, str]] = []
+    ble: list[tuple[float, int, float]] = []
     header_lines: list[tuple[int, str]] = []
     header: dict[str, str] = {}
     bad = reader.bad
@@ -129,7 +135,7 @@ def parse_log(path: str | os.PathLike[str], max_line_warnings: int = MAX_LINE_WA
         n = _FIELDS[kind]
         if len(parts) > n and parts[-1] == "":
             parts.pop()  # a trailing ';' (the header writes WIFI and POSI so)
-        if len(parts) != n and not (kind == "WIFI" and len(parts) > n):
+        if len(parts) != n and not (kind in ("WIFI", "BLE4") and len(parts) > n):
             bad(line_no, f"{kind} with {len(parts)} fields, expected {n}")
             continue
         try:
@@ -147,6 +153,10 @@ def parse_log(path: str | os.PathLike[str], max_line_warnings: int = MAX_LINE_WA
                 wifi.append(
                     (app, sensor, bssid_to_int(parts[-3].strip()), finite(parts[-1:])[0], int(parts[-2]))
                 )
+            elif kind == "BLE4":
+                if parts[2] not in BLE4_KINDS:
+                    raise ValueError(f"frame kind {parts[2][:20]!r} not one of {BLE4_KINDS}")
+                ble.append((finite(parts[1:2])[0], bssid_to_int(parts[3].strip()), finite(parts[4:5])[0]))
             else:  # POSI
                 app, lat, lon = finite([parts[1], parts[3], parts[4]])
                 _latlon_ok(lat, lon)
@@ -162,6 +172,7 @@ def parse_log(path: str | os.PathLike[str], max_line_warnings: int = MAX_LINE_WA
         gnss=gnss,
         wifi=wifi,
         posi=posi,
+        ble=ble,
         header=header,
         pa_per_unit=pa_per_unit,
         pressure_unit=unit,

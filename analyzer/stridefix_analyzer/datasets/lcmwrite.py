@@ -10,6 +10,7 @@ MAG      mag_t        ``mag``: t_us, seq = row, field
 BARO     baro_t       ``baro``: t_us, seq = row, pressure; temperature NaN (no data set has it)
 GNSS     gnss_t       ``gnss``: t_us, latitude, longitude, altitude, accuracy
 WIFI     wifi_scan_t  one message per scan of ``wifi``: scan_id = scan index, complete, its APs
+BLE      ble_scan_t   one message per window of ``ble``: t_us, its beacons' ids and RSSIs
 TRUTH    truth_t      ``truth``: t_us, x, y, floor; heading NaN, step_count −1, SOURCE_WAYPOINT
 =======  ===========  ==============================================================================
 
@@ -29,7 +30,7 @@ import numpy as np
 from stridefix_analyzer.datasets.rawwalk import RawWalk
 
 #: Channels, also the tie-break order of equal times.
-CHANNELS = ("IMU", "MAG", "BARO", "GNSS", "WIFI", "TRUTH")
+CHANNELS = ("IMU", "MAG", "BARO", "GNSS", "WIFI", "BLE", "TRUTH")
 
 
 class _Encodable(Protocol):
@@ -38,10 +39,11 @@ class _Encodable(Protocol):
 
 def _makers(raw: RawWalk) -> tuple[Callable[[int], _Encodable], ...]:
     """One message builder per channel of :data:`CHANNELS`: row index → LCM message."""
-    from stridefix import baro_t, gnss_t, imu_t, mag_t, truth_t, wifi_scan_t
+    from stridefix import baro_t, ble_scan_t, gnss_t, imu_t, mag_t, truth_t, wifi_scan_t
 
     imu, mag, baro, gnss, truth = raw.imu, raw.mag, raw.baro, raw.gnss, raw.truth
     wifi, bounds = raw.wifi, raw.scan_bounds()
+    ble, ble_bounds = raw.ble, raw.ble_bounds()
 
     def imu_msg(i: int) -> _Encodable:
         m = imu_t()
@@ -79,6 +81,14 @@ def _makers(raw: RawWalk) -> tuple[Callable[[int], _Encodable], ...]:
         m.freq_mhz = wifi["freq_mhz"][rows].tolist()
         return m  # type: ignore[no-any-return]
 
+    def ble_msg(i: int) -> _Encodable:
+        rows = slice(int(ble_bounds[i]), int(ble_bounds[i + 1]))
+        m = ble_scan_t()
+        m.t_us, m.n = int(ble["t_us"][rows.start]), rows.stop - rows.start
+        m.beacon_id = ble["beacon_id"][rows].tolist()
+        m.rssi_dbm = ble["rssi_dbm"][rows].tolist()
+        return m  # type: ignore[no-any-return]
+
     def truth_msg(i: int) -> _Encodable:
         m = truth_t()
         m.t_us = int(truth["t_us"][i])
@@ -87,7 +97,7 @@ def _makers(raw: RawWalk) -> tuple[Callable[[int], _Encodable], ...]:
         m.source = truth_t.SOURCE_WAYPOINT
         return m  # type: ignore[no-any-return]
 
-    return imu_msg, mag_msg, baro_msg, gnss_msg, wifi_msg, truth_msg
+    return imu_msg, mag_msg, baro_msg, gnss_msg, wifi_msg, ble_msg, truth_msg
 
 
 def write_lcmlog(raw: RawWalk, out_path: str | os.PathLike[str]) -> int:
@@ -106,7 +116,7 @@ def write_lcmlog(raw: RawWalk, out_path: str | os.PathLike[str]) -> int:
     out = os.fspath(out_path)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     times = [raw.imu["t_us"], raw.mag["t_us"], raw.baro["t_us"], raw.gnss["t_us"]]
-    times += [raw.scan_t_us(), raw.truth["t_us"]]
+    times += [raw.scan_t_us(), raw.ble_t_us(), raw.truth["t_us"]]
     times = [np.asarray(t, dtype=np.int64) for t in times]
     t_all = np.concatenate(times)
     rank = np.concatenate([np.full(len(t), r) for r, t in enumerate(times)])

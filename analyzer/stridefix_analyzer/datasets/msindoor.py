@@ -3,7 +3,7 @@
 Layout: ``../shared/data/msindoor/<site>/<floor>/path_data_files/*.txt`` (one walk per trace; format
 in that folder's README), with the floor's ``floor_info.json`` (extent in metres), ``floor_image.png``
 and ``geojson_map.json`` beside ``path_data_files``. Walks group per floor folder: each floor is its
-own map. No beacon table. One trace becomes one raw-sensor LCM log (:mod:`.msindoor_parse` reads it):
+own map. No beacon table (beacon positions are learnt by ``stridefix radiomap build``). One trace becomes one raw-sensor LCM log (:mod:`.msindoor_parse` reads it):
 
 =======  ===========  =====================================================================================
 channel  type         from
@@ -14,11 +14,13 @@ MAG      mag_t        TYPE_MAGNETIC_FIELD (µT)
 WIFI     wifi_scan_t  one scan = the TYPE_WIFI lines sharing a first-column time; BSSID ``aa:bb:..:ff`` →
                       0xaabb..ff; cached entries (last_seen more than ``max_wifi_age_s`` before the scan)
                       dropped; a BSSID heard twice keeps its freshest entry
+BLE      ble_scan_t   TYPE_BEACON: MAC → beacon id, RSSI; readings grouped into windows of
+                      ``rawwalk.BLE_WINDOW_S`` (a beacon heard twice in one: its mean RSSI)
 TRUTH    truth_t      TYPE_WAYPOINT: x_m, y_m, floor index from the FloorName header (F1 → 0, F2 → 1,
                       B1 → −1, ...), heading NaN, step_count −1, source SOURCE_WAYPOINT
 =======  ===========  =====================================================================================
 
-Times: ``t_us`` = the file's unix time [ms] × 1000; events in time order (ties: IMU, MAG, WIFI, TRUTH).
+Times: ``t_us`` = the file's unix time [ms] × 1000; events in time order (ties: IMU, MAG, WIFI, BLE, TRUTH).
 A missing or unreadable file raises :class:`~.msindoor_parse.TraceReadError` naming it; a FloorName
 that cannot be mapped to a floor index raises :class:`~.msindoor_parse.TraceHeaderError` unless the
 floor is given.
@@ -118,6 +120,7 @@ class MsIndoor(Dataset):
                 "IMU": len(raw.imu),
                 "MAG": len(raw.mag),
                 "WIFI": raw.n_scans,
+                "BLE": raw.n_ble_scans,
                 "TRUTH": len(raw.truth),
             },
             "waypoints": len(raw.truth),
@@ -139,6 +142,7 @@ class MsIndoor(Dataset):
             f"{os.path.basename(s['trace'])}: {s['duration_s']:.1f} s, floor {s['floor_name']} "
             f"({s['floor']}), IMU {m['IMU']} ({rate}), MAG {m['MAG']}, WIFI {m['WIFI']} scans / "
             f"{s['wifi_aps_written']} APs ({s['wifi_aps_stale_dropped']} cached dropped), "
+            f"BLE {m['BLE']} scans / {s['ble_readings']} readings of {s['ble_beacons']} beacons, "
             f"TRUTH {m['TRUTH']} waypoints, {s['skipped_lines']} malformed line(s) skipped"
         )
 

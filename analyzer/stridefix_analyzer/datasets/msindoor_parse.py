@@ -9,6 +9,9 @@ lines after ``#`` header lines. What becomes of each record (:mod:`.msindoor` ha
 * TYPE_WIFI lines sharing a first-column time are one scan; an entry whose last_seen time is more than
   ``max_wifi_age_s`` older than the scan is a cached result, dropped; a BSSID heard twice keeps its
   freshest entry; a scan left empty is counted, not kept.
+* TYPE_BEACON → ``ble``: the MAC is the beacon id, the RSSI [dBm] the reading; like Wi-Fi lines the
+  first column is system time, used as is (as the Wi-Fi scans are), and readings group into windows
+  of :data:`~.rawwalk.BLE_WINDOW_S` (:func:`~.rawwalk.ble_scans`; the format has no scan grouping).
 * TYPE_WAYPOINT → ``truth`` on the floor of the FloorName header (F1 → 0, F2 → 1, B1 → −1, ...).
 
 Times: ``t_us`` = the file's unix time [ms] × 1000. Bad data is not an error: a malformed line is
@@ -27,6 +30,7 @@ from stridefix_analyzer.datasets.lines import LineReader
 from stridefix_analyzer.datasets.protocol import DatasetReadError
 from stridefix_analyzer.datasets.rawwalk import (
     RawWalk,
+    ble_scans,
     bssid_to_int,
     dedupe_sorted,
     finite,
@@ -49,6 +53,7 @@ _FIELDS = {
     "TYPE_MAGNETIC_FIELD": 6,
     "TYPE_WIFI": 7,
     "TYPE_WAYPOINT": 4,
+    "TYPE_BEACON": 10,
 }
 
 
@@ -120,6 +125,7 @@ def read_trace(
     samples: dict[str, list[tuple[float, ...]]] = {"accel": [], "gyro": [], "mag": []}
     wifi: dict[int, list[tuple[int, float, int, float]]] = {}
     waypoints: list[tuple[float, ...]] = []
+    beacons: list[tuple[int, int, float]] = []
     header: dict[str, str] = {}
     bad = reader.bad
     for line_no, line in reader.lines():
@@ -156,6 +162,8 @@ def read_trace(
                     int(parts[6]),
                 )
                 wifi.setdefault(t_ms, []).append((bssid, rssi, freq, float(t_ms - seen)))
+            elif kind == "TYPE_BEACON":
+                beacons.append((t_ms * 1000, bssid_to_int(parts[8]), finite(parts[6:7])[0]))
             elif kind == "TYPE_WAYPOINT":
                 waypoints.append((t_ms, *finite(parts[2:4])))
             else:
@@ -185,6 +193,7 @@ def read_trace(
         notes.append("no TYPE_ACCELEROMETER line: no IMU message")
 
     scans = wifi_scans([(t_ms * 1000, wifi[t_ms]) for t_ms in sorted(wifi)], max_wifi_age_s, stats)
+    ble = ble_scans(beacons, stats)
 
     waypoints.sort(key=lambda w: w[0])
     wp_t = np.array([w[0] for w in waypoints], dtype=np.int64)
@@ -194,6 +203,7 @@ def read_trace(
         imu=Table({"t_us": acc_t * 1000, "accel_mps2": acc, "gyro_radps": gyro}),
         mag=Table({"t_us": mag_t * 1000, "field_ut": mag}),
         wifi=scans,
+        ble=ble,
         truth=Table(
             {
                 "t_us": wp_t * 1000,

@@ -15,6 +15,8 @@ gnss     t_us (g,), lat_deg, lon_deg, alt_m, accuracy_m
 wifi     one row per access point of a scan: scan (scan index 0, 1, ..., non-decreasing), t_us (the
          scan's time), bssid (int64), rssi_dbm (float32), freq_mhz (int32), age_ms (float64, NaN
          when unknown)
+ble      one row per beacon of a BLE window (:func:`ble_scans`): scan (window index 0, 1, ...), t_us
+         (the window's first reading), beacon_id (int64, 48-bit MAC), rssi_dbm (float32)
 truth    t_us (w,), x_m, y_m (map metres), floor (int64): surveyed waypoints or reference positions
 =======  ==========================================================================================
 
@@ -42,6 +44,7 @@ STREAMS: dict[str, tuple[str, ...]] = {
     "baro": ("t_us", "pressure_pa"),
     "gnss": ("t_us", "lat_deg", "lon_deg", "alt_m", "accuracy_m"),
     "wifi": ("scan", "t_us", "bssid", "rssi_dbm", "freq_mhz", "age_ms"),
+    "ble": ("scan", "t_us", "beacon_id", "rssi_dbm"),
     "truth": ("t_us", "x_m", "y_m", "floor"),
 }
 
@@ -51,7 +54,9 @@ def empty(stream: str) -> Table:
     wide = {"accel_mps2", "gyro_radps", "field_ut"}
     return Table(
         {
-            c: np.zeros((0, 3)) if c in wide else np.zeros(0, np.int64 if c in ("t_us", "scan") else float)
+            c: np.zeros((0, 3))
+            if c in wide
+            else np.zeros(0, np.int64 if c in ("t_us", "scan", "beacon_id") else float)
             for c in STREAMS[stream]
         }
     )
@@ -73,6 +78,7 @@ class RawWalk:
     baro: Table = dataclasses.field(default_factory=lambda: empty("baro"))
     gnss: Table = dataclasses.field(default_factory=lambda: empty("gnss"))
     wifi: Table = dataclasses.field(default_factory=lambda: empty("wifi"))
+    ble: Table = dataclasses.field(default_factory=lambda: empty("ble"))
     truth: Table = dataclasses.field(default_factory=lambda: empty("truth"))
     meta: dict[str, Any] = dataclasses.field(default_factory=dict)
     stats: dict[str, Any] = dataclasses.field(default_factory=dict)
@@ -100,6 +106,21 @@ class RawWalk:
         t: np.ndarray = self.wifi["t_us"][self.scan_bounds()[:-1]]
         return t.astype(np.int64)
 
+    @property
+    def n_ble_scans(self) -> int:
+        """Number of BLE windows (ble_scan_t messages)."""
+        scan = self.ble["scan"]
+        return int(scan[-1]) + 1 if len(scan) else 0
+
+    def ble_bounds(self) -> np.ndarray:
+        """(n_ble_scans + 1,) row offsets of the BLE windows in :attr:`ble`."""
+        return np.searchsorted(self.ble["scan"], np.arange(self.n_ble_scans + 1))
+
+    def ble_t_us(self) -> np.ndarray:
+        """(n_ble_scans,) time of each BLE window [µs]."""
+        t: np.ndarray = self.ble["t_us"][self.ble_bounds()[:-1]]
+        return t.astype(np.int64)
+
     def scan(self, i: int) -> Table:
         """The access points of scan ``i``."""
         b = self.scan_bounds()
@@ -118,11 +139,14 @@ class RawWalk:
     def n_sensor_records(self) -> int:
         """Samples and scans of the sensor streams (imu, mag, baro, gnss, wifi; not truth): what a
         replay feeds ``stridefixd``. 0 means the walk holds nothing valid to import."""
-        return len(self.imu) + len(self.mag) + len(self.baro) + len(self.gnss) + self.n_scans
+        return (
+            len(self.imu) + len(self.mag) + len(self.baro) + len(self.gnss) + self.n_scans + self.n_ble_scans
+        )
 
     def time_span_us(self) -> tuple[int, int] | None:
         """(first, last) time of any sample [µs], or None for a walk without samples."""
-        ts = [s["t_us"] for s in (self.imu, self.mag, self.baro, self.gnss, self.wifi, self.truth) if len(s)]
+        streams = (self.imu, self.mag, self.baro, self.gnss, self.wifi, self.ble, self.truth)
+        ts = [s["t_us"] for s in streams if len(s)]
         if not ts:
             return None
         return int(min(t.min() for t in ts)), int(max(t.max() for t in ts))
@@ -215,6 +239,40 @@ def wifi_scans(
         max_wifi_age_s=max_wifi_age_s,
     )
     return wifi_table(kept)
+
+
+#: One ble_scan_t holds the advertisements of this window [s] from its first one: beacons advertise
+#: every 0.1–1 s (iBeacon/Eddystone practice), so a window hears most beacons in range once or more,
+#: while a walker (~1.4 m/s) moves about a metre in it, less than the range model resolves.
+BLE_WINDOW_S = 1.0
+
+
+def ble_scans(readings: list[tuple[int, int, float]], stats: dict[str, Any]) -> Table:
+    """The :attr:`RawWalk.ble` stream of (t_us, beacon_id, rssi_dbm) readings: windows of
+    :data:`BLE_WINDOW_S` from each window's first reading, a beacon heard more than once in a window
+    written once at its mean RSSI [dBm] (rows sorted by id). Counts into ``stats``: ``ble_readings``,
+    ``ble_scans``, ``ble_beacons`` (distinct ids), ``ble_repeats_merged``, ``ble_window_s``."""
+    windows: list[tuple[int, dict[int, list[float]]]] = []
+    for t_us, beacon, rssi in sorted(readings, key=lambda r: r[0]):
+        if not windows or t_us - windows[-1][0] >= BLE_WINDOW_S * 1e6:
+            windows.append((t_us, {}))
+        windows[-1][1].setdefault(beacon, []).append(rssi)
+    rows = [
+        (scan, t0, beacon, float(np.mean(heard[beacon])))
+        for scan, (t0, heard) in enumerate(windows)
+        for beacon in sorted(heard)
+    ]
+    merged = len(readings) - len(rows)
+    stats.update(
+        ble_readings=len(readings),
+        ble_scans=len(windows),
+        ble_beacons=len({r[1] for r in readings}),
+        ble_repeats_merged=merged,
+        ble_window_s=BLE_WINDOW_S,
+    )
+    cols: list[Sequence[object]] = list(zip(*rows)) if rows else [[] for _ in STREAMS["ble"]]
+    dtypes = (np.int64, np.int64, np.int64, np.float32)
+    return Table({n: np.asarray(c, dtype=d) for n, c, d in zip(STREAMS["ble"], cols, dtypes)})
 
 
 def bssid_to_int(bssid: str) -> int:

@@ -4,7 +4,7 @@ Layout (all header integers little-endian)::
 
     offset  size  field
          0     8  magic            b"SFSITE\\0\\x01"
-         8     4  format version   uint32, 1
+         8     4  format version   uint32, 2 (version 1 files are refused: rebuild them)
         12     4  payload length   uint32, bytes after the header (file size − 24)
         16     4  payload CRC-32   uint32, IEEE 802.3 (zlib.crc32) of the payload
         20     4  reserved         uint32, 0
@@ -22,7 +22,9 @@ order and word their messages alike, so a file rejected by one is rejected by th
    ascending; ``cell_size_m`` finite and ≥ 0; reference points with finite positions, a floor in
    ``lowest_floor`` … ``lowest_floor + n_floors − 1`` and ``rp_scans`` ≥ 1; entries with AP and RP
    indices in range, strictly sorted by (ap, rp), finite mean, finite std ≥ 0, and
-   1 ≤ count ≤ ``rp_scans`` of their RP. Every array's length must equal its count.
+   1 ≤ count ≤ ``rp_scans`` of their RP; then the version-2 content (:mod:`.site_v2`: geo altitude
+   and rotation, walls, ports, beacons and the BLE path-loss model). Every array's length must equal
+   its count.
 
 Errors: :class:`SiteFileError` (``path: what``), with ``kind`` one of :data:`ERROR_KINDS`.
 Cost: one read of the file, O(n_ap + n_rp + n_entries) checks.
@@ -41,8 +43,16 @@ from typing import Any
 
 from stridefix import site_t
 
+from stridefix_analyzer.io.site_v2 import (
+    SiteV2ValidationError,
+    init_v2_fields,
+    set_v2_counts,
+    validate_geo,
+    validate_plan,
+)
+
 MAGIC = b"SFSITE\0\x01"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 HEADER = struct.Struct("<8sIIII")
 HEADER_SIZE = HEADER.size  # 24
 #: Largest payload either reader accepts [bytes] (the firmware allocates the whole file).
@@ -110,6 +120,10 @@ def validate_site(site: site_t) -> None:
             raise SiteValidationError(f"origin_lat_deg = {site.origin_lat_deg:g} outside -90..90")
         if not (_finite(site.origin_lon_deg) and -180.0 <= site.origin_lon_deg <= 180.0):
             raise SiteValidationError(f"origin_lon_deg = {site.origin_lon_deg:g} outside -180..180")
+        try:
+            validate_geo(site)
+        except SiteV2ValidationError as exc:
+            raise SiteValidationError(str(exc)) from None
 
     if site.has_fix_model:
         fxx, fxy, fyy = site.fix_floor_cov_m2
@@ -194,6 +208,10 @@ def validate_site(site: site_t) -> None:
             raise SiteValidationError(
                 f"entry {i}: count {count} outside 1..{site.rp_scans[r]} (rp_scans of rp {r})"
             )
+    try:
+        validate_plan(site, site.lowest_floor, top_floor)
+    except SiteV2ValidationError as exc:
+        raise SiteValidationError(str(exc)) from None
 
 
 # --- file I/O ------------------------------------------------------------------------------------
@@ -256,6 +274,12 @@ def decode_site_file(data: bytes, path: str = "<site>") -> site_t:
             path,
             "magic",
             f"bad magic {magic.hex(' ')}, expected {MAGIC.hex(' ')} (not a StrideFix site file)",
+        )
+    if version == 1:
+        raise SiteFileError(
+            path,
+            "version",
+            f"format version 1, this build reads {FORMAT_VERSION}: rebuild it with `stridefix radiomap build`",
         )
     if version != FORMAT_VERSION:
         raise SiteFileError(
@@ -339,6 +363,7 @@ def new_site(**fields: Any) -> site_t:
     s.entry_ap, s.entry_rp, s.entry_mean_dbm, s.entry_std_db, s.entry_count = [], [], [], [], []
     s.has_fix_model, s.fix_floor_cov_m2, s.fix_cov_per_acc2 = False, [0.0, 0.0, 0.0], [1.0, 0.0, 1.0]
     s.fix_bias_sigma_m, s.fix_bias_length_m, s.fix_white_share = 0.0, 10.0, 1.0
+    init_v2_fields(s)
     for name, value in fields.items():
         if not hasattr(s, name):
             raise AttributeError(f"site_t has no field {name!r}")
@@ -356,4 +381,5 @@ def set_counts(site: site_t) -> site_t:
     site.n_ap = len(site.ap_bssid)
     site.n_rp = len(site.rp_x_m)
     site.n_entries = len(site.entry_ap)
+    set_v2_counts(site)
     return site

@@ -146,4 +146,10 @@ def site_summary(site: site_t) -> dict:
         "geo": [site.origin_lat_deg, site.origin_lon_deg] if site.has_geo else None,
         "rps_without_ap": int(np.sum(aps_per_rp == 0)),
         "floors": floors,
+        "n_walls": site.n_walls,
+        "n_ports": site.n_ports,
+        "n_beacons": site.n_beacons,
+        "ble_model": [site.ble_rssi_1m_dbm, site.ble_path_loss_exponent, site.ble_range_sigma_db]
+        if site.n_beacons
+        else None,
     }

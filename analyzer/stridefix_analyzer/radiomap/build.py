@@ -3,6 +3,7 @@
 The modules of the data flow: :mod:`.recordings` (logs → recordings on one clock), :mod:`.placement`
 (each scan's position on the truth), :mod:`.survey` and :mod:`.grid` (scans → reference points),
 :mod:`.assemble` (statistics → ``site_t``), :mod:`.walkstats` (walk-mode maps that add and subtract),
+:mod:`.beacons` (BLE beacons and the path-loss model), :mod:`.building` (building.toml),
 :mod:`.show` (summary text and plot), :mod:`.cli` (the command line).
 
 Modes (``--mode``, default ``auto``):
@@ -32,6 +33,7 @@ import os
 import numpy as np
 from stridefix import site_t
 
+from stridefix_analyzer.io.sitefile import set_counts
 from stridefix_analyzer.radiomap.assemble import (
     DEFAULT_FLOOR_HEIGHT_M,
     DEFAULT_MIN_COUNT,
@@ -39,6 +41,7 @@ from stridefix_analyzer.radiomap.assemble import (
     assemble_site,
     site_summary,
 )
+from stridefix_analyzer.radiomap.beacons import site_beacons
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M, walk_cells
 from stridefix_analyzer.radiomap.placement import (
     DEFAULT_SCAN_DURATION_MS,
@@ -79,6 +82,7 @@ def build_site(
     origin_deg: tuple[float, float] | None = None,
     scan_duration_ms: float = DEFAULT_SCAN_DURATION_MS,
     static_tol_m: float = DEFAULT_STATIC_TOL_M,
+    beacon_table: dict[str, tuple[float, float, int]] | None = None,
 ) -> tuple[site_t, dict]:
     """Build a site from recordings; return (site, summary dict).
 
@@ -168,4 +172,18 @@ def build_site(
         min_count=min_count,
         rps_dropped_no_entry=int(np.sum(~has_entry)),
     )
+    # 5. BLE beacons and the path-loss model from the recordings' BLE readings (.beacons)
+    ble = site_beacons(recordings, beacon_table)
+    fields = ble["fields"]
+    if fields:
+        lo, hi = site.lowest_floor, site.lowest_floor + site.n_floors - 1
+        keep = [i for i, f in enumerate(fields["beacon_floor"]) if lo <= f <= hi]
+        ble["report"]["outside_site_floors"] = len(fields["beacon_id"]) - len(keep)
+        for k in ("beacon_id", "beacon_x_m", "beacon_y_m", "beacon_floor", "beacon_rssi_1m_dbm"):
+            fields[k] = [fields[k][i] for i in keep]
+        for k, v in fields.items():
+            setattr(site, k, v)
+        set_counts(site)
+    summary["ble"] = ble["report"]
+    summary.update(n_beacons=site.n_beacons, ble_model=site_summary(site)["ble_model"])
     return site, summary

@@ -17,6 +17,7 @@ from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
 from stridefix_analyzer.radiomap.build import MODES, build_site
+from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
 from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
 from stridefix_analyzer.radiomap.recordings import RadioMapInputError, load_recordings
@@ -28,6 +29,29 @@ def _float_list(text: str) -> list[float]:
         return [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
+
+
+def read_beacon_table(path: str, origin: tuple[float, float]) -> dict[str, tuple[float, float, int]]:
+    """A beacon table CSV (bleID, Lat, Lon, floor) → name → (x, y, floor) in the frame about origin."""
+    import csv
+
+    from stridefix_analyzer.datasets.gsd_convert import project
+
+    try:
+        with open(path, encoding="utf-8", newline="") as f:
+            rows = list(csv.DictReader(f))
+        out = {}
+        i = 0
+        for i, r in enumerate(rows):  # noqa: B007 - i names the row in the message
+            x, y = project([float(r["Lat"])], [float(r["Lon"])], *origin)
+            out[r["bleID"]] = (float(x[0]), float(y[0]), int(r["floor"]))
+    except OSError as exc:
+        raise RadioMapInputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except (KeyError, ValueError) as exc:
+        raise RadioMapInputError(
+            f"{path}: row {i + 2}: bad field {exc} (needs bleID,Lat,Lon,floor)"
+        ) from None
+    return out
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -115,14 +139,31 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=DEFAULT_STATIC_TOL_M,
         help=f"truth within this distance counts as the same spot [m] (default {DEFAULT_STATIC_TOL_M:g})",
     )
+    b.add_argument(
+        "--building",
+        default=None,
+        metavar="FILE",
+        help="building description (building.toml, docs/building.md): geo-reference, BLE model, "
+        "walls, ports and beacons merged into the site",
+    )
+    b.add_argument(
+        "--beacon-table",
+        default=None,
+        metavar="CSV",
+        help="beacon positions (gsd's BLE_Locations.csv: bleID,Lat,Lon,floor), projected about "
+        "--origin-deg; each name is matched to the MAC loudest near it in the walks",
+    )
     s = sub.add_parser(
         "show",
         help="summary (and PNG) of a site file",
         description="Check a site file and print its summary; --png plots the "
-        "reference points per floor coloured by APs heard.",
+        "reference points per floor coloured by APs heard, with the walls, "
+        "beacons (ids) and ports of the site.",
     )
     s.add_argument("site", metavar="SITE.sfsite")
-    s.add_argument("--png", default=None, metavar="PATH", help="write a PNG of the RPs")
+    s.add_argument(
+        "--png", default=None, metavar="PATH", help="write a PNG of the floor plan, RPs, beacons and ports"
+    )
     return p
 
 
@@ -130,6 +171,11 @@ def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
     """Build and write the site of ``args`` (the ``build`` options); return (site, summary)."""
     if args.origin_deg is not None and len(args.origin_deg) != 2:
         raise RadioMapInputError("--origin-deg needs LAT,LON")
+    table = None
+    if getattr(args, "beacon_table", None):
+        if args.origin_deg is None:
+            raise RadioMapInputError("--beacon-table needs --origin-deg LAT,LON (the frame's origin)")
+        table = read_beacon_table(args.beacon_table, tuple(args.origin_deg))
     recordings = load_recordings(args.logs)
     name = args.name or os.path.splitext(os.path.basename(args.out))[0]
     site, summary = build_site(
@@ -145,7 +191,12 @@ def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
         origin_deg=tuple(args.origin_deg) if args.origin_deg else None,
         scan_duration_ms=args.scan_duration_ms,
         static_tol_m=args.static_tol_m,
+        beacon_table=table,
     )
+    if getattr(args, "building", None):
+        summary["building"] = merge_building(
+            site, read_building(args.building), os.path.basename(args.building)
+        )
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     summary["bytes"] = write_site(args.out, site)
     return site, summary
@@ -165,7 +216,7 @@ def run(args: argparse.Namespace) -> int:
             if args.png:
                 plot_site(site, args.png)
                 print(f"wrote {args.png}")
-    except (LogReadError, RadioMapInputError, SiteFileError) as exc:
+    except (LogReadError, RadioMapInputError, SiteFileError, BuildingError) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     return 0

@@ -1,4 +1,6 @@
 """Radio-map input: LCM logs with ``WIFI`` (scans) and ``TRUTH`` (positions), grouped into recordings.
+A recording also carries its ``BLE`` readings (one row per beacon of each ble_scan_t: t_us,
+beacon_id, rssi_dbm), which the beacon learning (:mod:`.beacons`) uses.
 
 Logs are grouped into *recordings* that share a clock: an argument ``a.lcmlog,b.lcmlog`` is one
 recording of those files; a plain argument holding both WIFI and TRUTH is a recording by itself; the
@@ -20,11 +22,46 @@ class RadioMapInputError(Exception):
 
 
 class Recording:
-    """One set of logs on one clock: WIFI scans, their APs and TRUTH, sorted by time."""
+    """One set of logs on one clock: WIFI scans, their APs, TRUTH and BLE readings, sorted by time."""
 
-    def __init__(self, files: list[str], wifi: Table, wifi_ap: Table, truth: Table):
+    def __init__(self, files: list[str], wifi: Table, wifi_ap: Table, truth: Table, ble: Table | None = None):
         self.files, self.wifi, self.wifi_ap, self.truth = list(files), wifi, wifi_ap, truth
+        self.ble = ble if ble is not None else _ble_table([])
         self.name = " + ".join(self.files)
+
+
+def _ble_table(rows: list[tuple[int, int, float]]) -> Table:
+    a = list(zip(*rows)) if rows else [(), (), ()]
+    return Table(
+        {
+            "t_us": np.asarray(a[0], dtype=np.int64),
+            "beacon_id": np.asarray(a[1], dtype=np.int64),
+            "rssi_dbm": np.asarray(a[2], dtype=np.float64),
+        }
+    ).sorted_by("t_us")
+
+
+def read_ble(paths: list[str]) -> Table:
+    """The BLE readings of the logs: one row (t_us, beacon_id, rssi_dbm) per beacon of each
+    ble_scan_t on channel BLE (bad payloads skipped), sorted by time."""
+    from stridefix import ble_scan_t
+
+    from stridefix_analyzer.io.lcmfile import read_file
+
+    rows: list[tuple[int, int, float]] = []
+
+    def on_event(channel: str, payload: bytes) -> None:
+        if channel != "BLE":
+            return
+        try:
+            m = ble_scan_t.decode(payload)
+        except Exception:  # noqa: BLE001 - a corrupt payload is bad data, skipped
+            return
+        rows.extend((int(m.t_us), int(b), float(r)) for b, r in zip(m.beacon_id, m.rssi_dbm))
+
+    for path in paths:
+        read_file(path, on_event)
+    return _ble_table(rows)
 
 
 def _read_one(path: str) -> LogData:
@@ -64,7 +101,7 @@ def _merge(files: list[str], datas: list[LogData]) -> Recording:
     wifi = wifi.rows(order)
     cols = wifi_ap.to_dict()
     cols["scan_row"] = renumber[cols["scan_row"]]
-    return Recording(files, wifi, Table(cols), truth)
+    return Recording(files, wifi, Table(cols), truth, read_ble(files))
 
 
 def load_recordings(args: list[str]) -> list[Recording]:

@@ -39,6 +39,25 @@ def format_summary(s: dict) -> str:
     cell = f"cell {s['cell_size_m']:g} m" if s["cell_size_m"] > 0 else "surveyed points"
     geo = f", origin {s['geo'][0]:.6f}, {s['geo'][1]:.6f}" if s.get("geo") else ""
     lines.append(f"frame       rotation {s['map_rotation_deg']:g} deg, {cell}{geo}")
+    if "n_walls" in s:
+        plan = f"plan        {s['n_walls']} wall segments, {s['n_ports']} ports, {s['n_beacons']} beacons"
+        if s.get("ble_model"):
+            r1, n, sig = s["ble_model"]
+            plan += f" (RSSI(d) = {r1:.1f} dBm - 10·{n:.2f}·log10 d, σ {sig:.1f} dB)"
+        lines.append(plan)
+    if s.get("ble"):
+        b = s["ble"]
+        text = f"ble         {b['placed']} of {b['readings']} readings placed on the truth"
+        if "from_table" in b:
+            text += (
+                f"; {b['from_table']} beacons from the table, {b['learnt']} learnt, {b['left_out']} left out"
+            )
+            text += f"; model {'learnt' if b['model_learnt'] else 'defaults'}"
+        lines.append(text)
+        if b.get("table_matched"):
+            lines.append(
+                "  table ↔ MAC " + ", ".join(f"{n}={m or '?'}" for n, m in b["table_matched"].items())
+            )
     lines.append(f"floors      {s['n_floors']} from {s['lowest_floor']}")
     for f, info in s["floors"].items():
         text = f"  floor {f:>3}  h {info['height_m']:6.2f} m  {info['rps']:5d} RPs  {info['aps']:4d} APs"
@@ -54,23 +73,45 @@ def format_summary(s: dict) -> str:
     return "\n".join(lines)
 
 
+def _site_floors(site: site_t) -> list[int]:
+    """Floors with anything to draw (RPs, walls, beacons, ports), else the lowest."""
+    used = set(np.asarray(site.rp_floor).tolist()) | set(np.asarray(site.wall_floor).tolist())
+    used |= set(np.asarray(site.beacon_floor).tolist())
+    for lo, hi in zip(site.port_floor_lo, site.port_floor_hi):
+        used |= set(range(lo, hi + 1))
+    floors = [site.lowest_floor + i for i in range(site.n_floors) if site.lowest_floor + i in used]
+    return floors or [site.lowest_floor]
+
+
 def plot_site(site: site_t, png_path: str) -> None:
-    """PNG of the RPs per floor (one panel each), coloured by the number of APs heard."""
+    """PNG of the site per floor (one panel each): walls (grey lines), RPs coloured by the number of
+    APs heard, beacons (triangles with their ids' last two bytes) and ports (circles: door green,
+    stairs orange, elevator purple)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Circle
 
     rp_floor = np.asarray(site.rp_floor)
     n_aps = np.bincount(np.asarray(site.entry_rp, dtype=np.int64), minlength=site.n_rp)
-    floors = [
-        site.lowest_floor + i for i in range(site.n_floors) if np.any(rp_floor == site.lowest_floor + i)
-    ] or [site.lowest_floor]
+    floors = _site_floors(site)
     fig, axes = plt.subplots(
-        1, len(floors), figsize=(5 * len(floors), 4.5), squeeze=False, constrained_layout=True
+        1, len(floors), figsize=(6 * len(floors), 5.5), squeeze=False, constrained_layout=True
     )
     vmax = max(1, int(n_aps.max())) if site.n_rp else 1
+    wall_floor, beacon_floor = np.asarray(site.wall_floor), np.asarray(site.beacon_floor)
+    port_colours = {1: "tab:green", 2: "tab:orange", 3: "tab:purple"}
+    sc = None
     for ax, f in zip(axes[0], floors):
+        w = np.flatnonzero(wall_floor == f)
+        if len(w):
+            segs = [
+                [(site.wall_x0_m[i], site.wall_y0_m[i]), (site.wall_x1_m[i], site.wall_y1_m[i])] for i in w
+            ]
+            ax.add_collection(LineCollection(segs, colors="0.35", linewidths=0.8, zorder=1))
+            ax.autoscale()
         sel = rp_floor == f
         sc = ax.scatter(
             np.asarray(site.rp_x_m)[sel],
@@ -79,15 +120,41 @@ def plot_site(site: site_t, png_path: str) -> None:
             cmap="viridis",
             vmin=0,
             vmax=vmax,
-            s=18,
+            s=14,
+            zorder=2,
         )
-        ax.set_title(f"floor {f}: {int(sel.sum())} RPs")
+        for i in np.flatnonzero(beacon_floor == f):
+            x, y = site.beacon_x_m[i], site.beacon_y_m[i]
+            ax.plot(x, y, "^", color="tab:red", ms=8, zorder=3)
+            ax.annotate(
+                f"{site.beacon_id[i] & 0xFFFF:04x}",
+                (x, y),
+                fontsize=7,
+                xytext=(3, 3),
+                textcoords="offset points",
+            )
+        for k in range(site.n_ports):
+            if site.port_floor_lo[k] <= f <= site.port_floor_hi[k]:
+                ax.add_patch(
+                    Circle(
+                        (site.port_x_m[k], site.port_y_m[k]),
+                        site.port_radius_m[k],
+                        fill=False,
+                        color=port_colours.get(site.port_kind[k], "k"),
+                        lw=1.5,
+                        zorder=3,
+                    )
+                )
+        ax.set_title(
+            f"floor {f}: {int(sel.sum())} RPs, {len(w)} walls, {int(np.sum(beacon_floor == f))} beacons"
+        )
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
-    fig.colorbar(sc, ax=list(axes[0]), label="APs heard at RP")
-    fig.suptitle(site.name or "radio map")
+    if sc is not None:
+        fig.colorbar(sc, ax=list(axes[0]), label="APs heard at RP")
+    fig.suptitle(site.name or "site")
     os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
     fig.savefig(png_path, dpi=110)
     plt.close(fig)

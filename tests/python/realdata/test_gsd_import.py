@@ -33,7 +33,7 @@ def _events(tmp_path, channel, decoder):
 
 def test_handmade_counts_and_summary(gsd_log, tmp_path):
     s, _ = _import(gsd_log, tmp_path)
-    assert s["messages"] == {"IMU": 3, "MAG": 2, "BARO": 2, "GNSS": 2, "WIFI": 2, "TRUTH": 3}
+    assert s["messages"] == {"IMU": 3, "MAG": 2, "BARO": 2, "GNSS": 2, "WIFI": 2, "BLE": 0, "TRUTH": 3}
     assert s["events"] == 3 + 2 + 2 + 2 + 2 + 3
     assert s["skipped_lines"] == 3
     assert s["ignored_lines_by_type"] == {"AHRS": 1, "LIGH": 1}

@@ -25,7 +25,7 @@ def _import(trace, tmp_path, **kw):
 
 def test_handmade_counts_and_summary(handmade_trace, tmp_path):
     s, _ = _import(handmade_trace, tmp_path)
-    assert s["messages"] == {"IMU": 3, "MAG": 2, "WIFI": 2, "TRUTH": 2}
+    assert s["messages"] == {"IMU": 3, "MAG": 2, "WIFI": 2, "BLE": 0, "TRUTH": 2}
     assert s["waypoints"] == 2
     assert s["skipped_lines"] == 4
     assert s["ignored_lines_by_type"] == {"TYPE_ACCELEROMETER_UNCALIBRATED": 1}

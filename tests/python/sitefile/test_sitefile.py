@@ -26,6 +26,19 @@ _FLOAT32_FIELDS = {
     "fix_bias_sigma_m",
     "fix_bias_length_m",
     "fix_white_share",
+    "wall_x0_m",
+    "wall_y0_m",
+    "wall_x1_m",
+    "wall_y1_m",
+    "port_x_m",
+    "port_y_m",
+    "port_radius_m",
+    "beacon_x_m",
+    "beacon_y_m",
+    "beacon_rssi_1m_dbm",
+    "ble_rssi_1m_dbm",
+    "ble_path_loss_exponent",
+    "ble_range_sigma_db",
 }
 
 
@@ -43,7 +56,7 @@ def test_round_trip_every_value_equal(tmp_path, vector_site):
     for name in site_t.__slots__:
         want, back = getattr(vector_site, name), getattr(got, name)
         if name in _FLOAT32_FIELDS:
-            assert np.array_equal(np.asarray(back, float), _f32(want)), name
+            assert np.array_equal(np.asarray(back, float), _f32(want), equal_nan=True), name
         elif isinstance(want, list | tuple):
             assert list(back) == list(want), name
         else:
@@ -55,7 +68,7 @@ def test_header_layout(tmp_path, vector_site):
     sitefile.write_site(path, vector_site)
     data = path.read_bytes()
     magic, version, length, crc, reserved = struct.unpack_from("<8sIIII", data)
-    assert (magic, version, reserved) == (b"SFSITE\0\x01", 1, 0)
+    assert (magic, version, reserved) == (b"SFSITE\0\x01", 2, 0)
     assert length == len(data) - 24
     assert crc == zlib.crc32(data[24:])
     assert data[24:] == vector_site.encode()
@@ -94,7 +107,7 @@ def test_variant_rejected(tmp_path, name, data, kind, c_text):
     "field,offset,value,kind,text",
     [
         ("magic", 0, b"XFSITE\0\x01", "magic", "bad magic 58 46 53 49 54 45 00 01"),
-        ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 1"),
+        ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 2"),
         ("length", 12, struct.pack("<I", 5), "length", "length mismatch (trailing bytes): header says 5"),
         ("crc", 16, struct.pack("<I", 0x12345678), "crc", "CRC-32 mismatch: header says 0x12345678"),
         ("reserved", 20, struct.pack("<I", 1), "reserved", "reserved header field is 0x00000001"),

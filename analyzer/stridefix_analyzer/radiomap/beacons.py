@@ -1,0 +1,280 @@
+"""BLE beacons of a site from walks with truth: the site's log-distance path-loss model and, for sites
+without a beacon table (msindoor), each beacon's position.
+
+Model: RSSI(d) = A − 10·n·log10(max(d, :data:`MIN_RANGE_M`)) + ε, ε ~ N(0, σ²), d the horizontal
+distance from the walker (the truth, linearly interpolated in time between waypoints on one floor)
+to the beacon. A reading outside the truth's span, or between waypoints on different floors, is not
+placed.
+
+* :func:`fit_model` — known beacon positions (a table): A and n by least squares over every placed
+  reading on the beacon's floor, σ = the residuals' standard deviation.
+* :func:`learn_beacons` — unknown positions: alternating least squares. Start with n = 2 (free space)
+  and A = the 95th-percentile RSSI; per beacon, its position minimises the squared RSSI residuals
+  (scipy least_squares, started at the RSSI-weighted centroid of its strongest readings, bounded to
+  the box of its readings ± :data:`POSITION_MARGIN_M`); then A and n by linear least squares over all
+  beacons; repeated :data:`ALTERNATIONS` times. A beacon needs :data:`MIN_READINGS` placed readings
+  from :data:`MIN_CELLS` distinct 2 m cells on one floor (else the position is not determined, and
+  it is left out); a beacon whose fit leaves an RMS residual above :data:`MAX_RMS_FACTOR` × the
+  site's σ is left out too (a moved beacon, or one heard through floors).
+
+Cost: O(R) per alternation for R readings, plus one small least-squares problem per beacon.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+#: Readings closer than this are taken at this range [m] (the model's reference distance, 1 m).
+MIN_RANGE_M = 1.0
+#: Fewest placed readings and distinct 2 m cells that determine a beacon's position (3 unknowns:
+#: x, y and the residual scale need well over 3 independent positions).
+MIN_READINGS = 15
+MIN_CELLS = 6
+CELL_M = 2.0
+#: A learnt position stays within the box of its readings ± this [m] (a beacon is heard from ~20 m).
+POSITION_MARGIN_M = 10.0
+ALTERNATIONS = 5
+MAX_RMS_FACTOR = 2.0
+#: Defaults of the site model where nothing can be learnt: −59 dBm at 1 m (the iBeacon "measured
+#: power" convention), n = 2 (free space), σ = 6 dB (indoor shadowing, a typical 4–8 dB).
+DEFAULT_MODEL = {"rssi_1m_dbm": -59.0, "path_loss_exponent": 2.0, "range_sigma_db": 6.0}
+
+
+def place_readings(recordings: Sequence[Any]) -> dict[str, np.ndarray]:
+    """Every BLE reading of the recordings placed on its recording's truth: columns beacon_id, x_m,
+    y_m, floor, rssi_dbm (readings that cannot be placed are dropped; ``n_total`` counts all)."""
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in ("beacon_id", "x_m", "y_m", "floor", "rssi_dbm")}
+    n_total = 0
+    for rec in recordings:
+        ble, truth = rec.ble, rec.truth
+        n_total += len(ble)
+        if not len(ble) or len(truth) < 2:
+            continue
+        t, tt = ble["t_us"].astype(np.float64), truth["t_us"].astype(np.float64)
+        i = np.searchsorted(tt, t, side="right")
+        ok = (i >= 1) & (i < len(tt))
+        i = np.clip(i, 1, len(tt) - 1)
+        f0, f1 = truth["floor"][i - 1], truth["floor"][i]
+        ok &= f0 == f1
+        w = np.where(tt[i] > tt[i - 1], (t - tt[i - 1]) / np.maximum(tt[i] - tt[i - 1], 1.0), 0.0)
+        x = truth["x_m"][i - 1] + w * (truth["x_m"][i] - truth["x_m"][i - 1])
+        y = truth["y_m"][i - 1] + w * (truth["y_m"][i] - truth["y_m"][i - 1])
+        for k, v in (("beacon_id", ble["beacon_id"]), ("x_m", x), ("y_m", y), ("floor", f0)):
+            cols[k].append(np.asarray(v)[ok])
+        cols["rssi_dbm"].append(ble["rssi_dbm"][ok])
+    out = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
+    out["beacon_id"] = out["beacon_id"].astype(np.int64)
+    out["floor"] = out["floor"].astype(np.int64)
+    out["n_total"] = np.asarray(n_total)
+    return out
+
+
+def _log_d(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    return np.log10(np.maximum(np.hypot(dx, dy), MIN_RANGE_M))
+
+
+def _linear_model(rssi: np.ndarray, logd: np.ndarray) -> tuple[float, float]:
+    """(A, n) of rssi ≈ A − 10·n·logd by least squares (n from the data only when logd varies)."""
+    design = np.column_stack([np.ones_like(logd), -10.0 * logd])
+    (a, n), *_ = np.linalg.lstsq(design, rssi, rcond=None)
+    return float(a), float(n)
+
+
+def fit_model(placed: dict[str, np.ndarray], table: dict[int, tuple[float, float, int]]) -> dict[str, Any]:
+    """The site model from readings of beacons at known positions ``table`` (id → x, y, floor)."""
+    keep = np.array(
+        [
+            b in table and table[b][2] == f
+            for b, f in zip(placed["beacon_id"].tolist(), placed["floor"].tolist())
+        ],
+        dtype=bool,
+    )
+    if keep.sum() < MIN_READINGS:
+        return {**DEFAULT_MODEL, "readings": int(keep.sum()), "learnt": False}
+    ids = placed["beacon_id"][keep]
+    bx = np.array([table[b][0] for b in ids.tolist()])
+    by = np.array([table[b][1] for b in ids.tolist()])
+    logd = _log_d(placed["x_m"][keep] - bx, placed["y_m"][keep] - by)
+    rssi = placed["rssi_dbm"][keep]
+    a, n = _linear_model(rssi, logd)
+    resid = rssi - (a - 10.0 * n * logd)
+    return {
+        "rssi_1m_dbm": a,
+        "path_loss_exponent": n,
+        "range_sigma_db": float(np.std(resid)),
+        "readings": int(keep.sum()),
+        "learnt": n > 0,
+    }
+
+
+def learn_beacons(placed: dict[str, np.ndarray]) -> dict[str, Any]:
+    """Beacon positions and the site model from placed readings (see the module docstring).
+
+    Returns ``beacons`` {id: (x, y, floor, n_readings, rms_db)}, the model (``rssi_1m_dbm``,
+    ``path_loss_exponent``, ``range_sigma_db``, ``learnt``) and ``left_out`` {id: reason}."""
+    from scipy.optimize import least_squares
+
+    ids, floors = placed["beacon_id"], placed["floor"]
+    groups: dict[int, np.ndarray] = {}
+    left_out: dict[int, str] = {}
+    for b in np.unique(ids).tolist():
+        sel = ids == b
+        fl, counts = np.unique(floors[sel], return_counts=True)
+        sel &= floors == fl[np.argmax(counts)]  # the floor it is heard most on
+        cells = {(int(x // CELL_M), int(y // CELL_M)) for x, y in zip(placed["x_m"][sel], placed["y_m"][sel])}
+        if sel.sum() < MIN_READINGS or len(cells) < MIN_CELLS:
+            left_out[b] = f"{int(sel.sum())} readings in {len(cells)} cells"
+            continue
+        groups[b] = np.flatnonzero(sel)
+    rssi_all = placed["rssi_dbm"]
+    a = float(np.percentile(rssi_all, 95)) if len(rssi_all) else DEFAULT_MODEL["rssi_1m_dbm"]
+    n = DEFAULT_MODEL["path_loss_exponent"]
+    pos: dict[int, np.ndarray] = {}
+    for b, rows in groups.items():
+        x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
+        top = r >= np.percentile(r, 75)
+        w = 10.0 ** (r[top] / 10.0)
+        pos[b] = np.array([np.sum(w * x[top]) / w.sum(), np.sum(w * y[top]) / w.sum()])
+    if not groups:
+        return {"beacons": {}, **DEFAULT_MODEL, "learnt": False, "left_out": left_out, "readings": 0}
+    for _ in range(ALTERNATIONS):
+        for b, rows in groups.items():
+            x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
+            lo = np.array([x.min(), y.min()]) - POSITION_MARGIN_M
+            hi = np.array([x.max(), y.max()]) + POSITION_MARGIN_M
+            start = np.clip(pos[b], lo + 1e-6, hi - 1e-6)
+            res = least_squares(
+                lambda p: r - (a - 10.0 * n * _log_d(x - p[0], y - p[1])),  # noqa: B023 - used at once
+                start,
+                bounds=(lo, hi),
+            )
+            pos[b] = res.x
+        rows_all = np.concatenate(list(groups.values()))
+        bx = np.concatenate([np.full(len(rows), pos[b][0]) for b, rows in groups.items()])
+        by = np.concatenate([np.full(len(rows), pos[b][1]) for b, rows in groups.items()])
+        logd = _log_d(placed["x_m"][rows_all] - bx, placed["y_m"][rows_all] - by)
+        a, n = _linear_model(rssi_all[rows_all], logd)
+        if not n > 0:
+            a, n = _linear_model(
+                rssi_all[rows_all] + 10.0 * DEFAULT_MODEL["path_loss_exponent"] * logd, 0 * logd
+            )
+            n = DEFAULT_MODEL["path_loss_exponent"]
+    resid_all = rssi_all[rows_all] - (a - 10.0 * n * logd)
+    sigma = float(np.std(resid_all))
+    beacons: dict[int, tuple[float, float, int, int, float]] = {}
+    for b, rows in groups.items():
+        x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
+        rms = float(np.sqrt(np.mean((r - (a - 10.0 * n * _log_d(x - pos[b][0], y - pos[b][1]))) ** 2)))
+        if rms > MAX_RMS_FACTOR * sigma:
+            left_out[b] = f"RMS residual {rms:.1f} dB > {MAX_RMS_FACTOR:g} x site sigma {sigma:.1f} dB"
+            continue
+        beacons[b] = (float(pos[b][0]), float(pos[b][1]), int(floors[rows[0]]), len(rows), rms)
+    kept = np.concatenate([groups[b] for b in beacons]) if beacons else np.zeros(0, np.int64)
+    if len(kept):
+        bx = np.concatenate([np.full(len(groups[b]), beacons[b][0]) for b in beacons])
+        by = np.concatenate([np.full(len(groups[b]), beacons[b][1]) for b in beacons])
+        resid = rssi_all[kept] - (a - 10.0 * n * _log_d(placed["x_m"][kept] - bx, placed["y_m"][kept] - by))
+        sigma = float(np.std(resid))
+    return {
+        "beacons": beacons,
+        "rssi_1m_dbm": a,
+        "path_loss_exponent": n,
+        "range_sigma_db": sigma,
+        "learnt": True,
+        "left_out": left_out,
+        "readings": int(len(kept)),
+    }
+
+
+def mac_check(
+    placed: dict[str, np.ndarray], table: dict[str, tuple[float, float, int]], radius_m: float = 5.0
+) -> dict[str, Any]:
+    """Which MAC is loudest near each table position: per (name, MAC) the median RSSI of the readings
+    within ``radius_m`` of the position on its floor. Returns {name: {"loudest": id, "median_dbm":
+    {id: dBm}, "readings": n}}."""
+    out: dict[str, Any] = {}
+    for name, (tx, ty, tf) in table.items():
+        near = (np.hypot(placed["x_m"] - tx, placed["y_m"] - ty) <= radius_m) & (placed["floor"] == tf)
+        med = {
+            int(b): float(np.median(placed["rssi_dbm"][near & (placed["beacon_id"] == b)]))
+            for b in np.unique(placed["beacon_id"][near]).tolist()
+        }
+        loudest = max(med, key=lambda b: med[b]) if med else None
+        out[name] = {"loudest": loudest, "median_dbm": med, "readings": int(near.sum())}
+    return out
+
+
+def site_fields(beacons: dict[int, tuple[float, float, int]], model: dict[str, Any]) -> dict[str, Any]:
+    """site_t fields of beacons {id: (x, y, floor, ...)} and a model (ids ascending, own RSSI NaN)."""
+    ids = sorted(beacons)
+    return {
+        "beacon_id": ids,
+        "beacon_x_m": [beacons[b][0] for b in ids],
+        "beacon_y_m": [beacons[b][1] for b in ids],
+        "beacon_floor": [int(beacons[b][2]) for b in ids],
+        "beacon_rssi_1m_dbm": [math.nan] * len(ids),
+        "ble_rssi_1m_dbm": float(model["rssi_1m_dbm"]),
+        "ble_path_loss_exponent": float(model["path_loss_exponent"]),
+        "ble_range_sigma_db": float(model["range_sigma_db"]),
+    }
+
+
+#: A table position is matched to the MAC loudest near it (mac_check) when it has this many readings
+#: within the check radius and leads the runner-up by this margin [dB] (else no MAC is assumed).
+MATCH_MIN_READINGS = 10
+MATCH_MARGIN_DB = 6.0
+
+
+def site_beacons(
+    recordings: Sequence[Any], table: dict[str, tuple[float, float, int]] | None
+) -> dict[str, Any]:
+    """The beacons and model a build writes: with a ``table`` (name → x, y, floor in the map frame),
+    each name matched to a MAC by :func:`mac_check` (decisive matches only) at the table's position,
+    the model fitted on those; the MACs left are learnt (:func:`learn_beacons`) like a site without a
+    table. Returns ``fields`` (site_t fields, empty without readings) and the ``report``."""
+    placed = place_readings(recordings)
+    report: dict[str, Any] = {"readings": int(placed["n_total"]), "placed": len(placed["rssi_dbm"])}
+    if not len(placed["rssi_dbm"]):
+        return {"fields": {}, "report": report}
+    known: dict[int, tuple[float, float, int]] = {}
+    if table:
+        check = mac_check(placed, table)
+        matches: dict[str, str | None] = {}
+        for name, c in check.items():
+            med = sorted(c["median_dbm"].values(), reverse=True)
+            decisive = c["loudest"] is not None and c["readings"] >= MATCH_MIN_READINGS
+            decisive = decisive and (len(med) < 2 or med[0] - med[1] >= MATCH_MARGIN_DB)
+            if decisive and c["loudest"] not in known:
+                known[c["loudest"]] = table[name]
+                matches[name] = f"{c['loudest']:012x}"
+            else:
+                matches[name] = None
+        report["mac_check"] = {
+            n: {
+                "loudest": None if c["loudest"] is None else f"{c['loudest']:012x}",
+                "readings": c["readings"],
+                "median_dbm": {f"{k:012x}": round(v, 1) for k, v in c["median_dbm"].items()},
+            }
+            for n, c in check.items()
+        }
+        report["table_matched"] = matches
+    rest = ~np.isin(placed["beacon_id"], list(known))
+    learnt = learn_beacons({k: (v[rest] if v.ndim else v) for k, v in placed.items()})
+    model = fit_model(placed, known) if known else {}
+    if not model.get("learnt"):
+        model = learnt if learnt["learnt"] else {**DEFAULT_MODEL, "learnt": False}
+    beacons: dict[int, tuple[float, float, int]] = dict(known)
+    beacons.update({b: v[:3] for b, v in learnt["beacons"].items()})
+    report.update(
+        from_table=len(known),
+        learnt=len(learnt["beacons"]),
+        left_out=len(learnt["left_out"]),
+        model={k: model[k] for k in ("rssi_1m_dbm", "path_loss_exponent", "range_sigma_db")},
+        model_learnt=bool(model.get("learnt")),
+        learnt_rms_db=[round(v[4], 2) for v in learnt["beacons"].values()],
+    )
+    return {"fields": site_fields(beacons, model) if beacons else {}, "report": report}
