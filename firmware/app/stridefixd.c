@@ -173,6 +173,8 @@ static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
         break;
     case sf_rx_wifi: on_wifi(d, &ev->u.wifi); break;
     case sf_rx_gnss: break; /* logged; the estimator takes no GNSS fixes yet */
+    case sf_rx_ble: break;
+    case sf_rx_landmark: break;
     case sf_rx_none: break;
     }
 }
@@ -354,6 +356,7 @@ static int serve(daemon_t *const d)
         fprintf(stderr, "stridefixd: %s\n", err);
         return SF_EXIT_USAGE;
     }
+    sf_input_configure(d->in, &d->params);
     if (open_output(d, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return 1;
