@@ -144,10 +144,11 @@
     X(floor,  vote_margin,         double,  3.0,     0.5,     1000.0,  "fixes", "start-floor vote (sf_floor_vote.h): lead in full-weight agreeing fixes that decides or moves the start floor; 3: a floor classifier right 80 % of the time among 3 floors is then 512 times likelier right than wrong ((0.8/0.1)^3), and one scan never flips") \
     X(floor,  between_reject,      int32_t, 1,       0,       1,       "",      "1 = fixes taken between floors (stairs, a moving lift, a landing half-way up; multi-floor sites) are rejected FLOOR_MISMATCH: a radio map is of floors (SIL tour: such fixes 6.9 m mean error against 1.2 m on the floors; gsd Trial51, open stairs: 4.8 against 4.3 m)")
 
-/* firmware/board (sf_board_rx.h): how the CAN decoder turns the BLE_ADV and LANDMARK frames into events. */
+/* firmware/board (sf_board_rx.h): how the CAN decoder turns the BLE_ADV and LANDMARK frames into events
+ * (listed just before SF_PARAMS_SOURCES, so that the [ble] keys stay together). */
 #define SF_PARAMS_BOARD_INPUT(X)                                                                       \
-    X(ble,    window_ms,           int32_t, 1000,    100,     60000,   "ms",    "BLE advertisements of this much board time (from the window's first) form one scan; a beacon heard several times in it is averaged in dBm") \
-    X(landmark, accuracy_m,        double,  0.3,     0.01,    100.0,   "m",     "1-sigma position of a LANDMARK frame (the frame has none): an NFC reader's range, a few decimetres")
+    X(landmark, accuracy_m,        double,  0.3,     0.01,    100.0,   "m",     "1-sigma position of a LANDMARK frame (the frame has none): an NFC reader's range, a few decimetres") \
+    X(ble,    window_ms,           int32_t, 1000,    100,     60000,   "ms",    "BLE advertisements of this much board time (from the window's first) form one scan; a beacon heard several times in it is averaged in dBm")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \
@@ -174,6 +175,20 @@
     X(fingerprint, nb_p_min,       double,  0.05,    0.001,   0.5,     "",      "naive Bayes: detection probability clamped to [p, 1-p]; an AP the map lacks at an RP is heard with p") \
     X(fingerprint, accuracy_floor_m, double, 1.5,    0.0,     100.0,   "m",     "fix accuracy: added in quadrature to the neighbours' spread") \
     X(fingerprint, accuracy_ref_aps, int32_t, 6,     1,       64,      "APs",   "fix accuracy x sqrt(ref / APs used) when fewer APs are used")
+
+/* sf_ble.h, sf_geo.h, sf_estimator.h: the absolute sources besides Wi-Fi. BLE: a phone hears
+ * iBeacons down to about −100 dBm; below −95 dBm a reading is at the noise floor and says "far", not
+ * how far. GNSS: receivers report 1σ-ish accuracy; indoors it grows to tens of metres, and a fix
+ * claiming more than 50 m is no position within a building. */
+#define SF_PARAMS_SOURCES(X)                                                                           \
+    X(ble,  min_rssi_dbm,          double,  -95.0,   -150.0,  0.0,     "dBm",   "BLE readings weaker than this are ignored") \
+    X(ble,  min_beacons,           int32_t, 1,       1,       8,       "beacons", "fewest usable beacons for a BLE fix (one gives a disc about the beacon)") \
+    X(ble,  same_floor,            int32_t, 1,       0,       1,       "",      "1 = only beacons on the caller's floor are used (a floor slab attenuates ~15-20 dB, which the model lacks)") \
+    X(ble,  min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a BLE fix's accuracy (1 sigma)") \
+    X(gnss, use,                   int32_t, 1,       0,       1,       "",      "1 = GNSS fixes are offered to the schemes (the site needs a geo-reference)") \
+    X(gnss, max_accuracy_m,        double,  50.0,    0.0,     1e4,     "m",     "GNSS fixes reporting a worse accuracy are not used") \
+    X(gnss, accuracy_scale,        double,  1.0,     0.1,     10.0,    "",      "the receiver's reported accuracy times this is the fix's 1 sigma") \
+    X(gnss, min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a GNSS fix's accuracy (receivers round and under-report)")
 
 /* sf_fusion.h */
 #define SF_PARAMS_FUSION(X)                                                                            \
@@ -229,7 +244,7 @@
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;
