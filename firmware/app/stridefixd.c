@@ -322,18 +322,18 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
             c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order, st.gaps_bridged);
     fprintf(stderr,
             "stridefixd: %" PRIu64 " IMU, %" PRIu64 " MAG, %" PRIu64 " BARO, %" PRIu64 " WIFI, %" PRIu64
-            " GNSS, %" PRIu64 " BLE (%" PRIu64 " advertisements, %" PRIu64 " dropped), %" PRIu64
-            " LANDMARK; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
-            c->imu, c->mag, c->baro, c->wifi, c->gnss, c->ble, c->ble_adverts, c->ble_dropped, c->landmark,
-            (int)st.step_count, d->opt.no_log ? "(none)" : d->log_path, oc->events, (double)oc->bytes / 1e6,
-            oc->drops, wall_s);
+            " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
+            c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)st.step_count, d->opt.no_log ? "(none)" : d->log_path,
+            oc->events, (double)oc->bytes / 1e6, oc->drops, wall_s);
     const sf_publish_sources_t *const src = &d->sources;
     fprintf(stderr,
-            "stridefixd: fixes made of offered: Wi-Fi %" PRIu64 " of %" PRIu64 ", GNSS %" PRIu64 " of %" PRIu64
-            ", BLE %" PRIu64 " of %" PRIu64 ", landmark %" PRIu64 " of %" PRIu64 "\n",
-            src->made[sf_fix_wifi], src->offered[sf_fix_wifi], src->made[sf_fix_gnss], src->offered[sf_fix_gnss],
-            src->made[sf_fix_ble], src->offered[sf_fix_ble], src->made[sf_fix_landmark],
-            src->offered[sf_fix_landmark]);
+            "stridefixd: sources: %" PRIu64 " BLE scans (%" PRIu64 " advertisements, %" PRIu64
+            " dropped from full windows), %" PRIu64 " LANDMARK; fixes made of offered: Wi-Fi %" PRIu64
+            " of %" PRIu64 ", GNSS %" PRIu64 " of %" PRIu64 ", BLE %" PRIu64 " of %" PRIu64 ", landmark %" PRIu64
+            " of %" PRIu64 "\n",
+            c->ble, c->ble_adverts, c->ble_dropped, c->landmark, src->made[sf_fix_wifi], src->offered[sf_fix_wifi],
+            src->made[sf_fix_gnss], src->offered[sf_fix_gnss], src->made[sf_fix_ble], src->offered[sf_fix_ble],
+            src->made[sf_fix_landmark], src->offered[sf_fix_landmark]);
     if (!d->opt.no_log) {
         fprintf(stderr,
                 "stridefixd: log detail: %" PRIu64 " files, %" PRIu64 " events written (%" PRIu64
