@@ -158,6 +158,7 @@ def test_log_carries_the_new_raw_inputs(sources_run):
     assert h["fixes_offered_ble"] == DURATION_S
     assert h["fixes_offered_gnss"] == DURATION_S
     assert h["fixes_offered_landmark"] == 1 and h["fixes_made_landmark"] == 1
+    assert "sources: 6 BLE scans (90 advertisements, 0 dropped from full windows), 1 LANDMARK" in sources_run["stderr"]
     assert "fixes made of offered: Wi-Fi 0 of 0, GNSS" in sources_run["stderr"]
     assert "landmark 1 of 1" in sources_run["stderr"]
 
