@@ -2,7 +2,8 @@
  *
  * One input (firmware/board/sf_input.h: candump file, stdin, SocketCAN or a raw-sensor LCM log) gives
  * timed samples; each is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch
- * (feed()); the core's steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
+ * (feed()): every absolute source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes; the core's
+ * steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
  * optionally, live LCM. Bad input is counted and skipped, never fatal; counts go into HEALTH and the
  * exit summary. The scheme names come from pose_t.SCHEME_* through the core's registry.
  * Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h) and the run closes as at the end of
@@ -61,6 +62,7 @@ typedef struct {
     int16_t last_pose_floor;
     bool config_written;
     sf_publish_loop_t loop;
+    sf_publish_sources_t sources; /* fixes offered and made, by source */
 } daemon_t;
 
 /* One bad-input message (file and line where there is one), at most opt.max_messages of them. */
@@ -95,7 +97,7 @@ static void write_health(daemon_t *const d)
     sf_input_counters(d->in, &ic);
     sf_estimator_status_t st;
     sf_estimator_status(&d->est, &st);
-    sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->loop);
+    sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->sources, &d->loop);
     d->last_health_t_us = d->board_t_us;
 }
 
@@ -117,7 +119,25 @@ static void write_pose(daemon_t *const d)
     d->last_pose_floor = st.floor;
 }
 
-/* The FIX audit records of one scan: every scheme's verdict. */
+/* What one absolute source gave the estimator (sf_estimator_wifi / _gnss / _ble / _landmark): its n
+ * FIX audit records (every scheme's verdict on the fix, or why there was none) published, the source
+ * counted (offered, and made a fix of), and the POSE written now when there were audits: the fix moved
+ * the fused schemes, say so now, not at the next step. */
+static void publish_fixes(daemon_t *const d, const int method, const int n, const bool has_fix,
+                          const sf_fix_audit_t audits[sf_scheme_count])
+{
+    d->sources.offered[method]++;
+    d->sources.made[method] += has_fix ? 1u : 0u;
+    for (int i = 0; i < n; i++) {
+        if (d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) {
+            sf_publish_fix(d->out, d->host_t_us, &audits[i]);
+        }
+    }
+    if (n > 0) {
+        write_pose(d);
+    }
+}
+
 static void on_wifi(daemon_t *const d, const sf_rx_wifi_t *const w)
 {
     const sf_wifi_scan_t scan = {.t_us = w->t_us, .n_ap = w->n_ap, .bssid = w->bssid, .rssi_dbm = w->rssi_dbm};
@@ -125,14 +145,43 @@ static void on_wifi(daemon_t *const d, const sf_rx_wifi_t *const w)
     bool has_fix = false;
     sf_fix_audit_t audits[sf_scheme_count];
     const int n = sf_estimator_wifi(&d->est, &d->params, &scan, &fix, &has_fix, audits);
-    for (int i = 0; i < n; i++) {
-        if (d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) {
-            sf_publish_fix(d->out, d->host_t_us, &audits[i]);
-        }
-    }
-    if (n > 0) {
-        write_pose(d); /* the fix moved the fused schemes: say so now, not at the next step */
-    }
+    publish_fixes(d, sf_fix_wifi, n, has_fix, audits);
+}
+
+static void on_gnss(daemon_t *const d, const sf_rx_gnss_t *const g)
+{
+    const sf_gnss_t in = {
+        .t_us = g->t_us, .lat_deg = g->lat_deg, .lon_deg = g->lon_deg, .alt_m = g->alt_m, .accuracy_m = g->accuracy_m};
+    sf_fix_t fix;
+    bool has_fix = false;
+    sf_fix_audit_t audits[sf_scheme_count];
+    const int n = sf_estimator_gnss(&d->est, &d->params, &in, &fix, &has_fix, audits);
+    publish_fixes(d, sf_fix_gnss, n, has_fix, audits);
+}
+
+static void on_ble(daemon_t *const d, const sf_rx_ble_t *const b)
+{
+    const sf_ble_scan_t scan = {.t_us = b->t_us, .n = b->n, .beacon_id = b->beacon_id, .rssi_dbm = b->rssi_dbm};
+    sf_fix_t fix;
+    bool has_fix = false;
+    sf_fix_audit_t audits[sf_scheme_count];
+    const int n = sf_estimator_ble(&d->est, &d->params, &scan, &fix, &has_fix, audits);
+    publish_fixes(d, sf_fix_ble, n, has_fix, audits);
+}
+
+static void on_landmark(daemon_t *const d, const sf_rx_landmark_t *const l)
+{
+    const sf_landmark_t in = {.t_us = l->t_us,
+                              .landmark_id = l->landmark_id,
+                              .x_m = l->x_m,
+                              .y_m = l->y_m,
+                              .floor = l->floor,
+                              .accuracy_m = l->accuracy_m};
+    sf_fix_t fix;
+    bool has_fix = false;
+    sf_fix_audit_t audits[sf_scheme_count];
+    const int n = sf_estimator_landmark(&d->est, &d->params, &in, &fix, &has_fix, audits);
+    publish_fixes(d, sf_fix_landmark, n, has_fix, audits);
 }
 
 static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
@@ -172,7 +221,9 @@ static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
         d->board_t_us = ev->u.baro.t_us;
         break;
     case sf_rx_wifi: on_wifi(d, &ev->u.wifi); break;
-    case sf_rx_gnss: break; /* logged; the estimator takes no GNSS fixes yet */
+    case sf_rx_gnss: on_gnss(d, &ev->u.gnss); break;
+    case sf_rx_ble: on_ble(d, &ev->u.ble); break;
+    case sf_rx_landmark: on_landmark(d, &ev->u.landmark); break;
     case sf_rx_none: break;
     }
 }
@@ -274,6 +325,15 @@ static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const 
             " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
             c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)st.step_count, d->opt.no_log ? "(none)" : d->log_path,
             oc->events, (double)oc->bytes / 1e6, oc->drops, wall_s);
+    const sf_publish_sources_t *const src = &d->sources;
+    fprintf(stderr,
+            "stridefixd: sources: %" PRIu64 " BLE scans (%" PRIu64 " advertisements, %" PRIu64
+            " dropped from full windows), %" PRIu64 " LANDMARK; fixes made of offered: Wi-Fi %" PRIu64
+            " of %" PRIu64 ", GNSS %" PRIu64 " of %" PRIu64 ", BLE %" PRIu64 " of %" PRIu64 ", landmark %" PRIu64
+            " of %" PRIu64 "\n",
+            c->ble, c->ble_adverts, c->ble_dropped, c->landmark, src->made[sf_fix_wifi], src->offered[sf_fix_wifi],
+            src->made[sf_fix_gnss], src->offered[sf_fix_gnss], src->made[sf_fix_ble], src->offered[sf_fix_ble],
+            src->made[sf_fix_landmark], src->offered[sf_fix_landmark]);
     if (!d->opt.no_log) {
         fprintf(stderr,
                 "stridefixd: log detail: %" PRIu64 " files, %" PRIu64 " events written (%" PRIu64
@@ -354,6 +414,7 @@ static int serve(daemon_t *const d)
         fprintf(stderr, "stridefixd: %s\n", err);
         return SF_EXIT_USAGE;
     }
+    sf_input_configure(d->in, &d->params);
     if (open_output(d, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return 1;

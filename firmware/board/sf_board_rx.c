@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "board.h"
+#include "sf_board_ble.h"
 #include "sf_board_scan.h"
 #include "sf_error.h"
 
@@ -24,6 +25,25 @@ void sf_board_rx_init(sf_board_rx_t *const rx)
     sf_stream_time_init(&rx->imu_time, IMU_PERIOD_MS);
     sf_stream_time_init(&rx->mag_time, MAG_PERIOD_MS);
     sf_stream_time_init(&rx->baro_time, BARO_PERIOD_MS);
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_board_rx_configure(rx, &p);
+}
+
+void sf_board_rx_configure(sf_board_rx_t *const rx, const sf_params_t *const p)
+{
+    rx->ble_window_us = (int64_t)p->ble_window_ms * 1000;
+    rx->landmark_accuracy_m = (float)p->landmark_accuracy_m;
+}
+
+int sf_board_rx_flush(sf_board_rx_t *const rx, sf_rx_event_t *const ev)
+{
+    ev->kind = sf_rx_none;
+    const int rc = sf_board_ble_close(rx, ev);
+    if (rc == 1) {
+        sf_rx_count_sample(&rx->counters, ev->kind);
+    }
+    return rc;
 }
 
 int32_t sf_wifi_channel_to_mhz(const unsigned channel)
@@ -156,11 +176,13 @@ int sf_board_rx_carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, in
 
 static int on_board_time(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
-    (void)ev;
     struct board_board_time_t m;
     (void)board_board_time_unpack(&m, f->data, f->dlc);
-    (void)sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us); /* a restart: see below */
-    return 0;
+    /* a restart: see sf_board_rx_frame; output time goes on across it, so the BLE window's does too */
+    if (sf_board_clock_on_time(&rx->clock, m.time_ms, m.boot_id, f->host_t_us) == sf_board_time_held) {
+        return 0;
+    }
+    return sf_board_ble_tick(rx, sf_board_clock_output_us(&rx->clock, rx->clock.board_ms), ev);
 }
 
 static int on_imu_accel(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -278,6 +300,38 @@ static int on_gnss_position(sf_board_rx_t *const rx, const sf_can_frame_t *const
     return 1;
 }
 
+static int on_ble_adv(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_ble_adv_t m;
+    (void)board_ble_adv_unpack(&m, f->data, f->dlc);
+    return sf_board_ble_adv(rx, &m, ev);
+}
+
+static int on_landmark(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
+{
+    struct board_landmark_t m;
+    (void)board_landmark_unpack(&m, f->data, f->dlc);
+    if (!board_landmark_x_is_in_range(m.x) || !board_landmark_y_is_in_range(m.y) ||
+        !board_landmark_floor_is_in_range(m.floor)) {
+        rx->counters.decode_errors++;
+        return SF_ERANGE;
+    }
+    int64_t t_ms;
+    if (sf_board_clock_event(&rx->clock, m.t_lo_ms, rx->host_t_us, &t_ms) != SF_OK) {
+        rx->counters.unsynced++;
+        return SF_ENOTSYNC;
+    }
+    sf_rx_landmark_t *const out = &ev->u.landmark;
+    out->t_us = sf_board_clock_output_us(&rx->clock, t_ms);
+    out->landmark_id = 0;
+    out->x_m = board_landmark_x_decode(m.x);
+    out->y_m = board_landmark_y_decode(m.y);
+    out->floor = (int16_t)board_landmark_floor_decode(m.floor);
+    out->accuracy_m = rx->landmark_accuracy_m;
+    ev->kind = sf_rx_landmark;
+    return 1;
+}
+
 static int on_board_status(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
     (void)ev;
@@ -312,6 +366,8 @@ static const frame_row_t frame_rows[] = {
     {BOARD_WIFI_SCAN_END_FRAME_ID, BOARD_WIFI_SCAN_END_LENGTH, on_wifi_scan_end},
     {BOARD_GNSS_POSITION_FRAME_ID, BOARD_GNSS_POSITION_LENGTH, on_gnss_position},
     {BOARD_GNSS_INFO_FRAME_ID, BOARD_GNSS_INFO_LENGTH, on_gnss_info},
+    {BOARD_BLE_ADV_FRAME_ID, BOARD_BLE_ADV_LENGTH, on_ble_adv},
+    {BOARD_LANDMARK_FRAME_ID, BOARD_LANDMARK_LENGTH, on_landmark},
     {BOARD_BOARD_STATUS_FRAME_ID, BOARD_BOARD_STATUS_LENGTH, on_board_status},
 };
 
@@ -378,6 +434,8 @@ void sf_rx_count_sample(sf_rx_counters_t *const c, const sf_rx_kind_t kind)
     case sf_rx_baro: c->baro++; break;
     case sf_rx_wifi: c->wifi++; break;
     case sf_rx_gnss: c->gnss++; break;
+    case sf_rx_ble: c->ble++; break;
+    case sf_rx_landmark: c->landmark++; break;
     case sf_rx_none: break;
     }
 }

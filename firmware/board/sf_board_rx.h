@@ -2,14 +2,28 @@
  *
  * Decodes each frame with the pack/unpack code that cantools generates from firmware/board.dbc,
  * gives every sample its board time (sf_board_time.h), pairs IMU_ACCEL with IMU_GYRO by seq,
- * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END (sf_board_scan.c), and pairs GNSS_INFO with
- * GNSS_POSITION.
+ * reassembles Wi-Fi scans from SCAN_BEGIN / AP / SCAN_END (sf_board_scan.c), pairs GNSS_INFO with
+ * GNSS_POSITION, groups BLE_ADV advertisements into one scan per window (sf_board_ble.c) and makes a
+ * LANDMARK frame one landmark event.
+ *
+ * BLE and landmark frames carry t_lo_ms but no seq: their time is the one with those low bits nearest
+ * to the clock (sf_board_clock_event). A BLE window starts at its first advertisement and spans
+ * ble.window_ms of board time (sf_params.h); it closes when an advertisement past it arrives (which
+ * opens the next) or when a believed BOARD_TIME is past it, never on a host clock; at the end of the
+ * input sf_board_rx_flush hands back the open one. A beacon heard several times in one window is
+ * averaged in dBm: its advertisements fade independently (several dB each, 20-100 ms apart), so the
+ * mean of n is a steadier level for a path-loss range than the latest alone. The same beacon at the
+ * same millisecond again is the bus repeating a frame (a beacon advertises at most every 20 ms, BLE
+ * spec): a duplicate. An advertisement older than the open window (or, with none open, the last closed
+ * one's end) arrived late and is skipped; a window's beacons beyond SF_BLE_MAX_BEACONS are counted in
+ * ble_dropped. A LANDMARK's accuracy is landmark.accuracy_m (the frame has none), its id 0.
  * One frame yields at most one event (sf_rx_event.h). Frames are dispatched through one table in
  * sf_board_rx.c (id, DBC length, handler): adding a frame is its DBC entry plus one row. Bad frames
  * are counted in sf_rx_counters_t and skipped: the return code says which counter moved, so the
  * caller can print a message naming the line.
  *
- * Memory: sizeof(sf_board_rx_t) = 4688 B on x86-64 (one scan in progress; asserted ≤ 4.75 KiB); no heap. */
+ * Memory: sizeof(sf_board_rx_t) = 5552 B on x86-64 (one Wi-Fi scan and one BLE window in progress;
+ * asserted ≤ 5.5 KiB); no heap. */
 #ifndef SF_BOARD_RX_H
 #define SF_BOARD_RX_H
 
@@ -18,6 +32,7 @@
 
 #include "sf_board_time.h"
 #include "sf_can_frame.h"
+#include "sf_params.h"
 #include "sf_rx_event.h"
 
 /* Counters never decrease. */
@@ -37,6 +52,10 @@ typedef struct {
     uint64_t baro;
     uint64_t wifi;
     uint64_t gnss;
+    uint64_t ble;             /* BLE scan windows handed out */
+    uint64_t landmark;        /* landmark events */
+    uint64_t ble_adverts;     /* BLE advertisements used (averaged into a window) */
+    uint64_t ble_dropped;     /* advertisements of beacons beyond a window's SF_BLE_MAX_BEACONS */
     uint64_t late;            /* samples that arrived after a newer one (reordered), skipped */
     uint64_t seq_rejected;    /* samples whose seq claims more time than passed (corrupt), skipped */
     uint64_t silences;        /* gaps of more than 1 s without any frame */
@@ -55,6 +74,15 @@ typedef struct {
 } sf_imu_half_t;
 
 #define SF_IMU_HALVES 2
+
+/* The BLE scan window in progress (sf_board_ble.c). Times are output times [µs]. */
+typedef struct {
+    bool open;
+    int64_t floor_us;                      /* advertisements before this are late */
+    uint16_t heard[SF_BLE_MAX_BEACONS];    /* advertisements averaged, per beacon */
+    int64_t last_us[SF_BLE_MAX_BEACONS];   /* per beacon: its latest advertisement */
+    sf_rx_ble_t scan;                      /* rssi_dbm holds the running mean */
+} sf_ble_window_t;
 
 typedef struct {
     sf_board_clock_t clock;
@@ -79,22 +107,34 @@ typedef struct {
     int64_t gnss_t_ms;
     double gnss_alt_m;
     float gnss_accuracy_m;
+    sf_ble_window_t ble;
+    int64_t ble_window_us;      /* ble.window_ms */
+    float landmark_accuracy_m;  /* landmark.accuracy_m */
     sf_rx_counters_t counters;
 } sf_board_rx_t;
 
-_Static_assert(sizeof(sf_board_rx_t) <= 4864, "sf_board_rx.h promises at most 4.75 KiB");
+_Static_assert(sizeof(sf_board_rx_t) <= 5632, "sf_board_rx.h promises at most 5.5 KiB");
 
+/* Starts the decoder with the params table's defaults for ble.window_ms and landmark.accuracy_m. */
 void sf_board_rx_init(sf_board_rx_t *rx);
+
+/* Takes ble.window_ms and landmark.accuracy_m from p (before the first frame). */
+void sf_board_rx_configure(sf_board_rx_t *rx, const sf_params_t *p);
 
 /* Consumes one frame. Returns 1 when *event was filled (a SCAN_BEGIN that finds a scan still open
  * returns that scan, marked incomplete), 0 when the frame was used without an event, or a negative
  * code when the frame was skipped and counted: SF_EUNKNOWN_ID, SF_ELENGTH, SF_ERANGE (decode error,
  * or a carried time far from the clock), SF_ENOTSYNC (no board time yet), SF_EDUPLICATE (a repeated
- * frame: IMU half, sample, scan, AP or SCAN_END), SF_ELATE (reordered), SF_ESEQ (corrupt seq).
+ * frame: IMU half, sample, scan, AP, SCAN_END or BLE advertisement), SF_ELATE (reordered), SF_ESEQ
+ * (corrupt seq), SF_EFULL (a BLE window already full: ble_dropped). A BLE_ADV past the open window
+ * returns that window (1) and opens the next with itself; a BOARD_TIME past it returns it too.
  * Sample times are output times (sf_board_time.h): continuous across board restarts. */
 int sf_board_rx_frame(sf_board_rx_t *rx, const sf_can_frame_t *frame, sf_rx_event_t *event);
 
-/* Counts one sample of a kind in its counter (imu .. gnss; sf_rx_none counts nothing): the one place
+/* At the end of the input: 1 with the open BLE window in *event (closed), else 0. */
+int sf_board_rx_flush(sf_board_rx_t *rx, sf_rx_event_t *event);
+
+/* Counts one sample of a kind in its counter (imu .. landmark; sf_rx_none counts nothing): the one place
  * for both input paths (sf_board_rx_frame, and the LCM replay in sf_input). */
 void sf_rx_count_sample(sf_rx_counters_t *counters, sf_rx_kind_t kind);
 

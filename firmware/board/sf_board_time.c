@@ -159,6 +159,16 @@ int sf_board_clock_carried(const sf_board_clock_t *const c, const uint32_t time_
     return SF_OK;
 }
 
+int sf_board_clock_event(const sf_board_clock_t *const c, const uint8_t t_lo_ms, const int64_t host_t_us,
+                         int64_t *const t_ms)
+{
+    if (!c->synced) {
+        return SF_ENOTSYNC;
+    }
+    *t_ms = snap(c->latest_ms + elapsed_ms(c->latest_host_us, host_t_us), t_lo_ms, 8);
+    return SF_OK;
+}
+
 int64_t sf_board_clock_output_us(const sf_board_clock_t *const clock, const int64_t board_ms)
 {
     return (board_ms + clock->offset_ms) * 1000;

@@ -98,6 +98,13 @@ int sf_board_clock_unwrap(const sf_board_clock_t *clock, uint32_t time_ms, int64
  * BOARD_TIME. */
 int sf_board_clock_carried(const sf_board_clock_t *clock, uint32_t time_ms, int64_t host_t_us, int64_t *t_ms);
 
+/* The board time of a frame that carries t_lo_ms but no seq (BLE_ADV, LANDMARK: events, not a
+ * periodic stream), received at host_t_us: the time with those low 8 bits nearest to the newest board
+ * time known plus the host time since (within ±128 ms of it; the bus delivers a frame within
+ * milliseconds of the samples around it). Such a frame never moves the clock: without a seq nothing
+ * could tell a corrupt t_lo from a true one. SF_ENOTSYNC before the first BOARD_TIME. */
+int sf_board_clock_event(const sf_board_clock_t *clock, uint8_t t_lo_ms, int64_t host_t_us, int64_t *t_ms);
+
 /* Output time [µs] of a board time of the clock's current epoch. */
 int64_t sf_board_clock_output_us(const sf_board_clock_t *clock, int64_t board_ms);
 

@@ -16,10 +16,11 @@ struct sf_input {
     sf_board_rx_t rx;       /* the decoder (CAN) and the counters (both) */
     sf_can_frame_t frame;   /* the latest frame, for messages */
     uint64_t bad_syntax;
+    bool flushed;           /* the end of a CAN input handed back the decoder's open BLE window */
     char name[256];
 };
 
-_Static_assert(sizeof(struct sf_input) <= 6 * 1024, "sf_input.h promises at most 6 KiB per input");
+_Static_assert(sizeof(struct sf_input) <= 7 * 1024, "sf_input.h promises at most 7 KiB per input");
 
 int sf_input_open(sf_input_t **const result, const char *const spec, char *const err, const size_t err_size)
 {
@@ -45,6 +46,11 @@ int sf_input_open(sf_input_t **const result, const char *const spec, char *const
     }
     *result = in;
     return SF_OK;
+}
+
+void sf_input_configure(sf_input_t *const in, const sf_params_t *const p)
+{
+    sf_board_rx_configure(&in->rx, p);
 }
 
 /* A replayed event: counted as the CAN decoder counts a frame, so HEALTH reads the same. */
@@ -76,6 +82,12 @@ int sf_input_next(sf_input_t *const in, sf_input_item_t *const item)
         in->bad_syntax++;
         return rc;
     }
+    if (rc == 0 && !in->flushed) {
+        in->flushed = true; /* the end: what the decoder still holds, as one more item */
+        item->log_t_us = in->frame.host_t_us;
+        item->status = SF_OK;
+        return sf_board_rx_flush(&in->rx, &item->event) == 1 ? 1 : 0;
+    }
     if (rc <= 0) {
         return rc;
     }
@@ -105,6 +117,10 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
         return buf;
     case SF_ERANGE:
         snprintf(buf, size, "CAN id 0x%03" PRIX32 ": signal out of range or out of sequence; skipped", f->id);
+        return buf;
+    case SF_EFULL:
+        snprintf(buf, size, "CAN id 0x%03" PRIX32 ": BLE window already holds %d beacons; skipped", f->id,
+                 SF_BLE_MAX_BEACONS);
         return buf;
     case SF_ELATE:
     case SF_ESEQ:
@@ -156,7 +172,7 @@ bool sf_input_nothing_valid(const sf_input_t *const in, char *const buf, const s
     }
     if (in->lcm != NULL) {
         if (c->frames == 0) {
-            snprintf(buf, size, "%s: nothing valid in the input: no sensor event (IMU MAG BARO WIFI GNSS)", in->name);
+            snprintf(buf, size, "%s: nothing valid in the input: no sensor event (IMU MAG BARO WIFI GNSS BLE LANDMARK)", in->name);
         } else {
             snprintf(buf, size, "%s: nothing valid in the input: %" PRIu64 " sensor events, none decodes",
                      in->name, c->frames);

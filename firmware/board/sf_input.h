@@ -10,8 +10,8 @@
  * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable, or a
  * directory or device: sf_file_kind.h; a FIFO is read like stdin),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
- * sf_input_next: see below. Memory: one heap block per open input (≈ 5.5 KiB on x86-64, asserted
- * ≤ 6 KiB: the decoder with its scan in progress, the candump line buffer), allocated by
+ * sf_input_next: see below. Memory: one heap block per open input (6656 B on x86-64, asserted
+ * ≤ 7 KiB: the decoder with its Wi-Fi scan and BLE window in progress, the candump line buffer), allocated by
  * sf_input_open, freed by sf_input_close; sf_input_item_t is ≈ 4 KiB (the caller's). */
 #ifndef SF_INPUT_H
 #define SF_INPUT_H
@@ -28,7 +28,7 @@
 typedef struct sf_input sf_input_t;
 
 /* The one set of input counters. `rx` are the decoder's (the LCM replay keeps the same ones: frames =
- * events of sensor channels, decode_errors = payloads that did not decode, imu .. gnss = samples). */
+ * events of sensor channels, decode_errors = payloads that did not decode, imu .. landmark = samples). */
 typedef struct {
     uint64_t frames_total; /* frames, lines or sensor events read, good or bad: rx.frames + bad_syntax */
     uint64_t bad_syntax;   /* candump lines that do not parse, SocketCAN reads that are not a frame */
@@ -48,7 +48,12 @@ typedef struct {
 
 int sf_input_open(sf_input_t **in, const char *spec, char *err_text, size_t err_size);
 
-/* Next item: 1 *item filled; 0 end of input; SF_EIO a read error (errno tells); SF_ESYNTAX a line or
+/* The decoder's parameters (ble.window_ms, landmark.accuracy_m; sf_board_rx_configure), before the
+ * first sf_input_next; without this call, the params table's defaults. */
+void sf_input_configure(sf_input_t *in, const sf_params_t *p);
+
+/* Next item: 1 *item filled; 0 end of input (a CAN input first hands back, as one last item, the BLE
+ * window still open, sf_board_rx_flush); SF_EIO a read error (errno tells); SF_ESYNTAX a line or
  * event that does not parse (counted and skipped, no item: call again); SF_EINTR a blocking read
  * (stdin, SocketCAN) interrupted by a signal (no item: call again, or stop); SF_ECORRUPT an LCM log
  * whose framing cannot be trusted from here on (counted; the rest is refused: the caller should fail). */

@@ -66,7 +66,7 @@ void sf_publish_fix(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_fi
 
 void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
                        const sf_input_counters_t *const in, const sf_estimator_status_t *const est,
-                       const sf_publish_loop_t *const loop)
+                       const sf_publish_sources_t *const src, const sf_publish_loop_t *const loop)
 {
     const sf_rx_counters_t *const c = &in->rx;
     sf_lcm_out_counters_t oc;
@@ -103,6 +103,18 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .baro_samples = (int64_t)c->baro,
         .wifi_scans = (int64_t)c->wifi,
         .gnss_fixes = (int64_t)c->gnss,
+        .ble_scans = (int64_t)c->ble,
+        .landmark_events = (int64_t)c->landmark,
+        .ble_adverts = (int64_t)c->ble_adverts,
+        .ble_dropped = (int64_t)c->ble_dropped,
+        .fixes_offered_wifi = (int64_t)src->offered[sf_fix_wifi],
+        .fixes_offered_gnss = (int64_t)src->offered[sf_fix_gnss],
+        .fixes_offered_ble = (int64_t)src->offered[sf_fix_ble],
+        .fixes_offered_landmark = (int64_t)src->offered[sf_fix_landmark],
+        .fixes_made_wifi = (int64_t)src->made[sf_fix_wifi],
+        .fixes_made_gnss = (int64_t)src->made[sf_fix_gnss],
+        .fixes_made_ble = (int64_t)src->made[sf_fix_ble],
+        .fixes_made_landmark = (int64_t)src->made[sf_fix_landmark],
         .steps = est->step_count,
         .mag_rejected = (int64_t)est->mag_rejected,
         .log_events = (int64_t)oc.events,

@@ -1,6 +1,6 @@
 /* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (one per scheme), FIX (the audit
- * record), HEALTH (input, estimator and log counters) and CONFIG (the effective parameters). The raw
- * inputs (IMU, MAG, BARO, WIFI, GNSS) are written by sf_rx_lcm.h, from the same kind table the
+ * record), HEALTH (input, estimator, fix-source and log counters) and CONFIG (the effective
+ * parameters). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h, from the same kind table the
  * replay reads.
  *
  * Each call converts a core struct into its generated stridefix type and queues it on the log with the
@@ -18,6 +18,17 @@
 #include "sf_lcm_out.h"
 #include "sf_params.h"
 
+/* Absolute fixes by source, indexed by the fix method (sf_fix_*, = fix_t.METHOD_*): events offered
+ * to the estimator and the fixes it made of them (HEALTH.fixes_offered_* / fixes_made_*). */
+#define SF_PUBLISH_METHOD_SLOTS 5
+_Static_assert((int)sf_fix_wifi < SF_PUBLISH_METHOD_SLOTS && (int)sf_fix_gnss < SF_PUBLISH_METHOD_SLOTS &&
+                   (int)sf_fix_ble < SF_PUBLISH_METHOD_SLOTS && (int)sf_fix_landmark < SF_PUBLISH_METHOD_SLOTS,
+               "one slot per fix method");
+typedef struct {
+    uint64_t offered[SF_PUBLISH_METHOD_SLOTS];
+    uint64_t made[SF_PUBLISH_METHOD_SLOTS];
+} sf_publish_sources_t;
+
 /* The main loop's timing, for HEALTH.loop_mean_us / loop_max_us. */
 typedef struct {
     double sum_us;
@@ -34,7 +45,8 @@ void sf_publish_fix(sf_lcm_out_t *out, int64_t log_t_us, const sf_fix_audit_t *a
 
 /* HEALTH at board time board_t_us; the log counters are read from out. */
 void sf_publish_health(sf_lcm_out_t *out, int64_t log_t_us, int64_t board_t_us, const sf_input_counters_t *in,
-                       const sf_estimator_status_t *est, const sf_publish_loop_t *loop);
+                       const sf_estimator_status_t *est, const sf_publish_sources_t *sources,
+                       const sf_publish_loop_t *loop);
 
 /* CONFIG: every key of sf_param_table as "section.name" with its value (%.9g). */
 void sf_publish_config(sf_lcm_out_t *out, int64_t log_t_us, int64_t board_t_us, const sf_params_t *params,

@@ -19,6 +19,10 @@
 #include "sf_channels.h"
 
 #define SF_WIFI_MAX_AP 255 /* WIFI_SCAN_END.n_ap is 8 bits */
+/* Distinct beacons of one BLE scan window: msindoor site1/F2's phones heard at most 20 distinct
+ * beacons in one second (264 on the floor), the gsd trials 6 in all; a window's beacons beyond this
+ * are counted (ble_dropped) and dropped. */
+#define SF_BLE_MAX_BEACONS 32
 
 /*              kind  LCM channel (lcmtypes/channels.csv, generated sf_channels.h) */
 #define SF_RX_KINDS(X)        \
@@ -26,7 +30,9 @@
     X(mag,  SF_CHANNEL_MAG)   \
     X(baro, SF_CHANNEL_BARO)  \
     X(wifi, SF_CHANNEL_WIFI)  \
-    X(gnss, SF_CHANNEL_GNSS)
+    X(gnss, SF_CHANNEL_GNSS)  \
+    X(ble,  SF_CHANNEL_BLE)   \
+    X(landmark, SF_CHANNEL_LANDMARK)
 
 typedef enum {
     sf_rx_none = 0,
@@ -77,6 +83,25 @@ typedef struct {
     double alt_m;
     float accuracy_m;
 } sf_rx_gnss_t;
+
+/* One BLE scan window (ble_scan_t): each beacon once, its RSSI the mean in dBm of the window's
+ * advertisements from it. */
+typedef struct {
+    int64_t t_us; /* the window's first advertisement */
+    int32_t n;
+    int64_t beacon_id[SF_BLE_MAX_BEACONS]; /* 48-bit MAC */
+    float rssi_dbm[SF_BLE_MAX_BEACONS];
+} sf_rx_ble_t;
+
+/* One landmark event (landmark_t). */
+typedef struct {
+    int64_t t_us;
+    int32_t landmark_id; /* 0: unknown (the LANDMARK frame carries none) */
+    double x_m;
+    double y_m;
+    int16_t floor;
+    float accuracy_m; /* 1 sigma */
+} sf_rx_landmark_t;
 
 typedef struct {
     sf_rx_kind_t kind;

@@ -6,8 +6,10 @@
 #include "sf_error.h"
 #include "sf_lcm_walk.h"
 #include "stridefix_baro_t.h"
+#include "stridefix_ble_scan_t.h"
 #include "stridefix_gnss_t.h"
 #include "stridefix_imu_t.h"
+#include "stridefix_landmark_t.h"
 #include "stridefix_mag_t.h"
 #include "stridefix_wifi_scan_t.h"
 
@@ -97,7 +99,8 @@ static void encode_baro(sf_lcm_out_t *const out, const char *const channel, cons
     SF_LCM_WRITE(out, channel, ts_us, stridefix_baro_t, &msg);
 }
 
-/* wifi_scan_t.lcm field by field (sf_lcm_walk.h says why): the only raw-sensor type with a count. */
+/* wifi_scan_t.lcm field by field (sf_lcm_walk.h says why); ble_scan_t is the other raw-sensor type
+ * with a count. */
 static int walk_wifi(const void *const data, const int size, const where_t *const e)
 {
     sf_lcm_walk_t w = {data, (size_t)size, 0, e->name, e->err, e->err_size};
@@ -160,6 +163,67 @@ static void encode_gnss(sf_lcm_out_t *const out, const char *const channel, cons
     stridefix_gnss_t msg = {.t_us = s->t_us, .lat_deg = s->lat_deg, .lon_deg = s->lon_deg, .alt_m = s->alt_m,
                             .accuracy_m = s->accuracy_m};
     SF_LCM_WRITE(out, channel, ts_us, stridefix_gnss_t, &msg);
+}
+
+/* ble_scan_t.lcm field by field. */
+static int walk_ble(const void *const data, const int size, const where_t *const e)
+{
+    sf_lcm_walk_t w = {data, (size_t)size, 0, e->name, e->err, e->err_size};
+    int rc = sf_lcm_walk_skip(&w, 8, "type hash");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_skip(&w, 8, "t_us");
+    rc = rc != SF_OK ? rc : sf_lcm_walk_count(&w, "n", 8 + 4);
+    return rc != SF_OK ? rc : sf_lcm_walk_end(&w, "stridefix.ble_scan_t");
+}
+
+static int decode_ble(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
+{
+    stridefix_ble_scan_t m;
+    if (walk_ble(data, size, e) != SF_OK ||
+        decoded(stridefix_ble_scan_t_decode(data, 0, size, &m), size, "stridefix.ble_scan_t", e) != SF_OK) {
+        return SF_ESYNTAX; /* after the walk, the decode fails only on the type hash: nothing allocated */
+    }
+    sf_rx_ble_t *const b = &ev->u.ble;
+    b->t_us = m.t_us;
+    b->n = m.n < SF_BLE_MAX_BEACONS ? m.n : SF_BLE_MAX_BEACONS;
+    for (int32_t i = 0; i < b->n; i++) {
+        b->beacon_id[i] = m.beacon_id[i];
+        b->rssi_dbm[i] = m.rssi_dbm[i];
+    }
+    stridefix_ble_scan_t_decode_cleanup(&m);
+    return 1;
+}
+
+static void encode_ble(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                       const sf_rx_event_t *const ev)
+{
+    const sf_rx_ble_t *const s = &ev->u.ble;
+    /* DEVIATION: the generated type has non-const array pointers; encoding only reads them. */
+    stridefix_ble_scan_t msg = {
+        .t_us = s->t_us, .n = s->n, .beacon_id = (int64_t *)s->beacon_id, .rssi_dbm = (float *)s->rssi_dbm};
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_ble_scan_t, &msg);
+}
+
+static int decode_landmark(const void *const data, const int size, sf_rx_event_t *const ev, const where_t *const e)
+{
+    stridefix_landmark_t m;
+    if (decoded(stridefix_landmark_t_decode(data, 0, size, &m), size, "stridefix.landmark_t", e) != SF_OK) {
+        return SF_ESYNTAX;
+    }
+    ev->u.landmark = (sf_rx_landmark_t){m.t_us, m.landmark_id, m.x_m, m.y_m, m.floor, m.accuracy_m};
+    return 1;
+}
+
+static void encode_landmark(sf_lcm_out_t *const out, const char *const channel, const int64_t ts_us,
+                            const sf_rx_event_t *const ev)
+{
+    const sf_rx_landmark_t *const s = &ev->u.landmark;
+    stridefix_landmark_t msg = {.t_us = s->t_us,
+                                .landmark_id = s->landmark_id,
+                                .x_m = s->x_m,
+                                .y_m = s->y_m,
+                                .floor = s->floor,
+                                .accuracy_m = s->accuracy_m};
+    SF_LCM_WRITE(out, channel, ts_us, stridefix_landmark_t, &msg);
 }
 
 /* ---- the table, generated from SF_RX_KINDS ------------------------------------------------------- */

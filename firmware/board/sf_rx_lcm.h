@@ -1,5 +1,5 @@
 /* sf_rx_lcm.h — the raw sensor samples as LCM messages, both ways: sf_rx_event_t → IMU, MAG, BARO,
- * WIFI, GNSS messages (what stridefixd logs for every input) and back (what a raw-sensor log replay
+ * WIFI, GNSS, BLE, LANDMARK messages (what stridefixd logs for every input) and back (what a raw-sensor log replay
  * reads, sf_lcm_input.h).
  *
  * One row per SF_RX_KINDS entry (sf_rx_event.h) with its channel, decode and encode, generated from
@@ -23,7 +23,8 @@ const char *sf_rx_lcm_channel(sf_rx_kind_t kind);
  * payload before the generated decode runs (sf_lcm_walk.h), and trailing bytes are refused; err (if
  * err_size > 0) then holds "<name>: <what>", e.g. "payload: n_ap = 536870912 needs 8589934592 bytes
  * of arrays, 13 left" (name NULL: the channel). A scan longer than SF_WIFI_MAX_AP keeps its first
- * SF_WIFI_MAX_AP access points (the rest cannot be used anyway). */
+ * SF_WIFI_MAX_AP access points (the rest cannot be used anyway), a BLE scan longer than
+ * SF_BLE_MAX_BEACONS its first SF_BLE_MAX_BEACONS beacons. */
 int sf_rx_lcm_decode(const char *channel, const void *data, size_t size, sf_rx_event_t *event, const char *name,
                      char *err, size_t err_size);
 

@@ -144,6 +144,12 @@
     X(floor,  vote_margin,         double,  3.0,     0.5,     1000.0,  "fixes", "start-floor vote (sf_floor_vote.h): lead in full-weight agreeing fixes that decides or moves the start floor; 3: a floor classifier right 80 % of the time among 3 floors is then 512 times likelier right than wrong ((0.8/0.1)^3), and one scan never flips") \
     X(floor,  between_reject,      int32_t, 1,       0,       1,       "",      "1 = fixes taken between floors (stairs, a moving lift, a landing half-way up; multi-floor sites) are rejected FLOOR_MISMATCH: a radio map is of floors (SIL tour: such fixes 6.9 m mean error against 1.2 m on the floors; gsd Trial51, open stairs: 4.8 against 4.3 m)")
 
+/* firmware/board (sf_board_rx.h): how the CAN decoder turns the BLE_ADV and LANDMARK frames into events
+ * (listed just before SF_PARAMS_SOURCES, so that the [ble] keys stay together). */
+#define SF_PARAMS_BOARD_INPUT(X)                                                                       \
+    X(landmark, accuracy_m,        double,  0.3,     0.01,    100.0,   "m",     "1-sigma position of a LANDMARK frame (the frame has none): an NFC reader's range, a few decimetres") \
+    X(ble,    window_ms,           int32_t, 1000,    100,     60000,   "ms",    "BLE advertisements of this much board time (from the window's first) form one scan; a beacon heard several times in it is averaged in dBm")
+
 #define SF_PARAMS_OUTPUT(X)                                                                            \
     X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_COUNT - 1, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side, else pose_t.SCHEME_*") \
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
@@ -239,7 +245,7 @@
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

@@ -119,4 +119,23 @@ static inline sf_can_frame_t tf_gnss_position(const double lat_deg, const double
     return f;
 }
 
+static inline sf_can_frame_t tf_ble_adv(const uint64_t beacon_id, const int8_t rssi_dbm, const uint8_t t_lo_ms)
+{
+    sf_can_frame_t f = tf_frame(BOARD_BLE_ADV_FRAME_ID);
+    const struct board_ble_adv_t m = {.beacon_id = beacon_id, .rssi = rssi_dbm, .t_lo_ms = t_lo_ms};
+    (void)board_ble_adv_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
+static inline sf_can_frame_t tf_landmark(const double x_m, const double y_m, const int8_t floor, const uint8_t t_lo_ms)
+{
+    sf_can_frame_t f = tf_frame(BOARD_LANDMARK_FRAME_ID);
+    const struct board_landmark_t m = {.x = (int32_t)TF_RAW(landmark, x, x_m),
+                                       .y = (int32_t)TF_RAW(landmark, y, y_m),
+                                       .floor = floor,
+                                       .t_lo_ms = t_lo_ms};
+    (void)board_landmark_pack(f.data, &m, sizeof f.data);
+    return f;
+}
+
 #endif

@@ -27,7 +27,7 @@
 
 #define MAX_VECTORS 1024
 #define MAX_SIGNALS 16
-#define N_MESSAGES 11
+#define N_MESSAGES 13
 #define DEG_TO_RAD (3.14159265358979323846 / 180.0)
 
 typedef struct {
@@ -146,6 +146,8 @@ CODEC_BEGIN(wifi_scan_end) SIG(wifi_scan_end, scan_id) SIG(wifi_scan_end, n_ap) 
 CODEC_BEGIN(gnss_position) SIG(gnss_position, latitude) SIG(gnss_position, longitude) CODEC_END(gnss_position)
 CODEC_BEGIN(gnss_info) SIG(gnss_info, time_ms) SIG(gnss_info, altitude) SIG(gnss_info, accuracy)
     CODEC_END(gnss_info)
+CODEC_BEGIN(ble_adv) SIG(ble_adv, beacon_id) SIG(ble_adv, rssi) SIG(ble_adv, t_lo_ms) CODEC_END(ble_adv)
+CODEC_BEGIN(landmark) SIG(landmark, x) SIG(landmark, y) SIG(landmark, floor) SIG(landmark, t_lo_ms) CODEC_END(landmark)
 CODEC_BEGIN(board_status) SIG(board_status, tx_overflows) SIG(board_status, board_temp) SIG(board_status, fw_major)
     SIG(board_status, fw_minor) SIG(board_status, imu_ok) SIG(board_status, mag_ok) SIG(board_status, baro_ok)
         SIG(board_status, wifi_ok) CODEC_END(board_status)
@@ -165,6 +167,8 @@ static const struct {
     {BOARD_WIFI_SCAN_END_FRAME_ID, "WIFI_SCAN_END", codec_wifi_scan_end},
     {BOARD_GNSS_POSITION_FRAME_ID, "GNSS_POSITION", codec_gnss_position},
     {BOARD_GNSS_INFO_FRAME_ID, "GNSS_INFO", codec_gnss_info},
+    {BOARD_BLE_ADV_FRAME_ID, "BLE_ADV", codec_ble_adv},
+    {BOARD_LANDMARK_FRAME_ID, "LANDMARK", codec_landmark},
     {BOARD_BOARD_STATUS_FRAME_ID, "BOARD_STATUS", codec_board_status},
 };
 
@@ -220,7 +224,7 @@ static void test_vectors_cover_every_message(void **state)
             fail_msg("%s: %d vectors, want at least 11", k_codecs[k].name, count[k]);
         }
     }
-    assert_int_equal(g_nvec, 121);
+    assert_int_equal(g_nvec, 13 * 11 + 2); /* + the typical BLE_ADV and LANDMARK */
 }
 
 /* C unpack + decode equals Python's values; C pack of the unpacked struct equals Python's bytes. */
@@ -420,6 +424,36 @@ static void rx_one(const vector_t *const v)
         /* accuracy is a float in the event: allow its rounding on top of half a step */
         assert_close(ev->u.gnss.accuracy_m, py(v, "accuracy"), step_of(v, "accuracy") / 2 + 1e-4, v,
                      "event accuracy [m]");
+        break;
+    }
+    case BOARD_BLE_ADV_FRAME_ID: {
+        tmp = tf_board_time(t0, 1);
+        assert_int_equal(sf_board_rx_frame(rx, &tmp, ev), 0);
+        const bool valid = py(v, "beacon_id") != 0.0 && py(v, "rssi") < 0;
+        const int rc = sf_board_rx_frame(rx, &f, ev);
+        if (!valid) { /* MAC 0, or rssi >= 0 dBm: a decode error */
+            assert_int_equal(rc, SF_ERANGE);
+            assert_int_equal(rx->counters.decode_errors, 1);
+            break;
+        }
+        assert_int_equal(rc, 0); /* in the open window */
+        assert_int_equal(sf_board_rx_flush(rx, ev), 1);
+        assert_int_equal(ev->kind, sf_rx_ble);
+        assert_int_equal(ev->u.ble.n, 1);
+        assert_int_equal(ev->u.ble.beacon_id[0], (int64_t)py(v, "beacon_id"));
+        assert_close(ev->u.ble.rssi_dbm[0], py(v, "rssi"), 0.5, v, "event rssi [dBm]");
+        assert_sample_time(ev->u.ble.t_us, t0, py(v, "t_lo_ms"), v);
+        break;
+    }
+    case BOARD_LANDMARK_FRAME_ID: {
+        tmp = tf_board_time(t0, 1);
+        assert_int_equal(sf_board_rx_frame(rx, &tmp, ev), 0);
+        assert_int_equal(sf_board_rx_frame(rx, &f, ev), 1);
+        assert_int_equal(ev->kind, sf_rx_landmark);
+        assert_close(ev->u.landmark.x_m, py(v, "x"), step_of(v, "x") / 2, v, "event x [m]");
+        assert_close(ev->u.landmark.y_m, py(v, "y"), step_of(v, "y") / 2, v, "event y [m]");
+        assert_int_equal(ev->u.landmark.floor, (int)py(v, "floor"));
+        assert_sample_time(ev->u.landmark.t_us, t0, py(v, "t_lo_ms"), v);
         break;
     }
     case BOARD_BOARD_STATUS_FRAME_ID:

@@ -52,8 +52,9 @@ static sf_can_frame_t baro_frame(const uint8_t seq, const uint8_t t_lo_ms, const
     return f;
 }
 
-/* A walk in miniature: board time, 4 IMU samples, 2 MAG, 2 BARO, one scan of 3 APs, one GNSS fix,
- * plus a garbage line and an unknown id. Returns the number of lines written. */
+/* A walk in miniature: board time, 4 IMU samples, 2 MAG, 2 BARO, one scan of 3 APs, one GNSS fix, one
+ * landmark, three BLE advertisements of two beacons (one window, still open at the end: the input's
+ * end hands it back), plus a garbage line and an unknown id. Returns the number of lines written. */
 static int write_candump(const char *const path)
 {
     sf_can_frame_t frames[32];
@@ -76,6 +77,10 @@ static int write_candump(const char *const path)
     frames[n++] = baro_frame(1, (uint8_t)(5100 & 0xFF), 101320.0);
     frames[n++] = tf_gnss_info(5100, 120.0, 8.0);
     frames[n++] = tf_gnss_position(48.1, 11.5);
+    frames[n++] = tf_ble_adv(0xE078A33DB49CULL, -82, (uint8_t)(5105 & 0xFF));
+    frames[n++] = tf_landmark(12.34, -5.67, 1, (uint8_t)(5106 & 0xFF));
+    frames[n++] = tf_ble_adv(0xE078A33DB573ULL, -87, (uint8_t)(5107 & 0xFF));
+    frames[n++] = tf_ble_adv(0xE078A33DB49CULL, -78, (uint8_t)(5108 & 0xFF));
     FILE *const f = fopen(path, "w");
     assert_non_null(f);
     for (int i = 0; i < n; i++) {
@@ -155,6 +160,21 @@ static void assert_same_event(const sf_rx_event_t *const a, const sf_rx_event_t 
         assert_true(a->u.gnss.lat_deg == b->u.gnss.lat_deg && a->u.gnss.lon_deg == b->u.gnss.lon_deg);
         assert_true(a->u.gnss.alt_m == b->u.gnss.alt_m && a->u.gnss.accuracy_m == b->u.gnss.accuracy_m);
         break;
+    case sf_rx_ble:
+        assert_int_equal(a->u.ble.t_us, b->u.ble.t_us);
+        assert_int_equal(a->u.ble.n, b->u.ble.n);
+        for (int32_t i = 0; i < a->u.ble.n; i++) {
+            assert_int_equal(a->u.ble.beacon_id[i], b->u.ble.beacon_id[i]);
+            assert_true(a->u.ble.rssi_dbm[i] == b->u.ble.rssi_dbm[i]);
+        }
+        break;
+    case sf_rx_landmark:
+        assert_int_equal(a->u.landmark.t_us, b->u.landmark.t_us);
+        assert_int_equal(a->u.landmark.landmark_id, b->u.landmark.landmark_id);
+        assert_true(a->u.landmark.x_m == b->u.landmark.x_m && a->u.landmark.y_m == b->u.landmark.y_m);
+        assert_int_equal(a->u.landmark.floor, b->u.landmark.floor);
+        assert_true(a->u.landmark.accuracy_m == b->u.landmark.accuracy_m);
+        break;
     case sf_rx_none: fail_msg("an event without a kind"); break;
     }
 }
@@ -172,13 +192,29 @@ static void test_candump_and_lcm_replay_give_the_same_events(void **state)
     static events_t can, replay;
     sf_input_counters_t cc, rc;
     read_all(candump, &can, &cc);
-    assert_int_equal(can.n, 4 + 2 + 2 + 1 + 1);
+    assert_int_equal(can.n, 4 + 2 + 2 + 1 + 1 + 1 + 1);
     assert_int_equal(cc.bad_syntax, 1);
     assert_int_equal(cc.rx.unknown_id, 1);
     assert_int_equal(cc.frames_total, cc.rx.frames + 1);
     assert_int_equal(cc.rx.imu, 4);
     assert_int_equal(cc.rx.wifi, 1);
     assert_int_equal(cc.rx.gnss, 1);
+    assert_int_equal(cc.rx.landmark, 1);
+    assert_int_equal(cc.rx.ble, 1);
+    assert_int_equal(cc.rx.ble_adverts, 3);
+    const sf_rx_event_t *const ble = &can.ev[can.n - 1]; /* the window, handed back at the end */
+    assert_int_equal(ble->kind, sf_rx_ble);
+    assert_int_equal(ble->u.ble.t_us, 5105 * 1000LL);
+    assert_int_equal(ble->u.ble.n, 2);
+    assert_int_equal(ble->u.ble.beacon_id[0], 0xE078A33DB49CLL);
+    assert_float_equal(ble->u.ble.rssi_dbm[0], -80.0, 1e-6); /* mean of -82 and -78 dBm */
+    assert_float_equal(ble->u.ble.rssi_dbm[1], -87.0, 1e-6);
+    const sf_rx_event_t *const lm = &can.ev[can.n - 2];
+    assert_int_equal(lm->kind, sf_rx_landmark);
+    assert_float_equal(lm->u.landmark.x_m, 12.34, 1e-9);
+    assert_float_equal(lm->u.landmark.y_m, -5.67, 1e-9);
+    assert_int_equal(lm->u.landmark.floor, 1);
+    assert_float_equal(lm->u.landmark.accuracy_m, 0.3, 1e-6); /* landmark.accuracy_m's default */
 
     sf_lcm_out_t *out = NULL;
     char err[256];
@@ -201,6 +237,7 @@ static void test_candump_and_lcm_replay_give_the_same_events(void **state)
     assert_int_equal(rc.bad_syntax, 0);
     assert_true(rc.rx.imu == cc.rx.imu && rc.rx.mag == cc.rx.mag && rc.rx.baro == cc.rx.baro);
     assert_true(rc.rx.wifi == cc.rx.wifi && rc.rx.gnss == cc.rx.gnss);
+    assert_true(rc.rx.ble == cc.rx.ble && rc.rx.landmark == cc.rx.landmark);
     unlink(candump);
     unlink(lcmlog);
 }

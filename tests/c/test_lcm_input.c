@@ -3,7 +3,8 @@
  * generated decode (SIGSEGV), a negative count asked for a huge allocation and an event header
  * claiming 1.9 GB made liblcm map 1.9 GB and then end the replay silently with status 0. Each case
  * checks the code, the counters, the message (event number, offset, field) and that the good events
- * around the bad one are still used. */
+ * around the bad one are still used. BLE (ble_scan_t, the other type with a count) gets the same
+ * checks, and a scan of more beacons than SF_BLE_MAX_BEACONS keeps its first ones. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,7 @@
 #include "sf_error.h"
 #include "sf_eventlog.h"
 #include "sf_lcm_input.h"
+#include "stridefix_ble_scan_t.h"
 #include "stridefix_imu_t.h"
 #include "stridefix_wifi_scan_t.h"
 
@@ -81,6 +83,27 @@ static void put_wifi_claiming(log_t *const log, const int32_t n_ap_claimed)
         buf[at + (size_t)i] = (uint8_t)((uint32_t)n_ap_claimed >> (24 - 8 * i));
     }
     put_event(log, "WIFI", buf, (size_t)n);
+}
+
+/* A BLE scan of n beacons (ids 1 .. n, rssi -40 - i) whose n field is then overwritten with n_claimed. */
+static void put_ble_claiming(log_t *const log, const int32_t n, const int32_t n_claimed)
+{
+    int64_t id[64];
+    float rssi[64];
+    assert_true(n <= 64);
+    for (int32_t i = 0; i < n; i++) {
+        id[i] = i + 1;
+        rssi[i] = -40.0f - (float)i;
+    }
+    const stridefix_ble_scan_t m = {.t_us = 5, .n = n, .beacon_id = id, .rssi_dbm = rssi};
+    uint8_t buf[2048];
+    const int size = stridefix_ble_scan_t_encode(buf, 0, sizeof buf, &m);
+    assert_true(size > 0);
+    const size_t at = 8 + 8; /* hash, t_us */
+    for (int i = 0; i < 4; i++) {
+        buf[at + (size_t)i] = (uint8_t)((uint32_t)n_claimed >> (24 - 8 * i));
+    }
+    put_event(log, "BLE", buf, (size_t)size);
 }
 
 typedef struct {
@@ -179,6 +202,41 @@ static void test_wifi_with_trailing_bytes_is_skipped(void **state)
     expect_error(&r, "16 trailing bytes");
 }
 
+static void test_ble_with_hostile_counts_is_skipped(void **state)
+{
+    log_t *const log = *state;
+    put_ble_claiming(log, 1, 1 << 29);
+    put_ble_claiming(log, 1, -3);
+    put_ble_claiming(log, 2, 1); /* one beacon's 12 bytes left over */
+    put_imu(log, 1);
+    const replay_t r = replay(log);
+    assert_int_equal(r.used, 1);
+    assert_int_equal(r.c.decode_errors, 3);
+    expect_error(&r, "event 0 at offset 0 (BLE): payload: n = 536870912 needs");
+}
+
+/* GIVEN a logged BLE scan of 40 beacons, WHEN replayed, THEN the event keeps the first
+ * SF_BLE_MAX_BEACONS with their levels, in order. */
+static void test_ble_longer_than_the_window_keeps_the_first(void **state)
+{
+    log_t *const log = *state;
+    put_ble_claiming(log, 40, 40);
+    FILE *const f = fmemopen(log->p, log->n, "rb");
+    assert_non_null(f);
+    sf_lcm_input_t *in = NULL;
+    assert_int_equal(sf_lcm_input_open_stream(&in, f, "long.lcmlog", NULL, 0), SF_OK);
+    static sf_rx_event_t ev;
+    int64_t t_us;
+    assert_int_equal(sf_lcm_input_next(in, &ev, &t_us), 1);
+    assert_int_equal(ev.kind, sf_rx_ble);
+    assert_int_equal(ev.u.ble.t_us, 5);
+    assert_int_equal(ev.u.ble.n, SF_BLE_MAX_BEACONS);
+    assert_int_equal(ev.u.ble.beacon_id[SF_BLE_MAX_BEACONS - 1], SF_BLE_MAX_BEACONS);
+    assert_float_equal(ev.u.ble.rssi_dbm[SF_BLE_MAX_BEACONS - 1], -40.0 - (SF_BLE_MAX_BEACONS - 1), 1e-6);
+    assert_int_equal(sf_lcm_input_next(in, &ev, &t_us), 0);
+    sf_lcm_input_close(in);
+}
+
 static void test_header_claiming_1_9_gb_is_a_truncated_last_event(void **state)
 {
     log_t *const log = *state;
@@ -274,6 +332,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_wifi_declaring_2_pow_29_readings_is_skipped, setup, teardown),
         cmocka_unit_test_setup_teardown(test_wifi_with_a_negative_count_is_skipped, setup, teardown),
         cmocka_unit_test_setup_teardown(test_wifi_with_trailing_bytes_is_skipped, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ble_with_hostile_counts_is_skipped, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_ble_longer_than_the_window_keeps_the_first, setup, teardown),
         cmocka_unit_test_setup_teardown(test_header_claiming_1_9_gb_is_a_truncated_last_event, setup, teardown),
         cmocka_unit_test_setup_teardown(test_event_above_the_cap_is_skipped_unread, setup, teardown),
         cmocka_unit_test_setup_teardown(test_bad_magic_refuses_the_rest, setup, teardown),

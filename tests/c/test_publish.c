@@ -47,10 +47,21 @@ static void test_every_output_round_trips(void **state)
     const sf_step_t step = {.t_us = 7000002, .index = 12, .length_m = 0.625, .accel_range_mps2 = 4.0,
                             .period_s = 0.5, .heading_rad = 1.0, .activity = sf_activity_walking, .floor = 3};
     sf_publish_step(out, 13, &step);
-    sf_input_counters_t ic = {.frames_total = 10, .bad_syntax = 2, .rx = {.frames = 8, .frames_ok = 6, .imu = 4}};
+    sf_input_counters_t ic = {.frames_total = 10, .bad_syntax = 2,
+                              .rx = {.frames = 8, .frames_ok = 6, .imu = 4, .ble = 5, .landmark = 2, .ble_adverts = 17,
+                                     .ble_dropped = 1}};
+    sf_publish_sources_t src = {{0}, {0}};
+    src.offered[sf_fix_wifi] = 9;
+    src.made[sf_fix_wifi] = 7;
+    src.offered[sf_fix_gnss] = 6;
+    src.made[sf_fix_gnss] = 4;
+    src.offered[sf_fix_ble] = 5;
+    src.made[sf_fix_ble] = 3;
+    src.offered[sf_fix_landmark] = 2;
+    src.made[sf_fix_landmark] = 1;
     const sf_estimator_status_t st = {.step_count = 12, .mag_rejected = 3};
     const sf_publish_loop_t loop = {.sum_us = 30.0, .max_us = 9.0, .n = 3};
-    sf_publish_health(out, 14, 7000003, &ic, &st, &loop);
+    sf_publish_health(out, 14, 7000003, &ic, &st, &src, &loop);
     sf_params_t p;
     sf_params_default(&p);
     p.stride_weinberg_k = 0.5;
@@ -88,6 +99,11 @@ static void test_every_output_round_trips(void **state)
             assert_int_equal(m.host_t_us, 14);
             assert_true(m.frames_total == 10 && m.bad_syntax == 2 && m.frames_ok == 6 && m.imu_samples == 4);
             assert_true(m.steps == 12 && m.mag_rejected == 3 && m.loop_mean_us == 10.0f && m.loop_max_us == 9.0f);
+            assert_true(m.ble_scans == 5 && m.landmark_events == 2 && m.ble_adverts == 17 && m.ble_dropped == 1);
+            assert_true(m.fixes_offered_wifi == 9 && m.fixes_made_wifi == 7);
+            assert_true(m.fixes_offered_gnss == 6 && m.fixes_made_gnss == 4);
+            assert_true(m.fixes_offered_ble == 5 && m.fixes_made_ble == 3);
+            assert_true(m.fixes_offered_landmark == 2 && m.fixes_made_landmark == 1);
         } else {
             stridefix_config_t m;
             assert_true(stridefix_config_t_decode(e->data, 0, e->datalen, &m) > 0);

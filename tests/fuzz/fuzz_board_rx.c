@@ -3,7 +3,7 @@
  * handler; else the next two bytes form a raw 11-bit id), flags (dlc = low nibble mod 9, bit 4
  * extended, bit 5 remote), host time step [µs, 2 bytes] and 8 data bytes. Reference checks: the
  * counters never decrease and add up (frames = ok + every skip kind), events carry a known kind and a
- * scan never more than SF_WIFI_MAX_AP access points. */
+ * scan never more than SF_WIFI_MAX_AP access points, a BLE window 1 .. SF_BLE_MAX_BEACONS beacons. */
 #include <string.h>
 
 #include "sf_board_rx.h"
@@ -12,9 +12,9 @@
 
 #define RECORD_BYTES 12
 
-static const uint32_t dbc_ids[] = {0x080, 0x100, 0x101, 0x110, 0x120, 0x200, 0x201, 0x202, 0x300, 0x301, 0x7f0};
+static const uint32_t dbc_ids[] = {0x080, 0x100, 0x101, 0x110, 0x120, 0x200, 0x201, 0x202, 0x300, 0x301, 0x7f0, 0x210, 0x400};
 
-static sf_board_rx_t rx; /* 4.5 KiB: static rather than on the stack; re-initialised per input */
+static sf_board_rx_t rx; /* 5.5 KiB: static rather than on the stack; re-initialised per input */
 
 int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
 {
@@ -39,12 +39,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
         SF_FUZZ_CHECK(c->frames == before.frames + 1);
         SF_FUZZ_CHECK(c->frames_ok >= before.frames_ok && c->decode_errors >= before.decode_errors);
         SF_FUZZ_CHECK(rc == 0 || rc == 1 || rc == SF_EUNKNOWN_ID || rc == SF_ELENGTH || rc == SF_ERANGE ||
-                      rc == SF_ENOTSYNC || rc == SF_EDUPLICATE || rc == SF_ELATE || rc == SF_ESEQ);
+                      rc == SF_ENOTSYNC || rc == SF_EDUPLICATE || rc == SF_ELATE || rc == SF_ESEQ || rc == SF_EFULL);
         skipped += rc < 0;
         if (rc == 1) {
             SF_FUZZ_CHECK(ev.kind > sf_rx_none && (int)ev.kind <= SF_RX_KIND_COUNT);
             if (ev.kind == sf_rx_wifi) {
                 SF_FUZZ_CHECK(ev.u.wifi.n_ap >= 0 && ev.u.wifi.n_ap <= SF_WIFI_MAX_AP);
+            }
+            if (ev.kind == sf_rx_ble) {
+                SF_FUZZ_CHECK(ev.u.ble.n >= 1 && ev.u.ble.n <= SF_BLE_MAX_BEACONS);
             }
         }
     }

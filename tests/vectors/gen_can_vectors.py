@@ -3,8 +3,9 @@
 
 Usage: gen_can_vectors.py BOARD_DBC OUTPUT_TXT
 
-For every message: all signals zero, all at minimum, all at maximum, and RANDOM_SETS seeded random
-sets. Every value lies on the signal's scaling grid (raw integer * scale + offset) and inside its
+For every message: all signals zero, all at minimum, all at maximum, RANDOM_SETS seeded random
+sets, and the TYPICAL sets below (values a real board sends, so that the decoder's accepting path is
+certain to be covered where zeros and extremes are refused: BLE_ADV with MAC 0 or rssi >= 0). Every value lies on the signal's scaling grid (raw integer * scale + offset) and inside its
 DBC range. One line per vector:
 
     ID_HEX DATA_HEX signal=value signal=value ...
@@ -21,6 +22,11 @@ import cantools
 
 RANDOM_SETS = 8
 SEED = 20240611
+# message name -> extra signal sets (physical values on the signal's grid)
+TYPICAL = {
+    "BLE_ADV": [{"beacon_id": 0xE078A33DB49C, "rssi": -82, "t_lo_ms": 17}],  # msindoor site1's beacon
+    "LANDMARK": [{"x": -12.34, "y": 56.78, "floor": 1, "t_lo_ms": 200}],
+}
 
 
 def raw_limits(sig):
@@ -53,6 +59,7 @@ def signal_sets(msg, rng):
     ]
     for _ in range(RANDOM_SETS):
         sets.append({s.name: phys(s, rng.randint(*limits[s.name])) for s in msg.signals})
+    sets.extend(TYPICAL.get(msg.name, []))
     return sets
 
 
@@ -63,6 +70,9 @@ def main(argv):
     db = cantools.database.load_file(argv[1])
     rng = random.Random(SEED)
     lines = []
+    unknown = set(TYPICAL) - {m.name for m in db.messages}
+    if unknown:
+        raise SystemExit(f"{argv[1]}: TYPICAL names messages not in the DBC: {sorted(unknown)}")
     for msg in sorted(db.messages, key=lambda m: m.frame_id):
         for signals in signal_sets(msg, rng):
             data = db.encode_message(msg.name, signals)  # strict: raises if a value is out of range

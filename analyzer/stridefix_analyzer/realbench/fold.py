@@ -153,15 +153,16 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
         logs = [str(fw_log), job.import_log]
         try:
             try:
-                _, metrics = run_analyze(logs, str(adir), label=label, truth_source="waypoint")
+                analysis, metrics = run_analyze(logs, str(adir), label=label, truth_source="waypoint")
             except MetricsInputError as exc:
                 if "source" not in str(exc):
                     raise
-                _, metrics = run_analyze(logs, str(adir), label=label)
+                analysis, metrics = run_analyze(logs, str(adir), label=label)
         except (LogReadError, MetricsInputError) as exc:
             out["error"] = f"cannot score: {exc}"
             return out
         out[tag] = score_walk(metrics)
+        out.setdefault("fix_sources", {})[tag] = analysis["fix_sources"]
     out["run_s"] = time.perf_counter() - t0
     return out
 

@@ -33,6 +33,7 @@ from stridefix_analyzer.realbench.summary import (  # noqa: E402
     pdr_true_start_text,
 )
 from stridefix_analyzer.schemes import PDR_ONLY, UnknownSchemeError, scheme_code, scheme_colour  # noqa: E402
+from stridefix_analyzer.scoring.fixsources import fix_sources_html  # noqa: E402
 from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
 
 WORST_WALKS = 3
@@ -251,6 +252,9 @@ def render(doc: dict) -> str:
         if "summary_true_start" in g:
             parts.append("<h3>Truth-initialised start (labelled run)</h3>")
             parts.append(_scheme_table(g["summary_true_start"]))
+        if "fix_sources" in g:
+            parts.append("<h3>Fix sources (FIX records per scheme and source, pooled over the walks)</h3>")
+            parts.append(fix_sources_html(g["fix_sources"]))
         pooled = _pooled(g)
         if pooled:
             parts.append(_img(to_png(plot_cdf(pooled, f"{g['label']}: error CDF")), "CDF"))

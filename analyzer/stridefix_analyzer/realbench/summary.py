@@ -4,6 +4,10 @@ constants and the tuning choices of every fold, the JSON document and the consol
 Per walk and per group, per scheme: n, mean, median, p75, p90, p95, max, RMSE, floor hit rate, IPIN
 score = p75 of 2-D error + 15 m·|floor error|; the share of walks whose mean error exceeds
 :data:`ROBUST_MEAN_M`. Scheme names and their order come from :mod:`stridefix_analyzer.schemes`.
+Which source each fix came from: per walk (``walk_rows[].fix_sources``) and pooled per group
+(``groups[].fix_sources``, and ``fix_sources_true_start`` with ``--true-start``), FIX records per
+scheme and method (Wi-Fi, GNSS, BLE, landmark): offered, accepted, rejected, rejected by reason
+(:mod:`stridefix_analyzer.scoring.fixsources`).
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.realbench.fold import FoldJob
 from stridefix_analyzer.realbench.strides import error_stats, spread
 from stridefix_analyzer.realbench.tuning import Axis
+from stridefix_analyzer.scoring.fixsources import format_fix_sources, merge_fix_source_counts
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M, ipin_score
 
 #: a walk whose mean error exceeds this is a failure for the robustness share [m]
@@ -84,6 +89,11 @@ def build_doc(
         if true_start:
             entry["summary_true_start"] = summarize_group([r for r in rs if not r["error"]], "true_start")
         entry["fold_errors"] = [{"walk": r["walk"], "error": r["error"]} for r in rs if r["error"]]
+        for tag, key in (("fixes", "fix_sources"), ("true_start", "fix_sources_true_start")):
+            if tag == "fixes" or true_start:
+                entry[key] = merge_fix_source_counts(
+                    r["fix_sources"][tag] for r in rs if not r["error"] and tag in r.get("fix_sources", {})
+                )
         folds = [r["fold"] for r in rs if r.get("fold")]
         entry["constants"] = {
             "K": spread([f["K"] for f in folds]),
@@ -116,6 +126,7 @@ def build_doc(
             for tag in ("fixes", "true_start"):
                 if tag in r:
                     row[tag] = r[tag]
+            row["fix_sources"] = r.get("fix_sources", {}).get("fixes", {})
             entry["walk_rows"].append(row)
         per_group.append(entry)
     return {
@@ -215,6 +226,9 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
                 f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|)"
             )
         lines.append(f"  {pdr_true_start_text(doc['format'], g)}")
+        if "fix_sources" in g:
+            text = format_fix_sources(g["fix_sources"], "pooled over the walks")
+            lines.append("  " + text.replace("\n", "\n  "))
         for e in g["failed"] + g["fold_errors"]:
             lines.append(f"  failed {e['walk']}: {e['error']}")
     return "\n".join(lines)

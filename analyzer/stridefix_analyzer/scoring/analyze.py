@@ -7,6 +7,8 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
   ``inputs``, ``messages`` (events per channel), ``unknown_channels``, ``decode_errors``,
   ``health`` (last HEALTH fields), ``config`` (``version``, ``dbc_sha256``, ``params``) and
   ``warnings``. Non-finite numbers are written as ``null``.
+  ``fix_sources`` (FIX records per scheme and per method, Wi-Fi, GNSS, BLE, landmark: offered,
+  accepted, rejected and rejected by reason; :mod:`stridefix_analyzer.scoring.fixsources`) and
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
@@ -36,6 +38,7 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
 from stridefix_analyzer.scoring.metrics import (
     IPIN_FLOOR_PENALTY_M,
     Metrics,
@@ -114,6 +117,7 @@ def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> 
         unknown_channels=data.unknown_channels,
         decode_errors=data.decode_errors,
         health=data.health,
+        fix_sources=fix_source_counts(data.table("FIX")),
         config={**data.versions, "params": data.config},
         warnings=data.warnings,
     )
@@ -213,6 +217,7 @@ def run(args: argparse.Namespace) -> int:
     for note in summary["warnings"]:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))
+    print(format_fix_sources(summary["fix_sources"]))
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
         from stridefix_analyzer.io.tum import write_tum

@@ -20,6 +20,7 @@ import numpy as np
 
 from stridefix_analyzer.scoring import plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
+from stridefix_analyzer.scoring.fixsources import fix_sources_html
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
 
 
@@ -205,6 +206,10 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         _img(figs["error_time"], "error over time"),
         "<h2>Steps</h2>",
         _steps_table(summary),
+        "<h2>Fix sources</h2>",
+        "<p class='note'>FIX records per scheme and source (every scheme judges every fix): offered, "
+        "accepted, rejected and why.</p>",
+        fix_sources_html(summary.get("fix_sources") or {}),
         "<h2>Logger health (last HEALTH report)</h2>",
         _kv_table(list(health.items()), ("counter", "value"))
         if health
