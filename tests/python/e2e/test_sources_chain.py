@@ -15,7 +15,7 @@ import cantools
 import lcm
 import numpy as np
 import pytest
-from stridefix import fix_t, site_t, truth_t
+from stridefix import fix_t, truth_t
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.io.sitefile import new_site, write_site
 from stridefix_analyzer.schemes import NAMES
@@ -32,8 +32,6 @@ BEACONS = [(0xE078A33D0001, 0.0, 0.0), (0xE078A33D0002, 20.0, 0.0), (0xE078A33D0
 STAND_XY = (8.0, 6.0)
 LANDMARK_XY = (8.5, 6.5)
 RSSI_1M_DBM, PATH_LOSS_N = -59.0, 2.0
-#: site file v2 (beacons, the geo-reference's altitude and rotation) is on the site helper's branch
-SITE_V2 = hasattr(site_t(), "beacon_id")
 
 
 def _site(path: Path) -> None:
@@ -54,19 +52,18 @@ def _site(path: Path) -> None:
         entry_std_db=[3.0, 3.0],
         entry_count=[3, 3],
     )
-    if SITE_V2:
-        fields.update(
-            origin_alt_m=ORIGIN[2],
-            geo_rotation_deg=0.0,
-            beacon_id=[b[0] for b in BEACONS],
-            beacon_x_m=[b[1] for b in BEACONS],
-            beacon_y_m=[b[2] for b in BEACONS],
-            beacon_floor=[0] * len(BEACONS),
-            beacon_rssi_1m_dbm=[math.nan] * len(BEACONS),
-            ble_rssi_1m_dbm=RSSI_1M_DBM,
-            ble_path_loss_exponent=PATH_LOSS_N,
-            ble_range_sigma_db=4.0,
-        )
+    fields.update(
+        origin_alt_m=ORIGIN[2],
+        geo_rotation_deg=0.0,
+        beacon_id=[b[0] for b in BEACONS],
+        beacon_x_m=[b[1] for b in BEACONS],
+        beacon_y_m=[b[2] for b in BEACONS],
+        beacon_floor=[0] * len(BEACONS),
+        beacon_rssi_1m_dbm=[math.nan] * len(BEACONS),
+        ble_rssi_1m_dbm=RSSI_1M_DBM,
+        ble_path_loss_exponent=PATH_LOSS_N,
+        ble_range_sigma_db=4.0,
+    )
     write_site(path, new_site(**fields))
 
 
@@ -158,7 +155,10 @@ def test_log_carries_the_new_raw_inputs(sources_run):
     assert h["fixes_offered_ble"] == DURATION_S
     assert h["fixes_offered_gnss"] == DURATION_S
     assert h["fixes_offered_landmark"] == 1 and h["fixes_made_landmark"] == 1
-    assert "sources: 6 BLE scans (90 advertisements, 0 dropped from full windows), 1 LANDMARK" in sources_run["stderr"]
+    assert (
+        "sources: 6 BLE scans (90 advertisements, 0 dropped from full windows), 1 LANDMARK"
+        in sources_run["stderr"]
+    )
     assert "fixes made of offered: Wi-Fi 0 of 0, GNSS" in sources_run["stderr"]
     assert "landmark 1 of 1" in sources_run["stderr"]
 
@@ -172,7 +172,6 @@ def test_landmark_fix_is_judged_by_every_scheme(sources_run):
     assert np.all(fix["t_us"][sel] == (T0_MS + 3000) * 1000)
 
 
-@pytest.mark.xfail(not SITE_V2, strict=True, reason="site file v2 (beacons, geo altitude) not merged yet")
 def test_gnss_and_ble_fixes_with_a_v2_site(sources_run):
     """THEN GNSS fixes (through the geo-reference) and BLE fixes (ranges to the beacons) are FIX
     records of METHOD_GNSS and METHOD_BLE near where the walker stands, and HEALTH counts them made."""
