@@ -14,7 +14,8 @@
  * bit-identical and another seed gives another cloud):
  *     s ← clamp(s + √(q_s·L)·n3, scale_min, scale_max),  b ← b + √(q_b·L)·n4   (random walks per metre)
  *     d = s·L·(1 + σ_L·n1),  θ = ψ + b + σ_ψ·n2,  (x, y) ← (x, y) + d·(cos θ, sin θ).
- * A particle whose step crosses a wall of its floor (sf_wall_grid.h) dies (w = 0). If every particle
+ * A particle whose step crosses a wall of its floor (sf_wall_grid.h) dies (w = 0; it lies where the step
+ * took it, weightless, until the next resampling replaces it). If every particle
  * would die, none does: the step is taken as if there were no walls (counted in all_blocked): a map
  * error or a wrong floor must never lose the track; the fixes and the next walls sort it out.
  * Floors: when the barometric floor (passed with every step and fix) differs from a particle's, the
