@@ -6,6 +6,10 @@
 
 #include "sf_error.h"
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 #define FLOOR_KEEP INT16_MIN
 
 int sf_particle_init(sf_particle_t *const c, const sf_params_t *const p, sf_particle_state_t *const states,
@@ -195,7 +199,7 @@ void sf_particle_step(sf_particle_t *const c, const sf_params_t *const p, const 
         const double s = clamp((double)q->scale + sd_scale * n3, p->particle_scale_min, p->particle_scale_max);
         const double b = (double)q->bias_rad + sd_bias * n4;
         q->scale = (float)s;
-        q->bias_rad = (float)atan2(sin(b), cos(b));
+        q->bias_rad = (float)(b > M_PI ? b - 2.0 * M_PI : (b < -M_PI ? b + 2.0 * M_PI : b)); /* one step < π */
         const double d = s * length_m * (1.0 + p->particle_length_sigma * n1);
         const double th = heading_rad + b + p->particle_heading_sigma_rad * n2;
         const double x0 = q->x_m, y0 = q->y_m;

@@ -9,6 +9,16 @@
 
 /* ---- the exact predicate ------------------------------------------------------------------------- */
 
+static double min2(const double a, const double b)
+{
+    return a < b ? a : b; /* fmin is a libm call here; no NaN reaches these */
+}
+
+static double max2(const double a, const double b)
+{
+    return a > b ? a : b;
+}
+
 /* Twice the signed area of (a, b, c): > 0 when c is left of a → b. */
 static double orient(const double ax, const double ay, const double bx, const double by, const double cx,
                      const double cy)
@@ -20,7 +30,7 @@ static double orient(const double ax, const double ay, const double bx, const do
 static bool within(const double ax, const double ay, const double bx, const double by, const double cx,
                    const double cy)
 {
-    return fmin(ax, bx) <= cx && cx <= fmax(ax, bx) && fmin(ay, by) <= cy && cy <= fmax(ay, by);
+    return min2(ax, bx) <= cx && cx <= max2(ax, bx) && min2(ay, by) <= cy && cy <= max2(ay, by);
 }
 
 bool sf_wall_segments_cross(const double p0x, const double p0y, const double p1x, const double p1y,
@@ -28,6 +38,10 @@ bool sf_wall_segments_cross(const double p0x, const double p0y, const double p1x
 {
     if (p0x == p1x && p0y == p1y) {
         return false; /* a zero-length step goes nowhere: (p0, p0] is empty */
+    }
+    if (max2(p0x, p1x) < min2(q0x, q1x) || max2(q0x, q1x) < min2(p0x, p1x) || max2(p0y, p1y) < min2(q0y, q1y) ||
+        max2(q0y, q1y) < min2(p0y, p1y)) {
+        return false; /* closed boxes apart: no common point (exact, and most walls of a cell) */
     }
     const double d1 = orient(q0x, q0y, q1x, q1y, p0x, p0y);
     const double d2 = orient(q0x, q0y, q1x, q1y, p1x, p1y);
@@ -60,7 +74,7 @@ static int32_t clamp_i(const double v, const int32_t hi)
 static bool seg_rows(const sf_wall_floor_grid_t *const g, const double av, const double bv, int32_t *const r0,
                      int32_t *const r1)
 {
-    const double lo = floor(fmin(av, bv) - SF_WALL_GRID_PAD), hi = floor(fmax(av, bv) + SF_WALL_GRID_PAD);
+    const double lo = floor(min2(av, bv) - SF_WALL_GRID_PAD), hi = floor(max2(av, bv) + SF_WALL_GRID_PAD);
     if (hi < 0.0 || lo > (double)(g->ny - 1)) {
         return false;
     }
@@ -73,7 +87,7 @@ static bool seg_rows(const sf_wall_floor_grid_t *const g, const double av, const
 static bool seg_cols(const sf_wall_floor_grid_t *const g, const double au, const double av, const double bu,
                      const double bv, const int32_t r, int32_t *const c0, int32_t *const c1)
 {
-    double ulo = fmin(au, bu), uhi = fmax(au, bu);
+    double ulo = min2(au, bu), uhi = max2(au, bu);
     if (av != bv) { /* the part of the segment inside the row's band, padded */
         double t0 = ((double)r - SF_WALL_GRID_PAD - av) / (bv - av);
         double t1 = ((double)r + 1.0 + SF_WALL_GRID_PAD - av) / (bv - av);
@@ -82,11 +96,11 @@ static bool seg_cols(const sf_wall_floor_grid_t *const g, const double au, const
             t0 = t1;
             t1 = t;
         }
-        t0 = fmax(t0, 0.0);
-        t1 = fmin(t1, 1.0);
+        t0 = max2(t0, 0.0);
+        t1 = min2(t1, 1.0);
         const double u0 = au + t0 * (bu - au), u1 = au + t1 * (bu - au);
-        ulo = fmin(u0, u1);
-        uhi = fmax(u0, u1);
+        ulo = min2(u0, u1);
+        uhi = max2(u0, u1);
     }
     const double lo = floor(ulo - SF_WALL_GRID_PAD), hi = floor(uhi + SF_WALL_GRID_PAD);
     if (hi < 0.0 || lo > (double)(g->nx - 1)) {
