@@ -292,8 +292,8 @@ void sf_particle_summary(const sf_particle_t *const c, sf_particle_summary_t *co
     s->ess = sw * sw / s2;
     double xx = 0.0, xy = 0.0, yy = 0.0;
     /* the majority floor: up to 8 distinct floors tallied (more are a cloud in pieces: the first 8) */
-    int16_t fl[8];
-    double fw[8];
+    int16_t fl[8] = {s->floor};
+    double fw[8] = {0.0};
     int nf = 0;
     for (int32_t i = 0; i < c->n; i++) {
         const double w = c->p[i].w, dx = c->p[i].x_m - s->x_m, dy = c->p[i].y_m - s->y_m;
