@@ -30,6 +30,7 @@
 #include "sf_rx_lcm.h"
 #include "sf_signals.h"
 #include "sf_site.h"
+#include "sf_particle_mem.h"
 #include "sf_workspace.h"
 
 #ifndef SF_VERSION
@@ -53,6 +54,7 @@ typedef struct {
     sf_site_t site;
     sf_fingerprint_workspace_t ws;
     void *ws_memory;
+    sf_particle_mem_t particle_mem; /* the particle scheme's cloud and the site's wall index */
     char log_path[SF_LOG_FILE_PATH_MAX];
     long messages_printed;
     int64_t host_t_us;  /* log timestamp of the item being handled: every message's */
@@ -430,6 +432,17 @@ static int serve(daemon_t *const d)
             return SF_EXIT_USAGE;
         }
     }
+    if (sf_particle_mem_alloc(&d->params, d->opt.site_path != NULL ? &d->site : NULL, &d->particle_mem) != SF_OK ||
+        sf_estimator_attach_particles(&d->est, &d->params, d->particle_mem.states, d->particle_mem.floors,
+                                      d->particle_mem.capacity, &d->particle_mem.walls) != SF_OK) {
+        fprintf(stderr, "stridefixd: out of memory for the particle cloud or the wall index\n");
+        return 1;
+    }
+    if (d->opt.site_path != NULL && d->site.plan.n_walls > 0) {
+        fprintf(stderr, "stridefixd: site %s: %d walls on %d floors indexed (%zu bytes), %d ports\n",
+                d->opt.site_path, (int)d->site.plan.n_walls, (int)d->particle_mem.walls.n_floors,
+                d->particle_mem.grid_bytes, (int)d->site.ports.n_ports);
+    }
     d->last_pose_t_us = INT64_MIN / 2;
     const double t0 = monotonic_us();
     int status = run(d);
@@ -470,5 +483,6 @@ int main(int argc, char **argv)
     sf_input_close(d.in); /* only what was opened: never stdin on --replay */
     sf_site_store_free(&d.site_store);
     sf_workspace_free(d.ws_memory);
+    sf_particle_mem_free(&d.particle_mem);
     return status;
 }

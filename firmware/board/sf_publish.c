@@ -36,6 +36,7 @@ void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_p
                             .cov_yy_m2 = (float)p->cov_m2[2],
                             .heading_bias_rad = (float)p->heading_bias_rad,
                             .stride_scale = (float)p->stride_scale,
+                            .ess = (float)p->ess,
                             .step_count = p->step_count,
                             .scheme = p->scheme};
     SF_LCM_WRITE(out, SF_CHANNEL_POSE, log_t_us, stridefix_pose_t, &msg);
@@ -129,8 +130,8 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
 
 #define CONFIG_KEY_BYTES 64
 #define CONFIG_VALUE_BYTES 32
-_Static_assert(SF_PARAM_COUNT * (CONFIG_KEY_BYTES + CONFIG_VALUE_BYTES + 2 * sizeof(char *)) <= 20 * 1024,
-               "sf_publish.h promises CONFIG's text within 20 KiB of stack");
+_Static_assert(SF_PARAM_COUNT * (CONFIG_KEY_BYTES + CONFIG_VALUE_BYTES + 2 * sizeof(char *)) <= 28 * 1024,
+               "sf_publish.h promises CONFIG's text within 28 KiB of stack");
 
 void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
                        const sf_params_t *const params, const char *const version, const char *const dbc_sha256)

@@ -40,6 +40,21 @@ void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
     start_at_config(e, p);
 }
 
+int sf_estimator_attach_particles(sf_estimator_t *const e, const sf_params_t *const p,
+                                  sf_particle_state_t *const states, int16_t *const floors, const int32_t capacity,
+                                  const sf_wall_grid_t *const walls)
+{
+    const int rc = sf_particle_init(&e->particles, p, states, floors, capacity);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    sf_wall_grid_empty(&e->no_walls);
+    sf_particle_set_map(&e->particles, walls != NULL ? walls : &e->no_walls, e->site != NULL ? &e->site->ports : NULL);
+    e->has_particles = true;
+    sf_fusion_set_cloud(&e->fusion[sf_scheme_particle], p, &e->particles);
+    return SF_OK;
+}
+
 int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p, const sf_site_t *const site,
                              sf_fingerprint_workspace_t *const ws)
 {
@@ -67,6 +82,11 @@ int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p
         for (int s = 0; s < sf_scheme_count; s++) {
             (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
         }
+        if (e->has_particles) { /* a cloud attached before the site: unseeded again, with the site's ports */
+            e->particles.seeded = false;
+            sf_particle_set_map(&e->particles, e->particles.walls, &site->ports);
+            sf_fusion_set_cloud(&e->fusion[sf_scheme_particle], p, &e->particles);
+        }
     }
     for (int s = 0; s < sf_scheme_count; s++) { /* the ekf's fix-error model, if the site measured one */
         sf_fusion_set_fix_model(&e->fusion[s], p, &site->fix_model);
@@ -92,8 +112,9 @@ static void advance(sf_estimator_t *const e, const sf_params_t *const p, const i
     e->y_m += dy_m;
     e->distance_m += length_m;
     e->sigma_m += p->estimator_sigma_per_m * length_m;
+    const int16_t baro_floor = sf_floor_current(&e->floor); /* the particle scheme's floors */
     for (int s = 0; s < sf_scheme_count; s++) {
-        sf_fusion_step(&e->fusion[s], p, now_us, dx_m, dy_m, length_m);
+        sf_fusion_step_on_floor(&e->fusion[s], p, now_us, dx_m, dy_m, length_m, baro_floor);
     }
 }
 

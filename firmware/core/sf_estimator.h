@@ -34,14 +34,16 @@
  *
  * Absolute fixes: Wi-Fi scans are matched against the site's radio map (sf_fingerprint) and every
  * fix is offered to every fusion scheme of pose_t.SCHEME_* (sf_fusion.h; today pdr_only, wifi_only,
- * overwrite, static, adaptive, kalman), which all run side by side on the same steps and fixes, so one log
+ * overwrite, static, adaptive, kalman, ekf, particle), which all run side by side on the same steps and fixes, so one log
  * compares them all. Each scheme's pose is sf_estimator_scheme_pose; sf_estimator_pose is the PDR
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 34 040 B on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
- * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the seven schemes 3 640 B
- * (each carries the ekf's 408 B filter). Cost per IMU sample:
+ * Memory: sizeof(sf_estimator_t) ≈ 35.6 kB on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
+ * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the eight schemes 4 224 B
+ * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
+ * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
+ * (≤ 1 KiB) are here. Cost per IMU sample:
  * a few hundred flops; per MAG sample a few kflop (the sf_magcal solve). */
 #ifndef SF_ESTIMATOR_H
 #define SF_ESTIMATOR_H
@@ -101,6 +103,9 @@ typedef struct {
     uint32_t gnss_offered, gnss_refused, landmarks_refused; /* GNSS fixes seen / refused (no geo-reference
                                                              * counts as offered only), bad landmarks */
     sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
+    sf_particle_t particles; /* the particle scheme's cloud; its arrays are the caller's (attach_particles) */
+    bool has_particles;
+    sf_wall_grid_t no_walls;  /* the walls of a cloud attached without a grid: none */
     /* online stride calibration: the anchor is the last accepted Kalman fix */
     bool calib_anchor_valid;
     double calib_fix_x_m, calib_fix_y_m;   /* the anchor fix */
@@ -137,6 +142,15 @@ void sf_estimator_pose(const sf_estimator_t *est, sf_pose_t *pose);
  * SF_OK, or the error of sf_floor_set_heights / sf_fingerprint_prepare (bad site). */
 int sf_estimator_attach_site(sf_estimator_t *est, const sf_params_t *p, const sf_site_t *site,
                              sf_fingerprint_workspace_t *ws);
+
+/* Gives the particle scheme its cloud: the caller's arrays for `capacity` particles (states and floors,
+ * SF_PARTICLE_BYTES_PER bytes each; the cloud uses min(particle.count, capacity)) and the site's wall
+ * index (sf_wall_grid.h, built over site->plan; NULL: no walls). The ports are the attached site's
+ * (none without a site: floors change anywhere). Call after sf_estimator_attach_site (if any), before
+ * any input; a config start seeds the cloud at once. Without it the particle scheme has no position.
+ * SF_OK, or SF_EINVAL (NULL arrays, capacity outside 1..SF_PARTICLE_MAX). */
+int sf_estimator_attach_particles(sf_estimator_t *est, const sf_params_t *p, sf_particle_state_t *states,
+                                  int16_t *floors, int32_t capacity, const sf_wall_grid_t *walls);
 
 /* One Wi-Fi scan. With a site, matches it and offers the fix to every scheme; fills *fix (when the
  * match succeeded, *has_fix) and one audit per scheme (audits[s] for scheme s), and returns the

@@ -8,11 +8,7 @@
 #include <string.h>
 
 #include "sf_error.h"
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
+#include "sf_fusion_internal.h"
 
 static double us_to_s(const int64_t dt_us)
 {
@@ -24,77 +20,9 @@ static int16_t to_floor(const int32_t v)
     return (int16_t)(v < INT16_MIN ? INT16_MIN : (v > INT16_MAX ? INT16_MAX : v));
 }
 
-/* ---- the scheme registry: one row per pose_t.SCHEME_* ------------------------------------------- */
-
-/* How a scheme uses steps and fixes (sf_fusion.h): dead reckoning only (fixes initialise, then are
- * ignored), following the fixes (no prediction, no gate), predicting and blending gated fixes with
- * the row's gain law, or the error-state filter of sf_ekf.h (its own prediction, gain and R). */
-typedef enum { mode_dead_reckoning = 1, mode_follow_fixes, mode_blend, mode_ekf } scheme_mode_t;
-
-typedef double (*alpha_law_t)(const sf_fusion_t *f, const sf_params_t *p, const sf_fix_t *fix, double r_m2,
-                              sf_fix_audit_t *audit);
-
-typedef struct {
-    scheme_mode_t mode;
-    alpha_law_t alpha;    /* mode_blend: α of an accepted fix */
-    bool kalman_variance; /* var ← (1 − α)·var instead of the Joseph form */
-} scheme_row_t;
-
-static double alpha_one(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                        const double r_m2, sf_fix_audit_t *const audit)
+static const sf_scheme_row_t *row_of(const sf_fusion_t *const f)
 {
-    (void)f, (void)p, (void)fix, (void)r_m2, (void)audit;
-    return 1.0;
-}
-
-/* A landmark is where the walker is: α = 1 (the paper's NFC), whatever the fixed gain. */
-static double alpha_static(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                           const double r_m2, sf_fix_audit_t *const audit)
-{
-    (void)f, (void)r_m2, (void)audit;
-    return fix->method == sf_fix_landmark ? 1.0 : p->fusion_static_alpha;
-}
-
-/* Records the adaptive terms in the audit (FIX.accuracy_factor, FIX.drift). */
-static double alpha_adaptive(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                             const double r_m2, sf_fix_audit_t *const audit)
-{
-    (void)r_m2;
-    const double dt_s = us_to_s(fix->t_us - f->last_fix_t_us);
-    audit->accuracy_factor = sf_fusion_accuracy_factor(p, fix);
-    audit->drift = sf_fusion_drift(p, dt_s);
-    return clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
-}
-
-static double alpha_kalman(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
-                           const double r_m2, sf_fix_audit_t *const audit)
-{
-    (void)p, (void)fix, (void)audit;
-    return f->var_m2 / (f->var_m2 + r_m2);
-}
-
-/* Adding a scheme: its SCHEME_* constant in pose_t.lcm (which makes sf_scheme_<name>) and one row. */
-static const scheme_row_t scheme_rows[] = {
-    [sf_scheme_pdr_only] = {mode_dead_reckoning, NULL, false},
-    [sf_scheme_wifi_only] = {mode_follow_fixes, NULL, false},
-    [sf_scheme_overwrite] = {mode_blend, alpha_one, false},
-    [sf_scheme_static] = {mode_blend, alpha_static, false},
-    [sf_scheme_adaptive] = {mode_blend, alpha_adaptive, false},
-    [sf_scheme_kalman] = {mode_blend, alpha_kalman, true},
-    [sf_scheme_ekf] = {mode_ekf, NULL, false},
-};
-_Static_assert(sizeof scheme_rows / sizeof scheme_rows[0] == sf_scheme_count,
-               "one scheme_rows entry per pose_t.SCHEME_* (sf_schemes.h)");
-
-static const char *const scheme_names[] = {
-#define SF_SCHEME_NAME(name, id) [id] = #name,
-    SF_SCHEMES(SF_SCHEME_NAME)
-#undef SF_SCHEME_NAME
-};
-
-static const scheme_row_t *row_of(const sf_fusion_t *const f)
-{
-    return &scheme_rows[f->scheme];
+    return sf_fusion_row(f->scheme);
 }
 
 static bool blends(const sf_fusion_t *const f)
@@ -110,6 +38,11 @@ static bool predicts(const sf_fusion_t *const f)
 static bool is_ekf(const sf_fusion_t *const f)
 {
     return row_of(f)->mode == mode_ekf;
+}
+
+static bool is_particle(const sf_fusion_t *const f)
+{
+    return row_of(f)->mode == mode_particle;
 }
 
 /* An isotropic variance as a covariance [xx, xy, yy]. */
@@ -151,7 +84,7 @@ static void predict_to(sf_fusion_t *const f, const sf_params_t *const p, const i
     }
     if (f->initialised && is_ekf(f)) {
         sf_ekf_time(&f->ekf, p, us_to_s(t_us - f->t_us));
-    } else if (f->initialised && predicts(f)) {
+    } else if (f->initialised && predicts(f) && !is_particle(f)) {
         f->var_m2 += p->fusion_q_time_m2_per_s * us_to_s(t_us - f->t_us);
     }
     f->t_us = t_us;
@@ -275,7 +208,9 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
         start_ekf(f, p);
         sf_ekf_restart_known(&f->ekf, cov_m2);
     }
-    (void)baro_floor;
+    if (is_particle(f)) {
+        sf_fusion_particle_init_at(f, p, x_m, y_m, sigma_m, baro_floor);
+    }
     f->floor_offset = predicts(f) ? 0 : (int32_t)floor;
     f->t_us = t_us;
     f->last_fix_t_us = t_us;
@@ -286,6 +221,12 @@ int sf_fusion_init_at(sf_fusion_t *const f, const sf_params_t *const p, const in
 
 void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us, const double dx_m,
                     const double dy_m, const double length_m)
+{
+    sf_fusion_step_on_floor(f, p, t_us, dx_m, dy_m, length_m, SF_FUSION_FLOOR_KEEP);
+}
+
+void sf_fusion_step_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us, const double dx_m,
+                             const double dy_m, const double length_m, const int16_t baro_floor)
 {
     if (!predicts(f)) {
         return; /* wifi_only ignores steps */
@@ -298,7 +239,9 @@ void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int6
     if (!f->initialised) {
         return; /* nothing to move yet */
     }
-    if (is_ekf(f)) { /* the filter applies its learnt bias and scale to the PDR step */
+    if (is_particle(f)) {
+        sf_fusion_particle_step(f, p, dx_m, dy_m, length_m, baro_floor);
+    } else if (is_ekf(f)) { /* the filter applies its learnt bias and scale to the PDR step */
         double d_m[2];
         sf_ekf_step(&f->ekf, p, length_m, atan2(dy_m, dx_m), d_m);
         f->x_m += d_m[0];
@@ -320,7 +263,7 @@ int sf_fusion_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix
 int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                            const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
-    (void)baro_floor; /* DEVIATION: unused (Floors: the caller's floor rules); the call sites still pass it */
+    /* baro_floor: the particle scheme's floors; the others are on the caller's floor (Floors) */
     audit_begin(audit, f, fix);
     f->fixes++;
     if (!fix_usable(fix)) {
@@ -339,6 +282,10 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
 
     /* fusion: predict to the fix's time */
     predict_to(f, p, fix->t_us);
+    if (is_particle(f)) { /* its own likelihood, judgement and audit (sf_fusion_particle.c) */
+        sf_fusion_particle_fix(f, p, fix, baro_floor, between_floors, audit);
+        return SF_OK;
+    }
     /* the ekf's white R from its fix-error model */
     double ekf_r_m2[3] = {r_m2, 0.0, r_m2};
     if (is_ekf(f)) {
@@ -429,7 +376,11 @@ bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, cons
                     const int16_t baro_floor, sf_pose_t *const pose)
 {
     pose->scheme = f->scheme;
-    if (!f->initialised) {
+    pose->ess = 0.0;
+    if (f->initialised && is_particle(f) && sf_fusion_particle_pose(f, pose)) {
+        return true;
+    }
+    if (!f->initialised || is_particle(f)) { /* a particle scheme without a cloud has no position */
         pose->x_m = 0.0;
         pose->y_m = 0.0;
         pose->floor = baro_floor;
@@ -469,30 +420,20 @@ void sf_fusion_set_fix_model(sf_fusion_t *const f, const sf_params_t *const p, c
     }
 }
 
+void sf_fusion_set_cloud(sf_fusion_t *const f, const sf_params_t *const p, sf_particle_t *const cloud)
+{
+    if (!is_particle(f)) {
+        return;
+    }
+    f->cloud = cloud;
+    if (cloud != NULL && f->initialised && !cloud->seeded) { /* a config start made before the cloud came */
+        sf_particle_seed(cloud, p, f->x_m, f->y_m, sqrt(f->var_m2), (int16_t)p->init_floor, false);
+    }
+}
+
 void sf_fusion_audit_refused(const sf_fusion_t *const f, const sf_fix_t *const fix, const int8_t reason,
                              sf_fix_audit_t *const audit)
 {
     audit_begin(audit, f, fix);
     audit->reason = reason;
-}
-
-const char *sf_fusion_scheme_name(const int scheme)
-{
-    return scheme >= 0 && scheme < sf_scheme_count ? scheme_names[scheme] : NULL;
-}
-
-int sf_fusion_scheme_from_name(const char *const name)
-{
-    for (int s = 0; name != NULL && s < sf_scheme_count; s++) {
-        if (strcmp(name, scheme_names[s]) == 0) {
-            return s;
-        }
-    }
-    return SF_EINVAL;
-}
-
-bool sf_fusion_scheme_is_registered(const int scheme)
-{
-    return scheme >= 0 && scheme < sf_scheme_count && scheme_rows[scheme].mode != 0 &&
-           (scheme_rows[scheme].mode != mode_blend || scheme_rows[scheme].alpha != NULL);
 }

@@ -1,4 +1,4 @@
-/* sf_fusion.h — PDR + absolute-fix fusion: every scheme of pose_t.SCHEME_* (six today), side by side
+/* sf_fusion.h — PDR + absolute-fix fusion: every scheme of pose_t.SCHEME_* (eight today), side by side
  * on the same inputs.
  *
  * Ownership. One sf_fusion_t is one scheme. The estimator owns an array
@@ -49,6 +49,21 @@
  *              position gain; its initialisation and recovery restart the position from the fix (bias
  *              and scale keep what they learnt); its pose carries the covariance, the bias (added to the
  *              heading) and the scale. Floors and control as for the blends.
+ *   particle   (ours) the map-aware particle filter of sf_particle.h over a cloud in caller memory
+ *              (sf_fusion_set_cloud; without one the scheme has no position and every fix is recorded
+ *              NOT_INITIALISED): steps move every particle with its own stride scale, heading bias and
+ *              noise, walls kill particles, floors change only at ports; a fix is a likelihood (its
+ *              Gaussian with σ = accuracy_m mixed with particle.outlier_share of uniform). Control
+ *              (sf_fusion_particle.c): the first fix seeds the cloud (σ = accuracy; INITIALISED);
+ *              between floors FLOOR_MISMATCH as below; ν against the cloud's weighted mean, S = the
+ *              cloud's covariance + R (mean of the diagonal recorded), τ = νᵀS⁻¹ν / gate²; the fix is
+ *              accepted when the cloud's evidence E = Σ w·exp(−d²/2σ²) ≥ exp(−gate²/2) (as much as a
+ *              single particle at the gate's distance), α = the weights' change (total variation);
+ *              otherwise rejected GATE; RECOVERY (re-seed around the fix, α = 1) after
+ *              fusion_max_rejections consecutive rejections, at once for a landmark (a known
+ *              position), or when the update leaves ESS < particle.reseed_ess_ratio · N. Its pose is
+ *              the weighted mean and covariance, the weight's majority floor, the mean bias (added to
+ *              the heading) and scale, and the effective sample size (pose.ess; 0 for every other scheme).
  * Variance after an accepted fix: kalman var ← (1 − α)·var; the fixed-gain schemes take the Joseph form
  * var ← (1 − α)²·var + α²·R (the true variance of a blend with an arbitrary gain; equal to the Kalman
  * form when α is the Kalman gain). Every variance is floored at fusion_var_min_m2.
@@ -105,9 +120,11 @@
  * Errors: sf_fusion_init returns SF_OK or SF_EINVAL (NULL, scheme outside [0, sf_scheme_count));
  * sf_fusion_init_at SF_OK or SF_EINVAL (non-finite x, y or sigma, negative sigma; state unchanged);
  * sf_fusion_fix SF_OK or SF_ERANGE (bad fix, see above). Everything else cannot fail.
- * Cost: O(1), a few tens of flops and one sqrt per call (the ekf a few hundred, sf_ekf.h). Memory:
- * sizeof(sf_fusion_t) = 520 B per scheme on x86-64 (the sf_ekf_t in every scheme, 408 B, keeps the array
- * uniform), sf_fix_audit_t 120 B; at most 528 B and 160 B (checked). No heap, no I/O, no
+ * Cost: O(1), a few tens of flops and one sqrt per call (the ekf a few hundred, sf_ekf.h; the particle
+ * scheme O(N) per call, sf_particle.h). Memory:
+ * sizeof(sf_fusion_t) = 528 B per scheme on x86-64 (the sf_ekf_t in every scheme, 408 B, keeps the array
+ * uniform; the particle cloud lives outside, one pointer), sf_fix_audit_t 120 B; at most 528 B and 160 B
+ * (checked). No heap, no I/O, no
  * clock, no hidden state: the same inputs give bit-identical outputs. */
 #ifndef SF_FUSION_H
 #define SF_FUSION_H
@@ -117,6 +134,7 @@
 
 #include "sf_ekf.h"
 #include "sf_params.h"
+#include "sf_particle.h"
 #include "sf_types.h"
 
 /* Reasons, identical to fix_t.REASON_* in lcmtypes/stridefix/fix_t.lcm. */
@@ -137,6 +155,9 @@ enum {
 /* sf_fusion_init_at's time for a start before any input (the config pose): the scheme's clock starts
  * at its first input, so the time before it (a log's epoch time, say) adds no variance. */
 #define SF_FUSION_T_FIRST_INPUT INT64_MIN
+
+/* sf_fusion_step_on_floor's floor when the caller has none: the particle scheme's floors stay. */
+#define SF_FUSION_FLOOR_KEEP INT16_MIN
 
 /* σ reported by sf_fusion_pose for a scheme that has no position yet [m]. */
 #define SF_FUSION_SIGMA_UNKNOWN_M 1.0e6
@@ -179,6 +200,7 @@ typedef struct {
     uint32_t steps, bad_steps, fixes, accepted, rejected_gate, rejected_floor, recoveries,
         initialisations, bad_fixes, backwards;
     const sf_fix_model_t *fix_model; /* the site's measured fix model (ekf), caller-owned; NULL: params */
+    sf_particle_t *cloud; /* the particle scheme's cloud, caller-owned (sf_fusion_set_cloud); NULL otherwise */
     sf_ekf_t ekf; /* the ekf scheme's filter (bias, scale, fix error, 6×6 covariance, fix model); unused by
                    * the others */
 } sf_fusion_t;
@@ -197,6 +219,11 @@ int sf_fusion_init_at(sf_fusion_t *f, const sf_params_t *p, int64_t t_us, double
 /* One accepted PDR step at t_us: displacement (dx_m, dy_m) in the map frame, its length [m]. Moves
  * every initialised scheme except wifi_only. */
 void sf_fusion_step(sf_fusion_t *f, const sf_params_t *p, int64_t t_us, double dx_m, double dy_m, double length_m);
+
+/* The same while the barometer says baro_floor (the particle scheme's floors; SF_FUSION_FLOOR_KEEP:
+ * none known). sf_fusion_step is this with SF_FUSION_FLOOR_KEEP. */
+void sf_fusion_step_on_floor(sf_fusion_t *f, const sf_params_t *p, int64_t t_us, double dx_m, double dy_m,
+                             double length_m, int16_t baro_floor);
 
 /* One absolute fix, judged by this scheme while the barometer says baro_floor; fills *audit (always).
  * SF_OK, or SF_ERANGE for a bad fix (see the header's "Bad data"). */
@@ -222,6 +249,10 @@ double sf_fusion_adaptive_alpha(const sf_params_t *p, const sf_fix_t *fix, doubl
  * valid: the ekf.fix_* parameters). A scheme already started at a known pose takes it at once; every
  * later (re)start too. No effect on the other schemes. */
 void sf_fusion_set_fix_model(sf_fusion_t *f, const sf_params_t *p, const sf_fix_model_t *model);
+
+/* The particle scheme's cloud (initialised by sf_particle_init, caller-owned, must outlive f; NULL: none).
+ * A scheme already started at a known pose seeds the cloud there at once. No effect on other schemes. */
+void sf_fusion_set_cloud(sf_fusion_t *f, const sf_params_t *p, sf_particle_t *cloud);
 
 /* A record for a scan the matcher refused before any position existed (reason TOO_FEW_APS or
  * NO_MAP, or any reason the caller decides): the fix fields from *fix, ν = 0, S = 0, τ = 0, α = 0,

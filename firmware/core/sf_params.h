@@ -243,9 +243,29 @@
     X(ekf,    r_min,               double,  0.25,    1e-3,    1e3,     "",      "smallest eigenvalue of the fix-error model per accuracy_m^2 M, prior and learnt") \
     X(ekf,    r_max,               double,  100.0,   1e-3,    1e4,     "",      "largest eigenvalue of the learnt fix-error model (per accuracy_m^2)")
 
+/* sf_particle.h: the particle scheme. Noise figures from the sensors' and the gait's physics, not fitted
+ * to a data set; realbench tunes them (the lead's). SF_PARTICLE_MAX is the compile-time capacity. */
+#define SF_PARTICLE_MAX 2048
+#define SF_PARAMS_PARTICLE(X)                                                                          \
+    X(particle, count,             int32_t, 1000,    1,       SF_PARTICLE_MAX, "",  "particles in the cloud (issue 13: about 1 000; at most SF_PARTICLE_MAX; the board allocates this many)") \
+    X(particle, seed,              int32_t, 1,       0,       2147483647, "",      "seed of the cloud's generator (PCG32): the same seed gives a bit-identical replay") \
+    X(particle, length_sigma,      double,  0.08,    0.0,     1.0,     "",      "step-length noise per step, relative (Weinberg's model scatters 5-10 % step to step)") \
+    X(particle, heading_sigma_rad, double,  0.05,    0.0,     1.0,     "rad",   "walking-direction noise per step (a few degrees of body sway and gyro noise per step)") \
+    X(particle, bias_rw_rad2_per_m, double, 0.0005,  0.0,     1.0,     "rad2/m","heading-bias random walk per metre walked (0.22 rad after 100 m: re-grips, magnetic disturbances)") \
+    X(particle, scale_rw_per_m,    double,  1e-4,    0.0,     1.0,     "1/m",   "stride-scale random walk (variance) per metre walked (0.1 after 100 m: pace changes)") \
+    X(particle, init_bias_sigma_rad, double, 0.3,    0.0,     3.2,     "rad",   "heading-bias spread of a new cloud (a magnetometer indoors is off by tens of degrees; walls tell which bias fits)") \
+    X(particle, init_scale_sigma,  double,  0.1,     0.0,     1.0,     "",      "stride-scale spread of a new cloud (walkers differ by ~10-15 % from Weinberg's K)") \
+    X(particle, scale_min,         double,  0.5,     0.1,     1.0,     "",      "smallest stride scale of a particle") \
+    X(particle, scale_max,         double,  2.0,     1.0,     10.0,    "",      "largest stride scale of a particle") \
+    X(particle, outlier_share,     double,  0.05,    1e-6,    1.0,     "",      "uniform share of a fix's likelihood: one fix lowers no weight by more than 1/share (a few per cent of fingerprint fixes are gross errors)") \
+    X(particle, resample_ess_ratio, double, 0.5,     0.0,     1.0,     "",      "systematic resampling when the effective sample size falls below this share of the particles (the usual N/2)") \
+    X(particle, reseed_ess_ratio,  double,  0.01,    0.0,     1.0,     "",      "re-seed around the fix when an update leaves an effective sample size below this share (the cloud no longer samples the posterior)") \
+    X(particle, floor_mismatch_weight, double, 0.7,  0.0,     1.0,     "",      "weight factor per step of a particle not on the barometric floor (a flight of ~10 steps: x0.03; a 1-2 step barometer glitch: x0.5)") \
+    X(particle, grid_cell_m,       double,  2.0,     0.1,     100.0,   "m",     "wall-index cell side (a room's scale: a 0.7 m step touches 1-3 cells)")
+
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_PARTICLE(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

@@ -108,8 +108,9 @@ typedef struct {
     double heading_rad;
     double sigma_m;
     double cov_m2[3];        /* [xx, xy, yy] map frame */
-    double heading_bias_rad; /* ekf: learnt; 0 otherwise */
-    double stride_scale;     /* ekf: learnt; 1 otherwise */
+    double heading_bias_rad; /* ekf, particle: learnt; 0 otherwise */
+    double stride_scale;     /* ekf, particle: learnt; 1 otherwise */
+    double ess;              /* particle: effective sample size; 0 otherwise */
     int32_t step_count;
     int8_t scheme;
 } sf_pose_t;

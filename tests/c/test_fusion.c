@@ -43,11 +43,24 @@ static sf_fix_t wifi(const double t_s, const double x, const double y, const dou
     return fix_at(t_s, sf_fix_wifi, x, y, 0, acc_m, n_ap);
 }
 
+/* Each init_all takes the next of these clouds for its particle scheme (two runs compared side by side
+ * need two clouds). */
+enum { N_CLOUDS = 4 };
+static sf_particle_state_t cloud_states[N_CLOUDS][SF_PARTICLE_MAX];
+static int16_t cloud_floors[N_CLOUDS][SF_PARTICLE_MAX];
+static sf_particle_t clouds[N_CLOUDS];
+static int next_cloud;
+
 static void init_all(sf_fusion_t f[sf_scheme_count])
 {
+    sf_params_t p;
+    sf_params_default(&p);
     for (int s = 0; s < sf_scheme_count; s++) {
         assert_int_equal(sf_fusion_init(&f[s], (int8_t)s), SF_OK);
     }
+    const int k = next_cloud++ % N_CLOUDS;
+    assert_int_equal(sf_particle_init(&clouds[k], &p, cloud_states[k], cloud_floors[k], SF_PARTICLE_MAX), SF_OK);
+    sf_fusion_set_cloud(&f[sf_scheme_particle], &p, &clouds[k]);
 }
 
 /* Checks every judgement field of an audit record, and that the fix fields are copied. */
@@ -261,6 +274,12 @@ static void test_schemes_by_hand(void **state)
             const double b = before[s].heading_bias_rad, k = before[s].stride_scale, h = atan2(-0.75, 0.0);
             near(after[s].x_m, before[s].x_m + k * 0.75 * cos(h + b));
             near(after[s].y_m, before[s].y_m + k * 0.75 * sin(h + b));
+            continue;
+        }
+        if (s == sf_scheme_particle) { /* every particle by the step with its own scale, bias and noise
+                                        * (test_particle.c): the mean by about the step, E[cos b] ≈ 0.96 */
+            assert_true(fabs(after[s].x_m - before[s].x_m) < 0.05);
+            assert_true(fabs(after[s].y_m - before[s].y_m + 0.75 * exp(-0.5 * 0.3 * 0.3)) < 0.05);
             continue;
         }
         const double dy = s == sf_scheme_wifi_only ? 0.0 : -0.75;
@@ -482,7 +501,12 @@ static void test_uninitialised_until_first_fix(void **state)
         check_audit(&a, &fx, (int8_t)s, sf_fix_reason_initialised, true, 1.0, 0.0, 0.0, 6.25, 3.0);
         assert_true(a.test_ratio == 0.0);
         assert_true(sf_fusion_pose(&f[s], &p, 2 * S_US, 2, &pose));
-        assert_true(pose.x_m == 10.0 && pose.y_m == -4.0 && pose.sigma_m == 2.5);
+        if (s == sf_scheme_particle) { /* particle.count (1 000) particles drawn about the fix with σ = 2.5 m */
+            assert_true(fabs(pose.x_m - 10.0) < 0.2 && fabs(pose.y_m + 4.0) < 0.2 && fabs(pose.sigma_m - 2.5) < 0.1);
+            assert_true(fabs(pose.ess - 1000.0) < 1e-6); /* equal weights */
+        } else {
+            assert_true(pose.x_m == 10.0 && pose.y_m == -4.0 && pose.sigma_m == 2.5);
+        }
         assert_int_equal(pose.floor, s == sf_scheme_wifi_only ? 1 : 2); /* the caller's (issue 11) */
         assert_int_equal(f[s].initialisations, 1);
     }

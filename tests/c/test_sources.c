@@ -177,10 +177,13 @@ static const double heights[] = {0.0};
 static void attach(sf_estimator_t *const est, const sf_params_t *const p, sf_site_t *const site,
                    sf_fingerprint_workspace_t *const ws)
 {
+    static sf_particle_state_t states[SF_PARTICLE_MAX];
+    static int16_t floors[SF_PARTICLE_MAX];
     *site = (sf_site_t){.lowest_floor = 0, .n_floors = 1, .floor_height_m = heights, .geo = gsd_geo(),
                         .beacons = beacons()};
     sf_estimator_init(est, p);
     assert_int_equal(sf_estimator_attach_site(est, p, site, ws), SF_OK);
+    assert_int_equal(sf_estimator_attach_particles(est, p, states, floors, SF_PARTICLE_MAX, NULL), SF_OK);
 }
 
 static void test_gnss_fix_through_every_scheme(void **state)

@@ -32,6 +32,7 @@ def test_columns_and_sorting(msg, write_log):
         "cov_yy_m2",
         "heading_bias_rad",
         "stride_scale",
+        "ess",
         "step_count",
         "scheme",
     ]

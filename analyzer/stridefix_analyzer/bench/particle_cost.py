@@ -1,0 +1,88 @@
+"""``stridefix bench particle-cost``: the particle scheme's instructions per step under callgrind.
+
+Issue 13's cost target: at most 1 million instructions per PDR step at 1 000 particles on a floor plan
+of 5 000 wall segments. The harness ``tests/perf/particle_cost.c`` (built as ``sf_particle_cost`` next
+to ``stridefixd``'s build tree) builds such a floor, seeds the cloud and walks; callgrind counts the
+instructions inside the scheme's step call (``--toggle-collect=sf_fusion_step_on_floor``) and, in a
+second run, inside its fix call (``sf_fusion_fix_on_floor``). Writes ``particle_cost.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+from stridefix_analyzer.stages import StageError
+
+TARGET_PER_STEP = 1_000_000
+STEPS = 400
+FIXES = STEPS // 4
+_COLLECTED = re.compile(r"Collected\s*:\s*(\d+)")
+
+
+def harness_path(stridefixd: Path) -> Path:
+    """``sf_particle_cost`` of the build tree that holds ``stridefixd`` (``build/firmware/stridefixd``)."""
+    return stridefixd.resolve().parents[1] / "tests" / "perf" / "sf_particle_cost"
+
+
+def _callgrind(harness: Path, function: str, out: Path) -> int:
+    valgrind = shutil.which("valgrind")
+    if valgrind is None:
+        raise StageError("particle-cost: valgrind not found (apt-get install valgrind)")
+    cmd = [
+        valgrind,
+        "--tool=callgrind",
+        f"--callgrind-out-file={out}",
+        f"--toggle-collect={function}",
+        str(harness),
+        str(STEPS),
+    ]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    m = _COLLECTED.search(proc.stderr)
+    if proc.returncode != 0 or m is None:
+        raise StageError(f"particle-cost: {' '.join(cmd)} failed ({proc.returncode}): {proc.stderr[-400:]}")
+    return int(m.group(1))
+
+
+def run_particle_cost(stridefixd: Path, out: Path) -> dict[str, Any]:
+    """Runs the harness twice under callgrind; returns (and writes) the document."""
+    harness = harness_path(stridefixd)
+    if not harness.is_file():
+        raise StageError(f"particle-cost: {harness} not found (build it: make build)")
+    out.mkdir(parents=True, exist_ok=True)
+    plain = subprocess.run([str(harness), str(STEPS)], capture_output=True, text=True, check=True)
+    walk = json.loads(plain.stdout)
+    step_ir = _callgrind(harness, "sf_fusion_step_on_floor", out / "particle_cost.step.callgrind")
+    fix_ir = _callgrind(harness, "sf_fusion_fix_on_floor", out / "particle_cost.fix.callgrind")
+    per_step = step_ir / STEPS
+    doc = {
+        "harness": str(harness),
+        "walk": walk,
+        "instructions_per_step": per_step,
+        "instructions_per_fix": fix_ir / FIXES,
+        "target_per_step": TARGET_PER_STEP,
+        "met": per_step <= TARGET_PER_STEP,
+    }
+    (out / "particle_cost.json").write_text(json.dumps(doc, indent=1))
+    return doc
+
+
+def format_table(doc: dict[str, Any]) -> str:
+    w = doc["walk"]
+    verdict = "MET" if doc["met"] else "MISSED"
+    return (
+        f"particle cost: {w['particles']} particles, {w['walls']} walls ({w['grid_bytes']} B index, "
+        f"{w['cell_m']:.1f} m cells), {w['steps']} steps\n"
+        f"  instructions per step {doc['instructions_per_step']:,.0f} (target <= {TARGET_PER_STEP:,}): {verdict}\n"
+        f"  instructions per fix  {doc['instructions_per_fix']:,.0f}"
+    )
+
+
+def missed_targets(doc: dict[str, Any]) -> list[str]:
+    if doc["met"]:
+        return []
+    return [f"particle-cost: {doc['instructions_per_step']:,.0f} instructions per step > {TARGET_PER_STEP:,}"]

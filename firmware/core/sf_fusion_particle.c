@@ -1,0 +1,135 @@
+/* sf_fusion_particle.c — the particle scheme's control (sf_fusion.h, "particle"): start, floor,
+ * evidence, recovery and the audit, around the cloud of sf_particle.h. Read top to bottom like
+ * sf_fusion_fix: floors, innovate, judge, apply, record. */
+#include <math.h>
+
+#include "sf_fusion_internal.h"
+
+static double fix_sigma_m(const sf_params_t *const p, const sf_fix_t *const fix)
+{
+    return fmax(fix->accuracy_m, sqrt(p->fusion_var_min_m2));
+}
+
+/* The cloud's mean and summary into the scheme's own fields (what the log's x, y, var show). */
+static void mirror(sf_fusion_t *const f, sf_particle_summary_t *const s)
+{
+    sf_particle_summary(f->cloud, s);
+    f->x_m = s->x_m;
+    f->y_m = s->y_m;
+    f->var_m2 = 0.5 * (s->cov_m2[0] + s->cov_m2[2]);
+}
+
+void sf_fusion_particle_init_at(sf_fusion_t *const f, const sf_params_t *const p, const double x_m, const double y_m,
+                                const double sigma_m, const int16_t baro_floor)
+{
+    if (f->cloud != NULL) {
+        sf_particle_seed(f->cloud, p, x_m, y_m, sigma_m, baro_floor, false);
+    }
+}
+
+void sf_fusion_particle_step(sf_fusion_t *const f, const sf_params_t *const p, const double dx_m, const double dy_m,
+                             const double length_m, const int16_t baro_floor)
+{
+    if (f->cloud == NULL || !f->cloud->seeded) {
+        return;
+    }
+    sf_particle_step(f->cloud, p, length_m, atan2(dy_m, dx_m), baro_floor);
+}
+
+/* Re-seeds around the fix (σ = its accuracy; bias and scale kept), α = 1. */
+static void reseed(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix, const int16_t floor,
+                   sf_fix_audit_t *const audit)
+{
+    sf_particle_seed(f->cloud, p, fix->x_m, fix->y_m, fix_sigma_m(p, fix), floor, true);
+    audit->alpha = 1.0;
+    audit->accepted = true;
+    audit->reason = sf_fix_reason_recovery;
+    f->recoveries++;
+}
+
+void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                            const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
+{
+    sf_particle_t *const c = f->cloud;
+    const double sigma_m = fix_sigma_m(p, fix), r_m2 = sigma_m * sigma_m;
+    sf_particle_summary_t s;
+    if (c == NULL) {
+        audit->reason = sf_fix_reason_not_initialised; /* no memory for a cloud: no position ever */
+        return;
+    }
+    /* control: start */
+    if (!f->initialised || !c->seeded) {
+        sf_particle_seed(c, p, fix->x_m, fix->y_m, sigma_m, baro_floor, false);
+        f->initialised = true;
+        f->initialisations++;
+        f->rejections = 0;
+        f->last_fix_t_us = fix->t_us;
+        mirror(f, &s);
+        audit->innovation_var_m2 = r_m2;
+        audit->alpha = 1.0;
+        audit->accepted = true;
+        audit->reason = sf_fix_reason_initialised;
+        return;
+    }
+    /* fusion: floors at the particles' positions, then ν against the cloud's mean, S = cov + R */
+    sf_particle_floors(c, baro_floor);
+    sf_particle_summary(c, &s);
+    const double nu_x = fix->x_m - s.x_m, nu_y = fix->y_m - s.y_m;
+    const double sxx = s.cov_m2[0] + r_m2, sxy = s.cov_m2[1], syy = s.cov_m2[2] + r_m2;
+    const double det = sxx * syy - sxy * sxy, gate = p->fusion_gate_sigma;
+    const double nis = det > 0.0 ? (syy * nu_x * nu_x - 2.0 * sxy * nu_x * nu_y + sxx * nu_y * nu_y) / det : INFINITY;
+    audit->innovation_m[0] = nu_x;
+    audit->innovation_m[1] = nu_y;
+    audit->innovation_var_m2 = 0.5 * (sxx + syy);
+    audit->test_ratio = nis / (gate * gate);
+
+    /* control: judge, then apply */
+    if (between_floors) {
+        audit->reason = sf_fix_reason_floor_mismatch;
+        f->rejected_floor++; /* not the scheme's divergence: no step toward recovery */
+        return;
+    }
+    const double evidence = sf_particle_evidence(c, fix->x_m, fix->y_m, sigma_m);
+    if (evidence >= exp(-0.5 * gate * gate)) {
+        double ess_after;
+        audit->alpha = sf_particle_update(c, p, fix->x_m, fix->y_m, sigma_m, &ess_after);
+        if (ess_after < p->particle_reseed_ess_ratio * (double)c->n) {
+            reseed(f, p, fix, s.floor, audit); /* collapsed: the cloud no longer samples the posterior */
+        } else {
+            audit->accepted = true;
+            audit->reason = sf_fix_reason_accepted;
+            f->accepted++;
+        }
+    } else if (fix->method == sf_fix_landmark || f->rejections >= p->fusion_max_rejections) {
+        reseed(f, p, fix, s.floor, audit); /* a known position, or the fixes keep landing where no particle is */
+    } else {
+        audit->reason = sf_fix_reason_gate;
+        f->rejected_gate++;
+        f->rejections++;
+        return;
+    }
+    f->last_fix_t_us = fix->t_us;
+    f->rejections = 0;
+    mirror(f, &s);
+}
+
+bool sf_fusion_particle_pose(const sf_fusion_t *const f, sf_pose_t *const pose)
+{
+    if (f->cloud == NULL || !f->cloud->seeded) {
+        return false;
+    }
+    sf_particle_summary_t s;
+    sf_particle_summary(f->cloud, &s);
+    pose->x_m = s.x_m;
+    pose->y_m = s.y_m;
+    pose->floor = s.floor;
+    pose->cov_m2[0] = s.cov_m2[0];
+    pose->cov_m2[1] = s.cov_m2[1];
+    pose->cov_m2[2] = s.cov_m2[2];
+    pose->sigma_m = sqrt(0.5 * (s.cov_m2[0] + s.cov_m2[2]));
+    pose->heading_bias_rad = s.bias_rad;
+    pose->stride_scale = s.scale;
+    pose->heading_rad = atan2(sin(pose->heading_rad + s.bias_rad), cos(pose->heading_rad + s.bias_rad));
+    pose->ess = s.ess;
+    return true;
+}
