@@ -32,6 +32,8 @@ from typing import Any
 
 import tomllib
 
+from .scenario_sources import SOURCE_DEFAULTS, validate_sources
+
 # Built-in default scenario. Units are in the key names; comments give ranges.
 DEFAULTS: dict[str, Any] = {
     "seed": 1,
@@ -152,6 +154,7 @@ DEFAULTS: dict[str, Any] = {
         "implausible_signal": "accel_z",  # accel_x..z, gyro_x..z
         "implausible_mode": "bitflip",  # "bitflip": sign bit flipped (9.8 -> -147 m/s2); "full_scale"
     },
+    **SOURCE_DEFAULTS,  # [ble], [gnss], [landmark] (scenario_sources.py)
 }
 
 
@@ -343,6 +346,7 @@ def _validate_values(d: dict, source: str) -> None:
     check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
     check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
     _validate_faults(d["faults"], check)
+    validate_sources(d, check)
     check(
         0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
         "radio.scan_interval_min_s",
@@ -419,6 +423,9 @@ BUILTIN: dict[str, dict] = {
     "aadr2015": _aadr2015_scenario("normal"),
     "aadr2015_fast": _aadr2015_scenario("fast"),
     "aadr2015_survey": _aadr2015_scenario(survey=True),
+    # world campus: indoor -> west door (landmark) -> 66 m outdoors (GNSS) -> south door (landmark) -> indoor
+    "campus": {"world": {"name": "campus"}, "walk": {"route": "track", "pause": []}},
+    "campus_survey": {"world": {"name": "campus"}, "walk": {"pause": []}, "survey": {"enabled": True}},
 }
 
 
