@@ -53,11 +53,18 @@ class Sources:
     def __bool__(self) -> bool:
         return bool(len(self.ble) or len(self.gnss) or self.landmarks)
 
-    def as_dict(self, start_ms: int) -> dict:
-        """sources.json: every landmark event and GNSS fix (board time [ms] and walk time [s]), BLE counts."""
+    def as_dict(self, start_ms: int, world: World) -> dict:
+        """sources.json: the building's footprint (indoors) and doors, every landmark event and GNSS fix
+        (board time [ms] and walk time [s]), BLE counts."""
         g = self.gnss
         macs, counts = np.unique(self.ble.mac, return_counts=True)
         return {
+            "board_time_start_ms": start_ms,
+            "footprint_m": None if world.footprint_m is None else np.asarray(world.footprint_m).tolist(),
+            "doors": [
+                {"name": d.name, "x_m": d.x_m, "y_m": d.y_m, "floor": d.floor, "landmark_id": d.landmark_id}
+                for d in world.doors
+            ],
             "landmarks": [
                 {
                     "t_s": e.t_ms / 1000.0,
@@ -382,7 +389,8 @@ def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | Non
     write_building(result.world, out_dir / "building.toml", result.scenario["ble"])
     if result.sources:
         (out_dir / "sources.json").write_text(
-            json.dumps(result.sources.as_dict(result.board_time_start_ms), indent=1) + "\n", encoding="utf-8"
+            json.dumps(result.sources.as_dict(result.board_time_start_ms, result.world), indent=1) + "\n",
+            encoding="utf-8",
         )
     summary = result.summary()
     (out_dir / "sim_summary.json").write_text(
