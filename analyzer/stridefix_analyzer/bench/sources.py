@@ -176,7 +176,7 @@ def pool(walks: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     table: dict[str, dict[str, Any]] = {}
     for name in [*names, "gnss fixes", "truth"]:
         rows = [w[name] for w in walks if name in w]
-        cat = {
+        cat: dict[str, list[Any]] = {
             k: sum((r.get(k, []) for r in rows), [])
             for k in ("indoor", "outdoor", "gnss_within", "gnss_sigma")
         }
