@@ -35,7 +35,8 @@ from .radio import Scan, simulate_scans
 from .scenario import Scenario
 from .sensors import IMU_RATE_HZ, SensorData, simulate_sensors
 from .walker import ACTIVITIES, Walk, simulate_walk
-from .world import World, load_world
+from .world import World
+from .worlds import load_world
 
 TRUTH_DECIMATION = 10  # 10 Hz truth from 100 Hz walker samples
 TRUTH_CHANNEL = "TRUTH"

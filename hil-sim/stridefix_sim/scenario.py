@@ -261,7 +261,7 @@ def _validate_values(d: dict, source: str) -> None:
         if not ok:
             raise ScenarioError(source, f"key '{key}' {what}")
 
-    from .world import WORLDS
+    from .worlds import WORLDS
 
     w, c, r, p, st, el = d["walk"], d["can"], d["radio"], d["person"], d["stairs"], d["elevator"]
     sv = d["survey"]

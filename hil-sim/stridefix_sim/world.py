@@ -368,16 +368,3 @@ def default_world(map_rotation_deg: float = 20.0) -> World:
         grid_origin_m=(LOOP_X0_M, LOOP_Y0_M),
         description="two-floor office, 60 m x 30 m, corridor loop, stairs and elevator",
     )
-
-
-# (the other worlds' modules import World from here, so they are imported once it exists)
-from .world_aadr2015 import aadr2015_world  # noqa: E402
-from .world_campus import campus_world  # noqa: E402
-
-WORLDS = {"default": default_world, "aadr2015": aadr2015_world, "campus": campus_world}
-
-
-def load_world(name: str, map_rotation_deg: float) -> World:
-    if name not in WORLDS:
-        raise KeyError(f"unknown world {name!r} (known: {', '.join(sorted(WORLDS))})")
-    return WORLDS[name](map_rotation_deg=map_rotation_deg)
