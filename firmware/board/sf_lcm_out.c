@@ -10,6 +10,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/statvfs.h>
 #include <time.h>
 
 #include <lcm/lcm.h>
@@ -41,6 +42,7 @@ struct sf_lcm_out {
     unsigned rotations_seen;
     item_t header; /* copy of the latest header event; channel NULL if none */
     bool failing;  /* inside a write-failure episode */
+    int fail_errno; /* why the episode began */
     /* shared, under lock */
     pthread_t writer;
     bool writer_started;
@@ -104,6 +106,7 @@ static void episode(sf_lcm_out_t *const out, const bool ok, const int err_no)
 {
     if (!ok && !out->failing) {
         out->failing = true;
+        out->fail_errno = err_no;
         report(out, "%s: writing the log failed: %s; events are dropped and counted until writes succeed again",
                out->file.fd >= 0 ? out->file.part_path : out->first_path, strerror(err_no));
     } else if (ok && out->failing) {
@@ -193,6 +196,18 @@ static void keep_header(sf_lcm_out_t *const out, const item_t *const it)
     out->header.is_header = true;
 }
 
+/* A full disk is not free again because one small event fits its last page (tmpfs: 346 B did, inside
+ * one episode): during an ENOSPC/EDQUOT episode writes resume only with 64 KiB free (or unknown). */
+static bool room_again(const sf_lcm_out_t *const out)
+{
+    struct statvfs st;
+    if (!out->failing || (out->fail_errno != ENOSPC && out->fail_errno != EDQUOT) || out->file.fd < 0 ||
+        fstatvfs(out->file.fd, &st) != 0) {
+        return true;
+    }
+    return (uint64_t)st.f_bavail * (uint64_t)st.f_frsize >= 64u * 1024u;
+}
+
 static void write_item(sf_lcm_out_t *const out, const item_t *const it)
 {
     if (it->is_header) {
@@ -202,6 +217,10 @@ static void write_item(sf_lcm_out_t *const out, const item_t *const it)
     if (out->file.fd >= 0 && out->cfg.rotate_bytes > 0 && out->file.offset > 0 &&
         out->file.offset + bytes > out->cfg.rotate_bytes) {
         close_file(out);
+    }
+    if (!room_again(out)) {
+        count(out, false, bytes); /* still full: dropped, counted, the episode goes on */
+        return;
     }
     int rc = out->file.fd >= 0 ? SF_OK : open_next(out, it->timestamp_us);
     if (rc == SF_OK) {

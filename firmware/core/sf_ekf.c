@@ -197,6 +197,11 @@ void sf_ekf_time(sf_ekf_t *const e, const sf_params_t *const p, const double dt_
     }
 }
 
+static double kappa(const bool correlated)
+{
+    return correlated ? 1.0 : 0.0;
+}
+
 void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const double accuracy_m,
                   double r_white_m2[3])
 {
@@ -213,23 +218,26 @@ void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const dou
     clamp_eigen2(r_white_m2, fmax(p->fusion_var_min_m2, white_min), INFINITY);
 }
 
-void sf_ekf_innovation(const sf_ekf_t *const e, double nu_m[2])
+void sf_ekf_innovation(const sf_ekf_t *const e, const bool correlated, double nu_m[2])
 {
-    nu_m[0] -= e->fix_bias_m[0];
-    nu_m[1] -= e->fix_bias_m[1];
+    nu_m[0] -= kappa(correlated) * e->fix_bias_m[0];
+    nu_m[1] -= kappa(correlated) * e->fix_bias_m[1];
 }
 
-/* H P Hᵀ, H = [I 0 0 I]: the covariance of p + c [xx, xy, yy]. */
-static void hph(const sf_ekf_t *const e, double m[3])
+/* H P Hᵀ, H = [I 0 0 κI] (κ = 1 for a Wi-Fi fix, which carries c; 0 for the other sources): the
+ * covariance of p + κc [xx, xy, yy]. */
+static void hph(const sf_ekf_t *const e, const double k, double m[3])
 {
-    m[0] = e->P[ix][ix] + 2.0 * e->P[ix][icx] + e->P[icx][icx];
-    m[1] = e->P[ix][iy] + e->P[ix][icy] + e->P[icx][iy] + e->P[icx][icy];
-    m[2] = e->P[iy][iy] + 2.0 * e->P[iy][icy] + e->P[icy][icy];
+    m[0] = e->P[ix][ix] + 2.0 * k * e->P[ix][icx] + k * k * e->P[icx][icx];
+    m[1] = e->P[ix][iy] + k * (e->P[ix][icy] + e->P[icx][iy]) + k * k * e->P[icx][icy];
+    m[2] = e->P[iy][iy] + 2.0 * k * e->P[iy][icy] + k * k * e->P[icy][icy];
 }
 
-double sf_ekf_nis(const sf_ekf_t *const e, const double nu_m[2], const double r_white_m2[3], double s_m2[3])
+
+double sf_ekf_nis(const sf_ekf_t *const e, const bool correlated, const double nu_m[2], const double r_white_m2[3],
+                  double s_m2[3])
 {
-    hph(e, s_m2);
+    hph(e, kappa(correlated), s_m2);
     for (int i = 0; i < 3; i++) {
         s_m2[i] += r_white_m2[i];
     }
@@ -248,12 +256,12 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
     }
     double r_m2[3], s_m2[3], m[3];
     sf_ekf_fix_r(e, p, accuracy_m, r_m2);
-    const double nis = sf_ekf_nis(e, nu_m, r_m2, s_m2);
+    const double nis = sf_ekf_nis(e, true, nu_m, r_m2, s_m2);
     /* an innovation beyond the gate enters shrunk onto it: evidence that R is too small, bounded */
     const double k = isfinite(nis) && nis > nis_max ? sqrt(nis_max / nis) : 1.0;
     const double vx = k * nu_m[0], vy = k * nu_m[1], a2 = accuracy_m * accuracy_m;
     const double c2 = c_var(e);
-    hph(e, m);
+    hph(e, 1.0, m);
     /* E[ννᵀ] = H P Hᵀ + F + a²M − σ_c² I, solved for M */
     const double *const f = e->fix_floor_m2;
     const double sample[3] = {(vx * vx - m[0] + c2 - f[0]) / a2, (vx * vy - m[1] - f[1]) / a2,
@@ -266,17 +274,18 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
     clamp_eigen2(e->fix_model, e->model_floor, p->ekf_r_max);
 }
 
-double sf_ekf_update(sf_ekf_t *const e, const sf_params_t *const p, const double nu_m[2],
+double sf_ekf_update(sf_ekf_t *const e, const sf_params_t *const p, const bool correlated, const double nu_m[2],
                      const double r_white_m2[3], double dpos_m[2])
 {
+    const double k = kappa(correlated);
     double s_m2[3];
-    (void)sf_ekf_nis(e, nu_m, r_white_m2, s_m2);
+    (void)sf_ekf_nis(e, correlated, nu_m, r_white_m2, s_m2);
     const double det = s_m2[0] * s_m2[2] - s_m2[1] * s_m2[1];
     const double Si[2][2] = {{s_m2[2] / det, -s_m2[1] / det}, {-s_m2[1] / det, s_m2[0] / det}};
-    /* P Hᵀ: the columns x + c_x and y + c_y */
+    /* P Hᵀ: the columns x + κc_x and y + κc_y */
     double W[n][2];
     for (int i = 0; i < n; i++) {
-        const double ph0 = e->P[i][ix] + e->P[i][icx], ph1 = e->P[i][iy] + e->P[i][icy];
+        const double ph0 = e->P[i][ix] + k * e->P[i][icx], ph1 = e->P[i][iy] + k * e->P[i][icy];
         W[i][0] = ph0 * Si[0][0] + ph1 * Si[1][0];
         W[i][1] = ph0 * Si[0][1] + ph1 * Si[1][1];
     }
@@ -288,7 +297,8 @@ double sf_ekf_update(sf_ekf_t *const e, const sf_params_t *const p, const double
     double A[n][n];
     for (int i = 0; i < n; i++) {
         for (int j = 0; j < n; j++) {
-            const double wh = j == ix || j == icx ? W[i][0] : (j == iy || j == icy ? W[i][1] : 0.0);
+            const double hx = j == ix ? 1.0 : (j == icx ? k : 0.0), hy = j == iy ? 1.0 : (j == icy ? k : 0.0);
+            const double wh = W[i][0] * hx + W[i][1] * hy;
             A[i][j] = (i == j ? 1.0 : 0.0) - wh;
         }
     }

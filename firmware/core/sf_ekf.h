@@ -112,11 +112,14 @@ void sf_ekf_time(sf_ekf_t *e, const sf_params_t *p, double dt_s);
  * above). */
 void sf_ekf_fix_r(const sf_ekf_t *e, const sf_params_t *p, double accuracy_m, double r_white_m2[3]);
 
-/* In place: the fix's offset z − p (fix minus the nominal position) becomes ν = z − p − c. */
-void sf_ekf_innovation(const sf_ekf_t *e, double nu_m[2]);
+/* In place: the fix's offset z − p (fix minus the nominal position) becomes ν = z − p − c for a fix
+ * that carries the correlated error (`correlated`: a Wi-Fi fix), ν = z − p for the other sources
+ * (GNSS, BLE, landmark: H = [I 0 0 0], their errors are not the radio map's). */
+void sf_ekf_innovation(const sf_ekf_t *e, bool correlated, double nu_m[2]);
 
 /* S = H P Hᵀ + R_w [xx, xy, yy] and the NIS νᵀ S⁻¹ ν (+∞ when S is not positive definite). */
-double sf_ekf_nis(const sf_ekf_t *e, const double nu_m[2], const double r_white_m2[3], double s_m2[3]);
+double sf_ekf_nis(const sf_ekf_t *e, bool correlated, const double nu_m[2], const double r_white_m2[3],
+                  double s_m2[3]);
 
 /* Learns the fix model from one accepted fix's innovation (before the update), clipped to nis_max. */
 void sf_ekf_learn_fix_model(sf_ekf_t *e, const sf_params_t *p, const double nu_m[2], double accuracy_m,
@@ -125,7 +128,7 @@ void sf_ekf_learn_fix_model(sf_ekf_t *e, const sf_params_t *p, const double nu_m
 /* The update and the closed-loop reset: fills the position correction dpos_m (the caller moves the
  * nominal position), corrects bias, scale and c, and returns the mean position gain of ν,
  * (W_xx + W_yy) / 2, as the record's α. */
-double sf_ekf_update(sf_ekf_t *e, const sf_params_t *p, const double nu_m[2], const double r_white_m2[3],
+double sf_ekf_update(sf_ekf_t *e, const sf_params_t *p, bool correlated, const double nu_m[2], const double r_white_m2[3],
                      double dpos_m[2]);
 
 #endif

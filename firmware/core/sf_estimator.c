@@ -240,73 +240,6 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->scheme = sf_scheme_pdr_only;
 }
 
-/* A Kalman-accepted fix: recalibrate K over the walk since the previous one (see sf_estimator.h). */
-static void calibrate_stride(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix)
-{
-    if (!p->stride_calib_enable) {
-        return;
-    }
-    if (e->calib_anchor_valid) {
-        const double walked_m = e->distance_m - e->calib_distance_m;
-        if (walked_m < p->stride_min_calib_distance_m) {
-            return; /* keep the anchor: the walk is still too short */
-        }
-        const double d_fix_m = hypot(fix->x_m - e->calib_fix_x_m, fix->y_m - e->calib_fix_y_m);
-        const double d_pdr_m = hypot(e->x_m - e->calib_pdr_x_m, e->y_m - e->calib_pdr_y_m);
-        if (d_pdr_m >= p->stride_calib_straightness * walked_m && d_pdr_m > 0.0 &&
-            sf_stride_calibrate(&e->stride, p, walked_m * d_fix_m / d_pdr_m, e->weinberg_sum) == SF_OK) {
-            e->stride_calibrations++;
-        }
-    }
-    e->calib_anchor_valid = true;
-    e->calib_fix_x_m = fix->x_m;
-    e->calib_fix_y_m = fix->y_m;
-    e->calib_pdr_x_m = e->x_m;
-    e->calib_pdr_y_m = e->y_m;
-    e->calib_distance_m = e->distance_m;
-    e->weinberg_sum = 0.0;
-}
-
-int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
-                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
-{
-    *has_fix = false;
-    if (e->site == NULL || e->site->radiomap.n_rp == 0) {
-        return 0;
-    }
-    const int16_t baro_floor = sf_floor_current(&e->floor);
-    const int rc = sf_fingerprint_match(&e->fingerprint, p, &e->site->radiomap, e->ws, scan, baro_floor, true, fix);
-    if (rc != SF_OK) {
-        /* no usable fix: each scheme records the refusal, nothing moves */
-        const sf_fix_t none = {.t_us = scan->t_us, .method = sf_fix_wifi, .floor = baro_floor,
-                               .n_ap_used = (int16_t)e->fingerprint.audit.n_used};
-        for (int s = 0; s < sf_scheme_count; s++) {
-            sf_fusion_audit_refused(&e->fusion[s], &none, sf_fix_reason_too_few_aps, &audits[s]);
-        }
-        return sf_scheme_count;
-    }
-    *has_fix = true;
-    const bool settled = sf_floor_settled(&e->floor, p);
-    if (e->floor_vote_active) { /* the fix votes before the schemes see it */
-        sf_floor_shift(&e->floor, sf_floor_vote_fix(&e->floor_vote, p, fix, baro_floor, settled), false);
-    }
-    /* between floors (the activity's stairs or moving lift, or a landing half-way up) only where there
-     * are floors to be between; a phone moved in the hand is not (settled's 0.1 m/s is for the vote) */
-    const int8_t activity = sf_activity_current(&e->activity);
-    const bool climbing = activity == sf_activity_stairs_up || activity == sf_activity_stairs_down ||
-                          activity == sf_activity_elevator;
-    const bool between = p->floor_between_reject && e->floor_vote_active && e->floor_vote.n_floors > 1 &&
-                         (climbing || !sf_floor_at_floor(&e->floor, p));
-    const int16_t floor = sf_floor_current(&e->floor);
-    for (int s = 0; s < sf_scheme_count; s++) {
-        (void)sf_fusion_fix_on_floor(&e->fusion[s], p, fix, floor, between, &audits[s]);
-    }
-    if (audits[sf_scheme_kalman].accepted) {
-        calibrate_stride(e, p, fix);
-    }
-    return sf_scheme_count;
-}
-
 bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
                               sf_pose_t *const pose)
 {
@@ -329,5 +262,10 @@ void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *c
                                       .samples_out_of_range = e->samples_refused[sf_gate_out_of_range],
                                       .samples_jumped = e->samples_refused[sf_gate_jump],
                                       .samples_out_of_order = e->samples_refused[sf_gate_out_of_order],
-                                      .gaps_bridged = e->gap.bridged};
+                                      .gaps_bridged = e->gap.bridged,
+                                      .gnss_offered = e->gnss_offered,
+                                      .gnss_refused = e->gnss_refused,
+                                      .ble_scans = e->ble.scans,
+                                      .ble_fixes = e->ble.fixes,
+                                      .landmarks_refused = e->landmarks_refused};
 }

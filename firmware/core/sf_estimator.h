@@ -51,6 +51,7 @@
 
 #include "sf_activity.h"
 #include "sf_attitude.h"
+#include "sf_ble.h"
 #include "sf_fingerprint.h"
 #include "sf_floor.h"
 #include "sf_floor_vote.h"
@@ -95,6 +96,9 @@ typedef struct {
     const sf_site_t *site;          /* NULL: no site, no Wi-Fi fixes */
     sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
     sf_fingerprint_t fingerprint;
+    sf_ble_t ble; /* the BLE ranging's counters (sf_ble.h) */
+    uint32_t gnss_offered, gnss_refused, landmarks_refused; /* GNSS fixes seen / refused (no geo-reference
+                                                             * counts as offered only), bad landmarks */
     sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
     /* online stride calibration: the anchor is the last accepted Kalman fix */
     bool calib_anchor_valid;
@@ -141,12 +145,20 @@ int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_s
                       bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
 
 /* The other absolute sources (issue 13), each with its own measurement model, offered to every scheme
- * like a Wi-Fi fix, with the same outputs and return value as sf_estimator_wifi (0 without a site):
- *   GNSS      mapped into the site frame by the site's geo-reference (sf_geo.h); accuracy = the
- *             receiver's; no fix without a valid geo-reference or with a bad accuracy.
+ * like a Wi-Fi fix, with the same outputs and return value as sf_estimator_wifi (sf_scheme_count
+ * audits, or 0 when the source cannot be used at all):
+ *   GNSS      mapped into the site frame by the site's geo-reference (sf_geo.h); 1σ = the receiver's
+ *             accuracy × gnss_accuracy_scale, floored at gnss_min_accuracy_m; on the caller's floor, no
+ *             floor vote. 0 audits without a site, a valid geo-reference or with gnss_use = 0; audits
+ *             with reason INACCURATE and no fix for an accuracy beyond gnss_max_accuracy_m or a
+ *             position off the plane (sf_geo_to_map's SF_ERANGE).
  *   BLE       ranges to the site's known beacons (sf_ble.h: log-distance path loss) → a position and
- *             accuracy; no fix with fewer beacons of the site heard than ble_min_beacons.
- *   landmark  the landmark's own position and accuracy (α = 1 in the blending schemes, sf_fusion.h). */
+ *             accuracy on the caller's floor, no floor vote; 0 audits without beacons in the site;
+ *             TOO_FEW_APS audits when fewer than ble_min_beacons usable beacons were heard.
+ *   landmark  the landmark's own position, floor and accuracy (needs no site); it votes on the floor;
+ *             every fusing scheme takes it whatever its gate (α = 1 in the fixed-gain blends,
+ *             sf_fusion.h, Sources); INACCURATE audits for a non-finite position or accuracy.
+ * A Kalman-accepted Wi-Fi or landmark fix recalibrates the stride (GNSS and BLE err too much for it). */
 int sf_estimator_gnss(sf_estimator_t *est, const sf_params_t *p, const sf_gnss_t *gnss, sf_fix_t *fix,
                       bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
 int sf_estimator_ble(sf_estimator_t *est, const sf_params_t *p, const sf_ble_scan_t *scan, sf_fix_t *fix,
@@ -171,6 +183,9 @@ typedef struct {
     uint32_t samples_jumped;       /* ... faster than a body moves */
     uint32_t samples_out_of_order; /* ... not later than their stream's last accepted sample */
     uint32_t gaps_bridged;         /* IMU gaps the walk went through, dead-reckoned (sf_gap_bridge) */
+    uint32_t gnss_offered, gnss_refused; /* GNSS fixes given to the estimator / refused (INACCURATE) */
+    uint32_t ble_scans, ble_fixes;       /* BLE windows given (with beacons in the site) / fixes made */
+    uint32_t landmarks_refused;          /* landmark events with a non-finite position or accuracy */
 } sf_estimator_status_t;
 
 /* Fills *status; cannot fail. */

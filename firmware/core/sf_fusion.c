@@ -9,8 +9,6 @@
 
 #include "sf_error.h"
 
-_Static_assert(sf_fix_reason_count == 9, "reasons mirror fix_t.REASON_*");
-
 static double clamp(const double v, const double lo, const double hi)
 {
     return v < lo ? lo : (v > hi ? hi : v);
@@ -49,11 +47,12 @@ static double alpha_one(const sf_fusion_t *const f, const sf_params_t *const p, 
     return 1.0;
 }
 
+/* A landmark is where the walker is: α = 1 (the paper's NFC), whatever the fixed gain. */
 static double alpha_static(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                            const double r_m2, sf_fix_audit_t *const audit)
 {
-    (void)f, (void)fix, (void)r_m2, (void)audit;
-    return p->fusion_static_alpha;
+    (void)f, (void)r_m2, (void)audit;
+    return fix->method == sf_fix_landmark ? 1.0 : p->fusion_static_alpha;
 }
 
 /* Records the adaptive terms in the audit (FIX.accuracy_factor, FIX.drift). */
@@ -195,14 +194,19 @@ static void reset_to_fix(sf_fusion_t *const f, const sf_params_t *const p, const
 /* ---- control: which fixes to fuse ---------------------------------------------------------------- */
 
 /* The decision for an initialised scheme, from the named conditions of the header. */
-static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const double test_ratio,
-                    const bool between_floors)
+static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
+                    const double test_ratio, const bool between_floors)
 {
     if (row_of(f)->mode == mode_dead_reckoning) {
         return sf_fix_reason_scheme_ignores;
     }
     if (row_of(f)->mode == mode_follow_fixes) {
         return sf_fix_reason_accepted; /* no gate: the scheme is the fixes */
+    }
+    /* a landmark is not a measurement to doubt: the walker is there (a tag is read within centimetres,
+     * on its floor), however far the dead reckoning has drifted */
+    if (fix->method == sf_fix_landmark) {
+        return sf_fix_reason_accepted;
     }
     /* The floor: between floors no fix is of the map's floors; on a floor, the fix's floor is one vote
      * on the caller's floor (sf_floor_vote.h) and its position is judged on the gate like any other (a
@@ -325,6 +329,13 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
         return SF_ERANGE;
     }
     const double r_m2 = fix->accuracy_m * fix->accuracy_m;
+    /* wifi_only is the paper's Wi-Fi baseline: the other sources are not its fixes */
+    if (row_of(f)->mode == mode_follow_fixes && fix->method != sf_fix_wifi) {
+        audit->reason = sf_fix_reason_scheme_ignores;
+        return SF_OK;
+    }
+    /* the ekf's correlated error c is the radio map's: only a Wi-Fi fix carries it (sf_ekf.h) */
+    const bool correlated = fix->method == sf_fix_wifi;
 
     /* fusion: predict to the fix's time */
     predict_to(f, p, fix->t_us);
@@ -334,7 +345,9 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
         if (!f->initialised) {
             start_ekf(f, p);
         }
-        sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
+        if (correlated) { /* the other sources' R is their own accuracy, white */
+            sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, ekf_r_m2);
+        }
     }
 
     /* control: start */
@@ -353,7 +366,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     /* fusion: innovation, its variance, the test ratio */
     double nu_m[2] = {fix->x_m - f->x_m, fix->y_m - f->y_m};
     if (is_ekf(f)) { /* the ekf predicts the fix at its position plus the fixes' correlated error */
-        sf_ekf_innovation(&f->ekf, nu_m);
+        sf_ekf_innovation(&f->ekf, correlated, nu_m);
     }
     const double nu_x = nu_m[0], nu_y = nu_m[1];
     const double gate = p->fusion_gate_sigma;
@@ -361,7 +374,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     audit->innovation_m[1] = nu_y;
     if (is_ekf(f)) { /* the full 2×2 S: NIS, χ² with 2 dof, on the same gate */
         double s3_m2[3];
-        audit->test_ratio = sf_ekf_nis(&f->ekf, nu_m, ekf_r_m2, s3_m2) / (gate * gate);
+        audit->test_ratio = sf_ekf_nis(&f->ekf, correlated, nu_m, ekf_r_m2, s3_m2) / (gate * gate);
         audit->innovation_var_m2 = 0.5 * (s3_m2[0] + s3_m2[2]);
     } else {
         const double s_m2 = f->var_m2 + r_m2;
@@ -370,9 +383,9 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
     }
 
     /* control: judge, then apply */
-    const int8_t reason = judge(f, p, audit->test_ratio, between_floors);
+    const int8_t reason = judge(f, p, fix, audit->test_ratio, between_floors);
     audit->reason = reason;
-    if (is_ekf(f) && reason == sf_fix_reason_accepted) { /* a rejected fix says nothing about R */
+    if (is_ekf(f) && correlated && reason == sf_fix_reason_accepted) { /* a rejected fix says nothing about R */
         sf_ekf_learn_fix_model(&f->ekf, p, nu_m, fix->accuracy_m, gate * gate);
     }
     switch (reason) {
@@ -382,7 +395,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
             blend(f, p, audit->alpha, nu_x, nu_y, r_m2);
         } else if (is_ekf(f)) {
             double dpos_m[2];
-            audit->alpha = sf_ekf_update(&f->ekf, p, nu_m, ekf_r_m2, dpos_m);
+            audit->alpha = sf_ekf_update(&f->ekf, p, correlated, nu_m, ekf_r_m2, dpos_m);
             f->x_m += dpos_m[0];
             f->y_m += dpos_m[1];
         } else { /* wifi_only */
@@ -461,22 +474,6 @@ void sf_fusion_audit_refused(const sf_fusion_t *const f, const sf_fix_t *const f
 {
     audit_begin(audit, f, fix);
     audit->reason = reason;
-}
-
-const char *sf_fix_reason_text(const int reason)
-{
-    static const char *const text[sf_fix_reason_count] = {
-        [sf_fix_reason_accepted] = "accepted",
-        [sf_fix_reason_gate] = "rejected: outside the innovation gate",
-        [sf_fix_reason_too_few_aps] = "rejected: too few access points",
-        [sf_fix_reason_no_map] = "rejected: no radio map",
-        [sf_fix_reason_floor_mismatch] = "rejected: floor differs from the scheme's floor",
-        [sf_fix_reason_not_initialised] = "rejected: scheme not initialised",
-        [sf_fix_reason_initialised] = "accepted: initialised the scheme",
-        [sf_fix_reason_recovery] = "accepted: recovery after consecutive rejections",
-        [sf_fix_reason_scheme_ignores] = "ignored: the scheme does not use fixes",
-    };
-    return reason >= 0 && reason < sf_fix_reason_count ? text[reason] : "unknown reason";
 }
 
 const char *sf_fusion_scheme_name(const int scheme)

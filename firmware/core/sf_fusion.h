@@ -29,13 +29,14 @@
  *   wifi_only  position = the latest fix, var = R: every fix accepted, no gate (τ recorded against the
  *              previous fix, S = var + R, for information only).
  *   overwrite  α = 1 (traditional dead reckoning).
- *   static     α = fusion_static_alpha (0.5: Jäger et al.'s baseline).
+ *   static     α = fusion_static_alpha (0.5: Jäger et al.'s baseline); a landmark α = 1.
  *   adaptive   α = clamp(accuracy(fix) + drift(Δt), 0, 1) (Jäger, Süß, Becker eq. 9, with the printed
  *              max(…, 1) read as min), Δt = time since this scheme's last accepted fix [s]:
  *                accuracy: Wi-Fi  piecewise-linear in n_ap_used over the knots
  *                                 (fusion_acc_wifi_ap1..4, fusion_acc_wifi_val1..4), flat outside;
  *                          GNSS   piecewise-linear in accuracy_m over (fusion_acc_gnss_m1..4,
  *                                 fusion_acc_gnss_val1..4), falling, flat outside;
+ *                          BLE    the same law in its accuracy_m (the paper has no BLE figure);
  *                          landmark fusion_acc_landmark (1: overwrite, as NFC in the paper);
  *                drift = min(fusion_drift_per_s · Δt, fusion_drift_max).
  *              The paper prints no numbers; the defaults are placeholders to tune in SIL (sf_params.h).
@@ -51,6 +52,14 @@
  * Variance after an accepted fix: kalman var ← (1 − α)·var; the fixed-gain schemes take the Joseph form
  * var ← (1 − α)²·var + α²·R (the true variance of a blend with an arbitrary gain; equal to the Kalman
  * form when α is the Kalman gain). Every variance is floored at fusion_var_min_m2.
+ *
+ * Sources (fix.method, the FIX record's source). Wi-Fi, GNSS, BLE and landmark fixes go through the
+ * same control with their own R = accuracy_m² (the ekf: a Wi-Fi fix's R from the site's fix model and
+ * the correlated error c in its innovation; the other sources white, without c). wifi_only, the
+ * paper's Wi-Fi baseline, ignores every other source (SCHEME_IGNORES). A landmark (the paper's NFC tag)
+ * is where the walker is: every scheme that fuses accepts it whatever the gate says (and between
+ * floors), the fixed-gain blends with α = 1, adaptive by its law (fusion_acc_landmark, default 1),
+ * kalman and ekf by their gain with its tiny R.
  *
  * Control (when to fuse), for the blending schemes overwrite/static/adaptive/kalman, in this order:
  *   start        uninitialised: the first fix initialises (α = 1, var = R; reason INITIALISED), or
@@ -81,7 +90,9 @@
  * (lcmtypes/stridefix/fix_t.lcm): the fix, ν, S, τ, α applied (0 when rejected), accepted, reason
  * (sf_fix_reason_*, identical to fix_t.REASON_*), scheme; plus the adaptive terms for analysis. For an
  * initialising fix ν = 0, S = R, τ = 0. TOO_FEW_APS and NO_MAP are the fingerprint matcher's reasons
- * (no position exists): the caller writes those records itself (sf_fusion_audit_refused helps);
+ * (no position exists), INACCURATE the estimator's for a source whose own accuracy or position is
+ * unusable (a GNSS fix beyond gnss_max_accuracy_m): the caller writes those records itself
+ * (sf_fusion_audit_refused helps);
  * NOT_INITIALISED is not produced here (a fix always initialises).
  *
  * Bad data (not an error of the caller, counted in the scheme's counters and skipped): a step with a
@@ -119,7 +130,8 @@ enum {
     sf_fix_reason_initialised = 6,
     sf_fix_reason_recovery = 7,
     sf_fix_reason_scheme_ignores = 8,
-    sf_fix_reason_count = 9
+    sf_fix_reason_inaccurate = 9,
+    sf_fix_reason_count = 10
 };
 
 /* sf_fusion_init_at's time for a start before any input (the config pose): the scheme's clock starts

@@ -34,7 +34,8 @@ double sf_fusion_accuracy_factor(const sf_params_t *const p, const sf_fix_t *con
                               p->fusion_acc_wifi_val4};
         return p->fusion_acc_wifi_scale * interp4(xs, vs, (double)fix->n_ap_used);
     }
-    case sf_fix_gnss: {
+    case sf_fix_gnss: /* the paper's GPS factor, falling with the reported accuracy */
+    case sf_fix_ble: { /* a BLE fix states its accuracy in metres too: the same law (no paper figure) */
         const double xs[4] = {p->fusion_acc_gnss_m1, p->fusion_acc_gnss_m2, p->fusion_acc_gnss_m3,
                               p->fusion_acc_gnss_m4};
         const double vs[4] = {p->fusion_acc_gnss_val1, p->fusion_acc_gnss_val2, p->fusion_acc_gnss_val3,

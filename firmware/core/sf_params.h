@@ -170,6 +170,20 @@
     X(fingerprint, accuracy_floor_m, double, 1.5,    0.0,     100.0,   "m",     "fix accuracy: added in quadrature to the neighbours' spread") \
     X(fingerprint, accuracy_ref_aps, int32_t, 6,     1,       64,      "APs",   "fix accuracy x sqrt(ref / APs used) when fewer APs are used")
 
+/* sf_ble.h, sf_geo.h, sf_estimator.h: the absolute sources besides Wi-Fi. BLE: a phone hears
+ * iBeacons down to about −100 dBm; below −95 dBm a reading is at the noise floor and says "far", not
+ * how far. GNSS: receivers report 1σ-ish accuracy; indoors it grows to tens of metres, and a fix
+ * claiming more than 50 m is no position within a building. */
+#define SF_PARAMS_SOURCES(X)                                                                           \
+    X(ble,  min_rssi_dbm,          double,  -95.0,   -150.0,  0.0,     "dBm",   "BLE readings weaker than this are ignored") \
+    X(ble,  min_beacons,           int32_t, 1,       1,       8,       "beacons", "fewest usable beacons for a BLE fix (one gives a disc about the beacon)") \
+    X(ble,  same_floor,            int32_t, 1,       0,       1,       "",      "1 = only beacons on the caller's floor are used (a floor slab attenuates ~15-20 dB, which the model lacks)") \
+    X(ble,  min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a BLE fix's accuracy (1 sigma)") \
+    X(gnss, use,                   int32_t, 1,       0,       1,       "",      "1 = GNSS fixes are offered to the schemes (the site needs a geo-reference)") \
+    X(gnss, max_accuracy_m,        double,  50.0,    0.0,     1e4,     "m",     "GNSS fixes reporting a worse accuracy are not used") \
+    X(gnss, accuracy_scale,        double,  1.0,     0.1,     10.0,    "",      "the receiver's reported accuracy times this is the fix's 1 sigma") \
+    X(gnss, min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a GNSS fix's accuracy (receivers round and under-report)")
+
 /* sf_fusion.h */
 #define SF_PARAMS_FUSION(X)                                                                            \
     X(fusion, gate_sigma,          double,  3.0,     0.5,     1e3,     "sigma", "innovation gate: reject when |nu|^2 > gate^2 S (2 dof: 3 passes 98.9% of consistent fixes)") \
@@ -224,7 +238,7 @@
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_OUTPUT(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

@@ -90,9 +90,9 @@ static void test_update_is_kalman(void **state)
     const double cov[3] = {4.0, 0.0, 4.0}, r[3] = {1.0, 0.0, 1.0}, nu[2] = {2.0, -1.0};
     sf_ekf_t e = known_start(&p, cov);
     double s[3];
-    near(sf_ekf_nis(&e, nu, r, s), (4.0 + 1.0) / 5.0, 1e-12);
+    near(sf_ekf_nis(&e, true, nu, r, s), (4.0 + 1.0) / 5.0, 1e-12);
     double dpos[2];
-    const double alpha = sf_ekf_update(&e, &p, nu, r, dpos);
+    const double alpha = sf_ekf_update(&e, &p, true, nu, r, dpos);
     near(alpha, 0.8, 1e-12);
     near(dpos[0], 1.6, 1e-12);
     near(dpos[1], -0.8, 1e-12);
@@ -128,7 +128,7 @@ static void test_learns_bias_and_scale(void **state)
             const double nu[2] = {tx + sigma_fix * rng_gauss(&rng) - x, ty + sigma_fix * rng_gauss(&rng) - y};
             const double r[3] = {sigma_fix * sigma_fix, 0.0, sigma_fix * sigma_fix};
             double dpos[2];
-            (void)sf_ekf_update(&e, &p, nu, r, dpos);
+            (void)sf_ekf_update(&e, &p, true, nu, r, dpos);
             x += dpos[0], y += dpos[1];
         }
         if (k >= 400) {
@@ -195,9 +195,9 @@ static double stuck_fix_run(const double sigma_c_m, sf_ekf_t *const out)
     double x = 0.0, y = 0.0;
     for (int i = 0; i < 20; i++) {
         double nu[2] = {5.0 - x, 0.0 - y}, r[3], dpos[2];
-        sf_ekf_innovation(&e, nu);
+        sf_ekf_innovation(&e, true, nu);
         sf_ekf_fix_r(&e, &p, 3.0, r);
-        (void)sf_ekf_update(&e, &p, nu, r, dpos);
+        (void)sf_ekf_update(&e, &p, true, nu, r, dpos);
         x += dpos[0], y += dpos[1];
     }
     *out = e;

@@ -1,0 +1,145 @@
+/* sf_estimator_fix.c — the estimator's absolute fixes (see sf_estimator.h): a Wi-Fi scan matched on
+ * the radio map (sf_fingerprint), a GNSS fix through the geo-reference (sf_geo), a BLE scan ranged to
+ * the site's beacons (sf_ble), a landmark as it is; each fix then votes on the floor and is offered to
+ * every scheme (sf_fusion), and a Kalman-accepted Wi-Fi or landmark fix recalibrates the stride. */
+#include <math.h>
+
+#include "sf_ble.h"
+#include "sf_error.h"
+#include "sf_estimator.h"
+#include "sf_geo.h"
+
+/* A Kalman-accepted fix: recalibrate K over the walk since the previous one (see sf_estimator.h). */
+static void calibrate_stride(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix)
+{
+    if (!p->stride_calib_enable) {
+        return;
+    }
+    if (e->calib_anchor_valid) {
+        const double walked_m = e->distance_m - e->calib_distance_m;
+        if (walked_m < p->stride_min_calib_distance_m) {
+            return; /* keep the anchor: the walk is still too short */
+        }
+        const double d_fix_m = hypot(fix->x_m - e->calib_fix_x_m, fix->y_m - e->calib_fix_y_m);
+        const double d_pdr_m = hypot(e->x_m - e->calib_pdr_x_m, e->y_m - e->calib_pdr_y_m);
+        if (d_pdr_m >= p->stride_calib_straightness * walked_m && d_pdr_m > 0.0 &&
+            sf_stride_calibrate(&e->stride, p, walked_m * d_fix_m / d_pdr_m, e->weinberg_sum) == SF_OK) {
+            e->stride_calibrations++;
+        }
+    }
+    e->calib_anchor_valid = true;
+    e->calib_fix_x_m = fix->x_m;
+    e->calib_fix_y_m = fix->y_m;
+    e->calib_pdr_x_m = e->x_m;
+    e->calib_pdr_y_m = e->y_m;
+    e->calib_distance_m = e->distance_m;
+    e->weinberg_sum = 0.0;
+}
+
+/* Every scheme judges the fix (one audit each); the floor vote first when the fix knows its floor. */
+static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix,
+                     const bool votes, sf_fix_audit_t audits[sf_scheme_count])
+{
+    const int16_t baro_floor = sf_floor_current(&e->floor);
+    const bool settled = sf_floor_settled(&e->floor, p);
+    if (votes && e->floor_vote_active) { /* the fix votes before the schemes see it */
+        sf_floor_shift(&e->floor, sf_floor_vote_fix(&e->floor_vote, p, fix, baro_floor, settled), false);
+    }
+    /* between floors (the activity's stairs or moving lift, or a landing half-way up) only where there
+     * are floors to be between; a phone moved in the hand is not (settled's 0.1 m/s is for the vote) */
+    const int8_t activity = sf_activity_current(&e->activity);
+    const bool climbing = activity == sf_activity_stairs_up || activity == sf_activity_stairs_down ||
+                          activity == sf_activity_elevator;
+    const bool between = p->floor_between_reject && e->floor_vote_active && e->floor_vote.n_floors > 1 &&
+                         (climbing || !sf_floor_at_floor(&e->floor, p));
+    const int16_t floor = sf_floor_current(&e->floor);
+    for (int s = 0; s < sf_scheme_count; s++) {
+        (void)sf_fusion_fix_on_floor(&e->fusion[s], p, fix, floor, between, &audits[s]);
+    }
+    /* the stride is calibrated on fixes whose error does not grow with the building: Wi-Fi (as since
+     * issue 4) and landmarks; GNSS and BLE fixes err by metres over a few metres of walk */
+    if (audits[sf_scheme_kalman].accepted && (fix->method == sf_fix_wifi || fix->method == sf_fix_landmark)) {
+        calibrate_stride(e, p, fix);
+    }
+    return sf_scheme_count;
+}
+
+/* No fix from this input: each scheme records the refusal, nothing moves. */
+static int refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t method, const int16_t n_used,
+                  const int8_t reason, sf_fix_audit_t audits[sf_scheme_count])
+{
+    const sf_fix_t none = {.t_us = t_us, .method = method, .floor = sf_floor_current(&e->floor), .n_ap_used = n_used};
+    for (int s = 0; s < sf_scheme_count; s++) {
+        sf_fusion_audit_refused(&e->fusion[s], &none, reason, &audits[s]);
+    }
+    return sf_scheme_count;
+}
+
+int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
+                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    if (e->site == NULL || e->site->radiomap.n_rp == 0) {
+        return 0;
+    }
+    const int16_t baro_floor = sf_floor_current(&e->floor);
+    const int rc = sf_fingerprint_match(&e->fingerprint, p, &e->site->radiomap, e->ws, scan, baro_floor, true, fix);
+    if (rc != SF_OK) {
+        return refuse(e, scan->t_us, sf_fix_wifi, (int16_t)e->fingerprint.audit.n_used, sf_fix_reason_too_few_aps,
+                      audits);
+    }
+    *has_fix = true;
+    return offer_fix(e, p, fix, true, audits);
+}
+
+int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const sf_gnss_t *const gnss,
+                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    e->gnss_offered++;
+    if (e->site == NULL || !e->site->geo.valid || p->gnss_use == 0) {
+        return 0;
+    }
+    double x_m, y_m;
+    const double acc_m = gnss->accuracy_m * p->gnss_accuracy_scale;
+    if (!(isfinite(acc_m) && acc_m >= 0.0 && acc_m <= p->gnss_max_accuracy_m) ||
+        sf_geo_to_map(&e->site->geo, gnss->lat_deg, gnss->lon_deg, &x_m, &y_m) != SF_OK) {
+        e->gnss_refused++;
+        return refuse(e, gnss->t_us, sf_fix_gnss, 0, sf_fix_reason_inaccurate, audits);
+    }
+    /* a GNSS fix knows no floor: it is on the caller's, and does not vote */
+    *fix = (sf_fix_t){.t_us = gnss->t_us, .method = sf_fix_gnss, .x_m = x_m, .y_m = y_m,
+                      .floor = sf_floor_current(&e->floor), .accuracy_m = fmax(acc_m, p->gnss_min_accuracy_m)};
+    *has_fix = true;
+    return offer_fix(e, p, fix, false, audits);
+}
+
+int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const sf_ble_scan_t *const scan,
+                     sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    if (e->site == NULL || e->site->beacons.n_beacons == 0) {
+        return 0;
+    }
+    int32_t n_used = 0;
+    if (sf_ble_fix(&e->ble, p, &e->site->beacons, scan, sf_floor_current(&e->floor), fix, &n_used) != SF_OK) {
+        return refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
+    }
+    *has_fix = true;
+    return offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
+}
+
+int sf_estimator_landmark(sf_estimator_t *const e, const sf_params_t *const p, const sf_landmark_t *const lm,
+                          sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    if (!(isfinite(lm->x_m) && isfinite(lm->y_m) && isfinite(lm->accuracy_m) && lm->accuracy_m >= 0.0)) {
+        e->landmarks_refused++;
+        return refuse(e, lm->t_us, sf_fix_landmark, 0, sf_fix_reason_inaccurate, audits);
+    }
+    /* a landmark needs no site: its position is in the map frame already */
+    *fix = (sf_fix_t){.t_us = lm->t_us, .method = sf_fix_landmark, .x_m = lm->x_m, .y_m = lm->y_m,
+                      .floor = lm->floor, .accuracy_m = lm->accuracy_m};
+    *has_fix = true;
+    return offer_fix(e, p, fix, true, audits);
+}
