@@ -9,7 +9,9 @@ same scenario and seed give byte-identical outputs.
 Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
 10 Hz, t_us = unwrapped board time in µs, also the event timestamp; x, y, the true floor, the true
 heading = walking direction in the map frame, steps so far; source SIMULATION), ``sim_summary.json``
-and ``init_truth.ini`` (the true start pose for the firmware). On a route with reference points (the
+``init_truth.ini`` (the true start pose for the firmware), ``building.toml`` (the world's building
+description, building.py) and, for a world with beacons, GNSS or landmarks, ``sources.json`` (what
+they sent: ``Sources.as_dict``). On a route with reference points (the
 ``track``), one extra TRUTH with source WAYPOINT at the moment the walker passes each reference point
 (time interpolated to the µs between walker samples; x, y = the surveyed point), in time order
 with the 10 Hz messages (a SIMULATION message first when both fall on the same µs).

@@ -15,7 +15,9 @@ Built-in named scenarios (``BUILTIN``, ``stridefix sim --scenario NAME``): ``def
 ``office_survey``: the survey of the office's calibration points (2 m along the corridors, both
 floors, the elevator between them); ``aadr2015_slow`` / ``aadr2015`` / ``aadr2015_fast``: the 70 m
 track with 14 reference points through the aadr2015 foyer (world ``aadr2015``) at one pace;
-``aadr2015_survey``: the survey of the foyer's 67 calibration points.
+``aadr2015_survey``: the survey of the foyer's 67 calibration points; ``campus`` / ``campus_survey``:
+world ``campus`` (indoor, a door with a landmark, 66 m outdoors with GNSS, another door, indoor) and its
+survey. ``[ble]``, ``[gnss]``, ``[landmark]``: scenario_sources.py.
 
 Survey mode (``[survey] enabled = true`` or ``stridefix sim --survey``): instead of ``walk.route`` the
 person walks from calibration point to calibration point, and at each stands still, faces
