@@ -277,7 +277,7 @@ def format_table(doc: dict[str, Any]) -> str:
         f"fixes sent; site {'with' if doc['site_has_building'] else 'WITHOUT'} the building description "
         f"(walls, beacons, geo-reference)",
         f"{'scheme':<{w}}{'in m':>8}{'out m':>8}{'<=2sig':>8}{'sig m':>8}{'lm max m':>9}{'walls':>7}"
-        f"{'  GNSS fix acc/off':>19}{'  LM fix':>10}{'  BLE fix':>12}",
+        f" {'GNSS acc/off':>19}{'LM acc/off':>10}{'BLE acc/off':>12}",
     ]
     for name, r in t.items():
         fx = r["fixes"]
