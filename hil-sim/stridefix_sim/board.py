@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cantools
 import numpy as np
@@ -39,13 +40,16 @@ from . import faults as flt
 from .radio import Scan
 from .sensors import SensorData
 
+if TYPE_CHECKING:
+    from .pipeline import Sources
+
 EPOCH_US = 1_700_000_000 * 1_000_000
 DBC_PATH = Path(__file__).resolve().parents[2] / "firmware" / "board.dbc"
 IMU_PERIOD_MS = 10
 FW_MAJOR, FW_MINOR = 1, 0
 
 # priority of frames that share a board millisecond
-P_TIME, P_IMU, P_MAG, P_BARO, P_WIFI, P_STATUS = range(6)
+P_TIME, P_IMU, P_MAG, P_BARO, P_WIFI, P_BLE, P_GNSS, P_LANDMARK, P_STATUS = range(9)
 
 
 @dataclass
@@ -118,6 +122,7 @@ def _events(
     sc: dict,
     clock: flt.BoardClock,
     rec: flt.FaultRecord,
+    sources: Sources | None = None,
 ) -> _Frames:
     """Every frame the board sends, unsorted (``emulate_board`` orders them by simulated ms, then
     priority, then the order they are added here). ``clock`` gives board time and counter restarts
@@ -225,6 +230,8 @@ def _events(
             pack(msgs[name], {f: a[:, 2 + c] for c, f in enumerate(names[name])}),
             ins=base + a[:, 1],
         )
+    if sources is not None:
+        _source_frames(ev, msgs, sources, sc, clock, rec, sent, duration_ms)
     t, _ = clock.periodic(500, 1000, duration_ms)
     j = np.minimum(np.searchsorted(baro_t, t), len(tmp) - 1)
     ev.add(
@@ -246,6 +253,56 @@ def _events(
         ),
     )
     return ev
+
+
+def _source_frames(
+    ev: _Frames, msgs: dict, src: Sources, sc: dict, clock, rec, sent, duration_ms: int
+) -> None:
+    """BLE_ADV (one per advertisement heard, at its reception), LANDMARK (``landmark.latency_ms`` after
+    the read; t_lo_ms = the read's board time mod 256) and GNSS_INFO + GNSS_POSITION (``gnss.latency_ms``
+    after the fix; time_ms = the fix's full board time). A source sample taken while the board was down,
+    or whose frame would fall in another boot than the sample, is not sent (board resets)."""
+    ad = src.ble
+    if len(ad):
+        t, _, lo, mac, rssi = sent(ad.t_ms.astype(np.int64), ad.mac, ad.rssi_dbm)
+        ev.add("BLE_ADV", t, P_BLE, pack(msgs["BLE_ADV"], {"beacon_id": mac, "rssi": rssi, "t_lo_ms": lo}))
+
+    def same_boot(t_a: np.ndarray, t_b: np.ndarray) -> np.ndarray:
+        if not clock.resets:
+            return np.ones(len(t_a), bool)
+        seg_a = clock.segment(t_a)
+        ok = (seg_a >= 0) & (seg_a == clock.segment(t_b))
+        rec.unsent_reset += int(np.sum(~ok))
+        return ok
+
+    if src.landmarks:
+        t_read = np.array([e.t_ms for e in src.landmarks], np.int64)
+        t_tx = t_read + int(sc["landmark"]["latency_ms"])
+        ok = (t_tx <= duration_ms) & same_boot(t_read, t_tx)
+        sel = [e for e, k in zip(src.landmarks, ok) if k]
+        if sel:
+            fields = {
+                "x": np.array([e.x_m for e in sel]),
+                "y": np.array([e.y_m for e in sel]),
+                "floor": np.array([e.floor for e in sel], np.int64),
+                "t_lo_ms": clock.board_ms(t_read[ok]) % 256,
+            }
+            ev.add("LANDMARK", t_tx[ok], P_LANDMARK, pack(msgs["LANDMARK"], fields))
+    fx = src.gnss
+    if len(fx):
+        t_tx = fx.t_ms.astype(np.int64) + int(sc["gnss"]["latency_ms"])
+        ok = (t_tx <= duration_ms) & same_boot(fx.t_ms.astype(np.int64), t_tx)
+        n = int(ok.sum())
+        base = ev.reserve(2 * n)  # INFO then POSITION of the same fix
+        i = np.arange(n, dtype=np.int64)
+        info = {
+            "time_ms": clock.board_ms(fx.t_ms.astype(np.int64)[ok]),
+            "altitude": fx.alt_m[ok],
+            "accuracy": np.clip(fx.accuracy_m[ok], 0.0, 409.5),
+        }
+        ev.add("GNSS_INFO", t_tx[ok], P_GNSS, pack(msgs["GNSS_INFO"], info), ins=base + 2 * i)
+        pos = {"latitude": fx.lat_deg[ok], "longitude": fx.lon_deg[ok]}
+        ev.add("GNSS_POSITION", t_tx[ok], P_GNSS, pack(msgs["GNSS_POSITION"], pos), ins=base + 2 * i + 1)
 
 
 def _digits(v: np.ndarray, width: int) -> np.ndarray:
@@ -293,6 +350,7 @@ def emulate_board(
     rng: np.random.Generator,
     dbc_path: Path | str = DBC_PATH,
     fault_rng: np.random.Generator | None = None,
+    sources: Sources | None = None,
 ) -> BoardOutput:
     """The board's frames as candump lines; ``rng`` draws the random loss, ``fault_rng`` the
     ``[faults]`` (faults.py; needed only when one is on)."""
@@ -305,7 +363,7 @@ def emulate_board(
     rec = flt.FaultRecord()
     clock = flt.BoardClock(start_ms, int(can["boot_id"]), fc if on else None)
     rec.resets = clock.resets
-    ev = _events(db, sensors, scans, n_imu, sc, clock, rec)
+    ev = _events(db, sensors, scans, n_imu, sc, clock, rec, sources)
     names = [m.name for m in db.messages]
     code = {name: c for c, name in enumerate(names)}
     t = np.concatenate([p[0] for p in ev.parts])

@@ -9,7 +9,9 @@ same scenario and seed give byte-identical outputs.
 Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
 10 Hz, t_us = unwrapped board time in µs, also the event timestamp; x, y, the true floor, the true
 heading = walking direction in the map frame, steps so far; source SIMULATION), ``sim_summary.json``
-and ``init_truth.ini`` (the true start pose for the firmware). On a route with reference points (the
+``init_truth.ini`` (the true start pose for the firmware), ``building.toml`` (the world's building
+description, building.py) and, for a world with beacons, GNSS or landmarks, ``sources.json`` (what
+they sent: ``Sources.as_dict``). On a route with reference points (the
 ``track``), one extra TRUTH with source WAYPOINT at the moment the walker passes each reference point
 (time interpolated to the µs between walker samples; x, y = the surveyed point), in time order
 with the 10 Hz messages (a SIMULATION message first when both fall on the same µs).
@@ -25,16 +27,105 @@ from typing import TextIO
 
 import numpy as np
 
+from .ble import Advertisements, simulate_ble
 from .board import IMU_PERIOD_MS, BoardOutput, emulate_board
+from .building import write_building
 from .gait import make_person
+from .gnss import Fixes, simulate_gnss
+from .landmarks import LandmarkEvent, simulate_landmarks
 from .radio import Scan, simulate_scans
 from .scenario import Scenario
 from .sensors import IMU_RATE_HZ, SensorData, simulate_sensors
 from .walker import ACTIVITIES, Walk, simulate_walk
-from .world import World, load_world
+from .world import World
+from .worlds import load_world
 
 TRUTH_DECIMATION = 10  # 10 Hz truth from 100 Hz walker samples
 TRUTH_CHANNEL = "TRUTH"
+SOURCE_TABLES = ("ble", "gnss", "landmark")  # scenario tables of sources.py's models
+
+
+@dataclass
+class Sources:
+    """What the board heard and read besides its sensors and Wi-Fi (empty where the world has none)."""
+
+    ble: Advertisements
+    gnss: Fixes
+    landmarks: list[LandmarkEvent]
+
+    def __bool__(self) -> bool:
+        return bool(len(self.ble) or len(self.gnss) or self.landmarks)
+
+    def as_dict(self, start_ms: int, world: World) -> dict:
+        """sources.json: the building's footprint (indoors) and doors, every landmark event and GNSS fix
+        (board time [ms] and walk time [s]), BLE counts."""
+        g = self.gnss
+        macs, counts = np.unique(self.ble.mac, return_counts=True)
+        return {
+            "board_time_start_ms": start_ms,
+            "footprint_m": None if world.footprint_m is None else np.asarray(world.footprint_m).tolist(),
+            "doors": [
+                {"name": d.name, "x_m": d.x_m, "y_m": d.y_m, "floor": d.floor, "landmark_id": d.landmark_id}
+                for d in world.doors
+            ],
+            "landmarks": [
+                {
+                    "t_s": e.t_ms / 1000.0,
+                    "board_time_ms": (start_ms + e.t_ms) % 2**32,
+                    "landmark_id": e.landmark_id,
+                    "x_m": e.x_m,
+                    "y_m": e.y_m,
+                    "floor": e.floor,
+                    "distance_m": round(e.distance_m, 4),
+                }
+                for e in self.landmarks
+            ],
+            "gnss": {
+                "n": len(g),
+                "columns": [
+                    "t_s",
+                    "lat_deg",
+                    "lon_deg",
+                    "alt_m",
+                    "accuracy_m",
+                    "x_m",
+                    "y_m",
+                    "truth_x_m",
+                    "truth_y_m",
+                    "mode",
+                ],
+                "rows": [
+                    [
+                        t / 1000.0,
+                        la,
+                        lo,
+                        round(al, 3),
+                        round(ac, 3),
+                        round(x, 4),
+                        round(y, 4),
+                        round(tx, 4),
+                        round(ty, 4),
+                        int(m),
+                    ]
+                    for t, la, lo, al, ac, x, y, tx, ty, m in zip(
+                        g.t_ms.tolist(),
+                        g.lat_deg.tolist(),
+                        g.lon_deg.tolist(),
+                        g.alt_m.tolist(),
+                        g.accuracy_m.tolist(),
+                        g.x_m.tolist(),
+                        g.y_m.tolist(),
+                        g.truth_x_m.tolist(),
+                        g.truth_y_m.tolist(),
+                        g.mode.tolist(),
+                    )
+                ],
+            },
+            "ble": {
+                "advertisements": len(self.ble),
+                "per_beacon": {f"{int(m):012x}": int(c) for m, c in zip(macs, counts)},
+            },
+        }
 
 
 @dataclass
@@ -46,6 +137,7 @@ class SimResult:
     scans: list[Scan]
     board: BoardOutput
     duration_s: float
+    sources: Sources | None = None
 
     @property
     def board_time_start_ms(self) -> int:
@@ -138,6 +230,15 @@ class SimResult:
                 {k: r[k] for k in ("index", "x_m", "y_m", "floor", "s_m", "t_s")} for r in refs
             ]
         scenario = self.scenario.data
+        if not (self.world.beacons or self.world.doors or self.world.footprint_m is not None):
+            # a world without these sources: its summary stays as it was before they existed
+            scenario = {k: v for k, v in scenario.items() if k not in SOURCE_TABLES}
+        elif self.sources is not None:
+            extra["sources"] = {
+                "ble_advertisements": len(self.sources.ble),
+                "gnss_fixes": len(self.sources.gnss),
+                "landmark_events": len(self.sources.landmarks),
+            }
         if "faults" in c:  # the ground truth of what the faults damaged (faults.FaultRecord)
             extra["faults"] = c["faults"]
         else:  # faults off: the summary of a clean run stays as it was before faults existed
@@ -193,7 +294,9 @@ def simulate(scenario: Scenario) -> SimResult:
     world = load_world(sc["world"]["name"], sc["world"]["map_rotation_deg"])
     ss = np.random.SeedSequence(scenario.seed)
     # (a sixth stream for the faults leaves the first five as they were: child i has spawn key (i,))
-    r_walk, r_sens, r_radio, r_can, r_person, r_faults = (np.random.default_rng(s) for s in ss.spawn(6))
+    # (children 6, 7 for BLE and GNSS leave the first six as they were)
+    streams = [np.random.default_rng(s) for s in ss.spawn(8)]
+    r_walk, r_sens, r_radio, r_can, r_person, r_faults, r_ble, r_gnss = streams
     duration = float(sc["duration_s"])
     duration = math.ceil(duration * 10 - 1e-9) / 10 if duration > 0 else None  # whole truth periods
     person = make_person(sc, r_person)
@@ -201,7 +304,12 @@ def simulate(scenario: Scenario) -> SimResult:
     duration_s = float(walk.t_s[-1])
     sensors = simulate_sensors(sc, world, walk, r_sens)
     scans = simulate_scans(sc, world, walk, r_radio)
-    board = emulate_board(sensors, scans, len(walk.t_s), sc, r_can, fault_rng=r_faults)
+    sources = Sources(
+        simulate_ble(sc, world, walk, r_ble),
+        simulate_gnss(sc, world, walk, r_gnss),
+        simulate_landmarks(sc, world, walk),
+    )
+    board = emulate_board(sensors, scans, len(walk.t_s), sc, r_can, fault_rng=r_faults, sources=sources)
     return SimResult(
         scenario=scenario,
         world=world,
@@ -210,6 +318,7 @@ def simulate(scenario: Scenario) -> SimResult:
         scans=scans,
         board=board,
         duration_s=duration_s,
+        sources=sources,
     )
 
 
@@ -280,6 +389,12 @@ def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | Non
         candump_stream.flush()
     write_truth_log(result, out_dir / "truth.lcmlog")
     write_init_ini(result, out_dir / "init_truth.ini")
+    write_building(result.world, out_dir / "building.toml", result.scenario["ble"])
+    if result.sources:
+        (out_dir / "sources.json").write_text(
+            json.dumps(result.sources.as_dict(result.board_time_start_ms, result.world), indent=1) + "\n",
+            encoding="utf-8",
+        )
     summary = result.summary()
     (out_dir / "sim_summary.json").write_text(
         json.dumps(summary, indent=2, sort_keys=True) + "\n", encoding="utf-8"

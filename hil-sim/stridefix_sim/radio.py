@@ -68,6 +68,37 @@ def walls_loss_db(px, py, ax, ay, walls: np.ndarray, loss_db: np.ndarray) -> np.
     return (hit * loss_db).sum(axis=-1)
 
 
+def mean_rssi_dbm(world: World, r: dict, p0_dbm, exponent: float, rx: tuple, tx: tuple) -> np.ndarray:
+    """The model's mean RSSI [dBm] without shadowing: P0 − 10·n·log10(max(d, 1 m)) − walls − floors.
+
+    ``rx`` = (x, y, z, floor) of the receiver and ``tx`` = (x, y, z, floor) of the transmitter
+    (arrays that broadcast, z in metres above floor 0); ``p0_dbm`` the RSSI at 1 m; walls cost
+    ``r["wall_loss_db"]`` unless the world gives a wall its own loss, floors ``r["floor_loss_db"]`` each.
+    Shared by the Wi-Fi scans (here) and the BLE advertisements (ble.py)."""
+    px, py, pz, pf = rx
+    ax, ay, az, af = tx
+    d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + (pz - az) ** 2)
+    args = (
+        np.broadcast_to(px, d.shape),
+        np.broadcast_to(py, d.shape),
+        np.broadcast_to(ax, d.shape),
+        np.broadcast_to(ay, d.shape),
+        world.walls_m,
+    )
+    if world.walls_loss_db is None:
+        wall_db = r["wall_loss_db"] * walls_crossed(*args)
+    else:
+        wall_db = walls_loss_db(
+            *args, np.where(np.isnan(world.walls_loss_db), r["wall_loss_db"], world.walls_loss_db)
+        )
+    return (
+        p0_dbm
+        - 10.0 * exponent * np.log10(np.maximum(d, 1.0))
+        - wall_db
+        - r["floor_loss_db"] * np.abs(af - pf)
+    )
+
+
 def scan_times_ms(duration_ms: int, rng: np.random.Generator, r: dict) -> np.ndarray:
     times = []
     t = rng.uniform(0.5, 2.0)
@@ -105,27 +136,8 @@ def simulate_scans(sc: dict, world: World, walk: Walk, rng: np.random.Generator)
     tx = np.array([a.tx_power_dbm for a in aps])
     f_mhz = np.array([a.freq_mhz for a in aps], dtype=float)
     p0 = tx - (20.0 * np.log10(f_mhz) - 27.55)
-    d = np.sqrt((px - ax) ** 2 + (py - ay) ** 2 + (pz - az) ** 2)
-    args = (
-        np.broadcast_to(px, d.shape),
-        np.broadcast_to(py, d.shape),
-        np.broadcast_to(ax, d.shape),
-        np.broadcast_to(ay, d.shape),
-        world.walls_m,
-    )
-    if world.walls_loss_db is None:
-        wall_db = r["wall_loss_db"] * walls_crossed(*args)
-    else:
-        wall_db = walls_loss_db(
-            *args, np.where(np.isnan(world.walls_loss_db), r["wall_loss_db"], world.walls_loss_db)
-        )
-    rssi = (
-        p0[None, :]
-        - 10.0 * r["path_loss_exponent"] * np.log10(np.maximum(d, 1.0))
-        - wall_db
-        - r["floor_loss_db"] * np.abs(af - pf)
-        + r["shadowing_db"] * rng.standard_normal(d.shape)
-    )
+    rssi = mean_rssi_dbm(world, r, p0[None, :], r["path_loss_exponent"], (px, py, pz, pf), (ax, ay, az, af))
+    rssi = rssi + r["shadowing_db"] * rng.standard_normal(rssi.shape)
     if r["body_loss_db"] > 0:
         facing = walk.heading_rad[idx][:, None]
         rssi = rssi - r["body_loss_db"] * 0.5 * (1.0 - np.cos(np.arctan2(ay - py, ax - px) - facing))

@@ -15,7 +15,9 @@ Built-in named scenarios (``BUILTIN``, ``stridefix sim --scenario NAME``): ``def
 ``office_survey``: the survey of the office's calibration points (2 m along the corridors, both
 floors, the elevator between them); ``aadr2015_slow`` / ``aadr2015`` / ``aadr2015_fast``: the 70 m
 track with 14 reference points through the aadr2015 foyer (world ``aadr2015``) at one pace;
-``aadr2015_survey``: the survey of the foyer's 67 calibration points.
+``aadr2015_survey``: the survey of the foyer's 67 calibration points; ``campus`` / ``campus_survey``:
+world ``campus`` (indoor, a door with a landmark, 66 m outdoors with GNSS, another door, indoor) and its
+survey. ``[ble]``, ``[gnss]``, ``[landmark]``: scenario_sources.py.
 
 Survey mode (``[survey] enabled = true`` or ``stridefix sim --survey``): instead of ``walk.route`` the
 person walks from calibration point to calibration point, and at each stands still, faces
@@ -31,6 +33,8 @@ from pathlib import Path
 from typing import Any
 
 import tomllib
+
+from .scenario_sources import SOURCE_DEFAULTS, validate_sources
 
 # Built-in default scenario. Units are in the key names; comments give ranges.
 DEFAULTS: dict[str, Any] = {
@@ -152,6 +156,7 @@ DEFAULTS: dict[str, Any] = {
         "implausible_signal": "accel_z",  # accel_x..z, gyro_x..z
         "implausible_mode": "bitflip",  # "bitflip": sign bit flipped (9.8 -> -147 m/s2); "full_scale"
     },
+    **SOURCE_DEFAULTS,  # [ble], [gnss], [landmark] (scenario_sources.py)
 }
 
 
@@ -258,7 +263,7 @@ def _validate_values(d: dict, source: str) -> None:
         if not ok:
             raise ScenarioError(source, f"key '{key}' {what}")
 
-    from .world import WORLDS
+    from .worlds import WORLDS
 
     w, c, r, p, st, el = d["walk"], d["can"], d["radio"], d["person"], d["stairs"], d["elevator"]
     sv = d["survey"]
@@ -343,6 +348,7 @@ def _validate_values(d: dict, source: str) -> None:
     check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
     check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
     _validate_faults(d["faults"], check)
+    validate_sources(d, check)
     check(
         0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
         "radio.scan_interval_min_s",
@@ -419,6 +425,9 @@ BUILTIN: dict[str, dict] = {
     "aadr2015": _aadr2015_scenario("normal"),
     "aadr2015_fast": _aadr2015_scenario("fast"),
     "aadr2015_survey": _aadr2015_scenario(survey=True),
+    # world campus: indoor -> west door (landmark) -> 66 m outdoors (GNSS) -> south door (landmark) -> indoor
+    "campus": {"world": {"name": "campus"}, "walk": {"route": "track", "pause": []}},
+    "campus_survey": {"world": {"name": "campus"}, "walk": {"pause": []}, "survey": {"enabled": True}},
 }
 
 

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import fusion, particle_cost, realdata, reliability, sil_pdr, soak
+from stridefix_analyzer.bench import fusion, particle_cost, realdata, reliability, sil_pdr, soak, sources
 from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
@@ -55,6 +55,13 @@ def _run_office(args: argparse.Namespace, firmware: Firmware, seeds: list[int], 
     print(f"targets (kalman mean <= 2.0 m, p95 <= 4.5 m) met: {doc['targets_met']}")
     print(f"wrote {out / 'office_wifi' / 'office_wifi.json'} ({doc['run_s']:.0f} s)")
     return fusion.missed_targets_office(doc)
+
+
+def _run_sources(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    doc = sources.run_sources(seeds, firmware, out / "sources", args.sets)
+    print(sources.format_table(doc))
+    print(f"wrote {out / 'sources.json'} ({doc['run_s']:.0f} s)")
+    return sources.missed_targets(doc)
 
 
 def _run_real_targets(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
@@ -110,6 +117,7 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "sil-pdr": (_run_sil_pdr, "1,2,3"),
     "aadr2015": (_run_aadr2015, "1,2,3,4,5"),
     "office-wifi": (_run_office, "1,2,3"),
+    "sources": (_run_sources, "1,2,3"),
     "real-targets": (_run_real_targets, "1"),
     "reliability": (_run_reliability, "1"),
     "soak": (_run_soak, "1"),
@@ -140,7 +148,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         choices=list(BENCHES),
         help="sil-pdr: PDR targets at each pace; aadr2015: the auto-adaptive DR paper's "
         "experiment (fusion schemes at the reference points); office-wifi: the fusion "
-        "schemes on the default office walk with a surveyed radio map; real-targets: issue 11's "
+        "schemes on the default office walk with a surveyed radio map; sources: every scheme on the campus walk "
+        "(indoor, door landmark, outdoor GNSS, door landmark, indoor): errors in and out, GNSS accuracy, "
+        "landmarks, wall crossings; real-targets: issue 11's "
         "targets on realbench results.json files (--results); reliability: the default walk with each bus "
         "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
         "accounting (make soak); particle-cost: the particle scheme's instructions per step under callgrind "

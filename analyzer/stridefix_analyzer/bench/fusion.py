@@ -75,8 +75,8 @@ def simulate_and_log(
     return summary
 
 
-def build_site(survey_scenario: str, firmware: Firmware, out: Path) -> Path:
-    """Survey → firmware log → radio map → site file."""
+def build_site(survey_scenario: str, firmware: Firmware, out: Path, extra: Sequence[str] = ()) -> Path:
+    """Survey → firmware log → radio map → site file (``extra``: more ``radiomap build`` options)."""
     summary = simulate_and_log(survey_scenario, SURVEY_SEED, firmware, out, None)
     site = out / "site.sfsite"
     cmd = [
@@ -96,6 +96,7 @@ def build_site(survey_scenario: str, firmware: Firmware, out: Path) -> Path:
     ]
     if "floor_height_m" in summary:
         cmd += ["--floor-height-m", str(summary["floor_height_m"])]
+    cmd += list(extra)
     run_stage(cmd, f"radiomap build {survey_scenario}", BenchError)
     return site
 

@@ -100,7 +100,12 @@ def test_builtin_named_scenarios():
         "aadr2015",
         "aadr2015_fast",
         "aadr2015_survey",
+        "campus",
+        "campus_survey",
     }
+    assert builtin_scenario("campus")["world"]["name"] == "campus"
+    assert builtin_scenario("campus")["walk"]["route"] == "track"
+    assert builtin_scenario("campus_survey")["survey"]["enabled"]
     assert resolve_scenario(None).data == resolve_scenario("default").data == DEFAULTS
     assert DEFAULTS["walk"]["route"] == "tour" and DEFAULTS["walk"]["pace"] == "normal"
     for pace in ("slow", "normal", "fast"):

@@ -16,7 +16,8 @@ from stridefix_sim.board import load_dbc, pack
 from stridefix_sim.pipeline import simulate, write_truth_log
 from stridefix_sim.route import Polyline
 from stridefix_sim.scenario import BUILTIN, ScenarioError, builtin_scenario, parse_scenario
-from stridefix_sim.world import aadr2015_world, survey_points
+from stridefix_sim.world import survey_points
+from stridefix_sim.world_aadr2015 import aadr2015_world
 
 # sha256 of board.candump / truth.lcmlog of the built-in scenarios (seed 1) before survey mode existed
 OLD_BYTES = {

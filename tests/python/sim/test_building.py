@@ -1,0 +1,59 @@
+"""The building description (building.toml, ``stridefix-building 1``) round-trips a world: parsed with
+tomllib it gives back the world's walls, ports, beacons and geo-reference."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import tomllib
+from stridefix_sim.building import FORMAT, building_text
+from stridefix_sim.scenario import builtin_scenario
+from stridefix_sim.worlds import WORLDS, load_world
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_building_round_trips_the_world(name):
+    world = load_world(name, 20.0)
+    ble = builtin_scenario("campus").data["ble"]
+    doc = tomllib.loads(building_text(world, ble))
+    assert doc["format"] == FORMAT
+    # walls: every segment once per floor, coordinates as the world has them (to 1 µm)
+    walls = doc["wall"]
+    assert len(walls) == len(world.walls_m) * world.n_floors
+    for f in range(world.n_floors):
+        got = np.array([[*w["points"][0], *w["points"][1]] for w in walls if w["floor"] == f])
+        np.testing.assert_allclose(got, world.walls_m, atol=1e-6)
+    assert all(w["closed"] is False and len(w["points"]) == 2 for w in walls)
+    # ports: stairs, elevator, each door to the outside
+    kinds = [p["kind"] for p in doc.get("port", [])]
+    assert kinds.count("stairs") == (world.stairs is not None)
+    assert kinds.count("elevator") == (world.elevator is not None)
+    doors = [p for p in doc.get("port", []) if p["kind"] == "door"]
+    assert [(p["x_m"], p["y_m"], p["floors"]) for p in doors] == [
+        (d.x_m, d.y_m, [d.floor]) for d in world.doors
+    ]
+    for p in doc.get("port", []):
+        assert p["radius_m"] > 0 and p["floors"] == sorted(p["floors"])
+        assert all(0 <= f < world.n_floors for f in p["floors"])
+    # beacons: MAC text, position, floor, measured power
+    beacons = doc.get("beacon", [])
+    assert len(beacons) == len(world.beacons)
+    for b, w in zip(beacons, world.beacons):
+        assert int(b["id"].replace(":", ""), 16) == w.mac
+        assert (b["x_m"], b["y_m"], b["floor"], b["rssi_1m_dbm"]) == (w.x_m, w.y_m, w.floor, w.rssi_1m_dbm)
+    # BLE model and geo-reference
+    assert doc["ble"]["path_loss_exponent"] == ble["path_loss_exponent"]
+    assert doc["ble"]["range_sigma_db"] == ble["shadowing_db"]
+    assert doc["geo"]["rotation_deg"] == world.map_rotation_deg
+    if world.geo is not None:
+        assert doc["geo"]["origin_lat_deg"] == world.geo.origin_lat_deg
+        assert doc["geo"]["origin_alt_m"] == world.geo.origin_alt_m
+        assert math.isfinite(doc["geo"]["origin_lon_deg"])
+
+
+def test_campus_building_has_its_sources():
+    doc = tomllib.loads(building_text(load_world("campus", 20.0)))
+    assert len(doc["beacon"]) >= 6 and len({b["id"] for b in doc["beacon"]}) == len(doc["beacon"])
+    assert [p["kind"] for p in doc["port"]] == ["door", "door"]
