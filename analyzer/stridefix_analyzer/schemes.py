@@ -78,3 +78,6 @@ def scheme_colour(code: int) -> str:
 
 PDR_ONLY: str = scheme_name(pose_t.SCHEME_PDR_ONLY)
 """The dead-reckoning baseline's name (its truth-initialised run is reported per data set)."""
+
+WIFI_ONLY: str = scheme_name(pose_t.SCHEME_WIFI_ONLY)
+"""The Wi-Fi baseline's name (it follows Wi-Fi fixes only: the other sources are not its fixes)."""

@@ -56,9 +56,10 @@ class Sources:
     def __bool__(self) -> bool:
         return bool(len(self.ble) or len(self.gnss) or self.landmarks)
 
-    def as_dict(self, start_ms: int, world: World) -> dict:
-        """sources.json: the building's footprint (indoors) and doors, every landmark event and GNSS fix
-        (board time [ms] and walk time [s]), BLE counts."""
+    def as_dict(self, start_ms: int, world: World, landmark_latency_ms: int = 0) -> dict:
+        """sources.json: the building's footprint (indoors) and doors, every landmark event (with the
+        delay of its LANDMARK frame after the read) and GNSS fix (board time [ms] and walk time [s]),
+        BLE counts."""
         g = self.gnss
         macs, counts = np.unique(self.ble.mac, return_counts=True)
         return {
@@ -77,6 +78,7 @@ class Sources:
                     "y_m": e.y_m,
                     "floor": e.floor,
                     "distance_m": round(e.distance_m, 4),
+                    "latency_ms": landmark_latency_ms,
                 }
                 for e in self.landmarks
             ],
@@ -392,7 +394,13 @@ def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | Non
     write_building(result.world, out_dir / "building.toml", result.scenario["ble"])
     if result.sources:
         (out_dir / "sources.json").write_text(
-            json.dumps(result.sources.as_dict(result.board_time_start_ms, result.world), indent=1) + "\n",
+            json.dumps(
+                result.sources.as_dict(
+                    result.board_time_start_ms, result.world, int(result.scenario["landmark"]["latency_ms"])
+                ),
+                indent=1,
+            )
+            + "\n",
             encoding="utf-8",
         )
     summary = result.summary()
