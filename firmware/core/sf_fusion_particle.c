@@ -10,12 +10,26 @@ static double fix_sigma_m(const sf_params_t *const p, const sf_fix_t *const fix)
     return fmax(fix->accuracy_m, sqrt(p->fusion_var_min_m2));
 }
 
-/* The cloud's mean and summary into the scheme's own fields (what the log's x, y, var show). */
-static void mirror(sf_fusion_t *const f, sf_particle_summary_t *const s)
+/* The published track into the scheme's own fields (x, y, var; floor_offset holds the track's floor):
+ * the cloud's mean, unless that lies behind a wall from the track's last position on the same floor —
+ * then the reachable part of the cloud (sf_particle_reachable), so the track never walks through a
+ * wall. A start or a re-seed (`jump`) is a new position: taken as it is. */
+static void mirror(sf_fusion_t *const f, sf_particle_summary_t *const s, const bool jump)
 {
-    sf_particle_summary(f->cloud, s);
-    f->x_m = s->x_m;
-    f->y_m = s->y_m;
+    sf_particle_t *const c = f->cloud;
+    sf_particle_summary(c, s);
+    double x = s->x_m, y = s->y_m;
+    if (!jump && c->walls != NULL && f->floor_offset == (int32_t)s->floor &&
+        sf_wall_grid_crosses(c->walls, s->floor, f->x_m, f->y_m, x, y)) {
+        if (sf_particle_reachable(c, s->floor, f->x_m, f->y_m, s->x_m, s->y_m, &x, &y)) {
+            c->detours++;
+        } else {
+            c->jumps++; /* no probed particle within reach: the cloud is elsewhere, follow it */
+        }
+    }
+    f->x_m = x;
+    f->y_m = y;
+    f->floor_offset = (int32_t)s->floor;
     f->var_m2 = 0.5 * (s->cov_m2[0] + s->cov_m2[2]);
 }
 
@@ -24,6 +38,8 @@ void sf_fusion_particle_init_at(sf_fusion_t *const f, const sf_params_t *const p
 {
     if (f->cloud != NULL) {
         sf_particle_seed(f->cloud, p, x_m, y_m, sigma_m, baro_floor, false);
+        sf_particle_summary_t s;
+        mirror(f, &s, true);
     }
 }
 
@@ -34,6 +50,8 @@ void sf_fusion_particle_step(sf_fusion_t *const f, const sf_params_t *const p, c
         return;
     }
     sf_particle_step(f->cloud, p, length_m, atan2(dy_m, dx_m), baro_floor);
+    sf_particle_summary_t s;
+    mirror(f, &s, false);
 }
 
 /* Re-seeds around the fix (σ = its accuracy; bias and scale kept), α = 1. */
@@ -64,7 +82,7 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
         f->initialisations++;
         f->rejections = 0;
         f->last_fix_t_us = fix->t_us;
-        mirror(f, &s);
+        mirror(f, &s, true);
         audit->innovation_var_m2 = r_m2;
         audit->alpha = 1.0;
         audit->accepted = true;
@@ -100,8 +118,15 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
             audit->reason = sf_fix_reason_accepted;
             f->accepted++;
         }
-    } else if (fix->method == sf_fix_landmark || f->rejections >= p->fusion_max_rejections) {
-        reseed(f, p, fix, s.floor, audit); /* a known position, or the fixes keep landing where no particle is */
+    } else if (fix->method == sf_fix_landmark) {
+        reseed(f, p, fix, s.floor, audit); /* a known position: the whole cloud goes there */
+    } else if (f->rejections >= p->fusion_max_rejections) {
+        /* the fixes keep landing where no particle is: a new hypothesis beside the old one */
+        sf_particle_inject(c, fix->x_m, fix->y_m, sigma_m, s.floor, p->particle_recovery_share);
+        audit->alpha = p->particle_recovery_share;
+        audit->accepted = true;
+        audit->reason = sf_fix_reason_recovery;
+        f->recoveries++;
     } else {
         audit->reason = sf_fix_reason_gate;
         f->rejected_gate++;
@@ -110,7 +135,7 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
     }
     f->last_fix_t_us = fix->t_us;
     f->rejections = 0;
-    mirror(f, &s);
+    mirror(f, &s, audit->reason == sf_fix_reason_recovery && audit->alpha >= 1.0); /* a whole re-seed jumps */
 }
 
 bool sf_fusion_particle_pose(const sf_fusion_t *const f, sf_pose_t *const pose)
@@ -120,8 +145,8 @@ bool sf_fusion_particle_pose(const sf_fusion_t *const f, sf_pose_t *const pose)
     }
     sf_particle_summary_t s;
     sf_particle_summary(f->cloud, &s);
-    pose->x_m = s.x_m;
-    pose->y_m = s.y_m;
+    pose->x_m = f->x_m; /* the walkable track (mirror), not the bare mean */
+    pose->y_m = f->y_m;
     pose->floor = s.floor;
     pose->cov_m2[0] = s.cov_m2[0];
     pose->cov_m2[1] = s.cov_m2[1];

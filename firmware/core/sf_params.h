@@ -259,6 +259,7 @@
     X(particle, scale_max,         double,  2.0,     1.0,     10.0,    "",      "largest stride scale of a particle") \
     X(particle, outlier_share,     double,  0.05,    1e-6,    1.0,     "",      "uniform share of a fix's likelihood: one fix lowers no weight by more than 1/share (a few per cent of fingerprint fixes are gross errors)") \
     X(particle, resample_ess_ratio, double, 0.5,     0.0,     1.0,     "",      "systematic resampling when the effective sample size falls below this share of the particles (the usual N/2)") \
+    X(particle, recovery_share,    double,  0.25,    0.0,     1.0,     "",      "a recovery (fixes keep landing where no particle is) redraws this share of the cloud around the fix, keeping the rest: one wrong fix after a run of rejections cannot move the whole cloud; 1 = the whole cloud") \
     X(particle, reseed_ess_ratio,  double,  0.01,    0.0,     1.0,     "",      "re-seed around the fix when an update leaves an effective sample size below this share (the cloud no longer samples the posterior)") \
     X(particle, floor_mismatch_weight, double, 0.7,  0.0,     1.0,     "",      "weight factor per step of a particle not on the barometric floor (a flight of ~10 steps: x0.03; a 1-2 step barometer glitch: x0.5)") \
     X(particle, grid_cell_m,       double,  2.0,     0.1,     100.0,   "m",     "wall-index cell side (a room's scale: a 0.7 m step touches 1-3 cells)")

@@ -321,3 +321,53 @@ void sf_particle_summary(const sf_particle_t *const c, sf_particle_summary_t *co
     }
     s->floor = fl[best];
 }
+
+bool sf_particle_reachable(const sf_particle_t *const c, const int16_t floor, const double x0_m, const double y0_m,
+                           const double mx_m, const double my_m, double *const x_m, double *const y_m)
+{
+    const int32_t stride = c->n > SF_PARTICLE_PROBES ? c->n / SF_PARTICLE_PROBES : 1;
+    double sw = 0.0, sx = 0.0, sy = 0.0, best_d2 = INFINITY, bx = 0.0, by = 0.0, probed = 0.0;
+    for (int32_t i = 0; i < c->n; i += stride) {
+        const sf_particle_state_t *const q = &c->p[i];
+        probed += q->w;
+        if (c->floor[i] != floor || !(q->w > 0.0) ||
+            (c->walls != NULL && sf_wall_grid_crosses(c->walls, floor, x0_m, y0_m, q->x_m, q->y_m))) {
+            continue;
+        }
+        sw += q->w;
+        sx += q->w * q->x_m;
+        sy += q->w * q->y_m;
+        const double d2 = (q->x_m - mx_m) * (q->x_m - mx_m) + (q->y_m - my_m) * (q->y_m - my_m);
+        if (d2 < best_d2) {
+            best_d2 = d2;
+            bx = q->x_m;
+            by = q->y_m;
+        }
+    }
+    if (!(sw > 0.0) || sw < SF_PARTICLE_REACH_SHARE * probed) {
+        return false; /* most of the cloud is elsewhere: the track follows it */
+    }
+    *x_m = sx / sw;
+    *y_m = sy / sw;
+    if (c->walls != NULL && sf_wall_grid_crosses(c->walls, floor, x0_m, y0_m, *x_m, *y_m)) {
+        *x_m = bx;
+        *y_m = by;
+    }
+    return true;
+}
+
+void sf_particle_inject(sf_particle_t *const c, const double x_m, const double y_m, const double sigma_m,
+                        const int16_t floor, const double share)
+{
+    const int32_t k = share > 0.0 && share < 1.0 ? (int32_t)lround(1.0 / share) : 1;
+    const double w = 1.0 / (double)c->n;
+    for (int32_t i = 0; i < c->n; i += k) { /* every k-th: a strided, not a weight-ordered, choice */
+        sf_particle_state_t *const q = &c->p[i];
+        q->x_m = x_m + sigma_m * sf_rng_normal(&c->rng);
+        q->y_m = y_m + sigma_m * sf_rng_normal(&c->rng);
+        q->w = w; /* the particle keeps its gait (bias, scale): the walker's, not the position's */
+        c->floor[i] = floor;
+    }
+    (void)normalise(c);
+    c->injections++;
+}

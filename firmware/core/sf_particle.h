@@ -73,6 +73,8 @@ typedef struct {
     bool seeded;
     /* counters, never decrease */
     uint32_t steps, deaths, all_blocked, resamples, seeds, floor_changes;
+    uint32_t detours, jumps; /* the published track (sf_particle_reachable): mean replaced, no way found */
+    uint32_t injections;     /* sf_particle_inject calls (recoveries) */
 } sf_particle_t;
 _Static_assert(sizeof(sf_particle_t) <= 128, "sf_particle.h promises at most 128 B");
 
@@ -100,6 +102,13 @@ void sf_particle_set_map(sf_particle_t *c, const sf_wall_grid_t *walls, const sf
 void sf_particle_seed(sf_particle_t *c, const sf_params_t *p, double x_m, double y_m, double sigma_m, int16_t floor,
                       bool keep_gait);
 
+/* Recovery without forgetting (augmented MCL, Thrun et al., "Probabilistic Robotics" §8.3.5): every
+ * round(1/share)-th particle is redrawn around (x, y) with per-axis σ on floor, at weight 1/N, keeping
+ * its gait; then the weights are normalised, so the new hypothesis holds about `share` of the weight
+ * and the old one the rest. The next fixes decide between them: one wrong fix after a run of
+ * rejections cannot move the whole cloud (and its track) into a room the walker is not in. */
+void sf_particle_inject(sf_particle_t *c, double x_m, double y_m, double sigma_m, int16_t floor, double share);
+
 /* One PDR step (see the header); baro_floor INT16_MIN: no floor logic. */
 void sf_particle_step(sf_particle_t *c, const sf_params_t *p, double length_m, double heading_rad,
                       int16_t baro_floor);
@@ -119,6 +128,24 @@ double sf_particle_update(sf_particle_t *c, const sf_params_t *p, double x_m, do
 void sf_particle_resample(sf_particle_t *c);
 
 void sf_particle_summary(const sf_particle_t *c, sf_particle_summary_t *s);
+
+/* Particles of a strided sample probed for sf_particle_reachable (bounds its cost: as many wall
+ * queries of the grid, only when the cloud's mean is behind a wall). */
+#define SF_PARTICLE_PROBES 64
+/* Below this share of the probed weight within reach, the cloud is elsewhere and the track jumps to it. */
+#define SF_PARTICLE_REACH_SHARE 0.2
+
+/* The published track walks like the walker: the cloud's weighted mean can lie behind a wall from the
+ * previous published position (a cloud in two rooms, a door's corner cut by the mean), and a track
+ * through walls is no walker's. This is the weighted mean of the particles on `floor` reachable in a
+ * straight line from (x0, y0) without crossing a wall (a strided sample of SF_PARTICLE_PROBES of them),
+ * or — when that mean is itself behind a wall (the reachable particles round a corner) — the
+ * reachable particle nearest (mx, my), the cloud's mean. Fills (*x, *y) and returns true; false when the
+ * reachable particles hold less than SF_PARTICLE_REACH_SHARE of the probed weight (the cloud is elsewhere
+ * — a track stuck on the wrong side of a wall must not hold it there: the caller takes the mean, a jump).
+ * Cost: ≤ SF_PARTICLE_PROBES + 1 wall queries. */
+bool sf_particle_reachable(const sf_particle_t *c, int16_t floor, double x0_m, double y0_m, double mx_m,
+                           double my_m, double *x_m, double *y_m);
 
 double sf_particle_ess(const sf_particle_t *c);
 
