@@ -370,3 +370,63 @@ def wall_fields(walls: np.ndarray, floor: int) -> dict[str, Any]:
         "wall_y1_m": w[:, 3].tolist(),
         "wall_floor": [int(floor)] * len(w),
     }
+
+
+def load_plan(geojson_path: str, info_path: str | None = None) -> GeoFloorPlan:
+    """Read ``geojson_map.json`` and ``floor_info.json`` (default: the one beside it). Raises
+    :class:`FloorPlanError` naming the file and field."""
+    import json
+    import os
+
+    info_path = info_path or os.path.join(os.path.dirname(os.path.abspath(geojson_path)), "floor_info.json")
+    docs = []
+    for p in (geojson_path, info_path):
+        try:
+            with open(p, encoding="utf-8") as f:
+                docs.append(json.load(f))
+        except OSError as exc:
+            raise FloorPlanError(f"{p}: cannot read: {exc.strerror or exc}") from None
+        except ValueError as exc:
+            raise FloorPlanError(f"{p}: not JSON: {exc}") from None
+    try:
+        width, height = float(docs[1]["map_info"]["width"]), float(docs[1]["map_info"]["height"])
+    except (KeyError, TypeError, ValueError):
+        raise FloorPlanError(f"{info_path}: map_info.width/height: missing or not numbers") from None
+    return read_geojson_plan(docs[0], width, height, geojson_path)
+
+
+def site_plan(
+    plan: GeoFloorPlan,
+    walks_xy: Sequence[Any],
+    walks_floor: Sequence[Any] | None,
+    floor: int,
+    *,
+    min_room_area_m2: float = 0.0,
+    crossing_check: bool = True,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The site fields (walls opened where the walks cross them, geo-reference) and the report
+    (waypoints inside the outline, wall counts, openings, held-out crossing fraction, geo scale)."""
+    walls = plan_walls(plan, min_room_area_m2=min_room_area_m2)
+    survey = DoorSurvey.of(walls, walks_xy, walks_floor)
+    opened, openings = survey.fold_walls(None)
+    pts = [np.asarray(w, float).reshape(-1, 2) for w in walks_xy]
+    xy = np.concatenate(pts) if pts else np.zeros((0, 2))
+    geo = geo_reference(plan)
+    report: dict[str, Any] = {
+        "floor": int(floor),
+        "waypoints_inside_outline": float(inside_outline(plan, xy).mean()) if len(xy) else math.nan,
+        "waypoints": len(xy),
+        "rooms": len(plan.rooms),
+        "min_room_area_m2": min_room_area_m2,
+        "edges_raw": sum(len(r) - 1 for p in plan.outline for r in p) + sum(len(r) - 1 for r in plan.rooms),
+        "walls_simplified": len(walls),
+        "walls_opened": len(opened),
+        "openings": openings,
+        "crossings": len(survey.cross_wall),
+        "truth_segments": len(survey.segments["seg"]),
+        "geo_scale": geo["scale"],
+    }
+    if crossing_check:
+        h = survey.held_out_crossing()
+        report["held_out_crossing_fraction"] = h["fraction"]
+    return {**wall_fields(opened, floor), **geo["fields"]}, report
