@@ -236,7 +236,24 @@ def site_beacons(
     each name matched to a MAC by :func:`mac_check` (decisive matches only) at the table's position,
     the model fitted on those; the MACs left are learnt (:func:`learn_beacons`) like a site without a
     table. Returns ``fields`` (site_t fields, empty without readings) and the ``report``."""
-    placed = place_readings(recordings)
+    return placed_beacons(place_readings(recordings), table)
+
+
+def merge_placed(parts: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """The placed readings of several :func:`place_readings` results as one (realbench's folds add
+    the training walks' readings)."""
+    keys = ("beacon_id", "x_m", "y_m", "floor", "rssi_dbm")
+    out = {k: np.concatenate([p[k] for p in parts]) if parts else np.zeros(0) for k in keys}
+    out["beacon_id"] = out["beacon_id"].astype(np.int64)
+    out["floor"] = out["floor"].astype(np.int64)
+    out["n_total"] = np.asarray(sum(int(p["n_total"]) for p in parts))
+    return out
+
+
+def placed_beacons(
+    placed: dict[str, np.ndarray], table: dict[str, tuple[float, float, int]] | None
+) -> dict[str, Any]:
+    """:func:`site_beacons` of readings already placed (:func:`place_readings`)."""
     report: dict[str, Any] = {"readings": int(placed["n_total"]), "placed": len(placed["rssi_dbm"])}
     if not len(placed["rssi_dbm"]):
         return {"fields": {}, "report": report}

@@ -10,6 +10,7 @@ import argparse
 import os
 import sys
 
+import numpy as np
 from stridefix import site_t
 
 from stridefix_analyzer.exits import input_error_status
@@ -18,6 +19,7 @@ from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
 from stridefix_analyzer.radiomap.build import MODES, build_site
 from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
+from stridefix_analyzer.radiomap.floorplan import FloorPlanError
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
 from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
 from stridefix_analyzer.radiomap.recordings import RadioMapInputError, load_recordings
@@ -153,6 +155,33 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="beacon positions (gsd's BLE_Locations.csv: bleID,Lat,Lon,floor), projected about "
         "--origin-deg; each name is matched to the MAC loudest near it in the walks",
     )
+    b.add_argument(
+        "--floor-plan",
+        default=None,
+        metavar="GEOJSON",
+        help="msindoor floor plan (geojson_map.json): its outline and rooms become walls, opened "
+        "(a door's width) where the walks' truth crosses them; sets the geo-reference",
+    )
+    b.add_argument(
+        "--floor-info",
+        default=None,
+        metavar="JSON",
+        help="the plan's floor_info.json (map width/height [m]; default: the one beside --floor-plan)",
+    )
+    b.add_argument(
+        "--plan-floor",
+        type=int,
+        default=None,
+        metavar="N",
+        help="floor index of the plan's walls (default: the walks' floor, when they are on one)",
+    )
+    b.add_argument(
+        "--min-room-area-m2",
+        type=float,
+        default=0.0,
+        metavar="A",
+        help="rooms of the plan smaller than this are no walls (default 0: every room)",
+    )
     s = sub.add_parser(
         "show",
         help="summary (and PNG) of a site file",
@@ -165,6 +194,35 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--png", default=None, metavar="PATH", help="write a PNG of the floor plan, RPs, beacons and ports"
     )
     return p
+
+
+def add_floor_plan(site: site_t, recordings: list, args: argparse.Namespace) -> dict:
+    """Walls and geo-reference of ``--floor-plan`` written into ``site``; returns the plan report."""
+    from stridefix_analyzer.io.sitefile import set_counts
+    from stridefix_analyzer.radiomap.floorplan import load_plan, site_plan
+
+    plan = load_plan(args.floor_plan, args.floor_info)
+    xy = [np.column_stack([r.truth["x_m"], r.truth["y_m"]]) for r in recordings]
+    floors = [np.asarray(r.truth["floor"], np.int64) for r in recordings]
+    seen = sorted({int(f) for fl in floors for f in fl})
+    floor = args.plan_floor
+    if floor is None:
+        if len(seen) != 1:
+            raise RadioMapInputError(f"--floor-plan: the walks are on floors {seen}: give --plan-floor N")
+        floor = seen[0]
+    on = [fl == floor for fl in floors]
+    fields, report = site_plan(
+        plan,
+        [p[m] for p, m in zip(xy, on)],
+        [f[m] for f, m in zip(floors, on)],
+        floor,
+        min_room_area_m2=args.min_room_area_m2,
+    )
+    for k, v in fields.items():
+        setattr(site, k, v)
+    set_counts(site)
+    site.source = f"{site.source}; floor plan {os.path.basename(args.floor_plan)}"
+    return report
 
 
 def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
@@ -193,6 +251,8 @@ def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
         static_tol_m=args.static_tol_m,
         beacon_table=table,
     )
+    if getattr(args, "floor_plan", None):
+        summary["floor_plan"] = add_floor_plan(site, recordings, args)
     if getattr(args, "building", None):
         summary["building"] = merge_building(
             site, read_building(args.building), os.path.basename(args.building)
@@ -216,7 +276,7 @@ def run(args: argparse.Namespace) -> int:
             if args.png:
                 plot_site(site, args.png)
                 print(f"wrote {args.png}")
-    except (LogReadError, RadioMapInputError, SiteFileError, BuildingError) as exc:
+    except (LogReadError, RadioMapInputError, SiteFileError, BuildingError, FloorPlanError) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     return 0

@@ -45,6 +45,16 @@ def format_summary(s: dict) -> str:
             r1, n, sig = s["ble_model"]
             plan += f" (RSSI(d) = {r1:.1f} dBm - 10·{n:.2f}·log10 d, σ {sig:.1f} dB)"
         lines.append(plan)
+    if s.get("floor_plan"):
+        fp = s["floor_plan"]
+        lines.append(
+            f"floor plan  floor {fp['floor']}: {fp['waypoints_inside_outline']:.1%} of {fp['waypoints']} "
+            f"waypoints inside the outline; {fp['edges_raw']} edges -> {fp['walls_simplified']} walls, "
+            f"{fp['openings']} openings ({fp['crossings']} crossings of {fp['truth_segments']} truth "
+            f"segments) -> {fp['walls_opened']} wall segments; held-out walks cross a kept wall in "
+            f"{fp.get('held_out_crossing_fraction', float('nan')):.1%} of their segments; "
+            f"geo scale x {fp['geo_scale'][0]:.4f}, y {fp['geo_scale'][1]:.4f}"
+        )
     if s.get("ble"):
         b = s["ble"]
         text = f"ble         {b['placed']} of {b['readings']} readings placed on the truth"

@@ -32,6 +32,7 @@ from stridefix_analyzer.realbench.pdr_distance import (
     missed_targets,
     run_pdr_distance,
 )
+from stridefix_analyzer.realbench.sitecontent import ContentOptions
 from stridefix_analyzer.realbench.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_analyzer.realbench.summary import format_tables
 from stridefix_analyzer.realbench.walks import RealbenchError
@@ -206,6 +207,21 @@ def add_fusion_parser(sub: Any) -> None:
         "--cache", default=None, metavar="DIR", help="import cache (default: <folder of results.json>/cache)"
     )
     d.add_argument("--reimport", action="store_true", help="ignore the cached imports")
+    d.add_argument(
+        "--no-floor-plan",
+        action="store_true",
+        help="fold sites without the data set's floor plan (walls opened where the training walks cross)",
+    )
+    d.add_argument(
+        "--no-beacons",
+        action="store_true",
+        help="fold sites without BLE beacons and path-loss model (learnt from the training walks)",
+    )
+    d.add_argument(
+        "--no-gnss",
+        action="store_true",
+        help="fold sites without a geo-reference, so no GNSS fix is used",
+    )
     d.add_argument("--no-report", action="store_true", help="skip the HTML report")
     d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
     d.set_defaults(_bench=_run_fusion_cli)
@@ -229,6 +245,9 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             report=not args.no_report,
             quiet=args.quiet,
             param_sets=args.param_sets,
+            content=ContentOptions(
+                floor_plan=not args.no_floor_plan, beacons=not args.no_beacons, gnss=not args.no_gnss
+            ),
         )
         doc = run_fusion(cfg)
     except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build

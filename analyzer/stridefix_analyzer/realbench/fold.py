@@ -2,7 +2,8 @@
 other walks of its group, every scheme scored at the walk's ground-truth times.
 
 The fold's site is the walk-mode radio map of ``total − held`` (sufficient statistics, so no map is
-rebuilt from scratch) with the fold's map rotation and floors; the replay adds
+rebuilt from scratch) with the fold's map rotation and floors, and the building content its training
+walks give (walls, geo-reference, beacons: :mod:`.sitecontent`); the replay adds
 ``--set stride.weinberg_k=K`` and the tuning axes' chosen settings (:mod:`.tuning`). One replay per
 start mode: the firmware decides the starting floor itself (a vote of the fixes held against the
 barometer, firmware/core/sf_floor_vote.h). Everything a worker needs comes in its :class:`FoldJob`: no
@@ -21,6 +22,7 @@ from typing import Any
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
 #: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
@@ -56,6 +58,9 @@ class FoldJob:
     held: WalkStats
     #: site_t fields measured for this fold (the ekf's fix-error model), written into its site
     site_fields: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    #: the group's building content (walls, geo, beacons) and this walk's index in its group
+    content: GroupContent | None = None
+    content_index: int = -1
 
 
 def fold_site(
@@ -106,6 +111,11 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
         return out
     for name, value in job.site_fields.items():
         setattr(site, name, value)
+    content: dict[str, Any] = {}
+    if job.content is not None:
+        fields, content = job.content.fold_fields(job.content_index)
+        dropped = apply_fields(site, fields)
+        content.update({f"{k}s_off_site_floors": v for k, v in dropped.items() if v})
     site_path = job.dir / "site.sfsite"
     write_site(site_path, site)
     out["fold"] = {
@@ -121,6 +131,10 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
         "floor_heights_m": [float(h) for h in site.floor_height_m],
         "floor_heights_source": job.floor_heights_source,
         "scans_used": summ["scans"].get("used"),
+        "n_walls": site.n_walls,
+        "n_beacons": site.n_beacons,
+        "has_geo": bool(site.has_geo),
+        **{f"content_{k}": v for k, v in content.items()},
     }
     sets = list(job.param_sets)
     if math.isfinite(job.K):

@@ -11,7 +11,8 @@ of the group only (DESIGN.md, evaluation protocol):
 2. per group the tuning rows choose per fold (:mod:`.tuning`), and per fold the constants follow: the
    stride constant K (:func:`.strides.calibrate_lowo`), the map rotation of the chosen heading
    candidate (:func:`.heading.learn_rotation_deg`) and the floors (:mod:`.floors`);
-3. walk i is replayed on its fold's site with every scheme and scored at its ground-truth times
+3. walk i is replayed on its fold's site (with the walls, geo-reference and beacons of the
+   training walks, :mod:`.sitecontent`) with every scheme and scored at its ground-truth times
    (:mod:`.fold`). ``--true-start`` adds a run labelled truth-initialised.
 
 Outputs (:mod:`.summary`): ``results.json``, the HTML report next to it (:mod:`.report`), and the
@@ -50,6 +51,7 @@ from stridefix_analyzer.realbench.heading import (
 from stridefix_analyzer.realbench.prepare import PrepareJob, prepare
 from stridefix_analyzer.realbench.progress import Progress
 from stridefix_analyzer.realbench.select_sites import SelectionSites
+from stridefix_analyzer.realbench.sitecontent import ContentOptions, group_content
 from stridefix_analyzer.realbench.strides import build_segments, calibrate_lowo, stride_k
 from stridefix_analyzer.realbench.summary import ROBUST_MEAN_M, build_doc, strip_samples
 from stridefix_analyzer.realbench.walks import dataset, find_groups, firmware
@@ -77,6 +79,8 @@ class FusionConfig:
     report: bool = True
     quiet: bool = False
     param_sets: Sequence[str] = ()
+    #: the building content the fold sites carry (walls, beacons, geo-reference)
+    content: ContentOptions = ContentOptions()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -87,6 +91,7 @@ class Part:
     walk_ids: list[int]
     floor_dir: Path | None
     work: Path
+    folder: Path | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -188,7 +193,7 @@ def prepare_walks(run: Run, groups: list[WalkGroup]) -> tuple[list[dict[str, Any
         ids = [i for i, (o, _) in enumerate(owner) if o is g]
         work = owner[ids[0]][1] if ids else run.out_dir / "realbench_work" / g.label.replace("/", "-")
         for label, mine in run.dataset.regroup(g, [walks[i].get("import") for i in ids]):
-            parts.append(Part(label, [ids[k] for k in mine], g.floor_dir, work))
+            parts.append(Part(label, [ids[k] for k in mine], g.floor_dir, work, g.folder))
     return walks, parts
 
 
@@ -222,6 +227,11 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
     choices = tuning.choose(run.axes, group)
     for c in choices.values():
         info.update(c.info)
+    content = group_content(run.dataset, part.folder, part.floor_dir, sub, run.cfg.content)
+    info["site_content"] = {
+        "options": dataclasses.asdict(run.cfg.content),
+        **content.report,
+    }
     jobs = []
     for j, i in enumerate(ok):
         variants = {name: c.per_walk[j] for name, c in choices.items()}
@@ -271,6 +281,8 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                 total=total,
                 held=walks[i]["stats"],
                 site_fields=tuning.walk_site_fields(choices, j),
+                content=content,
+                content_index=j,
             )
         )
     return info, jobs
@@ -308,4 +320,5 @@ def _params(run: Run) -> dict[str, Any]:
             "min_steps": ROT_MIN_STEPS,
         },
         "default_storey_m": DEFAULT_STOREY_M,
+        "site_content": dataclasses.asdict(cfg.content),
     }

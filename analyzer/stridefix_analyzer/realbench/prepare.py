@@ -53,8 +53,10 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
         ``waypoint_t_us``, ``waypoint_xy_m``, ``step_t_us``, ``step_range_mps2``,
         ``step_length_m``), plus ``stats`` (WalkStats), ``rotation`` (per heading candidate,
         :func:`.heading.rotation_stats`), ``floor_heights``, ``floors`` (truth floors),
-        ``first_waypoint`` (t_us, x, y, floor) and ``import_log``.
+        ``first_waypoint`` (t_us, x, y, floor), ``import_log`` and ``ble_placed`` (the BLE readings
+        placed on the truth, :func:`~stridefix_analyzer.radiomap.beacons.place_readings`).
     """
+    from stridefix_analyzer.radiomap.beacons import place_readings
     from stridefix_analyzer.radiomap.build import RadioMapInputError, WalkStats, load_recordings
 
     trace = job.trace
@@ -115,6 +117,7 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
     walk["step_length_m"] = steps["length_m"] if steps is not None else z
     walk["step_heading_rad"] = steps["heading_rad"] if steps is not None else z
     walk["stats"] = WalkStats.from_recordings(recs, cell_size_m=job.cell_size_m)
+    walk["ble_placed"] = place_readings(recs)
     wp_t, wp_xy = walk["waypoint_t_us"], walk["waypoint_xy_m"]
     walk["rotation"] = {first: rotation_stats(walk["step_t_us"], walk["step_heading_rad"], wp_t, wp_xy)}
     for name, th in headings.items():
