@@ -186,24 +186,24 @@ int sf_ble_fix(sf_ble_t *const ble, const sf_params_t *const p, const sf_beacons
     return SF_OK;
 }
 
-int sf_ble_loudest(const sf_beacons_t *const b, const sf_ble_scan_t *const scan, const double min_dbm,
+int sf_ble_nearest(const sf_beacons_t *const b, const sf_ble_scan_t *const scan, const double max_range_m,
                    sf_fix_t *const at)
 {
     int32_t best = -1;
-    double best_dbm = min_dbm;
+    double best_m = max_range_m;
     for (int32_t i = 0; i < scan->n; i++) {
         const double rssi = (double)scan->rssi_dbm[i];
-        const int32_t k = isfinite(rssi) && rssi >= best_dbm ? find_beacon(b, scan->beacon_id[i]) : -1;
-        if (k >= 0) {
+        const int32_t k = isfinite(rssi) ? find_beacon(b, scan->beacon_id[i]) : -1;
+        const double d_m = k >= 0 ? sf_ble_range_m(b, p1_of(b, k), rssi) : INFINITY;
+        if (d_m <= best_m) {
             best = k;
-            best_dbm = rssi;
+            best_m = d_m;
         }
     }
     if (best < 0) {
         return SF_ERANGE;
     }
     *at = (sf_fix_t){.t_us = scan->t_us, .method = sf_fix_ble, .x_m = (double)b->x_m[best],
-                     .y_m = (double)b->y_m[best], .floor = b->floor[best],
-                     .accuracy_m = sf_ble_range_m(b, p1_of(b, best), best_dbm), .n_ap_used = 1};
+                     .y_m = (double)b->y_m[best], .floor = b->floor[best], .accuracy_m = best_m, .n_ap_used = 1};
     return SF_OK;
 }

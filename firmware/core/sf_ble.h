@@ -54,10 +54,11 @@ _Static_assert(sizeof(sf_ble_t) <= 32, "sf_ble.h promises at most 32 B");
 int sf_ble_fix(sf_ble_t *ble, const sf_params_t *p, const sf_beacons_t *beacons, const sf_ble_scan_t *scan,
                int16_t floor, sf_fix_t *fix, int32_t *n_used);
 
-/* The loudest reading of a beacon the site knows (any floor) when at least min_dbm: fills *at with the
- * beacon's position and floor (method sf_fix_ble, accuracy = its model range) and returns SF_OK; else
- * SF_ERANGE. For the floor vote: a beacon that loud is on the caller's floor. */
-int sf_ble_loudest(const sf_beacons_t *beacons, const sf_ble_scan_t *scan, double min_dbm, sf_fix_t *at);
+/* The reading of a beacon the site knows (any floor) that the model puts nearest, when within
+ * max_range_m: fills *at with the beacon's position and floor (method sf_fix_ble, accuracy = its model
+ * range) and returns SF_OK; else SF_ERANGE. For the floor vote: a beacon that near is on the caller's
+ * floor (the range is the model's, so a site of weak beacons is judged by its own 1-m level). */
+int sf_ble_nearest(const sf_beacons_t *beacons, const sf_ble_scan_t *scan, double max_range_m, sf_fix_t *at);
 
 /* The model's range [m] of an RSSI from a beacon of RSSI-at-1-m p1_dbm (unclamped), for tests and
  * the analyzer. */

@@ -168,8 +168,8 @@ int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_s
  *             with reason INACCURATE and no fix for an accuracy beyond gnss_max_accuracy_m or a
  *             position off the plane (sf_geo_to_map's SF_ERANGE).
  *   BLE       ranges to the site's known beacons (sf_ble.h: log-distance path loss) → a position and
- *             accuracy on the caller's floor; first, the loudest known beacon, when at least
- *             ble_floor_vote_min_dbm, votes for its own floor; 0 audits without beacons in the site;
+ *             accuracy on the caller's floor; first, the nearest known beacon by the model, when within
+ *             ble_floor_vote_range_m, votes for its own floor; 0 audits without beacons in the site;
  *             TOO_FEW_APS audits when fewer than ble_min_beacons usable beacons were heard.
  *   landmark  the landmark's own position, floor and accuracy (needs no site); it votes on the floor;
  *             every fusing scheme takes it whatever its gate (α = 1 in the fixed-gain blends,

@@ -121,11 +121,11 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     if (e->site == NULL || e->site->beacons.n_beacons == 0) {
         return 0;
     }
-    /* the loudest known beacon, if loud enough, votes for its floor before the fix (which uses only
-     * the beacons of the caller's floor) */
+    /* the nearest known beacon by the path-loss model, if near enough, votes for its floor before the
+     * fix (which uses only the beacons of the caller's floor) */
     sf_fix_t vote;
-    if (e->floor_vote_active && p->ble_floor_vote_min_dbm < 0.0 &&
-        sf_ble_loudest(&e->site->beacons, scan, p->ble_floor_vote_min_dbm, &vote) == SF_OK) {
+    if (e->floor_vote_active && p->ble_floor_vote_range_m > 0.0 &&
+        sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK) {
         vote.n_ap_used = (int16_t)p->fingerprint_accuracy_ref_aps; /* a full-weight vote (sf_floor_vote.h) */
         const int16_t baro_floor = sf_floor_current(&e->floor);
         sf_floor_shift(&e->floor,

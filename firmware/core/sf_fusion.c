@@ -272,8 +272,10 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
         return SF_ERANGE;
     }
     const double r_m2 = fix->accuracy_m * fix->accuracy_m;
-    /* wifi_only is the paper's Wi-Fi baseline: the other sources are not its fixes */
-    if (row_of(f)->mode == mode_follow_fixes && fix->method != sf_fix_wifi) {
+    /* the paper's baselines, wifi_only and pdr_only (which starts at its first fix), are Wi-Fi's:
+     * the other sources are not their fixes */
+    if ((row_of(f)->mode == mode_follow_fixes || row_of(f)->mode == mode_dead_reckoning) &&
+        fix->method != sf_fix_wifi) {
         audit->reason = sf_fix_reason_scheme_ignores;
         return SF_OK;
     }

@@ -70,8 +70,9 @@
  *
  * Sources (fix.method, the FIX record's source). Wi-Fi, GNSS, BLE and landmark fixes go through the
  * same control with their own R = accuracy_m² (the ekf: a Wi-Fi fix's R from the site's fix model and
- * the correlated error c in its innovation; the other sources white, without c). wifi_only, the
- * paper's Wi-Fi baseline, ignores every other source (SCHEME_IGNORES). A landmark (the paper's NFC tag)
+ * the correlated error c in its innovation; the other sources white, without c). The paper's
+ * baselines, wifi_only and pdr_only (which starts at its first fix), ignore every other source
+ * (SCHEME_IGNORES): their rows stay the Wi-Fi-only comparisons they were. A landmark (the paper's NFC tag)
  * is where the walker is: every scheme that fuses accepts it whatever the gate says (and between
  * floors), the fixed-gain blends with α = 1, adaptive by its law (fusion_acc_landmark, default 1),
  * kalman and ekf by their gain with its tiny R.

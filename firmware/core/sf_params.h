@@ -185,7 +185,7 @@
     X(ble,  min_beacons,           int32_t, 1,       1,       8,       "beacons", "fewest usable beacons for a BLE fix (one gives a disc about the beacon)") \
     X(ble,  same_floor,            int32_t, 1,       0,       1,       "",      "1 = only beacons on the caller's floor are used (a floor slab attenuates ~15-20 dB, which the model lacks)") \
     X(ble,  min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a BLE fix's accuracy (1 sigma)") \
-    X(ble,  floor_vote_min_dbm,    double,  -75.0,   -150.0,  0.0,     "dBm",   "a beacon heard this loud votes for its floor (about 6 m at -59 dBm/1 m, n = 2; one slab, 15-20 dB, puts a beacon of another floor below it); 0 = never") \
+    X(ble,  floor_vote_range_m,    double,  6.0,     0.0,     50.0,    "m",     "a beacon whose RSSI puts it this near by the site's path-loss model votes for its floor (one slab, 15-20 dB, makes a beacon of another floor read 5-10x farther); 0 = never") \
     X(gnss, use,                   int32_t, 1,       0,       1,       "",      "1 = GNSS fixes are offered to the schemes (the site needs a geo-reference)") \
     X(gnss, max_accuracy_m,        double,  50.0,    0.0,     1e4,     "m",     "GNSS fixes reporting a worse accuracy are not used") \
     X(gnss, accuracy_scale,        double,  1.0,     0.1,     10.0,    "",      "the receiver's reported accuracy times this is the fix's 1 sigma") \

@@ -206,7 +206,7 @@ static void test_gnss_fix_through_every_scheme(void **state)
     assert_true(fix.accuracy_m == p.gnss_min_accuracy_m); /* 0.5 m reported: floored */
     for (int s = 0; s < sf_scheme_count; s++) {
         assert_int_equal(audits[s].method, sf_fix_gnss);
-        if (s == sf_scheme_wifi_only) {
+        if (s == sf_scheme_wifi_only || s == sf_scheme_pdr_only) { /* the Wi-Fi baselines */
             assert_int_equal(audits[s].reason, sf_fix_reason_scheme_ignores);
         } else {
             assert_int_equal(audits[s].reason, sf_fix_reason_initialised);
@@ -252,6 +252,7 @@ static void test_landmark_puts_every_scheme_on_it(void **state)
     assert_true(has_fix);
     assert_int_equal(audits[sf_scheme_kalman].reason, sf_fix_reason_initialised);
     assert_int_equal(audits[sf_scheme_wifi_only].reason, sf_fix_reason_scheme_ignores);
+    assert_int_equal(audits[sf_scheme_pdr_only].reason, sf_fix_reason_scheme_ignores);
     const sf_landmark_t lm = {.t_us = 10 * S_US, .landmark_id = 7, .x_m = 50.0, .y_m = 7.0, .floor = 0,
                               .accuracy_m = 0.3};
     assert_int_equal(sf_estimator_landmark(&est, &p, &lm, &fix, &has_fix, audits), sf_scheme_count);
