@@ -179,7 +179,7 @@ int sf_ble_fix(sf_ble_t *const ble, const sf_params_t *const p, const sf_beacons
         .x_m = x,
         .y_m = y,
         .floor = floor,
-        .accuracy_m = fmax(sqrt(var_m2), p->ble_min_accuracy_m),
+        .accuracy_m = fmax(sqrt(var_m2 + p->ble_position_sigma_m * p->ble_position_sigma_m), p->ble_min_accuracy_m),
         .n_ap_used = (int16_t)n,
     };
     ble->fixes++;

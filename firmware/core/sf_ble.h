@@ -13,7 +13,8 @@
  * prior at their weighted centroid (weights 1/d², d the model's range of each reading; prior σ² = the
  * weighted mean of d²), which keeps one or two beacons well posed (one beacon: a disc about it), by
  * SF_BLE_ITERATIONS Gauss–Newton steps on the 2-D position. The accuracy is √(½ trace) of the
- * posterior covariance (the inverse of the normal matrix), floored at ble_min_accuracy_m. Ranges are
+ * posterior covariance (the inverse of the normal matrix) with the beacons' own position uncertainty
+ * ble_position_sigma_m added in quadrature, floored at ble_min_accuracy_m. Ranges are
  * clamped to SF_BLE_RANGE_MIN_M … SF_BLE_RANGE_MAX_M (the model says nothing nearer than the antenna
  * size, and a reading at the noise floor says "far", not how far).
  *

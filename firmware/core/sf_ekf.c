@@ -202,14 +202,20 @@ static double kappa(const bool correlated)
     return correlated ? 1.0 : 0.0;
 }
 
+void sf_ekf_fix_total(const sf_ekf_t *const e, const double accuracy_m, double total_m2[3])
+{
+    const double a2 = accuracy_m * accuracy_m;
+    for (int i = 0; i < 3; i++) {
+        total_m2[i] = e->fix_floor_m2[i] + a2 * e->fix_model[i];
+    }
+}
+
 void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const double accuracy_m,
                   double r_white_m2[3])
 {
-    const double a2 = accuracy_m * accuracy_m, c2 = c_var(e);
+    const double c2 = c_var(e);
     double total[3];
-    for (int i = 0; i < 3; i++) {
-        total[i] = e->fix_floor_m2[i] + a2 * e->fix_model[i];
-    }
+    sf_ekf_fix_total(e, accuracy_m, total);
     r_white_m2[0] = total[0] - c2;
     r_white_m2[1] = total[1];
     r_white_m2[2] = total[2] - c2;

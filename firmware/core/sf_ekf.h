@@ -112,6 +112,10 @@ void sf_ekf_time(sf_ekf_t *e, const sf_params_t *p, double dt_s);
  * above). */
 void sf_ekf_fix_r(const sf_ekf_t *e, const sf_params_t *p, double accuracy_m, double r_white_m2[3]);
 
+/* One fix's whole error covariance F + accuracy_m² · M [xx, xy, yy] (white and correlated parts
+ * together): what a filter that does not carry c (the particle scheme) must take as its R. */
+void sf_ekf_fix_total(const sf_ekf_t *e, double accuracy_m, double total_m2[3]);
+
 /* In place: the fix's offset z − p (fix minus the nominal position) becomes ν = z − p − c for a fix
  * that carries the correlated error (`correlated`: a Wi-Fi fix), ν = z − p for the other sources
  * (GNSS, BLE, landmark: H = [I 0 0 0], their errors are not the radio map's). */

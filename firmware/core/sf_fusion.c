@@ -417,7 +417,8 @@ bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, cons
 void sf_fusion_set_fix_model(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_model_t *const model)
 {
     f->fix_model = model != NULL && model->valid ? model : NULL;
-    if (is_ekf(f) && f->initialised && f->fix_model != NULL) {
+    /* the particle scheme takes its Wi-Fi R from the same model (sf_fusion_particle.c) */
+    if ((is_particle(f) || (is_ekf(f) && f->initialised)) && f->fix_model != NULL) {
         sf_ekf_use_site_model(&f->ekf, p, f->fix_model);
     }
 }
@@ -428,6 +429,7 @@ void sf_fusion_set_cloud(sf_fusion_t *const f, const sf_params_t *const p, sf_pa
         return;
     }
     f->cloud = cloud;
+    start_ekf(f, p); /* only its fix-error model: the Wi-Fi fixes' R (sf_fusion_particle.c) */
     if (cloud != NULL && f->initialised && !cloud->seeded) { /* a config start made before the cloud came */
         sf_particle_seed(cloud, p, f->x_m, f->y_m, sqrt(f->var_m2), (int16_t)p->init_floor, false);
     }

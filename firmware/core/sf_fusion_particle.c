@@ -5,9 +5,18 @@
 
 #include "sf_fusion_internal.h"
 
-static double fix_sigma_m(const sf_params_t *const p, const sf_fix_t *const fix)
+/* The fix's 1σ per axis. A Wi-Fi matcher's accuracy is a shape, not a σ (sf_ekf.h: on site2/F3 the
+ * errors are ~15 m at claimed accuracies of a few metres): its R is the site's measured fix-error model
+ * F + a²M as a whole (the cloud carries no correlated error), isotropic; the other sources state a σ. */
+static double fix_sigma_m(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix)
 {
-    return fmax(fix->accuracy_m, sqrt(p->fusion_var_min_m2));
+    double var_m2 = fix->accuracy_m * fix->accuracy_m;
+    if (fix->method == sf_fix_wifi) {
+        double r_m2[3];
+        sf_ekf_fix_total(&f->ekf, fix->accuracy_m, r_m2);
+        var_m2 = 0.5 * (r_m2[0] + r_m2[2]);
+    }
+    return sqrt(fmax(var_m2, p->fusion_var_min_m2));
 }
 
 /* The published track into the scheme's own fields (x, y, var; floor_offset holds the track's floor):
@@ -58,7 +67,7 @@ void sf_fusion_particle_step(sf_fusion_t *const f, const sf_params_t *const p, c
 static void reseed(sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix, const int16_t floor,
                    sf_fix_audit_t *const audit)
 {
-    sf_particle_seed(f->cloud, p, fix->x_m, fix->y_m, fix_sigma_m(p, fix), floor, true);
+    sf_particle_seed(f->cloud, p, fix->x_m, fix->y_m, fix_sigma_m(f, p, fix), floor, true);
     audit->alpha = 1.0;
     audit->accepted = true;
     audit->reason = sf_fix_reason_recovery;
@@ -69,7 +78,7 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
                             const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
     sf_particle_t *const c = f->cloud;
-    const double sigma_m = fix_sigma_m(p, fix), r_m2 = sigma_m * sigma_m;
+    const double sigma_m = fix_sigma_m(f, p, fix), r_m2 = sigma_m * sigma_m;
     sf_particle_summary_t s;
     if (c == NULL) {
         audit->reason = sf_fix_reason_not_initialised; /* no memory for a cloud: no position ever */
@@ -107,10 +116,21 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
         f->rejected_floor++; /* not the scheme's divergence: no step toward recovery */
         return;
     }
-    const double evidence = sf_particle_evidence(c, fix->x_m, fix->y_m, sigma_m);
+    /* a Wi-Fi fix carries the radio map's correlated error (sf_particle.h): its white part is R */
+    const bool correlated = fix->method == sf_fix_wifi;
+    double r_white_m2 = r_m2;
+    if (correlated) {
+        double rw_m2[3];
+        sf_ekf_fix_r(&f->ekf, p, fix->accuracy_m, rw_m2);
+        r_white_m2 = fmax(0.5 * (rw_m2[0] + rw_m2[2]), p->fusion_var_min_m2);
+        sf_particle_c_predict(c, f->ekf.bias_sigma_m, f->ekf.bias_length_m);
+    }
+    const double evidence = correlated ? sf_particle_evidence_c(c, fix->x_m, fix->y_m, r_white_m2)
+                                       : sf_particle_evidence(c, fix->x_m, fix->y_m, sigma_m);
     if (evidence >= exp(-0.5 * gate * gate)) {
         double ess_after;
-        audit->alpha = sf_particle_update(c, p, fix->x_m, fix->y_m, sigma_m, &ess_after);
+        audit->alpha = correlated ? sf_particle_update_c(c, p, fix->x_m, fix->y_m, r_white_m2, &ess_after)
+                                  : sf_particle_update(c, p, fix->x_m, fix->y_m, sigma_m, &ess_after);
         if (ess_after < p->particle_reseed_ess_ratio * (double)c->n) {
             reseed(f, p, fix, s.floor, audit); /* collapsed: the cloud no longer samples the posterior */
         } else {

@@ -163,9 +163,10 @@ static void test_ble_one_beacon_other_floor_unknown(void **state)
     assert_int_equal(ble.other_floor, 1);
     assert_int_equal(ble.unknown, 1);
     assert_int_equal(ble.weak_or_bad, 1);
-    /* one beacon: the fix is the beacon, its accuracy the range (−71 dBm at P1 −59, n 2: 3.98 m) */
+    /* one beacon: the fix is the beacon, its accuracy the range (−71 dBm at P1 −59, n 2: 3.98 m) and
+     * the beacon's own position σ in quadrature */
     assert_true(hypot(fix.x_m - 0.0, fix.y_m - 0.0) < 1e-6);
-    assert_true(fabs(fix.accuracy_m - sf_ble_range_m(&b, -59.0, -71.0)) < 0.05);
+    assert_true(fabs(fix.accuracy_m - hypot(sf_ble_range_m(&b, -59.0, -71.0), p.ble_position_sigma_m)) < 0.05);
     /* nothing usable: no fix */
     p.ble_min_beacons = 2;
     assert_int_equal(sf_ble_fix(&ble, &p, &b, &scan, 0, &fix, &used), SF_ERANGE);
