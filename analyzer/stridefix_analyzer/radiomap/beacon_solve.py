@@ -102,17 +102,27 @@ def solve_positions(
     (G, 2) float
         The positions [m].
     """
-    n_g = len(start)
     c = 10.0 * n / math.log(10.0)
-    p = np.clip(np.asarray(start, np.float64), lo, hi)
+    out = np.clip(np.asarray(start, np.float64), lo, hi)
+    beacons = np.arange(len(out))  # the beacons still iterated, and their readings below
+    p, lo, hi = out.copy(), np.asarray(lo, np.float64), np.asarray(hi, np.float64)
     ev = _evaluate(g, qx, qy, r, a, n, p)
-    lam = np.full(n_g, LAMBDA_START)
-    live = np.ones(n_g, dtype=bool)
+    lam = np.full(len(p), LAMBDA_START)
+    live = np.ones(len(p), dtype=bool)
     for it in range(MAX_ITER):
         if not live.any():
             break
+        if 2 * live.sum() < len(live):  # drop the converged beacons' readings from the passes
+            out[beacons] = p
+            rows = live[g]
+            g = (np.cumsum(live) - 1)[g[rows]]
+            qx, qy, r = qx[rows], qy[rows], r[rows]
+            ev = (*(v[rows] for v in ev[:4]), ev[4][live])
+            beacons, p, lo, hi, lam = beacons[live], p[live], lo[live], hi[live], lam[live]
+            live = live[live]
+        n_g = len(p)
         sxx, sxy, syy, hxx, hxy, hyy, bx, by = _newton(g, ev, c, n_g)
-        # Newton where the Hessian is positive definite, else Gauss–Newton (JᵀJ)
+        # Newton where the Hessian is positive definite (after GN_ITER steps), else Gauss–Newton
         pd = (hxx > 0) & (hxx * hyy - hxy * hxy > 0) & (it >= GN_ITER)
         hxx, hxy, hyy = np.where(pd, hxx, sxx), np.where(pd, hxy, sxy), np.where(pd, hyy, syy)
         # a coordinate on its bound whose descent direction (−b) leaves the box is held
@@ -135,5 +145,6 @@ def solve_positions(
         live &= ~small & (lam < LAMBDA_MAX)
         p = np.where(take[:, None], trial, p)
         t = take[g]
-        ev = tuple(np.where(t, v1, v0) for v1, v0 in zip(ev1[:4], ev[:4])) + (np.where(take, cost1, cost),)
-    return p
+        ev = (*(np.where(t, v1, v0) for v1, v0 in zip(ev1[:4], ev[:4])), np.where(take, cost1, cost))
+    out[beacons] = p
+    return out
