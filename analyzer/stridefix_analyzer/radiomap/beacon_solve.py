@@ -58,15 +58,16 @@ def _evaluate(
     return f, dx, dy, k, np.bincount(g, f * f, minlength=len(p))
 
 
-def _newton(
-    g: np.ndarray, ev: tuple[np.ndarray, ...], c: float, n_g: int
-) -> tuple[np.ndarray, ...]:
+def _newton(g: np.ndarray, ev: tuple[np.ndarray, ...], c: float, n_g: int) -> tuple[np.ndarray, ...]:
     """Per beacon JᵀJ (xx, xy, yy), the Hessian Σ(∇f∇fᵀ + f·∇²f) (xx, xy, yy) and Jᵀf (x, y), with
     ∇f = k·u and ∇²f = k·I − 2·k²/c·u·uᵀ."""
     f, dx, dy, k, _ = ev
     jx, jy = k * dx, k * dy
     w = f / c
-    sums = [np.bincount(g, v, minlength=n_g) for v in (jx * jx, jx * jy, jy * jy, f * k, w * jx * jx, w * jx * jy, w * jy * jy, jx * f, jy * f)]
+    sums = [
+        np.bincount(g, v, minlength=n_g)
+        for v in (jx * jx, jx * jy, jy * jy, f * k, w * jx * jx, w * jx * jy, w * jy * jy, jx * f, jy * f)
+    ]
     sxx, sxy, syy, fk, wxx, wxy, wyy, bx, by = sums
     return sxx, sxy, syy, sxx + fk - 2.0 * wxx, sxy - 2.0 * wxy, syy + fk - 2.0 * wyy, bx, by
 
@@ -117,7 +118,7 @@ def solve_positions(
             rows = live[g]
             g = (np.cumsum(live) - 1)[g[rows]]
             qx, qy, r = qx[rows], qy[rows], r[rows]
-            ev = (*(v[rows] for v in ev[:4]), ev[4][live])
+            ev = (ev[0][rows], ev[1][rows], ev[2][rows], ev[3][rows], ev[4][live])
             beacons, p, lo, hi, lam = beacons[live], p[live], lo[live], hi[live], lam[live]
             live = live[live]
         n_g = len(p)
@@ -145,6 +146,7 @@ def solve_positions(
         live &= ~small & (lam < LAMBDA_MAX)
         p = np.where(take[:, None], trial, p)
         t = take[g]
-        ev = (*(np.where(t, v1, v0) for v1, v0 in zip(ev1[:4], ev[:4])), np.where(take, cost1, cost))
+        f, ux, uy, k = (np.where(t, v1, v0) for v1, v0 in zip(ev1[:4], ev[:4]))
+        ev = (f, ux, uy, k, np.where(take, cost1, cost))
     out[beacons] = p
     return out

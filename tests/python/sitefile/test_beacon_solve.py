@@ -25,13 +25,40 @@ def _beacons(seed: int, n_beacons: int = 40):
     d = np.maximum(np.hypot(qx - true[g, 0], qy - true[g, 1]), MIN_RANGE_M)
     r = A_DBM - 10 * N_EXP * np.log10(d) + rng.normal(0, SIGMA_DB, len(g))
     start = true + rng.normal(0, 3.0, true.shape)
-    lo = np.column_stack([np.minimum.reduceat(qx, np.r_[0, np.cumsum(counts)[:-1]]), np.minimum.reduceat(qy, np.r_[0, np.cumsum(counts)[:-1]])]) - 10
-    hi = np.column_stack([np.maximum.reduceat(qx, np.r_[0, np.cumsum(counts)[:-1]]), np.maximum.reduceat(qy, np.r_[0, np.cumsum(counts)[:-1]])]) + 10
+    lo = (
+        np.column_stack(
+            [
+                np.minimum.reduceat(qx, np.r_[0, np.cumsum(counts)[:-1]]),
+                np.minimum.reduceat(qy, np.r_[0, np.cumsum(counts)[:-1]]),
+            ]
+        )
+        - 10
+    )
+    hi = (
+        np.column_stack(
+            [
+                np.maximum.reduceat(qx, np.r_[0, np.cumsum(counts)[:-1]]),
+                np.maximum.reduceat(qy, np.r_[0, np.cumsum(counts)[:-1]]),
+            ]
+        )
+        + 10
+    )
     return g, qx, qy, r, start, lo, hi, true
 
 
 def _cost(x, y, r, p):
-    return np.sum((r - (A_DBM - 10 * N_EXP * np.log10(np.maximum(np.hypot(x - p[0], y - p[1]), MIN_RANGE_M)))) ** 2)
+    return np.sum(
+        (r - (A_DBM - 10 * N_EXP * np.log10(np.maximum(np.hypot(x - p[0], y - p[1]), MIN_RANGE_M)))) ** 2
+    )
+
+
+def _scipy(x, y, r, start, lo, hi):
+    """The reference: one scipy least_squares (TRF) call for one beacon, as learn_beacons did."""
+
+    def resid(q):
+        return r - (A_DBM - 10 * N_EXP * np.log10(np.maximum(np.hypot(x - q[0], y - q[1]), MIN_RANGE_M)))
+
+    return least_squares(resid, start, bounds=(lo, hi)).x
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
@@ -42,11 +69,7 @@ def test_same_minimum_as_scipy_per_beacon(seed):
     for b in range(len(start)):
         s = g == b
         x, y, rr = qx[s], qy[s], r[s]
-        ref = least_squares(
-            lambda q: rr - (A_DBM - 10 * N_EXP * np.log10(np.maximum(np.hypot(x - q[0], y - q[1]), MIN_RANGE_M))),  # noqa: B023
-            start[b],
-            bounds=(lo[b], hi[b]),
-        ).x
+        ref = _scipy(x, y, rr, start[b], lo[b], hi[b])
         dist.append(np.hypot(*(p[b] - ref)))
         cost, cost_ref = cost + _cost(x, y, rr, p[b]), cost_ref + _cost(x, y, rr, ref)
     assert np.mean(np.array(dist) < 0.01) >= 0.9, np.round(dist, 3)
@@ -62,9 +85,5 @@ def test_bounds_hold_and_start_outside_is_clipped():
     assert np.all(p >= lo) and np.all(p <= hi)
     for b in range(5):
         s = g == b
-        ref = least_squares(
-            lambda q: r[s] - (A_DBM - 10 * N_EXP * np.log10(np.maximum(np.hypot(qx[s] - q[0], qy[s] - q[1]), MIN_RANGE_M))),  # noqa: B023
-            np.clip(start[b] + 100.0, lo[b] + 1e-6, hi[b] - 1e-6),
-            bounds=(lo[b], hi[b]),
-        ).x
+        ref = _scipy(qx[s], qy[s], r[s], np.clip(start[b] + 100.0, lo[b] + 1e-6, hi[b] - 1e-6), lo[b], hi[b])
         assert np.hypot(*(p[b] - ref)) < 0.01, (b, p[b], ref)
