@@ -10,14 +10,16 @@ placed.
   reading on the beacon's floor, σ = the residuals' standard deviation.
 * :func:`learn_beacons` — unknown positions: alternating least squares. Start with n = 2 (free space)
   and A = the 95th-percentile RSSI; per beacon, its position minimises the squared RSSI residuals
-  (scipy least_squares, started at the RSSI-weighted centroid of its strongest readings, bounded to
+  (every beacon at once by :func:`~.beacon_solve.solve_positions`, a batched bounded
+  Levenberg–Marquardt, started at the RSSI-weighted centroid of its strongest readings, bounded to
   the box of its readings ± :data:`POSITION_MARGIN_M`); then A and n by linear least squares over all
   beacons; repeated :data:`ALTERNATIONS` times. A beacon needs :data:`MIN_READINGS` placed readings
   from :data:`MIN_CELLS` distinct 2 m cells on one floor (else the position is not determined, and
   it is left out); a beacon whose fit leaves an RMS residual above :data:`MAX_RMS_FACTOR` × the
   site's σ is left out too (a moved beacon, or one heard through floors).
 
-Cost: O(R) per alternation for R readings, plus one small least-squares problem per beacon.
+Cost: O(R) per solver iteration for R readings (numpy passes over all beacons' readings at once),
+a few tens of iterations per alternation; O(R log R) once to group the readings by beacon.
 """
 
 from __future__ import annotations
@@ -28,8 +30,9 @@ from typing import Any
 
 import numpy as np
 
-#: Readings closer than this are taken at this range [m] (the model's reference distance, 1 m).
-MIN_RANGE_M = 1.0
+#: Readings closer than MIN_RANGE_M [m] are taken at that range (the model's reference distance, 1 m).
+from stridefix_analyzer.radiomap.beacon_solve import MIN_RANGE_M, solve_positions
+
 #: Fewest placed readings and distinct 2 m cells that determine a beacon's position (3 unknowns:
 #: x, y and the residual scale need well over 3 independent positions).
 MIN_READINGS = 15
@@ -111,74 +114,71 @@ def fit_model(placed: dict[str, np.ndarray], table: dict[int, tuple[float, float
     }
 
 
+def _groups(placed: dict[str, np.ndarray]) -> tuple[dict[int, np.ndarray], dict[int, str]]:
+    """Per beacon the rows (ascending) of the floor it is heard most on, for the beacons with
+    :data:`MIN_READINGS` readings in :data:`MIN_CELLS` cells there; the rest with the reason."""
+    ids, floors = placed["beacon_id"], placed["floor"]
+    order = np.argsort(ids, kind="stable")  # rows ascending within each beacon
+    uniq, first = np.unique(ids[order], return_index=True)
+    cx = np.floor_divide(placed["x_m"], CELL_M).astype(np.int64)
+    cy = np.floor_divide(placed["y_m"], CELL_M).astype(np.int64)
+    groups: dict[int, np.ndarray] = {}
+    left_out: dict[int, str] = {}
+    for b, rows in zip(uniq.tolist(), np.split(order, first[1:])):
+        fl, counts = np.unique(floors[rows], return_counts=True)
+        rows = rows[floors[rows] == fl[np.argmax(counts)]]  # the floor it is heard most on
+        cells = len(np.unique(cx[rows] + 1j * cy[rows])) if len(rows) else 0
+        if len(rows) < MIN_READINGS or cells < MIN_CELLS:
+            left_out[b] = f"{len(rows)} readings in {cells} cells"
+            continue
+        groups[b] = rows
+    return groups, left_out
+
+
 def learn_beacons(placed: dict[str, np.ndarray]) -> dict[str, Any]:
     """Beacon positions and the site model from placed readings (see the module docstring).
 
     Returns ``beacons`` {id: (x, y, floor, n_readings, rms_db)}, the model (``rssi_1m_dbm``,
     ``path_loss_exponent``, ``range_sigma_db``, ``learnt``) and ``left_out`` {id: reason}."""
-    from scipy.optimize import least_squares
-
-    ids, floors = placed["beacon_id"], placed["floor"]
-    groups: dict[int, np.ndarray] = {}
-    left_out: dict[int, str] = {}
-    for b in np.unique(ids).tolist():
-        sel = ids == b
-        fl, counts = np.unique(floors[sel], return_counts=True)
-        sel &= floors == fl[np.argmax(counts)]  # the floor it is heard most on
-        cells = {(int(x // CELL_M), int(y // CELL_M)) for x, y in zip(placed["x_m"][sel], placed["y_m"][sel])}
-        if sel.sum() < MIN_READINGS or len(cells) < MIN_CELLS:
-            left_out[b] = f"{int(sel.sum())} readings in {len(cells)} cells"
-            continue
-        groups[b] = np.flatnonzero(sel)
-    rssi_all = placed["rssi_dbm"]
+    groups, left_out = _groups(placed)
+    rssi_all, floors = placed["rssi_dbm"], placed["floor"]
     a = float(np.percentile(rssi_all, 95)) if len(rssi_all) else DEFAULT_MODEL["rssi_1m_dbm"]
     n = DEFAULT_MODEL["path_loss_exponent"]
-    pos: dict[int, np.ndarray] = {}
-    for b, rows in groups.items():
+    if not groups:
+        return {"beacons": {}, **DEFAULT_MODEL, "learnt": False, "left_out": left_out, "readings": 0}
+    start = np.zeros((len(groups), 2))
+    for k, rows in enumerate(groups.values()):
         x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
         top = r >= np.percentile(r, 75)
         w = 10.0 ** (r[top] / 10.0)
-        pos[b] = np.array([np.sum(w * x[top]) / w.sum(), np.sum(w * y[top]) / w.sum()])
-    if not groups:
-        return {"beacons": {}, **DEFAULT_MODEL, "learnt": False, "left_out": left_out, "readings": 0}
+        start[k] = (np.sum(w * x[top]) / w.sum(), np.sum(w * y[top]) / w.sum())
+    rows_all = np.concatenate(list(groups.values()))
+    g = np.repeat(np.arange(len(groups)), [len(rows) for rows in groups.values()])
+    qx, qy, r_all = placed["x_m"][rows_all], placed["y_m"][rows_all], rssi_all[rows_all]
+    lo = np.column_stack([np.minimum.reduceat(qx, _starts(g)), np.minimum.reduceat(qy, _starts(g))])
+    hi = np.column_stack([np.maximum.reduceat(qx, _starts(g)), np.maximum.reduceat(qy, _starts(g))])
+    lo, hi = lo - POSITION_MARGIN_M, hi + POSITION_MARGIN_M
+    pos = start
     for _ in range(ALTERNATIONS):
-        for b, rows in groups.items():
-            x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
-            lo = np.array([x.min(), y.min()]) - POSITION_MARGIN_M
-            hi = np.array([x.max(), y.max()]) + POSITION_MARGIN_M
-            start = np.clip(pos[b], lo + 1e-6, hi - 1e-6)
-            res = least_squares(
-                lambda p: r - (a - 10.0 * n * _log_d(x - p[0], y - p[1])),  # noqa: B023 - used at once
-                start,
-                bounds=(lo, hi),
-            )
-            pos[b] = res.x
-        rows_all = np.concatenate(list(groups.values()))
-        bx = np.concatenate([np.full(len(rows), pos[b][0]) for b, rows in groups.items()])
-        by = np.concatenate([np.full(len(rows), pos[b][1]) for b, rows in groups.items()])
-        logd = _log_d(placed["x_m"][rows_all] - bx, placed["y_m"][rows_all] - by)
-        a, n = _linear_model(rssi_all[rows_all], logd)
+        pos = solve_positions(g, qx, qy, r_all, a, n, np.clip(pos, lo + 1e-6, hi - 1e-6), lo, hi)
+        logd = _log_d(qx - pos[g, 0], qy - pos[g, 1])
+        a, n = _linear_model(r_all, logd)
         if not n > 0:
-            a, n = _linear_model(
-                rssi_all[rows_all] + 10.0 * DEFAULT_MODEL["path_loss_exponent"] * logd, 0 * logd
-            )
+            a, n = _linear_model(r_all + 10.0 * DEFAULT_MODEL["path_loss_exponent"] * logd, 0 * logd)
             n = DEFAULT_MODEL["path_loss_exponent"]
-    resid_all = rssi_all[rows_all] - (a - 10.0 * n * logd)
-    sigma = float(np.std(resid_all))
+    resid = r_all - (a - 10.0 * n * logd)
+    sigma = float(np.std(resid))
+    rms_g = np.sqrt(np.bincount(g, resid * resid) / np.bincount(g))
     beacons: dict[int, tuple[float, float, int, int, float]] = {}
-    for b, rows in groups.items():
-        x, y, r = placed["x_m"][rows], placed["y_m"][rows], rssi_all[rows]
-        rms = float(np.sqrt(np.mean((r - (a - 10.0 * n * _log_d(x - pos[b][0], y - pos[b][1]))) ** 2)))
+    for k, (b, rows) in enumerate(groups.items()):
+        rms = float(rms_g[k])
         if rms > MAX_RMS_FACTOR * sigma:
             left_out[b] = f"RMS residual {rms:.1f} dB > {MAX_RMS_FACTOR:g} x site sigma {sigma:.1f} dB"
             continue
-        beacons[b] = (float(pos[b][0]), float(pos[b][1]), int(floors[rows[0]]), len(rows), rms)
-    kept = np.concatenate([groups[b] for b in beacons]) if beacons else np.zeros(0, np.int64)
-    if len(kept):
-        bx = np.concatenate([np.full(len(groups[b]), beacons[b][0]) for b in beacons])
-        by = np.concatenate([np.full(len(groups[b]), beacons[b][1]) for b in beacons])
-        resid = rssi_all[kept] - (a - 10.0 * n * _log_d(placed["x_m"][kept] - bx, placed["y_m"][kept] - by))
-        sigma = float(np.std(resid))
+        beacons[b] = (float(pos[k, 0]), float(pos[k, 1]), int(floors[rows[0]]), len(rows), rms)
+    kept = np.isin(g, [k for k, b in enumerate(groups) if b in beacons])
+    if kept.any():
+        sigma = float(np.std(resid[kept]))
     return {
         "beacons": beacons,
         "rssi_1m_dbm": a,
@@ -186,8 +186,13 @@ def learn_beacons(placed: dict[str, np.ndarray]) -> dict[str, Any]:
         "range_sigma_db": sigma,
         "learnt": True,
         "left_out": left_out,
-        "readings": int(len(kept)),
+        "readings": int(kept.sum()),
     }
+
+
+def _starts(g: np.ndarray) -> np.ndarray:
+    """Where each run of equal values of the sorted group index ``g`` starts."""
+    return np.flatnonzero(np.r_[True, g[1:] != g[:-1]])
 
 
 def mac_check(
