@@ -111,6 +111,8 @@ int sf_ble_fix(sf_ble_t *const ble, const sf_params_t *const p, const sf_beacons
         const int32_t k = find_beacon(b, scan->beacon_id[i]);
         if (k < 0) {
             ble->unknown++;
+        } else if (sf_ble_range_m(b, p1_of(b, k), rssi) > p->ble_max_range_m) {
+            ble->weak_or_bad++; /* too far to say where */
         } else if (p->ble_same_floor != 0 && b->floor[k] != floor) {
             ble->other_floor++;
         } else {

@@ -7,7 +7,8 @@
  * builder fits them on survey walks).
  *
  * The fix. The readings of the window are grouped by beacon (mean in dBm; readings weaker than
- * ble_min_rssi_dbm, non-finite, of beacons the site does not know, or — with ble_same_floor — of
+ * ble_min_rssi_dbm or that the model puts farther than ble_max_range_m, non-finite, of beacons the
+ * site does not know, or — with ble_same_floor — of
  * beacons on another floor than the caller's are counted and skipped); the SF_BLE_MAX_USED strongest
  * beacons are used. The position maximises the likelihood of their RSSIs under the model with a weak
  * prior at their weighted centroid (weights 1/d², d the model's range of each reading; prior σ² = the

@@ -182,6 +182,7 @@
  * claiming more than 50 m is no position within a building. */
 #define SF_PARAMS_SOURCES(X)                                                                           \
     X(ble,  min_rssi_dbm,          double,  -95.0,   -150.0,  0.0,     "dBm",   "BLE readings weaker than this are ignored") \
+    X(ble,  max_range_m,           double,  15.0,    1.0,     100.0,   "m",     "readings the site's path-loss model puts farther than this are not used (at 4-5 dB of shadowing a range is good to a factor ~1.8: beyond ~15 m it no longer says where in a building)") \
     X(ble,  min_beacons,           int32_t, 1,       1,       8,       "beacons", "fewest usable beacons for a BLE fix (one gives a disc about the beacon)") \
     X(ble,  same_floor,            int32_t, 1,       0,       1,       "",      "1 = only beacons on the caller's floor are used (a floor slab attenuates ~15-20 dB, which the model lacks)") \
     X(ble,  min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a BLE fix's accuracy (1 sigma)") \

@@ -88,6 +88,7 @@ static void test_ble_noiseless_is_exact(void **state)
     sf_params_t p;
     sf_params_default(&p);
     p.ble_min_rssi_dbm = -150.0;
+    p.ble_max_range_m = 100.0; /* the solver on every beacon of the box */
     const sf_beacons_t b = beacons();
     sf_ble_t ble = {0};
     const double tx = 6.0, ty = 4.0;
@@ -108,6 +109,10 @@ static void test_ble_noiseless_is_exact(void **state)
     assert_int_equal(fix.n_ap_used, 5);
     assert_int_equal(used, 5);
     assert_true(fix.accuracy_m >= p.ble_min_accuracy_m && fix.accuracy_m < 5.0);
+    /* by default the beacon 17.8 m away (20, 15) is too far to say where: four are used */
+    sf_params_default(&p);
+    assert_int_equal(sf_ble_fix(&ble, &p, &b, &scan, 0, &fix, &used), SF_OK);
+    assert_int_equal(used, 4);
 }
 
 static void test_ble_noisy_error_is_bounded(void **state)
@@ -116,6 +121,7 @@ static void test_ble_noisy_error_is_bounded(void **state)
     sf_params_t p;
     sf_params_default(&p);
     p.ble_min_rssi_dbm = -150.0;
+    p.ble_max_range_m = 100.0;
     const sf_beacons_t b = beacons();
     sf_ble_t ble = {0};
     rng_t r = {0x5eedULL};

@@ -16,7 +16,9 @@ placed.
   beacons; repeated :data:`ALTERNATIONS` times. A beacon needs :data:`MIN_READINGS` placed readings
   from :data:`MIN_CELLS` distinct 2 m cells on one floor (else the position is not determined, and
   it is left out); a beacon whose fit leaves an RMS residual above :data:`MAX_RMS_FACTOR` × the
-  site's σ is left out too (a moved beacon, or one heard through floors).
+  site's σ is left out too (a moved beacon, or one heard through floors), and so is one whose fit ends
+  within :data:`EDGE_M` of its box or whose position's 1σ (from the fit's information matrix) exceeds
+  :data:`MAX_POSITION_SIGMA_M` (the readings did not place it well enough for its fixes).
 
 Cost: O(R) per solver iteration for R readings (numpy passes over all beacons' readings at once),
 a few tens of iterations per alternation; O(R log R) once to group the readings by beacon.
@@ -38,6 +40,11 @@ from stridefix_analyzer.radiomap.beacon_solve import MIN_RANGE_M, solve_position
 MIN_READINGS = 15
 MIN_CELLS = 6
 CELL_M = 2.0
+#: Largest 1σ of a learnt beacon position kept [m]: the firmware takes a beacon as known to
+#: ble.position_sigma_m (3 m); a beacon placed worse than that would make its BLE fixes claim too much.
+MAX_POSITION_SIGMA_M = 3.0
+#: A learnt position within this of its box's edge [m] is one the readings did not determine.
+EDGE_M = 0.5
 #: A learnt position stays within the box of its readings ± this [m] (a beacon is heard from ~20 m).
 POSITION_MARGIN_M = 10.0
 ALTERNATIONS = 5
@@ -169,9 +176,22 @@ def learn_beacons(placed: dict[str, np.ndarray]) -> dict[str, Any]:
     resid = r_all - (a - 10.0 * n * logd)
     sigma = float(np.std(resid))
     rms_g = np.sqrt(np.bincount(g, resid * resid) / np.bincount(g))
+    pos_sigma = _position_sigma(g, qx - pos[g, 0], qy - pos[g, 1], n, sigma, len(groups))
     beacons: dict[int, tuple[float, float, int, int, float]] = {}
     for k, (b, rows) in enumerate(groups.items()):
         rms = float(rms_g[k])
+        if np.any(pos[k] <= lo[k] + EDGE_M) or np.any(pos[k] >= hi[k] - EDGE_M):
+            # the fit ran to the edge of the box it may lie in: the readings do not place it (a beacon
+            # heard only from one side, or only weakly); on 5 walks of site1/F2 such beacons were
+            # tens of metres off and their fixes started the schemes 40 m away
+            left_out[b] = f"fit at the edge of its box (readings ± {POSITION_MARGIN_M:g} m): not placed"
+            continue
+        if not pos_sigma[k] <= MAX_POSITION_SIGMA_M:
+            left_out[b] = (
+                f"position known to {pos_sigma[k]:.1f} m (1 sigma) > {MAX_POSITION_SIGMA_M:g} m: its fixes would "
+                "mislead"
+            )
+            continue
         if rms > MAX_RMS_FACTOR * sigma:
             left_out[b] = f"RMS residual {rms:.1f} dB > {MAX_RMS_FACTOR:g} x site sigma {sigma:.1f} dB"
             continue
@@ -188,6 +208,24 @@ def learn_beacons(placed: dict[str, np.ndarray]) -> dict[str, Any]:
         "left_out": left_out,
         "readings": int(kept.sum()),
     }
+
+
+def _position_sigma(
+    g: np.ndarray, dx: np.ndarray, dy: np.ndarray, n: float, sigma_db: float, n_groups: int
+) -> np.ndarray:
+    """Per beacon, √(½ trace) of its position's covariance from the fit (the inverse of Σ JᵀJ/σ² over
+    its readings, J = ∂RSSI/∂position = 10·n/ln 10 · (p − q)/d²; readings nearer than MIN_RANGE_M
+    carry no gradient); +∞ where the readings do not determine it (a singular information matrix)."""
+    d2 = np.maximum(dx * dx + dy * dy, MIN_RANGE_M**2)
+    k = 10.0 * n / np.log(10.0) / max(sigma_db, 1e-6)
+    jx, jy = k * -dx / d2, k * -dy / d2  # the model's slope in the beacon's x, y (p − q = −(q − p))
+    ixx = np.bincount(g, jx * jx, n_groups)
+    ixy = np.bincount(g, jx * jy, n_groups)
+    iyy = np.bincount(g, jy * jy, n_groups)
+    det = ixx * iyy - ixy * ixy
+    with np.errstate(divide="ignore", invalid="ignore"):
+        var = np.where(det > 0.0, 0.5 * (ixx + iyy) / det, np.inf)
+    return np.sqrt(var)
 
 
 def _starts(g: np.ndarray) -> np.ndarray:
