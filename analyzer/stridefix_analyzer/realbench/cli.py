@@ -218,6 +218,12 @@ def add_fusion_parser(sub: Any) -> None:
         help="fold sites without BLE beacons and path-loss model (learnt from the training walks)",
     )
     d.add_argument(
+        "--learn-beacons",
+        action="store_true",
+        help="a data set without a beacon table (msindoor): place its beacons from the training walks and "
+        "use them (off by default: positions from interpolated truth err by metres)",
+    )
+    d.add_argument(
         "--no-gnss",
         action="store_true",
         help="fold sites without a geo-reference, so no GNSS fix is used",
@@ -246,7 +252,10 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             quiet=args.quiet,
             param_sets=args.param_sets,
             content=ContentOptions(
-                floor_plan=not args.no_floor_plan, beacons=not args.no_beacons, gnss=not args.no_gnss
+                floor_plan=not args.no_floor_plan,
+                beacons=not args.no_beacons,
+                gnss=not args.no_gnss,
+                learn_beacons=args.learn_beacons,
             ),
         )
         doc = run_fusion(cfg)
