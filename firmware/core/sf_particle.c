@@ -45,8 +45,6 @@ void sf_particle_seed(sf_particle_t *const c, const sf_params_t *const p, const 
         q->x_m = x_m + sigma_m * sf_rng_normal(&c->rng);
         q->y_m = y_m + sigma_m * sf_rng_normal(&c->rng);
         q->w = w;
-        q->cx_m = 0.0f; /* a new position: its fixes' error is not known yet */
-        q->cy_m = 0.0f;
         c->floor[i] = floor;
         if (!keep) {
             q->bias_rad = (float)(p->particle_init_bias_sigma_rad * sf_rng_normal(&c->rng));
@@ -56,8 +54,6 @@ void sf_particle_seed(sf_particle_t *const c, const sf_params_t *const p, const 
     }
     c->seeded = true;
     c->seeds++;
-    c->c_var_m2 = -1.0; /* the prior σ_c², set at the next Wi-Fi fix (sf_particle_c_predict) */
-    c->c_walked_m = 0.0;
 }
 
 /* Whether a port that joins floors a and b (stairs or elevator) holds (x, y). */
@@ -237,91 +233,40 @@ void sf_particle_step(sf_particle_t *const c, const sf_params_t *const p, const 
     }
     resample_if_needed(c, p);
     c->steps++;
-    c->c_walked_m += length_m;
 }
 
-/* Σ w_i exp(−|z − x_i − κĉ_i|² / (2·var)), κ = 1 with the correlated error. */
-static double evidence(const sf_particle_t *const c, const double x_m, const double y_m, const double var_m2,
-                       const double kappa)
+double sf_particle_evidence(const sf_particle_t *const c, const double x_m, const double y_m, const double sigma_m)
 {
-    const double k = -0.5 / var_m2;
+    const double k = -0.5 / (sigma_m * sigma_m);
     double e = 0.0;
     for (int32_t i = 0; i < c->n; i++) {
-        const double dx = x_m - c->p[i].x_m - kappa * (double)c->p[i].cx_m;
-        const double dy = y_m - c->p[i].y_m - kappa * (double)c->p[i].cy_m;
+        const double dx = c->p[i].x_m - x_m, dy = c->p[i].y_m - y_m;
         e += c->p[i].w * exp(k * (dx * dx + dy * dy));
     }
     return e;
 }
 
-/* w_i ← w_i·((1 − ε)·g_i + ε), normalised; with the correlated error also ĉ_i ← ĉ_i + gain·ν_i. */
-static double update(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
-                     const double var_m2, const double kappa, const double gain, double *const ess_after)
+double sf_particle_update(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
+                          const double sigma_m, double *const ess_after)
 {
-    const double k = -0.5 / var_m2, eps = p->particle_outlier_share;
+    const double k = -0.5 / (sigma_m * sigma_m), eps = p->particle_outlier_share;
     double sum = 0.0;
     for (int32_t i = 0; i < c->n; i++) {
-        const double dx = x_m - c->p[i].x_m - kappa * (double)c->p[i].cx_m;
-        const double dy = y_m - c->p[i].y_m - kappa * (double)c->p[i].cy_m;
+        const double dx = c->p[i].x_m - x_m, dy = c->p[i].y_m - y_m;
         sum += c->p[i].w * ((1.0 - eps) * exp(k * (dx * dx + dy * dy)) + eps);
     }
     /* α = ½ Σ |w_i l_i / sum − w_i|, then the new weights; sum ≥ eps·Σw > 0 */
     double tv = 0.0, s2 = 0.0;
     for (int32_t i = 0; i < c->n; i++) {
-        sf_particle_state_t *const q = &c->p[i];
-        const double dx = x_m - q->x_m - kappa * (double)q->cx_m, dy = y_m - q->y_m - kappa * (double)q->cy_m;
-        const double w = q->w * ((1.0 - eps) * exp(k * (dx * dx + dy * dy)) + eps) / sum;
-        tv += fabs(w - q->w);
+        const double dx = c->p[i].x_m - x_m, dy = c->p[i].y_m - y_m;
+        const double w = c->p[i].w * ((1.0 - eps) * exp(k * (dx * dx + dy * dy)) + eps) / sum;
+        tv += fabs(w - c->p[i].w);
         s2 += w * w;
-        q->w = w;
-        q->cx_m = (float)((double)q->cx_m + gain * dx);
-        q->cy_m = (float)((double)q->cy_m + gain * dy);
+        c->p[i].w = w;
     }
     *ess_after = s2 > 0.0 ? 1.0 / s2 : 0.0;
     resample_if_needed(c, p);
     return clamp(0.5 * tv, 0.0, 1.0);
-}
-
-double sf_particle_evidence(const sf_particle_t *const c, const double x_m, const double y_m, const double sigma_m)
-{
-    return evidence(c, x_m, y_m, sigma_m * sigma_m, 0.0);
-}
-
-double sf_particle_update(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
-                          const double sigma_m, double *const ess_after)
-{
-    return update(c, p, x_m, y_m, sigma_m * sigma_m, 0.0, 0.0, ess_after);
-}
-
-void sf_particle_c_predict(sf_particle_t *const c, const double sigma_c_m, const double length_c_m)
-{
-    const double q = sigma_c_m > 0.0 && length_c_m > 0.0 ? sigma_c_m * sigma_c_m : 0.0;
-    if (c->c_var_m2 < 0.0 || q == 0.0) { /* a new cloud (or no correlated error): the prior */
-        c->c_var_m2 = q;
-    } else {
-        const double phi = exp(-c->c_walked_m / length_c_m);
-        for (int32_t i = 0; i < c->n; i++) {
-            c->p[i].cx_m = (float)(phi * (double)c->p[i].cx_m);
-            c->p[i].cy_m = (float)(phi * (double)c->p[i].cy_m);
-        }
-        c->c_var_m2 = phi * phi * c->c_var_m2 + (1.0 - phi * phi) * q;
-    }
-    c->c_walked_m = 0.0;
-}
-
-double sf_particle_evidence_c(const sf_particle_t *const c, const double x_m, const double y_m,
-                              const double r_white_m2)
-{
-    return evidence(c, x_m, y_m, fmax(c->c_var_m2, 0.0) + r_white_m2, 1.0);
-}
-
-double sf_particle_update_c(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
-                            const double r_white_m2, double *const ess_after)
-{
-    const double pc = fmax(c->c_var_m2, 0.0), s = pc + r_white_m2, gain = pc / s;
-    const double alpha = update(c, p, x_m, y_m, s, 1.0, gain, ess_after);
-    c->c_var_m2 = (1.0 - gain) * pc;
-    return alpha;
 }
 
 void sf_particle_summary(const sf_particle_t *const c, sf_particle_summary_t *const s)
@@ -421,8 +366,6 @@ void sf_particle_inject(sf_particle_t *const c, const double x_m, const double y
         q->x_m = x_m + sigma_m * sf_rng_normal(&c->rng);
         q->y_m = y_m + sigma_m * sf_rng_normal(&c->rng);
         q->w = w; /* the particle keeps its gait (bias, scale): the walker's, not the position's */
-        q->cx_m = 0.0f;
-        q->cy_m = 0.0f;
         c->floor[i] = floor;
     }
     (void)normalise(c);

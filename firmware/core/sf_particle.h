@@ -31,21 +31,11 @@
  * cloud. The evidence E = Σ w_i g_i ∈ [0, 1] (how much of the cloud lies near the fix) is what the
  * control judges (sf_fusion_particle.c); the effective weight change (total variation ½Σ|w'_i − w_i|,
  * 0 = nothing moved, 1 = a new distribution) is the audit's α.
- * Wi-Fi fixes err alike (sf_ekf.h, "Why c": a walker gets the same wrong fix again and again), and a
- * cloud that takes them as independent grows sure of a wrong place. So a Wi-Fi fix is z = x + c + w,
- * c Gauss–Markov in the distance walked (σ_c, ℓ: the site's measured fix model, as the ekf's), w white
- * (R_w). c is linear-Gaussian given a particle's position, so it is not sampled but carried as a
- * Kalman mean per particle, ĉ_i, with one shared variance P_c (the same for every particle: the same
- * H, R and decay) — a Rao-Blackwellised filter (Doucet et al. 2000). Per Wi-Fi fix: decay over the
- * distance walked d since the last one, φ = exp(−d/ℓ): ĉ_i ← φ·ĉ_i, P_c ← φ²·P_c + (1 − φ²)·σ_c²;
- * likelihood g_i = exp(−|z − x_i − ĉ_i|² / (2S)), S = P_c + R_w; then ĉ_i ← ĉ_i + K·(z − x_i − ĉ_i),
- * K = P_c / S, P_c ← (1 − K)·P_c. The other sources carry no c (their g_i uses z − x_i and R). A new
- * cloud starts at ĉ = 0, P_c = σ_c²; an injected particle at ĉ = 0.
  * Resampling: systematic (one uniform), in place, when ESS < resample_ess_ratio · N; after a step (walls
  * killed some) and after a fix.
  *
- * Memory: the caller's array of N particles, sizeof(sf_particle_state_t) = 40 B each (checked), plus
- * 2 B of floor: 1 000 particles 42 kB, SF_PARTICLE_MAX (2 048) 86 kB; sizeof(sf_particle_t) ≤ 160 B (checked).
+ * Memory: the caller's array of N particles, sizeof(sf_particle_state_t) = 32 B each (checked):
+ * 1 000 particles 32 kB, SF_PARTICLE_MAX (2 048) 64 kB; sizeof(sf_particle_t) ≤ 128 B (checked).
  * Cost per step: per particle 4 normals (2 polar pairs: 2 log, 2 sqrt), one sin and cos, the wall
  * query (sf_wall_grid.h: the cells on the step's path); per fix one exp per particle; resampling O(N).
  * Measured (make bench, particle-cost): see out/bench/particle_cost.json. No heap, no I/O, no clock.
@@ -69,10 +59,8 @@ typedef struct {
     double w;       /* normalised linear weight */
     float bias_rad; /* heading bias b */
     float scale;    /* stride scale s */
-    float cx_m;     /* ĉ: this particle's estimate of the Wi-Fi fixes' correlated error (below) */
-    float cy_m;
 } sf_particle_state_t;
-_Static_assert(sizeof(sf_particle_state_t) == 40, "sf_particle.h promises 40 B per particle");
+_Static_assert(sizeof(sf_particle_state_t) == 32, "sf_particle.h promises 32 B per particle");
 
 typedef struct {
     sf_particle_state_t *p; /* [capacity], caller-owned */
@@ -85,12 +73,10 @@ typedef struct {
     bool seeded;
     /* counters, never decrease */
     uint32_t steps, deaths, all_blocked, resamples, seeds, floor_changes;
-    double c_var_m2;         /* P_c, the shared variance of the ĉ_i (per axis) */
-    double c_walked_m;       /* walked since the last Wi-Fi fix (the decay of c) */
     uint32_t detours, jumps; /* the published track (sf_particle_reachable): mean replaced, no way found */
     uint32_t injections;     /* sf_particle_inject calls (recoveries) */
 } sf_particle_t;
-_Static_assert(sizeof(sf_particle_t) <= 160, "sf_particle.h promises at most 160 B");
+_Static_assert(sizeof(sf_particle_t) <= 128, "sf_particle.h promises at most 128 B");
 
 /* Bytes of caller memory for n particles (state and floor arrays). */
 #define SF_PARTICLE_BYTES_PER (sizeof(sf_particle_state_t) + sizeof(int16_t))
@@ -132,17 +118,6 @@ void sf_particle_floors(sf_particle_t *c, int16_t baro_floor);
 
 /* E = Σ w_i exp(−|z − x_i|² / (2σ²)). */
 double sf_particle_evidence(const sf_particle_t *c, double x_m, double y_m, double sigma_m);
-
-/* A Wi-Fi fix's correlated error decays over the distance walked since the last one (see the header),
- * with the site's σ_c and ℓ (ℓ ≤ 0 or σ_c ≤ 0: no correlated error, P_c = 0). Call before the
- * evidence and the update of a Wi-Fi fix. */
-void sf_particle_c_predict(sf_particle_t *c, double sigma_c_m, double length_c_m);
-
-/* The evidence and the update of a Wi-Fi fix with its white variance r_white_m2 (per axis): the
- * innovations z − x_i − ĉ_i, S = P_c + R_w, and the ĉ_i and P_c updated (see the header). */
-double sf_particle_evidence_c(const sf_particle_t *c, double x_m, double y_m, double r_white_m2);
-double sf_particle_update_c(sf_particle_t *c, const sf_params_t *p, double x_m, double y_m, double r_white_m2,
-                            double *ess_after);
 
 /* The fix's likelihood applied (see the header), resampled if needed; returns the effective weight
  * change α ∈ [0, 1]; *ess_after is the ESS right after the update, before any resampling. */

@@ -59,9 +59,9 @@ static void test_memory_and_contract(void **state)
     assert_int_equal(sf_particle_init(&c, &p, states[0], pfloors[0], SF_PARTICLE_MAX + 1), SF_EINVAL);
     assert_int_equal(sf_particle_init(&c, &p, states[0], pfloors[0], 300), SF_OK);
     assert_int_equal(c.n, 300); /* min(particle.count, capacity) */
-    assert_int_equal(sizeof(sf_particle_state_t), 40); /* position, weight, gait and the correlated-error mean */
-    assert_int_equal(SF_PARTICLE_BYTES_PER, 42);
-    assert_true(sizeof(sf_particle_t) <= 160);
+    assert_int_equal(sizeof(sf_particle_state_t), 32);
+    assert_int_equal(SF_PARTICLE_BYTES_PER, 34);
+    assert_true(sizeof(sf_particle_t) <= 128);
     printf("memory: %zu B per particle, %zu B for 1 000, %zu B header\n", SF_PARTICLE_BYTES_PER,
            1000 * SF_PARTICLE_BYTES_PER, sizeof(sf_particle_t));
 }
