@@ -1,4 +1,4 @@
-"""Issue 11's targets on the real data sets, checked on ``stridefix realbench`` results.
+"""Issues 11's and 13's targets on the real data sets, checked on ``stridefix realbench`` results.
 
 ``make bench`` runs ``stridefix realbench`` (every scheme from its first fix, and ``--true-start``) on
 each data set it finds and passes the ``results.json`` files here; every target is one row of
@@ -40,6 +40,11 @@ TARGETS: tuple[Target, ...] = (
     Target("gsd/building 100", "true start", "pdr_only", "mean", 6.0),
     # the trial that changes floors (0 → −1 → −2 and back)
     Target("gsd/building 100", "first fix", "ekf", "floor_hit_rate", 0.99, at_least=True, walk="Trial51"),
+    # issue 13: the map-aware particle filter with walls, BLE and GNSS
+    Target("site1/F2", "first fix", "particle", "mean", 3.0),
+    Target("site1/F2", "first fix", "particle", "p75", 4.0),
+    Target("site2/F3", "first fix", "particle", "mean", 8.0),
+    Target("gsd/building 100", "first fix", "particle", "ipin_score", 4.0),
 )
 
 _SUMMARY = {"first fix": "summary", "true start": "summary_true_start"}
