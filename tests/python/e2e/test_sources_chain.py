@@ -27,8 +27,8 @@ HOST0_S = 1_700_000_000.0
 DURATION_S = 6
 ORIGIN = (48.1, 11.5, 500.0)  # lat, lon [deg], alt [m]
 EARTH_R_M = 6_378_137.0
-#: beacons (MAC, x, y) on floor 0, and where the walker stands [m]
-BEACONS = [(0xE078A33D0001, 0.0, 0.0), (0xE078A33D0002, 20.0, 0.0), (0xE078A33D0003, 0.0, 20.0)]
+#: beacons (MAC, x, y) on floor 0, all within ble.max_range_m (15 m) of where the walker stands [m]
+BEACONS = [(0xE078A33D0001, 0.0, 0.0), (0xE078A33D0002, 20.0, 0.0), (0xE078A33D0003, 0.0, 16.0)]
 STAND_XY = (8.0, 6.0)
 LANDMARK_XY = (8.5, 6.5)
 RSSI_1M_DBM, PATH_LOSS_N = -59.0, 2.0
