@@ -71,7 +71,8 @@ enum { sf_port_door = 1, sf_port_stairs = 2, sf_port_elevator = 3 };
  * of radius_m about (x_m, y_m) that joins floors floor_lo .. floor_hi (a door: floor_lo = floor_hi). */
 typedef struct {
     int32_t n_ports;
-    const int8_t *kind;      /* [n_ports], sf_port_* */
+    const int16_t *kind;     /* [n_ports], sf_port_* (int16, not int8: lcm-gen copies an int8 array with
+                              * memcpy, undefined for the NULL pointer of a site without ports) */
     const float *x_m;        /* [n_ports] */
     const float *y_m;        /* [n_ports] */
     const float *radius_m;   /* [n_ports], > 0 */

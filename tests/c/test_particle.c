@@ -239,7 +239,7 @@ static void test_floor_changes_only_at_ports(void **state)
     sf_params_default(&p);
     sf_particle_t c;
     assert_int_equal(sf_particle_init(&c, &p, states[0], pfloors[0], SF_PARTICLE_MAX), SF_OK);
-    const int8_t kind[2] = {sf_port_door, sf_port_stairs};
+    const int16_t kind[2] = {sf_port_door, sf_port_stairs};
     const float px[2] = {0.0f, 10.0f}, py[2] = {0.0f, 0.0f}, pr[2] = {3.0f, 1.5f};
     const int16_t lo[2] = {0, 0}, hi[2] = {0, 1};
     const sf_ports_t ports = {.n_ports = 2, .kind = kind, .x_m = px, .y_m = py, .radius_m = pr, .floor_lo = lo,

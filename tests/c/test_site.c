@@ -390,7 +390,7 @@ static void test_index_out_of_range(void **state)
     sf_site_store_t loaded;
     sf_site_t view;
     assert_int_equal(sf_site_parse(buf, size, "site.sfsite", &loaded, &view, NULL, 0), SF_OK);
-    const size_t v2_bytes = 8u + 8u + 4u + 18u * (size_t)loaded.msg.n_walls + 4u + 17u * (size_t)loaded.msg.n_ports +
+    const size_t v2_bytes = 8u + 8u + 4u + 18u * (size_t)loaded.msg.n_walls + 4u + 18u * (size_t)loaded.msg.n_ports +
                             4u + 22u * (size_t)loaded.msg.n_beacons + 3u * 4u;
     sf_site_store_free(&loaded);
     const size_t fix_model_bytes = 1u + 9u * 4u;
