@@ -310,12 +310,29 @@ def _default_aps() -> tuple[AccessPoint, ...]:
         (45.0, 10.0, 48, 18.0),
         (30.0, 5.0, 157, 20.0),
     ]
-    aps = []
-    for floor in range(N_FLOORS):
-        for i, (x, y, ch, p) in enumerate(spec):
-            bssid = 0x3C_84_6A_00_10_00 + (floor << 12) + (i << 4) + (1 if ch > 14 else 0)
-            aps.append(AccessPoint(bssid=bssid, channel=ch, x_m=x, y_m=y, tx_power_dbm=p, floor=floor))
-    return tuple(aps)
+    return tuple(
+        ap
+        for floor in range(N_FLOORS)
+        for ap in aps_from_spec(spec, 0x3C_84_6A_00_10_00 + (floor << 12), floor)
+    )
+
+
+def aps_from_spec(
+    spec: list[tuple[float, float, int, float]], base_bssid: int, floor: int = 0
+) -> tuple[AccessPoint, ...]:
+    """Access points from rows (x_m, y_m, channel, tx_power_dbm) on one floor: the i-th BSSID is
+    base + 16·i, +1 on a 5 GHz channel (> 14), so every world numbers its APs the same way."""
+    return tuple(
+        AccessPoint(
+            bssid=base_bssid + (i << 4) + (1 if ch > 14 else 0),
+            channel=ch,
+            x_m=x,
+            y_m=y,
+            tx_power_dbm=p,
+            floor=floor,
+        )
+        for i, (x, y, ch, p) in enumerate(spec)
+    )
 
 
 def _default_mag_zones() -> tuple[MagZone, ...]:

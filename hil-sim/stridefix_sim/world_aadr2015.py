@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .world import AccessPoint, MagZone, World, _rect
+from .world import AccessPoint, MagZone, World, _rect, aps_from_spec
 
 # --- the aadr2015 foyer (Jäger, Süß, Becker: 8 APs, 67 calibration points, 70 m track, 14 reference points)
 FOYER_W_M, FOYER_H_M = 20.0, 14.0
@@ -80,17 +80,7 @@ def _foyer_aps() -> tuple[AccessPoint, ...]:
         (17.0, 0.5, 1, 17.0),
         (19.5, 5.0, 149, 20.0),
     ]
-    return tuple(
-        AccessPoint(
-            bssid=0x00_1A_2B_30_00_00 + (i << 4) + (1 if ch > 14 else 0),
-            channel=ch,
-            x_m=x,
-            y_m=y,
-            tx_power_dbm=p,
-            floor=0,
-        )
-        for i, (x, y, ch, p) in enumerate(spec)
-    )
+    return aps_from_spec(spec, 0x00_1A_2B_30_00_00)
 
 
 def aadr2015_world(map_rotation_deg: float = 20.0) -> World:

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .world import AccessPoint, World, _rect
+from .world import AccessPoint, World, _rect, aps_from_spec
 from .world_sources import Beacon, Door, GeoRef
 
 CAMPUS_W_M, CAMPUS_H_M = 40.0, 20.0
@@ -85,16 +85,7 @@ def _campus_aps() -> tuple[AccessPoint, ...]:
         (30.0, 5.0, 1, 18.0),
         (37.0, 4.0, 149, 20.0),
     ]
-    return tuple(
-        AccessPoint(
-            bssid=0x3C_84_6A_00_30_00 + (i << 4) + (1 if ch > 14 else 0),
-            channel=ch,
-            x_m=x,
-            y_m=y,
-            tx_power_dbm=p,
-        )
-        for i, (x, y, ch, p) in enumerate(spec)
-    )
+    return aps_from_spec(spec, 0x3C_84_6A_00_30_00)
 
 
 def _campus_beacons() -> tuple[Beacon, ...]:
