@@ -32,7 +32,7 @@ if __name__ == "__main__":
         sys.path.insert(0, _d)
 
 from stridefix import site_t, truth_t  # noqa: E402
-from stridefix_analyzer.io import sitefile  # noqa: E402
+from stridefix_analyzer.io import site_v2, sitefile  # noqa: E402
 
 _SCALAR_FIELDS = (
     "name",
@@ -48,31 +48,8 @@ _SCALAR_FIELDS = (
     "fix_bias_length_m",
     "fix_white_share",
 )
-_V2_SCALAR_FIELDS = (
-    "origin_alt_m",
-    "geo_rotation_deg",
-    "ble_rssi_1m_dbm",
-    "ble_path_loss_exponent",
-    "ble_range_sigma_db",
-)
-_V2_ARRAY_FIELDS = (
-    "wall_x0_m",
-    "wall_y0_m",
-    "wall_x1_m",
-    "wall_y1_m",
-    "wall_floor",
-    "port_kind",
-    "port_x_m",
-    "port_y_m",
-    "port_radius_m",
-    "port_floor_lo",
-    "port_floor_hi",
-    "beacon_id",
-    "beacon_x_m",
-    "beacon_y_m",
-    "beacon_floor",
-    "beacon_rssi_1m_dbm",
-)
+_V2_SCALAR_FIELDS = site_v2.V2_SCALARS
+_V2_ARRAY_FIELDS = tuple(name for arrays in site_v2.V2_ARRAYS.values() for name in arrays)
 _ARRAY_FIELDS = (
     "floor_height_m",
     "ap_bssid",

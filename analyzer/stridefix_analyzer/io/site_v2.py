@@ -26,40 +26,64 @@ PORT_KINDS = {site_t.PORT_DOOR: "door", site_t.PORT_STAIRS: "stairs", site_t.POR
 BEACON_ID_LIMIT = 1 << 48
 
 
+#: The version-2 fields of ``site_t``, the one list the checks, the empty content, the counts and the
+#: test vectors (tests/vectors/gen_site_vectors.py) read: scalars, and each count with its arrays.
+V2_SCALARS = (
+    "origin_alt_m",
+    "geo_rotation_deg",
+    "ble_rssi_1m_dbm",
+    "ble_path_loss_exponent",
+    "ble_range_sigma_db",
+)
+V2_ARRAYS = {
+    "n_walls": ("wall_x0_m", "wall_y0_m", "wall_x1_m", "wall_y1_m", "wall_floor"),
+    "n_ports": ("port_kind", "port_x_m", "port_y_m", "port_radius_m", "port_floor_lo", "port_floor_hi"),
+    "n_beacons": ("beacon_id", "beacon_x_m", "beacon_y_m", "beacon_floor", "beacon_rssi_1m_dbm"),
+}
+
+
 class SiteV2ValidationError(ValueError):
     """Base of the version-2 rule failures (sitefile re-raises them as SiteValidationError)."""
 
 
-def _fin(*values: float) -> bool:
+def finite(*values: float) -> bool:
     return all(math.isfinite(v) for v in values)
 
 
-def _lens(site: site_t, count_name: str, *arrays: str) -> int:
+def check_len(
+    site: site_t, count_name: str, *arrays: str, error: type[ValueError] = SiteV2ValidationError
+) -> int:
+    """``site.<count_name>``, after checking it is not negative and every array holds that many
+    values; raises ``error`` naming the field otherwise (sitefile passes its own error class)."""
     n = getattr(site, count_name)
     if n < 0:
-        raise SiteV2ValidationError(f"{count_name} = {n} is negative")
+        raise error(f"{count_name} = {n} is negative")
     for name in arrays:
         got = len(getattr(site, name))
         if got != n:
-            raise SiteV2ValidationError(f"{name} has {got} values but {count_name} = {n}")
+            raise error(f"{name} has {got} values but {count_name} = {n}")
     return int(n)
+
+
+def _lens(site: site_t, count_name: str) -> int:
+    return check_len(site, count_name, *V2_ARRAYS[count_name])
 
 
 def validate_geo(site: site_t) -> None:
     """The version-2 geo-reference rules (only called when ``has_geo``)."""
-    if not _fin(site.origin_alt_m):
+    if not finite(site.origin_alt_m):
         raise SiteV2ValidationError(f"origin_alt_m is {site.origin_alt_m:g}, must be finite")
-    if not _fin(site.geo_rotation_deg):
+    if not finite(site.geo_rotation_deg):
         raise SiteV2ValidationError(f"geo_rotation_deg is {site.geo_rotation_deg:g}, must be finite")
 
 
 def validate_plan(site: site_t, lowest: int, top: int) -> None:
     """Walls, ports and beacons against the floors ``lowest`` … ``top``; raise on the first broken."""
-    n_walls = _lens(site, "n_walls", "wall_x0_m", "wall_y0_m", "wall_x1_m", "wall_y1_m", "wall_floor")
+    n_walls = _lens(site, "n_walls")
     for i in range(n_walls):
         x0, y0, x1, y1 = site.wall_x0_m[i], site.wall_y0_m[i], site.wall_x1_m[i], site.wall_y1_m[i]
         f = site.wall_floor[i]
-        if not _fin(x0, y0, x1, y1):
+        if not finite(x0, y0, x1, y1):
             raise SiteV2ValidationError(
                 f"wall {i}: end points ({x0:g}, {y0:g}) - ({x1:g}, {y1:g}) not finite"
             )
@@ -67,32 +91,21 @@ def validate_plan(site: site_t, lowest: int, top: int) -> None:
             raise SiteV2ValidationError(f"wall {i}: floor {f} outside {lowest}..{top}")
         if x0 == x1 and y0 == y1:
             raise SiteV2ValidationError(f"wall {i}: zero length at ({x0:g}, {y0:g})")
-    n_ports = _lens(
-        site,
-        "n_ports",
-        "port_kind",
-        "port_x_m",
-        "port_y_m",
-        "port_radius_m",
-        "port_floor_lo",
-        "port_floor_hi",
-    )
+    n_ports = _lens(site, "n_ports")
     for i in range(n_ports):
         kind, x, y, r = site.port_kind[i], site.port_x_m[i], site.port_y_m[i], site.port_radius_m[i]
         lo, hi = site.port_floor_lo[i], site.port_floor_hi[i]
         if kind not in PORT_KINDS:
             raise SiteV2ValidationError(f"port {i}: kind {kind} unknown (1 door, 2 stairs, 3 elevator)")
-        if not _fin(x, y):
+        if not finite(x, y):
             raise SiteV2ValidationError(f"port {i}: position ({x:g}, {y:g}) not finite")
-        if not (_fin(r) and r > 0.0):
+        if not (finite(r) and r > 0.0):
             raise SiteV2ValidationError(f"port {i}: port_radius_m = {r:g}, must be finite and > 0")
         if lo > hi:
             raise SiteV2ValidationError(f"port {i}: floor_lo {lo} above floor_hi {hi}")
         if lo < lowest or hi > top:
             raise SiteV2ValidationError(f"port {i}: floors {lo}..{hi} outside {lowest}..{top}")
-    n_beacons = _lens(
-        site, "n_beacons", "beacon_id", "beacon_x_m", "beacon_y_m", "beacon_floor", "beacon_rssi_1m_dbm"
-    )
+    n_beacons = _lens(site, "n_beacons")
     for i in range(n_beacons):
         b, x, y, f = site.beacon_id[i], site.beacon_x_m[i], site.beacon_y_m[i], site.beacon_floor[i]
         if not 0 <= b < BEACON_ID_LIMIT:
@@ -102,7 +115,7 @@ def validate_plan(site: site_t, lowest: int, top: int) -> None:
                 f"beacon {i}: id 0x{b:012x} not above beacon {i - 1}'s 0x{site.beacon_id[i - 1]:012x} "
                 f"(ids must be strictly ascending)"
             )
-        if not _fin(x, y):
+        if not finite(x, y):
             raise SiteV2ValidationError(f"beacon {i}: position ({x:g}, {y:g}) not finite")
         if not lowest <= f <= top:
             raise SiteV2ValidationError(f"beacon {i}: floor {f} outside {lowest}..{top}")
@@ -112,13 +125,13 @@ def validate_plan(site: site_t, lowest: int, top: int) -> None:
                 f"beacon {i}: beacon_rssi_1m_dbm is {r1:g}, must be finite or NaN (unknown)"
             )
     if n_beacons > 0:
-        if not _fin(site.ble_rssi_1m_dbm):
+        if not finite(site.ble_rssi_1m_dbm):
             raise SiteV2ValidationError(f"ble_rssi_1m_dbm is {site.ble_rssi_1m_dbm:g}, must be finite")
-        if not (_fin(site.ble_path_loss_exponent) and site.ble_path_loss_exponent > 0.0):
+        if not (finite(site.ble_path_loss_exponent) and site.ble_path_loss_exponent > 0.0):
             raise SiteV2ValidationError(
                 f"ble_path_loss_exponent = {site.ble_path_loss_exponent:g}, must be finite and > 0"
             )
-        if not (_fin(site.ble_range_sigma_db) and site.ble_range_sigma_db > 0.0):
+        if not (finite(site.ble_range_sigma_db) and site.ble_range_sigma_db > 0.0):
             raise SiteV2ValidationError(
                 f"ble_range_sigma_db = {site.ble_range_sigma_db:g}, must be finite and > 0"
             )
@@ -126,21 +139,13 @@ def validate_plan(site: site_t, lowest: int, top: int) -> None:
 
 def init_v2_fields(s: site_t) -> None:
     """Empty version-2 content: no geo altitude or rotation, no walls, ports or beacons."""
-    s.origin_alt_m, s.geo_rotation_deg = 0.0, 0.0
-    s.wall_x0_m, s.wall_y0_m, s.wall_x1_m, s.wall_y1_m, s.wall_floor = [], [], [], [], []
-    s.port_kind, s.port_x_m, s.port_y_m, s.port_radius_m, s.port_floor_lo, s.port_floor_hi = (
-        [],
-        [],
-        [],
-        [],
-        [],
-        [],
-    )
-    s.beacon_id, s.beacon_x_m, s.beacon_y_m, s.beacon_floor, s.beacon_rssi_1m_dbm = [], [], [], [], []
-    s.ble_rssi_1m_dbm, s.ble_path_loss_exponent, s.ble_range_sigma_db = 0.0, 0.0, 0.0
+    for name in V2_SCALARS:
+        setattr(s, name, 0.0)
+    for arrays in V2_ARRAYS.values():
+        for name in arrays:
+            setattr(s, name, [])
 
 
 def set_v2_counts(s: site_t) -> None:
-    s.n_walls = len(s.wall_x0_m)
-    s.n_ports = len(s.port_kind)
-    s.n_beacons = len(s.beacon_id)
+    for count, arrays in V2_ARRAYS.items():
+        setattr(s, count, len(getattr(s, arrays[0])))

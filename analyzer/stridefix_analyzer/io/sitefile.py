@@ -33,7 +33,6 @@ Cost: one read of the file, O(n_ap + n_rp + n_entries) checks.
 from __future__ import annotations
 
 import io
-import math
 import os
 import stat
 import struct
@@ -45,6 +44,8 @@ from stridefix import site_t
 
 from stridefix_analyzer.io.site_v2 import (
     SiteV2ValidationError,
+    check_len,
+    finite,
     init_v2_fields,
     set_v2_counts,
     validate_geo,
@@ -90,19 +91,8 @@ class SiteValidationError(ValueError):
 # --- field validation ----------------------------------------------------------------------------
 
 
-def _finite(value: float) -> bool:
-    return math.isfinite(value)
-
-
 def _check_len(site: site_t, count_name: str, *arrays: str) -> int:
-    n = getattr(site, count_name)
-    if n < 0:
-        raise SiteValidationError(f"{count_name} = {n} is negative")
-    for name in arrays:
-        got = len(getattr(site, name))
-        if got != n:
-            raise SiteValidationError(f"{name} has {got} values but {count_name} = {n}")
-    return int(n)
+    return check_len(site, count_name, *arrays, error=SiteValidationError)
 
 
 def validate_site(site: site_t) -> None:
@@ -113,12 +103,12 @@ def validate_site(site: site_t) -> None:
     SiteValidationError
         Naming the field and index, e.g. ``"entry 17: rp index 300 outside 0..99"``.
     """
-    if not _finite(site.map_rotation_deg):
+    if not finite(site.map_rotation_deg):
         raise SiteValidationError(f"map_rotation_deg is {site.map_rotation_deg:g}, must be finite")
     if site.has_geo:
-        if not (_finite(site.origin_lat_deg) and -90.0 <= site.origin_lat_deg <= 90.0):
+        if not (finite(site.origin_lat_deg) and -90.0 <= site.origin_lat_deg <= 90.0):
             raise SiteValidationError(f"origin_lat_deg = {site.origin_lat_deg:g} outside -90..90")
-        if not (_finite(site.origin_lon_deg) and -180.0 <= site.origin_lon_deg <= 180.0):
+        if not (finite(site.origin_lon_deg) and -180.0 <= site.origin_lon_deg <= 180.0):
             raise SiteValidationError(f"origin_lon_deg = {site.origin_lon_deg:g} outside -180..180")
         try:
             validate_geo(site)
@@ -127,24 +117,22 @@ def validate_site(site: site_t) -> None:
 
     if site.has_fix_model:
         fxx, fxy, fyy = site.fix_floor_cov_m2
-        if not (
-            all(_finite(v) for v in (fxx, fxy, fyy)) and fxx >= 0 and fyy >= 0 and fxx * fyy >= fxy * fxy
-        ):
+        if not (all(finite(v) for v in (fxx, fxy, fyy)) and fxx >= 0 and fyy >= 0 and fxx * fyy >= fxy * fxy):
             raise SiteValidationError(
                 f"fix_floor_cov_m2 = [{fxx:g}, {fxy:g}, {fyy:g}] not positive semi-definite"
             )
         xx, xy, yy = site.fix_cov_per_acc2
-        if not (all(_finite(v) for v in (xx, xy, yy)) and xx > 0 and yy > 0 and xx * yy > xy * xy):
+        if not (all(finite(v) for v in (xx, xy, yy)) and xx > 0 and yy > 0 and xx * yy > xy * xy):
             raise SiteValidationError(f"fix_cov_per_acc2 = [{xx:g}, {xy:g}, {yy:g}] not positive definite")
-        if not (_finite(site.fix_bias_sigma_m) and site.fix_bias_sigma_m >= 0.0):
+        if not (finite(site.fix_bias_sigma_m) and site.fix_bias_sigma_m >= 0.0):
             raise SiteValidationError(
                 f"fix_bias_sigma_m = {site.fix_bias_sigma_m:g}, must be finite and >= 0"
             )
-        if not (_finite(site.fix_bias_length_m) and site.fix_bias_length_m > 0.0):
+        if not (finite(site.fix_bias_length_m) and site.fix_bias_length_m > 0.0):
             raise SiteValidationError(
                 f"fix_bias_length_m = {site.fix_bias_length_m:g}, must be finite and > 0"
             )
-        if not (_finite(site.fix_white_share) and 0.0 <= site.fix_white_share <= 1.0):
+        if not (finite(site.fix_white_share) and 0.0 <= site.fix_white_share <= 1.0):
             raise SiteValidationError(f"fix_white_share = {site.fix_white_share:g} outside 0..1")
 
     n_floors = _check_len(site, "n_floors", "floor_height_m")
@@ -154,7 +142,7 @@ def validate_site(site: site_t) -> None:
     if top_floor > 32767:
         raise SiteValidationError(f"floors {site.lowest_floor}..{top_floor} overflow int16")
     for i, h in enumerate(site.floor_height_m):
-        if not _finite(h):
+        if not finite(h):
             raise SiteValidationError(f"floor_height_m[{i}] is {h:g}, must be finite")
         if i > 0 and not h > site.floor_height_m[i - 1]:
             raise SiteValidationError(
@@ -172,13 +160,13 @@ def validate_site(site: site_t) -> None:
                 f"(BSSIDs must be strictly ascending)"
             )
 
-    if not (_finite(site.cell_size_m) and site.cell_size_m >= 0.0):
+    if not (finite(site.cell_size_m) and site.cell_size_m >= 0.0):
         raise SiteValidationError(f"cell_size_m = {site.cell_size_m:g}, must be finite and >= 0")
 
     n_rp = _check_len(site, "n_rp", "rp_x_m", "rp_y_m", "rp_floor", "rp_scans")
     for r in range(n_rp):
         x, y, f, s = site.rp_x_m[r], site.rp_y_m[r], site.rp_floor[r], site.rp_scans[r]
-        if not (_finite(x) and _finite(y)):
+        if not (finite(x) and finite(y)):
             raise SiteValidationError(f"rp {r}: position ({x:g}, {y:g}) not finite")
         if not site.lowest_floor <= f <= top_floor:
             raise SiteValidationError(f"rp {r}: floor {f} outside {site.lowest_floor}..{top_floor}")
@@ -200,9 +188,9 @@ def validate_site(site: site_t) -> None:
                 f"rp {site.entry_rp[i - 1]}) (entries must be sorted by (ap, rp), no duplicates)"
             )
         mean, std, count = site.entry_mean_dbm[i], site.entry_std_db[i], site.entry_count[i]
-        if not _finite(mean):
+        if not finite(mean):
             raise SiteValidationError(f"entry {i}: entry_mean_dbm is {mean:g}, must be finite")
-        if not (_finite(std) and std >= 0.0):
+        if not (finite(std) and std >= 0.0):
             raise SiteValidationError(f"entry {i}: entry_std_db = {std:g}, must be finite and >= 0")
         if not 1 <= count <= site.rp_scans[r]:
             raise SiteValidationError(
