@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "sf_assert.h"
+#include "sf_math.h"
 
 #define PI 3.14159265358979323846
 #define G_MPS2 9.80665
@@ -28,16 +29,6 @@ static double norm3(const double a[3])
 static bool finite3(const double a[3])
 {
     return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
-}
-
-static double wrap_pi(const double a)
-{
-    return atan2(sin(a), cos(a));
-}
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
 }
 
 static void qmul(const double a[4], const double b[4], double out[4])
@@ -153,7 +144,7 @@ static void clamp_bias(sf_attitude_t *const att, const sf_params_t *const p)
 {
     const double m = p->attitude_gyro_bias_max_radps;
     for (int i = 0; i < 3; i++) {
-        att->gyro_bias_radps[i] = clamp(att->gyro_bias_radps[i], -m, m);
+        att->gyro_bias_radps[i] = sf_clamp(att->gyro_bias_radps[i], -m, m);
     }
 }
 
@@ -319,7 +310,7 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
         att->mag_ref_dip_rad = att->mag_anchor_dip_rad = p->attitude_mag_dip_deg * deg;
         att->mag_acquire_start_t_us = t_us;
     }
-    const double dt_s = att->mag_seen ? clamp((double)(t_us - att->last_mag_t_us) * 1e-6, 0.0, MAG_DT_MAX_S) : 0.0;
+    const double dt_s = att->mag_seen ? sf_clamp((double)(t_us - att->last_mag_t_us) * 1e-6, 0.0, MAG_DT_MAX_S) : 0.0;
     att->mag_seen = true;
     att->last_mag_t_us = t_us;
 
@@ -337,9 +328,9 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
         reject(att, sf_mag_degenerate);
         return;
     }
-    const double dip = asin(clamp(-m_nav[2] / f, -1.0, 1.0));
+    const double dip = asin(sf_clamp(-m_nav[2] / f, -1.0, 1.0));
     audit->dip_rad = dip;
-    audit->yaw_innov_rad = wrap_pi(0.5 * PI - atan2(m_nav[1], m_nav[0]));
+    audit->yaw_innov_rad = sf_wrap_pi(0.5 * PI - atan2(m_nav[1], m_nav[0]));
 
     /* control: acquisition. The expected field and dip depend on the site (48 µT / 60° in central
      * Europe, 45 µT / 45° in southern China, less indoors near steel): during the first
@@ -407,8 +398,8 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
         const double k = dt_s / (p->attitude_mag_learn_tau_s + dt_s);
         const double f0 = att->mag_anchor_field_ut, ft = p->attitude_mag_field_tol_ut;
         const double d0 = att->mag_anchor_dip_rad, dtol = p->attitude_mag_dip_tol_deg * deg;
-        att->mag_ref_field_ut = clamp(att->mag_ref_field_ut + k * (f - att->mag_ref_field_ut), f0 - ft, f0 + ft);
-        att->mag_ref_dip_rad = clamp(att->mag_ref_dip_rad + k * (dip - att->mag_ref_dip_rad), d0 - dtol, d0 + dtol);
+        att->mag_ref_field_ut = sf_clamp(att->mag_ref_field_ut + k * (f - att->mag_ref_field_ut), f0 - ft, f0 + ft);
+        att->mag_ref_dip_rad = sf_clamp(att->mag_ref_dip_rad + k * (dip - att->mag_ref_dip_rad), d0 - dtol, d0 + dtol);
     }
 }
 
@@ -431,5 +422,5 @@ double sf_attitude_yaw_rad(const sf_attitude_t *const att)
 double sf_attitude_tilt_rad(const sf_attitude_t *const att)
 {
     const double x = att->q[1], y = att->q[2];
-    return acos(clamp(1 - 2 * (x * x + y * y), -1.0, 1.0));
+    return acos(sf_clamp(1 - 2 * (x * x + y * y), -1.0, 1.0));
 }

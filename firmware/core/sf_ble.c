@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "sf_error.h"
+#include "sf_math.h"
 
 #define LN10 2.302585092994046
 
@@ -45,11 +46,6 @@ static double p1_of(const sf_beacons_t *const b, const int32_t i)
 double sf_ble_range_m(const sf_beacons_t *const b, const double p1_dbm, const double rssi_dbm)
 {
     return pow(10.0, (p1_dbm - rssi_dbm) / (10.0 * b->path_loss_exponent));
-}
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
 }
 
 /* Adds a reading to its beacon's group; a window with more beacons than groups keeps the strongest. */
@@ -135,7 +131,7 @@ int sf_ble_fix(sf_ble_t *const ble, const sf_params_t *const p, const sf_beacons
         by[i] = (double)b->y_m[g[i].beacon];
         rssi[i] = mean_dbm(&g[i]);
         p1[i] = p1_of(b, g[i].beacon);
-        const double d = clamp(sf_ble_range_m(b, p1[i], rssi[i]), SF_BLE_RANGE_MIN_M, SF_BLE_RANGE_MAX_M);
+        const double d = sf_clamp(sf_ble_range_m(b, p1[i], rssi[i]), SF_BLE_RANGE_MIN_M, SF_BLE_RANGE_MAX_M);
         const double w = 1.0 / (d * d);
         sw += w;
         cx += w * bx[i];

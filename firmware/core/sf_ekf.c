@@ -4,12 +4,9 @@
 
 #include <math.h>
 
-enum { n = SF_EKF_N, ix = 0, iy = 1, ib = 2, is = 3, icx = 4, icy = 5 };
+#include "sf_math.h"
 
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
+enum { n = SF_EKF_N, ix = 0, iy = 1, ib = 2, is = 3, icx = 4, icy = 5 };
 
 static void symmetrise(sf_ekf_t *const e)
 {
@@ -56,7 +53,7 @@ static void clamp_eigen2(double m[3], const double lo, const double hi)
     const double mean = 0.5 * (m[0] + m[2]);
     const double half = 0.5 * (m[0] - m[2]);
     const double rad = sqrt(half * half + m[1] * m[1]);
-    const double l1 = clamp(mean + rad, lo, hi), l2 = clamp(mean - rad, lo, hi);
+    const double l1 = sf_clamp(mean + rad, lo, hi), l2 = sf_clamp(mean - rad, lo, hi);
     const double phi = rad > 0.0 ? 0.5 * atan2(m[1], half) : 0.0; /* the larger eigenvalue's direction */
     const double c = cos(phi), s = sin(phi);
     m[0] = l1 * c * c + l2 * s * s;
@@ -324,7 +321,7 @@ double sf_ekf_update(sf_ekf_t *const e, const sf_params_t *const p, const bool c
     dpos_m[0] = delta[ix];
     dpos_m[1] = delta[iy];
     e->heading_bias_rad = atan2(sin(e->heading_bias_rad + delta[ib]), cos(e->heading_bias_rad + delta[ib]));
-    e->stride_scale = clamp(e->stride_scale + delta[is], p->ekf_scale_min, p->ekf_scale_max);
+    e->stride_scale = sf_clamp(e->stride_scale + delta[is], p->ekf_scale_min, p->ekf_scale_max);
     e->fix_bias_m[0] += delta[icx];
     e->fix_bias_m[1] += delta[icy];
     return 0.5 * (W[ix][0] + W[iy][1]);

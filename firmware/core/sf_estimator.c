@@ -5,11 +5,7 @@
 
 #include "sf_assert.h"
 #include "sf_error.h"
-
-static double wrap_pi(const double a)
-{
-    return atan2(sin(a), cos(a));
-}
+#include "sf_math.h"
 
 /* Every scheme starts at the config pose (truth-initialised runs, and runs without a site). */
 static void start_at_config(sf_estimator_t *const e, const sf_params_t *const p)
@@ -101,7 +97,7 @@ static double walk_heading(const sf_estimator_t *const e, const sf_params_t *con
     if (e->attitude.yaw_absolute) {
         return sf_heading_walk_rad(&e->heading, p, yaw);
     }
-    return wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
+    return sf_wrap_pi(p->init_heading_rad + yaw + sf_heading_offset_rad(&e->heading, p));
 }
 
 /* Moves the PDR track and every fusion scheme by one displacement. */

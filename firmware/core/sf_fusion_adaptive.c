@@ -1,13 +1,9 @@
-/* sf_fusion_adaptive.c — the adaptive scheme's gain law, α = clamp(accuracy(fix) + drift(Δt), 0, 1)
+/* sf_fusion_adaptive.c — the adaptive scheme's gain law, α = sf_clamp(accuracy(fix) + drift(Δt), 0, 1)
  * (Jäger, Süß, Becker eq. 9; tables and knots in sf_fusion.h), apart from the control in sf_fusion.c. */
 #include <math.h>
 
 #include "sf_fusion.h"
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
+#include "sf_math.h"
 
 /* Piecewise-linear over four knots, flat outside. Reaching segment i means xs[i] < x ≤ xs[i+1], so the
  * width is positive: badly ordered knots make a jump, never a division by zero. NaN gives vs[0]. */
@@ -56,6 +52,6 @@ double sf_fusion_drift(const sf_params_t *const p, const double dt_s)
 
 double sf_fusion_adaptive_alpha(const sf_params_t *const p, const sf_fix_t *const fix, const double dt_s)
 {
-    return clamp(sf_fusion_accuracy_factor(p, fix) + sf_fusion_drift(p, dt_s), 0.0, 1.0);
+    return sf_clamp(sf_fusion_accuracy_factor(p, fix) + sf_fusion_drift(p, dt_s), 0.0, 1.0);
 }
 

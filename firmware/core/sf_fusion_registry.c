@@ -8,11 +8,7 @@
 
 #include "sf_error.h"
 #include "sf_fusion_internal.h"
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
+#include "sf_math.h"
 
 static double us_to_s(const int64_t dt_us)
 {
@@ -42,7 +38,7 @@ static double alpha_adaptive(const sf_fusion_t *const f, const sf_params_t *cons
     const double dt_s = us_to_s(fix->t_us - f->last_fix_t_us);
     audit->accuracy_factor = sf_fusion_accuracy_factor(p, fix);
     audit->drift = sf_fusion_drift(p, dt_s);
-    return clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
+    return sf_clamp(audit->accuracy_factor + audit->drift, 0.0, 1.0);
 }
 
 static double alpha_kalman(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,

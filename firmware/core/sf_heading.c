@@ -4,6 +4,7 @@
 #include <math.h>
 
 #include "sf_assert.h"
+#include "sf_math.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -11,11 +12,6 @@
 #define WINDOW_MIN_US 200000
 #define WINDOW_MAX_US 2000000
 #define WINDOW_MIN_SAMPLES 4
-
-static double wrap_pi(const double a)
-{
-    return atan2(sin(a), cos(a));
-}
 
 static void restart_window(sf_heading_t *const h, const int64_t t_us)
 {
@@ -27,7 +23,7 @@ static void restart_window(sf_heading_t *const h, const int64_t t_us)
 void sf_heading_init(sf_heading_t *const h, const sf_params_t *const p)
 {
     *h = (sf_heading_t){0};
-    h->offset_rad = wrap_pi(p->heading_mount_offset_deg * DEG);
+    h->offset_rad = sf_wrap_pi(p->heading_mount_offset_deg * DEG);
 }
 
 void sf_heading_update(sf_heading_t *const h, const sf_params_t *const p, const int64_t t_us,
@@ -143,7 +139,7 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
     const double denom = sqrt(fmax(var_f, 0.0) * fmax(czz, 0.0));
     a->ratio = l1 / fmax(l2, 1e-12 * fmax(l1, 1e-300));
     a->corr = denom > 0.0 ? cov_fz / denom : 0.0;
-    a->offset_rad = wrap_pi(axis);
+    a->offset_rad = sf_wrap_pi(axis);
     a->good = l1 > 0.0 && a->corr <= -p->heading_min_corr;
     if (!a->good) {
         return;
@@ -164,10 +160,10 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
 
 double sf_heading_offset_rad(const sf_heading_t *const h, const sf_params_t *const p)
 {
-    return h->confident && p->heading_learn_offset ? h->offset_rad : wrap_pi(p->heading_mount_offset_deg * DEG);
+    return h->confident && p->heading_learn_offset ? h->offset_rad : sf_wrap_pi(p->heading_mount_offset_deg * DEG);
 }
 
 double sf_heading_walk_rad(const sf_heading_t *const h, const sf_params_t *const p, const double device_yaw_rad)
 {
-    return wrap_pi(device_yaw_rad + sf_heading_offset_rad(h, p) - p->heading_map_rotation_deg * DEG);
+    return sf_wrap_pi(device_yaw_rad + sf_heading_offset_rad(h, p) - p->heading_map_rotation_deg * DEG);
 }

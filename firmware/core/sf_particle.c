@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "sf_error.h"
+#include "sf_math.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -30,11 +31,6 @@ void sf_particle_set_map(sf_particle_t *const c, const sf_wall_grid_t *const wal
     c->ports = ports;
 }
 
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
-
 void sf_particle_seed(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
                       const double sigma_m, const int16_t floor, const bool keep_gait)
 {
@@ -48,7 +44,7 @@ void sf_particle_seed(sf_particle_t *const c, const sf_params_t *const p, const 
         c->floor[i] = floor;
         if (!keep) {
             q->bias_rad = (float)(p->particle_init_bias_sigma_rad * sf_rng_normal(&c->rng));
-            q->scale = (float)clamp(1.0 + p->particle_init_scale_sigma * sf_rng_normal(&c->rng), p->particle_scale_min,
+            q->scale = (float)sf_clamp(1.0 + p->particle_init_scale_sigma * sf_rng_normal(&c->rng), p->particle_scale_min,
                                     p->particle_scale_max);
         }
     }
@@ -196,7 +192,7 @@ void sf_particle_step(sf_particle_t *const c, const sf_params_t *const p, const 
         sf_particle_state_t *const q = &c->p[i];
         const double n1 = sf_rng_normal(&c->rng), n2 = sf_rng_normal(&c->rng);
         const double n3 = sf_rng_normal(&c->rng), n4 = sf_rng_normal(&c->rng);
-        const double s = clamp((double)q->scale + sd_scale * n3, p->particle_scale_min, p->particle_scale_max);
+        const double s = sf_clamp((double)q->scale + sd_scale * n3, p->particle_scale_min, p->particle_scale_max);
         const double b = (double)q->bias_rad + sd_bias * n4;
         q->scale = (float)s;
         q->bias_rad = (float)(b > M_PI ? b - 2.0 * M_PI : (b < -M_PI ? b + 2.0 * M_PI : b)); /* one step < π */
@@ -266,7 +262,7 @@ double sf_particle_update(sf_particle_t *const c, const sf_params_t *const p, co
     }
     *ess_after = s2 > 0.0 ? 1.0 / s2 : 0.0;
     resample_if_needed(c, p);
-    return clamp(0.5 * tv, 0.0, 1.0);
+    return sf_clamp(0.5 * tv, 0.0, 1.0);
 }
 
 void sf_particle_summary(const sf_particle_t *const c, sf_particle_summary_t *const s)

@@ -4,16 +4,12 @@
 #include <math.h>
 
 #include "sf_error.h"
-
-static double clamp(const double v, const double lo, const double hi)
-{
-    return v < lo ? lo : (v > hi ? hi : v);
-}
+#include "sf_math.h"
 
 void sf_stride_init(sf_stride_t *const st, const sf_params_t *const p)
 {
     *st = (sf_stride_t){0};
-    st->k = clamp(p->stride_weinberg_k, p->stride_k_min, p->stride_k_max);
+    st->k = sf_clamp(p->stride_weinberg_k, p->stride_k_min, p->stride_k_max);
 }
 
 double sf_stride_range_mps2(const sf_step_event_t *const ev)
@@ -43,8 +39,8 @@ int sf_stride_calibrate(sf_stride_t *const st, const sf_params_t *const p, const
     const double k_target = true_distance_m / weinberg_sum;
     const double k_raw = st->k + p->stride_k_gain * (k_target - st->k);
     const double c = p->stride_k_max_change;
-    const double k_step = clamp(k_raw, st->k * (1.0 - c), st->k * (1.0 + c));
-    const double k_new = clamp(k_step, p->stride_k_min, p->stride_k_max);
+    const double k_step = sf_clamp(k_raw, st->k * (1.0 - c), st->k * (1.0 + c));
+    const double k_new = sf_clamp(k_step, p->stride_k_min, p->stride_k_max);
     if (k_new != k_raw) {
         st->clamped++;
     }
