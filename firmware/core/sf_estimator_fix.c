@@ -36,14 +36,22 @@ static void calibrate_stride(sf_estimator_t *const e, const sf_params_t *const p
     e->weinberg_sum = 0.0;
 }
 
+/* A fix's floor votes on the start floor (sf_floor_vote.h); the barometric floor is renumbered. */
+static void vote_floor(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix)
+{
+    if (e->floor_vote_active) {
+        const int32_t shift = sf_floor_vote_fix(&e->floor_vote, p, fix, sf_floor_current(&e->floor),
+                                                sf_floor_settled(&e->floor, p));
+        sf_floor_shift(&e->floor, shift, false);
+    }
+}
+
 /* Every scheme judges the fix (one audit each); the floor vote first when the fix knows its floor. */
 static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix,
                      const bool votes, sf_fix_audit_t audits[sf_scheme_count])
 {
-    const int16_t baro_floor = sf_floor_current(&e->floor);
-    const bool settled = sf_floor_settled(&e->floor, p);
-    if (votes && e->floor_vote_active) { /* the fix votes before the schemes see it */
-        sf_floor_shift(&e->floor, sf_floor_vote_fix(&e->floor_vote, p, fix, baro_floor, settled), false);
+    if (votes) { /* the fix votes before the schemes see it */
+        vote_floor(e, p, fix);
     }
     /* between floors (the activity's stairs or moving lift, or a landing half-way up) only where there
      * are floors to be between; a phone moved in the hand is not (settled's 0.1 m/s is for the vote) */
@@ -127,9 +135,7 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     if (e->floor_vote_active && p->ble_floor_vote_range_m > 0.0 &&
         sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK) {
         vote.n_ap_used = (int16_t)p->fingerprint_accuracy_ref_aps; /* a full-weight vote (sf_floor_vote.h) */
-        const int16_t baro_floor = sf_floor_current(&e->floor);
-        sf_floor_shift(&e->floor,
-                       sf_floor_vote_fix(&e->floor_vote, p, &vote, baro_floor, sf_floor_settled(&e->floor, p)), false);
+        vote_floor(e, p, &vote);
         e->ble_floor_votes++;
     }
     int32_t n_used = 0;

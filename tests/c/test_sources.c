@@ -233,8 +233,8 @@ static void test_gnss_fix_through_every_scheme(void **state)
     assert_int_equal(sf_estimator_gnss(&est, &p, &g, &fix, &has_fix, audits), 0);
 }
 
-/* Every scheme starts at a Wi-Fi-less BLE fix, drifts far with a bogus run of GNSS fixes it mostly
- * rejects, then a landmark 40 m away: every fusing scheme is on the landmark at once. */
+/* Every fusing scheme starts at a BLE fix (no Wi-Fi), then a landmark 40 m away, far outside every
+ * gate: every fusing scheme is on the landmark at once. */
 static void test_landmark_puts_every_scheme_on_it(void **state)
 {
     (void)state;
