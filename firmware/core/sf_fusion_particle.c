@@ -33,7 +33,7 @@ static void mirror(sf_fusion_t *const f, sf_particle_summary_t *const s, const b
         if (sf_particle_reachable(c, s->floor, f->x_m, f->y_m, s->x_m, s->y_m, &x, &y)) {
             c->detours++;
         } else {
-            c->jumps++; /* no probed particle within reach: the cloud is elsewhere, follow it */
+            c->jumps++; /* too little of the cloud within reach (SF_PARTICLE_REACH_SHARE): follow it */
         }
     }
     f->x_m = x;
