@@ -2,7 +2,7 @@
  * fusion's math and control (sf_fusion.c). */
 #include "sf_fusion.h"
 
-_Static_assert(sf_fix_reason_count == 10, "reasons mirror fix_t.REASON_*");
+_Static_assert(sf_fix_reason_count == 11, "reasons mirror fix_t.REASON_*");
 
 const char *sf_fix_reason_text(const int reason)
 {
@@ -17,6 +17,7 @@ const char *sf_fix_reason_text(const int reason)
         [sf_fix_reason_recovery] = "accepted: recovery after consecutive rejections",
         [sf_fix_reason_scheme_ignores] = "ignored: the scheme does not use fixes of this source",
         [sf_fix_reason_inaccurate] = "rejected: the source's own accuracy or position is unusable",
+        [sf_fix_reason_context_off] = "ignored: the controller keeps this source off in this context",
     };
     return reason >= 0 && reason < sf_fix_reason_count ? text[reason] : "unknown reason";
 }

@@ -150,7 +150,8 @@ enum {
     sf_fix_reason_recovery = 7,
     sf_fix_reason_scheme_ignores = 8,
     sf_fix_reason_inaccurate = 9,
-    sf_fix_reason_count = 10
+    sf_fix_reason_context_off = 10, /* the multi-scheme controller keeps this source off here (sf_controller.h) */
+    sf_fix_reason_count = 11
 };
 
 /* sf_fusion_init_at's time for a start before any input (the config pose): the scheme's clock starts

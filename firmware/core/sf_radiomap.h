@@ -95,6 +95,44 @@ typedef struct {
     double range_sigma_db;      /* RSSI spread about the model [dB], > 0 */
 } sf_beacons_t;
 
+/* Context kinds, identical to site_t.CONTEXT_* and context_t.KIND_*. */
+enum { sf_context_outdoor = 1, sf_context_building = 2, sf_context_floor = 3 };
+
+/* The positioning context map (site file v3; Jäger, Süß, Becker §III-C) of the multi-scheme controller
+ * (sf_controller.h): buildings with outlines, per-port extras beside sf_ports_t (building, outdoor,
+ * staircase steps and endpoints), the ports' reachability links, the contexts with their localization
+ * scheme descriptor (scheme, method) and context determination descriptor (method, constellation).
+ * n_contexts = 0: no controller (then every other array may be NULL). Field meanings: site_t.lcm. */
+typedef struct {
+    int32_t n_buildings;
+    int32_t n_outline;
+    const float *outline_x_m;          /* [n_outline] */
+    const float *outline_y_m;          /* [n_outline] */
+    const int16_t *outline_building;   /* [n_outline], each building's vertices consecutive, ≥ 3 */
+    const int16_t *port_building;      /* [ports.n_ports], −1: outdoors */
+    const int16_t *port_outdoor;       /* [ports.n_ports], 1: leads outdoors (GNSS on there) */
+    const int16_t *port_steps;         /* [ports.n_ports], stairs: steps end to end (> 0); else 0 */
+    const float *port_lo_x_m;          /* [ports.n_ports], the endpoint on floor_lo */
+    const float *port_lo_y_m;
+    const float *port_hi_x_m;          /* [ports.n_ports], the endpoint on floor_hi */
+    const float *port_hi_y_m;
+    int32_t n_links;
+    const int32_t *link_a;             /* [n_links], 0 ≤ value < ports.n_ports */
+    const int32_t *link_b;             /* [n_links] */
+    int32_t n_contexts;
+    const int16_t *kind;               /* [n_contexts], sf_context_* */
+    const int16_t *building;           /* [n_contexts], −1 for the outdoor context */
+    const int16_t *floor;              /* [n_contexts] */
+    const int16_t *scheme;             /* [n_contexts], a fusion scheme (sf_scheme_*, < sf_scheme_count) */
+    const int16_t *method;             /* [n_contexts], the absolute method it fuses (sf_fix_*) */
+    const int16_t *cdd_method;         /* [n_contexts], sf_fix_wifi, sf_fix_ble or sf_fix_gnss */
+    const int16_t *cdd_min_hits;       /* [n_contexts], ≥ 1 */
+    int32_t n_cdd;
+    const int16_t *cdd_context;        /* [n_cdd], non-decreasing, < n_contexts */
+    const int64_t *cdd_id;             /* [n_cdd], AP BSSID or beacon id */
+    const float *cdd_min_dbm;          /* [n_cdd] */
+} sf_context_map_t;
+
 /* Floors and frame of the site. */
 typedef struct {
     double map_rotation_deg;
@@ -107,6 +145,7 @@ typedef struct {
     sf_floor_plan_t plan;         /* n_walls = 0: no walls */
     sf_ports_t ports;             /* n_ports = 0: floors change anywhere */
     sf_beacons_t beacons;         /* n_beacons = 0: BLE readings are not used */
+    sf_context_map_t contexts;    /* n_contexts = 0: no multi-scheme controller */
 } sf_site_t;
 
 /* Checks every structural invariant above (sizes, orderings, index ranges, finite values).

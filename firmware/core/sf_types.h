@@ -34,7 +34,10 @@ enum {
 #define SF_SCHEME_ENUM(name, id) sf_scheme_##name = (id),
     SF_SCHEMES(SF_SCHEME_ENUM)
 #undef SF_SCHEME_ENUM
-    sf_scheme_count = SF_SCHEME_COUNT
+    sf_scheme_count = SF_SCHEME_COUNT,
+    /* not a fusion scheme: the controller's primary pose follows the scheme its context selects
+     * (sf_controller.h); pose_t.SCHEME_CONTROLLER */
+    sf_scheme_controller = SF_SCHEME_CONTROLLER
 };
 
 /* One Wi-Fi scan as the core sees it (views into the caller's arrays). */
@@ -74,7 +77,7 @@ typedef struct {
 } sf_landmark_t;
 
 /* Fix methods (the fix's source), identical to fix_t.METHOD_*. */
-enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3, sf_fix_ble = 4 };
+enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3, sf_fix_ble = 4, sf_fix_port = 5 };
 
 /* An absolute position fix offered to the fusion. */
 typedef struct {

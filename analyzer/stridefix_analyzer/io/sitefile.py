@@ -51,6 +51,7 @@ from stridefix_analyzer.io.site_v2 import (
     validate_geo,
     validate_plan,
 )
+from stridefix_analyzer.io.site_v3 import fill_port_defaults
 
 MAGIC = b"SFSITE\0\x01"
 FORMAT_VERSION = 2
@@ -207,6 +208,7 @@ def validate_site(site: site_t) -> None:
 
 def encode_site_file(site: site_t) -> bytes:
     """Header + payload bytes of ``site`` (validated first; raises SiteValidationError)."""
+    fill_port_defaults(site)
     validate_site(site)
     payload: bytes = site.encode()
     if len(payload) > MAX_PAYLOAD_BYTES:
@@ -370,4 +372,5 @@ def set_counts(site: site_t) -> site_t:
     site.n_rp = len(site.rp_x_m)
     site.n_entries = len(site.entry_ap)
     set_v2_counts(site)
+    fill_port_defaults(site)
     return site
