@@ -228,6 +228,12 @@ def add_fusion_parser(sub: Any) -> None:
         action="store_true",
         help="fold sites without a geo-reference, so no GNSS fix is used",
     )
+    d.add_argument(
+        "--no-controller",
+        action="store_true",
+        help="fold sites without a context map, so the multi-scheme controller does not run (and its "
+        "scheme is not chosen on the training walks)",
+    )
     d.add_argument("--no-report", action="store_true", help="skip the HTML report")
     d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
     d.set_defaults(_bench=_run_fusion_cli)
@@ -256,6 +262,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
                 beacons=not args.no_beacons,
                 gnss=not args.no_gnss,
                 learn_beacons=args.learn_beacons,
+                controller=not args.no_controller,
             ),
         )
         doc = run_fusion(cfg)

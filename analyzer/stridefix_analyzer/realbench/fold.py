@@ -22,6 +22,7 @@ from typing import Any
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.realbench import lsd
 from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
@@ -109,13 +110,21 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
     except RadioMapInputError as exc:
         out["error"] = f"no site for this fold: {exc}"
         return out
-    for name, value in job.site_fields.items():
+    site_fields = dict(job.site_fields)
+    lsd_scheme = site_fields.pop(lsd.SITE_KEY, None)
+    for name, value in site_fields.items():
         setattr(site, name, value)
     content: dict[str, Any] = {}
     if job.content is not None:
         fields, content = job.content.fold_fields(job.content_index)
         dropped = apply_fields(site, fields)
         content.update({f"{k}s_off_site_floors": v for k, v in dropped.items() if v})
+    if lsd_scheme is not None:
+        # one building, one context per floor, the scheme chosen on the training walks (.lsd)
+        from stridefix_analyzer.radiomap.contexts import single_building_context_map
+
+        site = single_building_context_map(site, scheme=lsd_scheme) or site
+        content["controller_scheme"] = lsd_scheme
     site_path = job.dir / "site.sfsite"
     write_site(site_path, site)
     out["fold"] = {

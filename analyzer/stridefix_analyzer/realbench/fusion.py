@@ -122,7 +122,10 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     out_dir.mkdir(parents=True, exist_ok=True)
     groups = find_groups(ds, cfg.dirs, cfg.limit)
     stream = open(os.devnull, "w") if cfg.quiet else sys.stderr
-    run = Run(cfg, ds, fw, tuning.axes(cfg.param_sets), age, out_dir, stream)
+    rows = tuning.axes(cfg.param_sets)
+    if not cfg.content.controller:
+        rows = tuple(a for a in rows if a.name != "lsd")
+    run = Run(cfg, ds, fw, rows, age, out_dir, stream)
     walks, parts = prepare_walks(run, groups)  # phase 1
     t_prep = time.perf_counter() - t_start
     planned = [plan_group(run, p, walks) for p in parts]  # phase 2

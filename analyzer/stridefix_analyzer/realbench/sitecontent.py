@@ -52,6 +52,9 @@ class ContentOptions:
     #: beacons of a data set without a beacon table, placed from the walks alone (off by default: see
     #: LEARNT_ONLY_NOTE)
     learn_beacons: bool = False
+    #: a context map (one building, a context per floor) with the scheme chosen on the training walks,
+    #: so the multi-scheme controller runs (realbench/lsd.py); ``--no-controller`` leaves it out
+    controller: bool = True
 
 
 #: Why a data set without a beacon table gets no beacons by default. Placing a beacon needs the

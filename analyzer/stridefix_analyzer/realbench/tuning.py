@@ -15,6 +15,9 @@ sees the prepared walks of one group and returns the candidate of every walk's f
   over per block).
 * ``fixmodel`` (:class:`Measured`): not a choice: the ``ekf`` scheme's fix-error model, measured on the
   other walks' Wi-Fi fixes against the truth (:mod:`.fixmodel`).
+* ``lsd`` (:class:`SchemeByError`, :mod:`.lsd`): the multi-scheme controller's scheme for the floor's
+  context (the site's localization scheme descriptor), the fusion scheme with the lowest POSE error
+  on the training walks, every scheme scored from one replay.
 
 A user's ``--set`` of any key an axis varies replaces that axis's candidates by ``{"given": []}``
 (:func:`axes`). A new tuning idea is one more row, not a new stage in ``run_fusion``.
@@ -28,7 +31,7 @@ from pathlib import Path
 from typing import Any, Protocol, TextIO
 
 from stridefix_analyzer.firmware import Firmware
-from stridefix_analyzer.realbench import fixmodel
+from stridefix_analyzer.realbench import fixmodel, lsd
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.heading import (
     HEADING_VARIANTS,
@@ -168,6 +171,27 @@ class Measured:
 
 
 @dataclasses.dataclass(frozen=True)
+class SchemeByError:
+    """The controller's scheme of every fold (:func:`.lsd.choose_lsd`): it goes into the fold's site
+    (its context map), not into the --set list, so each candidate's settings are empty."""
+
+    def __call__(self, axis: Axis, group: Group, block_sets: Mapping[int, Sequence[str]]) -> Choice:
+        per_walk, report = lsd.choose_lsd(
+            group.walks,
+            group.sites,
+            firmware=group.firmware,
+            work_dir=group.work_dir / axis.name,
+            base_sets=group.base_sets,
+            block_sets=block_sets,
+            jobs=group.jobs,
+            stream=group.stream,
+        )
+        fields: list[dict[str, Any] | None] = [{lsd.SITE_KEY: s} for s in per_walk]
+        extra = [{f"{axis.name}_scheme": s} for s in per_walk]
+        return Choice(per_walk, {f"{axis.name}_selection": report}, extra, walk_site_fields=fields)
+
+
+@dataclasses.dataclass(frozen=True)
 class Axis:
     """One tuning row: ``name`` (fold field ``<name>_variant``), ``label`` (console), the candidates
     (name → --set list) and the chooser."""
@@ -183,6 +207,7 @@ AXES: tuple[Axis, ...] = (
     Axis("matcher", "matcher", MATCHER_VARIANTS, InnerCV("matcher")),
     Axis("adaptive", "adaptive", ADAPTIVE_VARIANTS, InnerCV("adaptive")),
     Axis("fixmodel", "ekf fix model", {"measured": [f"{k}=" for k in fixmodel.KEYS]}, Measured()),
+    Axis("lsd", "controller scheme", {name: [] for name in lsd.CANDIDATES}, SchemeByError()),
 )
 
 

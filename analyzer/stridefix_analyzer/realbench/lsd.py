@@ -1,0 +1,135 @@
+"""The controller's localization scheme descriptor (LSD) of a fold, chosen inside the training walks.
+
+A real-data group is one building floor, so the multi-scheme controller has one context per walk and
+its primary pose is the pose of that context's scheme (firmware/core/sf_controller.h). Which fusion
+scheme serves a floor best depends on the building, the device and the radio map, so the fold's site
+names the scheme that did best on walks other than the held-out one — the site builder's choice, as the
+paper's context map names a scheme per context (Jäger et al. §III-C):
+
+* the inner cross-validation of :mod:`.select` (blocks a ≠ b, maps without both, with each block's
+  matcher settings) replays every walk of block b ONCE with every scheme running side by side;
+* each fusion scheme's POSE error at block b's waypoints (causal, as realbench scores) is pooled per
+  block a;
+* every held-out walk of block a gets the scheme with the lowest pooled mean error (ties: the
+  registry's order).
+
+The selection sites carry the radio map only (no walls, beacons or geo-reference), so a scheme that
+gains from the building content (``particle`` from walls) is judged without it here.
+Cost: (n_blocks − 1) replays of every walk (one per walk and block pair, not one per scheme).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from stridefix_analyzer import schemes
+from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.logread import read_table
+from stridefix_analyzer.realbench import select as rs
+from stridefix_analyzer.realbench.progress import Progress
+
+#: the fold's chosen scheme travels with the measured site fields under this key (not a site_t field:
+#: run_fold pops it and builds the context map with it)
+SITE_KEY = "controller_lsd_scheme"
+#: the scheme a fold gets when no choice can be made (fewer walks than the inner CV needs)
+DEFAULT_SCHEME = "ekf"
+#: the candidates: every fusion scheme (the controller itself is not one)
+CANDIDATES = tuple(s.name for s in schemes.SCHEMES if s.name != "controller")
+
+
+def scheme_pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> dict[str, np.ndarray]:
+    """Per fusion scheme of one stridefixd log: the 2-D error [m] at each waypoint of the scheme's
+    latest initialised POSE at or before it (waypoints before its first pose are left out)."""
+    pose = read_table(fw_log, "POSE")
+    wp_t_us = np.asarray(wp_t_us, np.int64)
+    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
+    out: dict[str, np.ndarray] = {}
+    if pose is None or not len(pose):
+        return out
+    pose = pose.rows(np.isfinite(pose["sigma_m"]) & (pose["sigma_m"] < 1e6))
+    for code in np.unique(pose["scheme"]):
+        name = schemes.scheme_name(int(code))
+        if name not in CANDIDATES:
+            continue
+        p = pose.rows(pose["scheme"] == code)
+        k = np.searchsorted(p["t_us"], wp_t_us, side="right") - 1
+        ok = k >= 0
+        out[name] = np.hypot(p["x_m"][k[ok]] - wp[ok, 0], p["y_m"][k[ok]] - wp[ok, 1])
+    return out
+
+
+def replay_all_schemes(job: dict[str, Any]) -> dict[str, Any]:
+    """One inner-CV replay with every scheme; ``errors`` is the per-scheme dict (None on failure)."""
+    proc = Firmware(job["stridefixd"]).run(
+        input=f"lcmlog:{job['import_log']}", site=job["site"], log=job["log"], sets=job["sets"], check=False
+    )
+    if proc.returncode != 0:
+        return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
+    err = scheme_pose_errors_m(job["log"], job["wp_t_us"], job["wp_xy_m"])
+    Path(job["log"]).unlink(missing_ok=True)
+    return {**job, "errors": err, "failure": None}
+
+
+def choose_lsd(
+    sub: list[dict[str, Any]],
+    build_site: Any,
+    *,
+    firmware: Firmware,
+    work_dir: Path,
+    base_sets: Sequence[str],
+    block_sets: Mapping[int, Sequence[str]],
+    jobs: int,
+    stream: Any,
+    n_blocks: int = rs.DEFAULT_BLOCKS,
+) -> tuple[list[str], dict[str, Any]]:
+    """The scheme of every walk's fold and the group's report (see the module text)."""
+    n_blocks = min(n_blocks, len(sub))
+    if len(sub) < rs.MIN_WALKS:
+        why = f"default {DEFAULT_SCHEME} (fewer than {rs.MIN_WALKS} walks)"
+        return [DEFAULT_SCHEME] * len(sub), {"chosen_by": why, "blocks": {}}
+    work_dir.mkdir(parents=True, exist_ok=True)
+    prog = Progress("choose controller scheme", (n_blocks - 1) * len(sub), stream)
+    block, results = rs.block_replays(
+        sub,
+        build_site,
+        stridefixd=firmware.path,
+        work_dir=work_dir,
+        base_sets=list(base_sets),
+        candidates={"all schemes": []},
+        jobs=jobs,
+        n_blocks=n_blocks,
+        progress=prog.step,
+        replay=replay_all_schemes,
+        stage="lsd",
+        block_sets=block_sets,
+    )
+    pooled: dict[int, dict[str, list[np.ndarray]]] = {a: {n: [] for n in CANDIDATES} for a in range(n_blocks)}
+    failures = []
+    for r in results:
+        if r["errors"] is None:
+            failures.append(f"{r['walk']}: {r['failure']}")
+            continue
+        for name, e in r["errors"].items():
+            pooled[r["a"]][name].append(e)
+    report: dict[str, Any] = {
+        "chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, mean POSE error at "
+        "waypoints, every scheme in one replay)",
+        "blocks": {},
+        "failures": failures[:10],
+    }
+    choice = {}
+    for a in range(n_blocks):
+        means = {}
+        for n in CANDIDATES:
+            e = np.concatenate(pooled[a][n]) if pooled[a][n] else np.zeros(0)
+            means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, "waypoints": int(len(e))}
+        finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
+        choice[a] = min(finite, key=lambda n: finite[n]) if finite else DEFAULT_SCHEME
+        report["blocks"][str(a)] = {"candidates": means, "chosen": choice[a]}
+    return [choice[block[i]] for i in range(len(sub))], report
