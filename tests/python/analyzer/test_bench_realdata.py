@@ -43,7 +43,7 @@ def test_targets_met_missed_and_not_run(tmp_path):
     assert math.isnan(by["site2/F3 [first fix] ekf mean <= 10"]["value"])
     assert "realbench site2/F3 [first fix] ekf mean <= 10: not run" in missed
     assert by["gsd/building 100 [true start] pdr_only mean <= 6"]["met"]
-    assert "realbench gsd/building 100 Trial51 [first fix] ekf floor_hit_rate >= 0.99: 0.9" in missed
+    assert "realbench gsd/building 100 Trial51 [first fix] ekf floor_hit_rate >= 0.99: 0.9 (bound 0.99)" in missed
 
 
 def test_bad_file_is_named(tmp_path):
@@ -51,3 +51,21 @@ def test_bad_file_is_named(tmp_path):
     bad.write_text("{not json")
     with pytest.raises(realdata.ResultsError, match="bad.json"):
         realdata.load_groups([bad])
+
+
+def test_controller_bound_is_relative_to_the_best_fixed_scheme(tmp_path):
+    """Issue 14: the controller's mean within 2 % of the best fusion scheme of the same group."""
+    doc = _doc("site1/F2", 3.0, 1.0)
+    schemes = doc["groups"][0]["summary"]["schemes"]
+    schemes["kalman"] = {"mean": 2.9}
+    schemes["controller"] = {"mean": 2.95}  # itself never counts as the best
+    path = tmp_path / "f2.json"
+    path.write_text(json.dumps(doc))
+    rows, missed = realdata.check(realdata.load_groups([path]))
+    (row,) = [r for r in rows if r["target"].startswith("site1/F2 [first fix] controller mean")]
+    assert row["bound"] == pytest.approx(1.02 * 2.9) and row["met"]
+    schemes["controller"] = {"mean": 2.96}  # 2.958 is the bound
+    path.write_text(json.dumps(doc))
+    rows, missed = realdata.check(realdata.load_groups([path]))
+    (row,) = [r for r in rows if r["target"].startswith("site1/F2 [first fix] controller mean")]
+    assert not row["met"] and any("controller mean <= 1.02 x best fixed scheme: 2.96" in m for m in missed)
