@@ -284,7 +284,14 @@ def run(args: argparse.Namespace) -> int:
             if args.png:
                 plot_site(site, args.png)
                 print(f"wrote {args.png}")
-    except (LogReadError, RadioMapInputError, SiteFileError, BuildingError, FloorPlanError, ContextMapError) as exc:
+    except (
+        LogReadError,
+        RadioMapInputError,
+        SiteFileError,
+        BuildingError,
+        FloorPlanError,
+        ContextMapError,
+    ) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     return 0

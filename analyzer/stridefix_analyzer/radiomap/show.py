@@ -199,7 +199,9 @@ def plot_site(site: site_t, png_path: str) -> None:
                     )
                 )
         for name, vertices in _outlines(site):
-            ax.add_patch(Polygon(vertices, closed=True, fill=False, ls="--", color="tab:blue", lw=1.2, zorder=1))
+            ax.add_patch(
+                Polygon(vertices, closed=True, fill=False, ls="--", color="tab:blue", lw=1.2, zorder=1)
+            )
             ax.annotate(name, vertices[0], fontsize=8, color="tab:blue")
             ax.autoscale()
         ax.set_title(
