@@ -283,3 +283,13 @@ def test_radiomap_build_and_show_print_the_context_map(write_log, msg, tmp_path,
     assert "   1 floor H          floor   0  LSD ekf + wifi  CDD wifi: 1 members, 1 to hear" in shown
     assert "port  0 door     floors 0..0  building H  outdoor" in shown
     assert png.stat().st_size > 0
+
+
+def test_documented_campus_example_is_the_test_campus():
+    """docs/examples/campus.toml parses to the campus of these tests (the documented example stays valid)."""
+    import pathlib
+
+    path = pathlib.Path(__file__).resolve().parents[3] / "docs" / "examples" / "campus.toml"
+    got, want = read_building(path), campus_building()
+    assert (got.buildings, got.port_extras, got.contexts) == (want.buildings, want.port_extras, want.contexts)
+    assert got.ports == want.ports and [b[:4] for b in got.beacons] == [b[:4] for b in want.beacons]
