@@ -32,6 +32,39 @@ class BuildingError(ValueError):
 
 
 @dataclasses.dataclass
+class BuildingOutline:
+    """A building of the context map (building_spec: ``[[building]]``)."""
+
+    name: str  # unique, e.g. "A"
+    outline: list[tuple[float, float]]  # polygon vertices, map frame [m], >= 3, closed implicitly
+    floors: list[int]  # the building's floor indices, e.g. [0, 1, 2]
+
+
+@dataclasses.dataclass
+class PortExtra:
+    """The context map's extras of one ``Building.ports`` row (same order)."""
+
+    name: str = ""  # unique when given; links refer to it
+    building: str | None = None  # BuildingOutline.name, None: an outdoor port
+    outdoor: bool = False  # leads outdoors (a door with an outdoor neighbour)
+    steps: int = 0  # stairs: steps end to end (> 0); others 0
+    end_lo: tuple[float, float] | None = None  # stairs: endpoint on the lowest floor (None: centre)
+    end_hi: tuple[float, float] | None = None  # stairs: endpoint on the highest floor
+    links: list[str] = dataclasses.field(default_factory=list)  # names of reachable ports
+
+
+@dataclasses.dataclass
+class ContextSpec:
+    """An optional override of a derived context (``[[context]]``)."""
+
+    kind: str  # "outdoor" | "building" | "floor"
+    building: str | None = None  # for building / floor
+    floor: int | None = None  # for floor
+    scheme: str | None = None  # a fusion scheme name (schemes.py), None: the build's default
+    method: str | None = None  # "wifi" | "ble" | "gnss", None: the build's default
+
+
+@dataclasses.dataclass
 class Building:
     """A parsed building description (map frame [m]; floors are indices)."""
 
@@ -40,6 +73,9 @@ class Building:
     walls: list[tuple[float, float, float, float, int]] = dataclasses.field(default_factory=list)
     ports: list[tuple[int, float, float, float, int, int]] = dataclasses.field(default_factory=list)
     beacons: list[tuple[int, float, float, int, float]] = dataclasses.field(default_factory=list)
+    buildings: list[BuildingOutline] = dataclasses.field(default_factory=list)
+    port_extras: list[PortExtra] = dataclasses.field(default_factory=list)  # [] or one per ports row
+    contexts: list[ContextSpec] = dataclasses.field(default_factory=list)
 
     def floors(self) -> set[int]:
         """Every floor a wall, port or beacon names."""
@@ -262,13 +298,42 @@ def building_toml(b: Building) -> str:
         out += ["", "[ble]", *(f"{k} = {v!r}" for k, v in b.ble.items())]
     for x0, y0, x1, y1, f in b.walls:
         out += ["", "[[wall]]", f"floor = {f}", f"points = [[{x0!r}, {y0!r}], [{x1!r}, {y1!r}]]"]
-    for kind, x, y, r, lo, hi in b.ports:
+    for bo in b.buildings:
+        pts = ", ".join(f"[{x!r}, {y!r}]" for x, y in bo.outline)
+        floors = ", ".join(str(f) for f in bo.floors)
+        out += ["", "[[building]]", f"name = {bo.name!r}", f"outline = [{pts}]", f"floors = [{floors}]"]
+    for i, (kind, x, y, r, lo, hi) in enumerate(b.ports):
         floors = ", ".join(str(f) for f in range(lo, hi + 1))
         out += ["", "[[port]]", f'kind = "{names[kind]}"', f"x_m = {x!r}", f"y_m = {y!r}"]
         out += [f"radius_m = {r!r}", f"floors = [{floors}]"]
+        if b.port_extras:
+            out += port_extra_lines(b.port_extras[i])
+    for c in b.contexts:
+        out += ["", "[[context]]", f'kind = "{c.kind}"']
+        out += [
+            f"{k} = {v!r}"
+            for k in ("building", "floor", "scheme", "method")
+            if (v := getattr(c, k)) is not None
+        ]
     for ident, x, y, f, rssi in b.beacons:
         mac = ":".join(f"{(ident >> s) & 0xFF:02X}" for s in range(40, -1, -8))
         out += ["", "[[beacon]]", f'id = "{mac}"', f"x_m = {x!r}", f"y_m = {y!r}", f"floor = {f}"]
         if not np.isnan(rssi):
             out.append(f"rssi_1m_dbm = {rssi!r}")
     return "\n".join(out) + "\n"
+
+
+def port_extra_lines(e: PortExtra) -> list[str]:
+    """The optional ``[[port]]`` fields of ``e`` (building_spec): only those it sets."""
+    out = [f"name = {e.name!r}"] if e.name else []
+    if e.building is not None:
+        out.append(f"building = {e.building!r}")
+    if e.outdoor:
+        out.append("outdoor = true")
+    if e.steps:
+        out.append(f"steps = {e.steps}")
+    if e.end_lo is not None and e.end_hi is not None:
+        out.append(f"ends = [[{e.end_lo[0]!r}, {e.end_lo[1]!r}], [{e.end_hi[0]!r}, {e.end_hi[1]!r}]]")
+    if e.links:
+        out.append("links = [" + ", ".join(repr(n) for n in e.links) + "]")
+    return out
