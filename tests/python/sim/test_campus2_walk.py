@@ -12,7 +12,7 @@ import pytest
 from stridefix_sim.building import building_text
 from stridefix_sim.pipeline import simulate
 from stridefix_sim.radio import walls_crossed
-from stridefix_sim.scenario import builtin_scenario
+from stridefix_sim.scenario import ScenarioError, builtin_scenario, parse_scenario
 from stridefix_sim.transitions import context_track
 from stridefix_sim.world_campus2 import ELEVATOR_WAIT_XY_M, WAIT_FLOOR1_S, WAIT_FLOOR2_S
 from stridefix_sim.world_sources import inside
@@ -169,3 +169,8 @@ def test_survey_covers_every_floor_and_b(survey):
         floor_of = {ap.bssid: ap.floor for ap in world.aps}
         loudest = max(scan.aps, key=lambda r: r[1])[0]
         assert floor_of[loudest] == w.floor[i]
+
+
+def test_legs_route_needs_a_world_with_legs():
+    with pytest.raises(ScenarioError, match="'legs': world 'default' has none"):
+        parse_scenario('[walk]\nroute = "legs"\n')
