@@ -56,8 +56,8 @@ def port_rows(world: World) -> list[tuple[str, float, float, float, list[int], P
         o = building_of(world.outlines, x, y)
         b = o.name if o is not None else None
         extra = PortExtra(building=b)
-        if kind == "stairs":
-            st = world.stairs
+        st = world.stairs
+        if kind == "stairs" and st is not None:
             extra.name, extra.steps = f"{b}-stairs", 2 * st.risers_per_flight
             extra.end_lo, extra.end_hi = st.flight1_start, st.flight2_end
         elif kind == "elevator":

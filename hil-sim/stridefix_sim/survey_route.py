@@ -15,6 +15,7 @@ import numpy as np
 
 from .route import Leg, LegBreak, Polyline, Route, SurveyStop, wrap_angle
 from .world import World
+from .world_parts import SurveyPart
 
 
 def _segment_crosses(a, b, walls: np.ndarray) -> bool:
@@ -181,8 +182,8 @@ def _parts_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
     el = world.elevator
     door = (float(world.loop_corners_m[0][0]), el.door_y_m) if el is not None else None
     cab = (el.x_m, el.door_y_m) if el is not None else None
-    parts = []
-    for k, part in enumerate(world.survey_parts):
+    parts: list[tuple[SurveyPart, np.ndarray, np.ndarray, np.ndarray, list[int]]] = []
+    for k, part in enumerate(world.survey_parts or ()):
         x0, y0, x1, y1 = part.area_m
         idx = np.flatnonzero(
             (points[:, 2] == part.floor)
@@ -208,7 +209,7 @@ def _parts_route(world: World, points: np.ndarray, spacing_m: float, radius_m: f
         pred, seq = _visit_order(xy, spacing_m, world.walls_m, ref, part.floor)
         parts.append((part, idx, xy, pred, seq))
     order: list[int] = []
-    stops = []
+    stops: list[list[SurveyStop]] = []
     for part, idx, xy, _pred, seq in parts:
         stops.append([])
         for j in seq:
