@@ -118,8 +118,9 @@ static void write_pose(daemon_t *const d)
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
-    sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8), with every scheme only */
-    if (d->params.output_scheme < 0 && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p)) {
+    sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8) */
+    const bool controller_out = d->params.output_scheme < 0 || d->params.output_scheme == sf_scheme_controller;
+    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p)) {
         sf_publish_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;

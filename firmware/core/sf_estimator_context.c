@@ -33,8 +33,10 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
     sf_controller_t *const c = &e->controller;
     sf_ctl_motion_t m;
     motion(e, p, t_us, &m);
-    const int16_t before = c->context;
-    if (!sf_controller_update(c, p, &m) || c->context == before) {
+    const uint32_t switches = c->switches;
+    const bool queued = sf_controller_update(c, p, &m);
+    /* cppcheck-suppress knownConditionTrueFalse ; sf_controller_update counts switches through c */
+    if (!queued || c->switches == switches) { /* no event, or none that switched */
         return;
     }
     /* a switch to a context on another floor: every scheme's floor follows the controller's (the body
