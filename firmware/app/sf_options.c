@@ -14,11 +14,17 @@
 #include "sf_fusion.h"
 #include "sf_input.h"
 
+/* The name of a pose_t.SCHEME_* id: a fusion scheme's, or the controller's (not a fusion scheme). */
+static const char *pose_scheme_name(const int s)
+{
+    return s == sf_scheme_controller ? SF_SCHEME_CONTROLLER_NAME : sf_fusion_scheme_name(s);
+}
+
 /* The scheme names of pose_t.SCHEME_*, as "a, b, ... or z". */
 static void scheme_list(FILE *const f, const char *const last_sep)
 {
-    for (int s = 0; s < sf_scheme_count; s++) {
-        fprintf(f, "%s%s", s == 0 ? "" : s + 1 == sf_scheme_count ? last_sep : ", ", sf_fusion_scheme_name(s));
+    for (int s = 0; s <= sf_scheme_controller; s++) {
+        fprintf(f, "%s%s", s == 0 ? "" : s == sf_scheme_controller ? last_sep : ", ", pose_scheme_name(s));
     }
 }
 
@@ -71,7 +77,9 @@ static void usage(FILE *const f)
             "\n"
             "Channels written: IMU MAG BARO WIFI GNSS (inputs), STEP, POSE (one per fusion scheme),\n"
             "FIX (with a site: every scheme's verdict on every Wi-Fi fix), HEALTH (every\n"
-            "output.health_period_ms of board time, and at exit), CONFIG (first in every log file).\n"
+            "output.health_period_ms of board time, and at exit), CONFIG (first in every log file),\n"
+            "CONTEXT (with a site's context map: every change of the multi-scheme controller; its primary\n"
+            "pose is POSE scheme 8, controller).\n"
             "Log durability: the writer fdatasyncs every output.fsync_interval_ms (default 1000); on a full\n"
             "disk events are dropped and counted (events and bytes, in HEALTH and the summary), the reason\n"
             "is printed once, and logging resumes when space returns.\n"
@@ -153,7 +161,9 @@ static int effective_params(const sf_options_t *const o, sf_params_t *const para
         }
     }
     if (o->fusion != NULL) {
-        const int code = strcmp(o->fusion, "all") == 0 ? -1 : sf_fusion_scheme_from_name(o->fusion);
+        const int code = strcmp(o->fusion, "all") == 0                      ? -1
+                         : strcmp(o->fusion, SF_SCHEME_CONTROLLER_NAME) == 0 ? sf_scheme_controller
+                                                                             : sf_fusion_scheme_from_name(o->fusion);
         if (code == SF_EINVAL) {
             fprintf(stderr, "stridefixd: --fusion %s: expected all, ", o->fusion);
             scheme_list(stderr, " or ");

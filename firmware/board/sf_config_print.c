@@ -124,5 +124,8 @@ void sf_config_print_json(FILE *const f, const sf_params_t *const p)
         json_string(f, sf_fusion_scheme_name(s));
         fputc('}', f);
     }
-    fputs("]}\n", f);
+    /* the controller's primary pose: not a fusion scheme, the id after the last one (pose_t.SCHEME_CONTROLLER) */
+    fprintf(f, ", {\"id\": %d, \"name\": ", sf_scheme_controller);
+    json_string(f, SF_SCHEME_CONTROLLER_NAME);
+    fputs("}]}\n", f);
 }

@@ -40,6 +40,7 @@ ${rows}
 #define SF_SCHEME_COUNT ${expected}
 /* the multi-scheme controller's primary pose: not a fusion scheme, the id after the last one */
 #define SF_SCHEME_CONTROLLER ${controller_id}
+#define SF_SCHEME_CONTROLLER_NAME \"controller\"
 
 #endif
 ")

@@ -84,10 +84,13 @@ static void test_scheme_registry_follows_pose_t(void **state)
     assert_int_equal(sf_scheme_adaptive, STRIDEFIX_POSE_T_SCHEME_ADAPTIVE);
     assert_int_equal(sf_scheme_kalman, STRIDEFIX_POSE_T_SCHEME_KALMAN);
     assert_string_equal(sf_fusion_scheme_name(sf_scheme_kalman), "kalman");
-    /* the params range of output.scheme ends at the last scheme */
+    /* the params range of output.scheme ends at the last pose_t id: the controller's primary pose,
+     * which follows the fusion schemes (not one itself) */
     const sf_param_desc_t *const d = sf_param_find("output", "scheme");
     assert_non_null(d);
-    assert_true(d->max_value == (double)(sf_scheme_count - 1));
+    assert_int_equal(sf_scheme_controller, sf_scheme_count);
+    assert_int_equal(sf_scheme_controller, STRIDEFIX_POSE_T_SCHEME_CONTROLLER);
+    assert_true(d->max_value == (double)sf_scheme_controller);
 }
 
 int main(void)

@@ -1,5 +1,6 @@
 /* test_publish.c — sf_publish (firmware/board/sf_publish.h): what goes out is what the core said.
- * A FIX audit with the adaptive terms, a POSE, a STEP, a HEALTH and a CONFIG are written to a log,
+ * A FIX audit with the adaptive terms, a POSE, a STEP, a HEALTH and a CONFIG (and the controller's
+ * CONTEXT events with their evidence in words, and HEALTH's controller counters) are written to a log,
  * read back with liblcm's reader and decoded with the generated types, field by field. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
@@ -18,6 +19,7 @@
 #include "sf_error.h"
 #include "sf_publish.h"
 #include "stridefix_config_t.h"
+#include "stridefix_context_t.h"
 #include "stridefix_fix_t.h"
 #include "stridefix_health_t.h"
 #include "stridefix_pose_t.h"
@@ -126,10 +128,91 @@ static void test_every_output_round_trips(void **state)
     unlink(path);
 }
 
+/* The controller's outputs: CONTEXT field by field with the rule and its evidence in words (a stairs
+ * exit with its recalibration, a door settled by the outline), HEALTH's controller counters. */
+static void test_context_round_trips(void **state)
+{
+    (void)state;
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/sf_test_publish_XXXXXX");
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    sf_lcm_out_t *out = NULL;
+    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    static const int16_t kind[] = {sf_context_outdoor, sf_context_floor, sf_context_floor};
+    static const int16_t building[] = {-1, 0, 0};
+    static const int16_t floor[] = {0, 0, 1};
+    static const int16_t port_kind[] = {sf_port_stairs};
+    static const int16_t steps[] = {20};
+    sf_site_t site = {.n_floors = 2};
+    site.ports = (sf_ports_t){.n_ports = 1, .kind = port_kind};
+    site.contexts = (sf_context_map_t){.n_contexts = 3, .kind = kind, .building = building, .floor = floor,
+                                       .port_steps = steps};
+    sf_params_t p;
+    sf_params_default(&p);
+    const sf_context_event_t stairs = {.t_us = 9000000, .state = sf_ctl_in_context, .context = 2, .prev_context = 1,
+                                       .kind = sf_context_floor, .building = 0, .floor = 1, .scheme = sf_scheme_ekf,
+                                       .method = sf_fix_wifi, .port = 0, .port_kind = sf_port_stairs,
+                                       .rule = sf_ctl_rule_stairs, .switched = true, .steps_in_transition = 22,
+                                       .cls_candidates = 2, .cls_identified = 1, .cls_method = sf_fix_wifi,
+                                       .cls_hits = 4, .recalibrated = true, .recal_x_m = 7.0, .recal_y_m = 15.0,
+                                       .wifi_on = true};
+    sf_publish_context(out, 21, &stairs, &site, &p);
+    const sf_context_event_t door = {.t_us = 9500000, .state = sf_ctl_in_context, .context = 0, .prev_context = 0,
+                                     .kind = sf_context_outdoor, .building = -1, .floor = 0, .port = -1,
+                                     .port_kind = sf_port_door, .rule = sf_ctl_rule_door, .steps_in_transition = 5,
+                                     .cls_candidates = 2, .cls_identified = 2, .gnss_on = true};
+    sf_publish_context(out, 22, &door, &site, &p);
+    sf_input_counters_t ic = {0};
+    const sf_publish_sources_t src = {{0}, {0}};
+    const sf_publish_loop_t loop = {0};
+    const sf_estimator_status_t st = {.controller_active = true, .context_transitions = 3, .context_switches = 2,
+                                      .context_recalibrations = 1, .gnss_on_s = 12.5, .wifi_on_s = 30.0,
+                                      .ble_on_s = 0.25};
+    sf_publish_health(out, 23, 9600000, &ic, &st, &src, &loop);
+    assert_int_equal(sf_lcm_out_close(out, NULL), SF_OK);
+
+    lcm_eventlog_t *const log = lcm_eventlog_create(path, "r");
+    assert_non_null(log);
+    lcm_eventlog_event_t *e = lcm_eventlog_read_next_event(log);
+    assert_string_equal(e->channel, "CONTEXT");
+    stridefix_context_t m;
+    assert_true(stridefix_context_t_decode(e->data, 0, e->datalen, &m) > 0);
+    assert_true(m.t_us == 9000000 && m.state == sf_ctl_in_context && m.context == 2 && m.prev_context == 1);
+    assert_true(m.kind == sf_context_floor && m.building == 0 && m.floor == 1 && m.scheme == sf_scheme_ekf);
+    assert_true(m.method == sf_fix_wifi && m.port == 0 && m.port_kind == sf_port_stairs && m.rule == sf_ctl_rule_stairs);
+    assert_true(m.switched && m.steps_in_transition == 22 && m.cls_candidates == 2 && m.cls_identified == 1);
+    assert_true(m.cls_method == sf_fix_wifi && m.cls_hits == 4 && m.recalibrated);
+    assert_true(m.recal_x_m == 7.0 && m.recal_y_m == 15.0 && !m.gnss_on && m.wifi_on && !m.ble_on);
+    assert_string_equal(m.rule_text, "stairs: the staircase's steps and a unique floor: 22 of 20 steps, floor 1 of "
+                                     "building 0 unique (Wi-Fi, 4 APs), recalibrated to (7.0, 15.0)");
+    stridefix_context_t_decode_cleanup(&m);
+    lcm_eventlog_free_event(e);
+    e = lcm_eventlog_read_next_event(log);
+    assert_true(stridefix_context_t_decode(e->data, 0, e->datalen, &m) > 0);
+    assert_string_equal(m.rule_text, "door: steps since the transition began: 5 of 5 steps, 2 of 2 candidates "
+                                     "identified: by the outline, outdoor");
+    stridefix_context_t_decode_cleanup(&m);
+    lcm_eventlog_free_event(e);
+    e = lcm_eventlog_read_next_event(log);
+    assert_string_equal(e->channel, "HEALTH");
+    stridefix_health_t h;
+    assert_true(stridefix_health_t_decode(e->data, 0, e->datalen, &h) > 0);
+    assert_true(h.context_transitions == 3 && h.context_switches == 2 && h.context_recalibrations == 1);
+    assert_true(h.gnss_on_s == 12.5f && h.wifi_on_s == 30.0f && h.ble_on_s == 0.25f);
+    lcm_eventlog_free_event(e);
+    assert_null(lcm_eventlog_read_next_event(log));
+    lcm_eventlog_destroy(log);
+    unlink(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_output_round_trips),
+        cmocka_unit_test(test_context_round_trips),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
