@@ -171,10 +171,11 @@ def sim_transitions(summary: Mapping[str, Any]) -> list[Transition]:
 
 
 def truth_transitions(t_us: Array, keys: Array) -> list[Transition]:
-    """The context changes of a truth timeline (the sample where the key changes; kind unknown)."""
+    """The context changes of a truth timeline (the sample where the key changes; kind ``truth``: the
+    timeline does not say which port)."""
     k = np.asarray(keys, dtype=object)
     change = np.flatnonzero(k[1:] != k[:-1]) + 1
-    return [Transition(int(t_us[i]), "", str(k[i - 1]), str(k[i])) for i in change]
+    return [Transition(int(t_us[i]), "truth", str(k[i - 1]), str(k[i])) for i in change]
 
 
 # --- latency and false switches ----------------------------------------------------------------------

@@ -65,8 +65,8 @@ def test_truth_transitions_from_a_timeline():
     t = np.arange(6) * S
     keys = np.array(["outdoor", "outdoor", "A/0", "A/0", "A/1", "A/1"], dtype=object)
     assert cs.truth_transitions(t, keys) == [
-        cs.Transition(2 * S, "", "outdoor", "A/0"),
-        cs.Transition(4 * S, "", "A/0", "A/1"),
+        cs.Transition(2 * S, "truth", "outdoor", "A/0"),
+        cs.Transition(4 * S, "truth", "A/0", "A/1"),
     ]
     assert cs.timeline(t, keys) == [(0, 2 * S, "outdoor"), (2 * S, 4 * S, "A/0"), (4 * S, 5 * S, "A/1")]
 
