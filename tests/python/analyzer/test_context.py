@@ -62,9 +62,7 @@ def test_analyze_writes_context_and_controller_is_primary(
     # the context section; the report shows the events with their evidence
     t, x, y = straight_walk
     events = [("TRUTH", msg.truth(ti, xi, yi)) for ti, xi, yi in zip(t, x, y)]
-    events += [
-        ("POSE", msg.pose(ti, xi, yi + 2.0, scheme=pose_t.SCHEME_EKF)) for ti, xi, yi in zip(t, x, y)
-    ]
+    events += [("POSE", msg.pose(ti, xi, yi + 2.0, scheme=pose_t.SCHEME_EKF)) for ti, xi, yi in zip(t, x, y)]
     events += [
         ("POSE", msg.pose(ti, xi, yi + 0.5, scheme=pose_t.SCHEME_CONTROLLER))
         for ti, xi, yi in zip(t, x, y)
