@@ -11,6 +11,7 @@
 #include "sf_file_kind.h"
 #include "sf_lcm_walk.h"
 #include "sf_site_v2.h"
+#include "sf_site_v3.h"
 
 static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
 
@@ -51,7 +52,9 @@ static int walk_site(sf_lcm_walk_t *const w)
     rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_rp", 4 + 4 + 2 + 4);
     rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_entries", 4 + 4 + 4 + 4 + 4);
     rc = rc != SF_OK ? rc : sf_lcm_walk_skip(w, 1 + 3 * 4 + 3 * 4 + 3 * 4, "has_fix_model .. fix_white_share");
-    rc = rc != SF_OK ? rc : sf_site_v2_walk(w);
+    int32_t n_ports = 0;
+    rc = rc != SF_OK ? rc : sf_site_v2_walk(w, &n_ports);
+    rc = rc != SF_OK ? rc : sf_site_v3_walk(w, n_ports);
     return rc != SF_OK ? rc : sf_lcm_walk_end(w, "site_t");
 }
 
@@ -171,7 +174,8 @@ static int check_fields(const stridefix_site_t *const s, const char *const name,
                        (int)s->rp_scans[r], (int)r);
         }
     }
-    return sf_site_v2_check_plan(s, (int)lowest, (int)top, name, err, err_size);
+    const int plan_rc = sf_site_v2_check_plan(s, (int)lowest, (int)top, name, err, err_size);
+    return plan_rc != SF_OK ? plan_rc : sf_site_v3_check(s, (int)lowest, (int)top, name, err, err_size);
 #undef BAD
 }
 
@@ -207,10 +211,10 @@ static int check_header(const uint8_t *const data, const size_t size, const char
     const uint32_t length = le32(data + 12);
     const uint32_t crc = le32(data + 16);
     const uint32_t reserved = le32(data + 20);
-    if (version == 1u) {
+    if (version == 1u || version == 2u) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX,
-                            "format version 1, this build reads %u: rebuild it with `stridefix radiomap build`",
-                            SF_SITE_FORMAT_VERSION);
+                            "format version %lu, this build reads %u: rebuild it with `stridefix radiomap build`",
+                            (unsigned long)version, SF_SITE_FORMAT_VERSION);
     }
     if (version != SF_SITE_FORMAT_VERSION) {
         return sf_lcm_failf(err, err_size, name, SF_ESYNTAX, "format version %lu, this reader supports %u",
@@ -283,6 +287,7 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     m->entry_std_db = s->entry_std_db;
     m->entry_count = s->entry_count;
     sf_site_v2_view(s, site);
+    sf_site_v3_view(s, site);
     const char *what = NULL;
     if (sf_radiomap_check(m, &what) != SF_OK) {
         return sf_lcm_failf(err, err_size, name, SF_ERANGE, "radio map check failed: %s", what != NULL ? what : "?");

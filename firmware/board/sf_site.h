@@ -1,5 +1,6 @@
 /* sf_site.h — loads a site file (floors, map rotation, radio map; since version 2 also the
- * geo-reference, walls, ports and BLE beacons) into the core's sf_site_t.
+ * geo-reference, walls, ports and BLE beacons; since version 3 the multi-scheme controller's context
+ * map: buildings, port extras and links, contexts, constellations) into the core's sf_site_t.
  *
  * File layout (written by analyzer/stridefix_analyzer/sitefile.py; header integers little-endian):
  *
@@ -13,7 +14,7 @@
  *                                    starting with the type hash
  *
  * Checks, in this order, each failing with a message "<path>: <what>" naming the values:
- *   1. SF_ESYNTAX — header: file ≥ 24 bytes, magic, version (1: "rebuild it"), reserved = 0, payload length equal to
+ *   1. SF_ESYNTAX — header: file ≥ 24 bytes, magic, version (1, 2: "rebuild it"), reserved = 0, payload length equal to
  *      the bytes after the header (truncation / trailing bytes), payload ≤ SF_SITE_MAX_PAYLOAD,
  *      CRC-32 of the payload;
  *   2. SF_ESYNTAX — payload: LCM type hash of site_t, every count and string fits in the payload,
@@ -24,7 +25,8 @@
  *      floor in lowest_floor … lowest_floor + n_floors − 1, rp_scans ≥ 1; entries with ap and rp
  *      indices in range (e.g. "entry 17: rp index 300 outside 0..99"), strictly sorted by (ap, rp),
  *      finite mean, finite std ≥ 0, 1 ≤ count ≤ rp_scans of the RP; then the version-2 rules
- *      (sf_site_v2.h: geo altitude and rotation when has_geo, walls, ports, beacons, BLE model);
+ *      (sf_site_v2.h: geo altitude and rotation when has_geo, walls, ports, beacons, BLE model),
+ *      then the version-3 rules (sf_site_v3.h: outlines, port extras, links, contexts, constellations);
  *      finally sf_radiomap_check on the core view.
  * SF_ENOENT: no such file; SF_EIO: cannot read it (or out of memory); SF_EINVAL: NULL argument.
  *
@@ -43,7 +45,7 @@
 #include "stridefix_site_t.h"
 
 #define SF_SITE_HEADER_SIZE 24
-#define SF_SITE_FORMAT_VERSION 2u /* version 1 files are refused: rebuild them */
+#define SF_SITE_FORMAT_VERSION 3u /* version 1 and 2 files are refused: rebuild them */
 #define SF_SITE_MAX_PAYLOAD (256u << 20) /* bytes; the same limit as sitefile.MAX_PAYLOAD_BYTES */
 
 /* What a loaded site owns. Zero-initialise (or sf_site_store_free) before sf_site_load; read

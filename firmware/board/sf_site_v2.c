@@ -5,11 +5,13 @@
 
 #include "sf_error.h"
 
-int sf_site_v2_walk(sf_lcm_walk_t *const w)
+int sf_site_v2_walk(sf_lcm_walk_t *const w, int32_t *const n_ports)
 {
     int rc = sf_lcm_walk_skip(w, 8 + 8, "origin_alt_m, geo_rotation_deg");
     rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_walls", 4 * 4 + 2);
+    const size_t ports_at = w->pos;
     rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_ports", 2 + 3 * 4 + 2 * 2);
+    *n_ports = rc == SF_OK ? sf_lcm_be32(w->p + ports_at) : 0; /* checked ≥ 0 by the walk */
     rc = rc != SF_OK ? rc : sf_lcm_walk_count(w, "n_beacons", 8 + 4 + 4 + 2 + 4);
     return rc != SF_OK ? rc : sf_lcm_walk_skip(w, 3 * 4, "ble_rssi_1m_dbm .. ble_range_sigma_db");
 }

@@ -11,13 +11,15 @@
 #define SF_SITE_V2_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "sf_lcm_walk.h"
 #include "sf_radiomap.h"
 #include "stridefix_site_t.h"
 
-/* Walks origin_alt_m .. ble_range_sigma_db (the fields after fix_white_share). */
-int sf_site_v2_walk(sf_lcm_walk_t *w);
+/* Walks origin_alt_m .. ble_range_sigma_db (the fields after fix_white_share); *n_ports gets the
+ * port count read (the version-3 per-port extras are sized by it). */
+int sf_site_v2_walk(sf_lcm_walk_t *w, int32_t *n_ports);
 
 /* The geo rules (call when has_geo); SF_OK or SF_ERANGE with "<name>: <what>" in err. */
 int sf_site_v2_check_geo(const stridefix_site_t *s, const char *name, char *err, size_t err_size);

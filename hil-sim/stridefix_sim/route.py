@@ -17,6 +17,9 @@ Routes built here (from the world's geometry):
   partial lap of floor 0 (leg 2);
 * ``track``: the world's track (``World.track_m``, e.g. the aadr2015 foyer), one leg; its surveyed
   reference points (``World.reference_points_m``, on straight stretches) become ``Route.marks``;
+* ``legs``: the world's walk as legs (``World.walk_legs``, world_parts.py: e.g. campus2, outdoors →
+  a building → stairs → elevator rides → outdoors → another building), an elevator ride between legs,
+  the legs' waits as pauses (``Route.pauses``);
 * ``survey``: the surveyor's walk over calibration points (``survey_route.py``), a ``SurveyStop`` at
   every point.
 """
@@ -227,6 +230,7 @@ class Route:
     start_stop: SurveyStop | None = None  # survey at the start point (before leg 0)
     end_stop: SurveyStop | None = None  # survey at the end point (after the last leg)
     survey_points: np.ndarray | None = None  # (n, 3) x, y, floor of the stops, in survey order
+    pauses: list[tuple[float, float]] = field(default_factory=list)  # the route's own: (s_m, duration_s)
 
     @property
     def leg_starts_m(self) -> np.ndarray:
@@ -357,6 +361,39 @@ def track_route(world: World, radius_m: float) -> Route:
     return Route(name="track", legs=[leg], breaks=[], radius_m=radius_m, marks=marks)
 
 
+def legs_route(world: World, radius_m: float) -> Route:
+    """The world's walk as legs (``World.walk_legs``): flights rise along their stretch (the person
+    slows from 2.2 m before a staircase's first flight to 1.6 m after its last, as on the tour), waits
+    become pauses, and an elevator ride joins each leg to the next (to the next leg's floor level)."""
+    if not world.walk_legs:
+        raise ValueError(f"world {world.name!r} has no legs")
+    legs, zones, pauses = [], [], []
+    s0 = 0.0
+    for spec in world.walk_legs:
+        path = Polyline(spec.points, radius_m)
+        v = path.vertex_d
+        flights = [Flight(float(v[i]), float(v[i + 1]), rise) for i, rise in spec.flights]
+        leg = Leg(path=path, z0_m=spec.floor * world.storey_m, flights=flights)
+        for f in flights:
+            zones.append((s0 + f.d_a - 0.15, s0 + f.d_b, "stairs"))
+        if flights:
+            zones.append((s0 + flights[0].d_a - 2.2, s0 + flights[-1].d_b + 1.6, "slow"))
+        pauses += [(s0 + float(v[i]), float(sec)) for i, sec in spec.waits]
+        legs.append(leg)
+        s0 += leg.length_m
+    breaks = [LegBreak("elevator", dz_m=nxt.z0_m - cur.z_end_m) for cur, nxt in zip(legs[:-1], legs[1:])]
+    tread = world.stairs.tread_m if world.stairs is not None else 0.28
+    return Route(
+        name="legs",
+        legs=legs,
+        breaks=breaks,
+        radius_m=radius_m,
+        tread_m=tread,
+        gait_zones=zones,
+        pauses=pauses,
+    )
+
+
 def make_route(world: World, route: str, laps: float, radius_m: float) -> Route:
     if route == "loop":
         return loop_route(world, laps, radius_m)
@@ -364,4 +401,6 @@ def make_route(world: World, route: str, laps: float, radius_m: float) -> Route:
         return tour_route(world, radius_m)
     if route == "track":
         return track_route(world, radius_m)
+    if route == "legs":
+        return legs_route(world, radius_m)
     raise ValueError(f"unknown route {route!r}")

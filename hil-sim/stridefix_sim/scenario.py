@@ -17,7 +17,8 @@ floors, the elevator between them); ``aadr2015_slow`` / ``aadr2015`` / ``aadr201
 track with 14 reference points through the aadr2015 foyer (world ``aadr2015``) at one pace;
 ``aadr2015_survey``: the survey of the foyer's 67 calibration points; ``campus`` / ``campus_survey``:
 world ``campus`` (indoor, a door with a landmark, 66 m outdoors with GNSS, another door, indoor) and its
-survey. ``[ble]``, ``[gnss]``, ``[landmark]``: scenario_sources.py.
+survey; ``campus2`` / ``campus2_survey``: world ``campus2`` (outdoors → building A's door → stairs
+up → elevator up, then down → outdoors → building B's door) and its survey. ``[ble]``, ``[gnss]``, ``[landmark]``: scenario_sources.py.
 
 Survey mode (``[survey] enabled = true`` or ``stridefix sim --survey``): instead of ``walk.route`` the
 person walks from calibration point to calibration point, and at each stands still, faces
@@ -270,7 +271,8 @@ def _validate_values(d: dict, source: str) -> None:
     check(d["world"]["name"] in WORLDS, "world.name", f"must be one of {', '.join(repr(k) for k in WORLDS)}")
     world = WORLDS[d["world"]["name"]]()
     check(d["duration_s"] >= 0, "duration_s", "must be >= 0")
-    check(w["route"] in ("tour", "loop", "track"), "walk.route", "must be 'tour', 'loop' or 'track'")
+    routes = ("tour", "loop", "track", "legs")
+    check(w["route"] in routes, "walk.route", "must be 'tour', 'loop', 'track' or 'legs'")
     if not sv["enabled"]:
         check(
             w["route"] != "tour" or (world.stairs is not None and world.elevator is not None),
@@ -281,6 +283,11 @@ def _validate_values(d: dict, source: str) -> None:
             w["route"] != "track" or world.track_m is not None,
             "walk.route",
             f"'track' needs a world with a track (world {world.name!r} has none)",
+        )
+        check(
+            w["route"] != "legs" or bool(world.walk_legs),
+            "walk.route",
+            f"'legs': world {world.name!r} has none",
         )
     check(sv["layout"] in ("grid", "world"), "survey.layout", "must be 'grid' or 'world'")
     check(
@@ -428,6 +435,13 @@ BUILTIN: dict[str, dict] = {
     # world campus: indoor -> west door (landmark) -> 66 m outdoors (GNSS) -> south door (landmark) -> indoor
     "campus": {"world": {"name": "campus"}, "walk": {"route": "track", "pause": []}},
     "campus_survey": {"world": {"name": "campus"}, "walk": {"pause": []}, "survey": {"enabled": True}},
+    # world campus2: outdoors -> A (door, stairs 0->1, elevator 1->2, 2->0) -> outdoors -> B; its survey
+    "campus2": {"world": {"name": "campus2"}, "walk": {"route": "legs", "pause": []}},
+    "campus2_survey": {
+        "world": {"name": "campus2"},
+        "walk": {"pause": []},
+        "survey": {"enabled": True, "layout": "world"},
+    },
 }
 
 

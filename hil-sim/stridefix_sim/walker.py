@@ -192,6 +192,8 @@ def plan_walk(sc: dict, route: Route, person: Person, rng: np.random.Generator) 
     for p in w["pause"] if route.name != "survey" else []:
         if 0 < p["at_m"] < total:
             cuts.setdefault(round(p["at_m"], 9), []).append(("pause", p["duration_s"]))
+    for at_m, dur_s in route.pauses:  # the route's own (the legs' waits)
+        cuts.setdefault(round(at_m, 9), []).append(("pause", dur_s))
     for i, _br in enumerate(route.breaks):
         cuts.setdefault(round(float(leg_s[i + 1]), 9), []).append(("leg", i))
     bounds = [0.0] + sorted(cuts) + [total]

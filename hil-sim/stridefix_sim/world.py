@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .world_parts import LegSpec, Outline, SurveyPart
 from .world_sources import Beacon, Door, GeoRef
 
 FLOOR_W_M = 60.0
@@ -154,6 +155,10 @@ class World:
     beacons: tuple[Beacon, ...] = ()
     doors: tuple[Door, ...] = ()  # doors to the outside (with their NFC landmark tags)
     footprint_m: np.ndarray | None = None  # (k, 4) the building's inside; None = all indoors
+    # several buildings (world_parts.py): () / None = one building as before
+    outlines: tuple[Outline, ...] = ()  # the buildings: name, footprint rectangle, floors
+    walk_legs: tuple[LegSpec, ...] = ()  # the ``legs`` route
+    survey_parts: tuple[SurveyPart, ...] | None = None  # the survey's parts, in walking order
 
     @property
     def area_m2(self) -> float:

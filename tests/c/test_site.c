@@ -293,7 +293,7 @@ static void test_python_variants_rejected(void **state)
         n++;
     }
     fclose(f);
-    assert_true(n >= 30);
+    assert_true(n >= 80); /* the header, v1, v2 and v3 variants */
 }
 
 static void test_truncation_at_every_length(void **state)
@@ -385,16 +385,25 @@ static void test_index_out_of_range(void **state)
     size_t size = 0;
     uint8_t *const buf = read_all(SF_SITE_VECTORS_DIR "/site.sfsite", &size);
     /* the payload has the five entry arrays of n_entries int32/float each (rp is the second), then
-     * the fix model: has_fix_model (1 B) and nine floats, then the version-2 fields (their sizes
-     * from the file as loaded) */
+     * the fix model: has_fix_model (1 B) and nine floats, then the version-2 and version-3 fields
+     * (their sizes from the file as loaded) */
     sf_site_store_t loaded;
     sf_site_t view;
     assert_int_equal(sf_site_parse(buf, size, "site.sfsite", &loaded, &view, NULL, 0), SF_OK);
     const size_t v2_bytes = 8u + 8u + 4u + 18u * (size_t)loaded.msg.n_walls + 4u + 18u * (size_t)loaded.msg.n_ports +
                             4u + 22u * (size_t)loaded.msg.n_beacons + 3u * 4u;
+    /* the version-3 fields: names (int32 length, bytes, NUL each), outline, per-port extras, links,
+     * contexts, constellation members */
+    size_t v3_bytes = 4u + 4u + 10u * (size_t)loaded.msg.n_outline + 22u * (size_t)loaded.msg.n_ports + 4u +
+                      8u * (size_t)loaded.msg.n_links + 4u + 14u * (size_t)loaded.msg.n_contexts + 4u +
+                      14u * (size_t)loaded.msg.n_cdd;
+    for (int32_t b = 0; b < loaded.msg.n_buildings; b++) {
+        v3_bytes += 4u + strlen(loaded.msg.building_name[b]) + 1u;
+    }
+    assert_true(loaded.msg.n_contexts > 0); /* the vector site has a context map */
     sf_site_store_free(&loaded);
     const size_t fix_model_bytes = 1u + 9u * 4u;
-    const size_t entry_rp_at = size - v2_bytes - fix_model_bytes - 4u * (size_t)d.n_entries * 4u;
+    const size_t entry_rp_at = size - v3_bytes - v2_bytes - fix_model_bytes - 4u * (size_t)d.n_entries * 4u;
     put_be32(buf + entry_rp_at + 4u * 2u, 300);
     put_le32(buf + 16, sf_site_crc32(buf + SF_SITE_HEADER_SIZE, size - SF_SITE_HEADER_SIZE));
     sf_site_store_t store;
@@ -463,6 +472,8 @@ static void test_empty_radiomap_from_c_encoder(void **state)
     assert_int_equal(site.plan.n_walls, 0);
     assert_int_equal(site.ports.n_ports, 0);
     assert_int_equal(site.beacons.n_beacons, 0);
+    assert_int_equal(site.contexts.n_contexts, 0); /* no version-3 content: no controller */
+    assert_int_equal(site.contexts.n_buildings, 0);
     sf_site_store_free(&store);
     free(buf);
 }

@@ -10,7 +10,8 @@ The seeds are committed; this script says where they came from and rewrites them
 - board_rx: the same frames in fuzz_board_rx.c's 12-byte records;
 - lcm_input: the raw-sensor LCM log stridefixd writes for the walk's first seconds (IMU, MAG, BARO,
   WIFI, a few non-sensor events), with one GNSS event added (the SIL walk has none);
-- site: the site-file test vector and five of its variants (two of them version-2 rules);
+- site: the site-file test vector and seven of its variants (two of them version-2 rules, two
+  version-3 rules);
 - config: `stridefixd --print-config`.
 """
 
@@ -122,7 +123,15 @@ def main() -> int:
         path.write_bytes(data)
     (args.out / "site").mkdir(parents=True, exist_ok=True)
     shutil.copy(args.site_vectors / "site.sfsite", args.out / "site" / "site.sfsite")
-    for variant in ("ap_index", "bssid_order", "count_zero", "wall_floor", "beacon_order"):
+    for variant in (
+        "ap_index",
+        "bssid_order",
+        "count_zero",
+        "wall_floor",
+        "beacon_order",
+        "outline_not_consecutive",
+        "context_duplicate",
+    ):
         shutil.copy(
             args.site_vectors / "variants" / f"{variant}.sfsite", args.out / "site" / f"{variant}.sfsite"
         )

@@ -11,6 +11,8 @@ script runs from a fresh build without an installed package. Writes into OUT_DIR
   ``<field> <value> [<value> ...]`` (strings: the rest of the line; floats by repr(), which round-trips
   a double, and float32 values are exact doubles); ``site_v2.txt`` the same for the version-2 fields
   (geo altitude and rotation, walls, ports, beacons; NaN as ``nan``), read by tests/c/test_site_v2.c;
+  ``site_v3.txt`` the same for the version-3 fields (the context map; ``building_name`` as names
+  separated by spaces), read by tests/c/test_site_v3.c;
 * ``variants/<name>.sfsite`` — corrupted or invalid files, and ``variants.txt`` with one line each:
   ``<name>\\t<kind>\\t<exact|contains>\\t<text>``: the reader must reject the file with the ``kind``
   (``field`` → SF_ERANGE, any other → SF_ESYNTAX) and a message equal to (``exact``) or containing
@@ -31,8 +33,8 @@ if __name__ == "__main__":
     for _d in reversed(sys.argv[2:]):
         sys.path.insert(0, _d)
 
-from stridefix import site_t, truth_t  # noqa: E402
-from stridefix_analyzer.io import site_v2, sitefile  # noqa: E402
+from stridefix import fix_t, pose_t, site_t, truth_t  # noqa: E402
+from stridefix_analyzer.io import site_v2, site_v3, sitefile  # noqa: E402
 
 _SCALAR_FIELDS = (
     "name",
@@ -50,6 +52,7 @@ _SCALAR_FIELDS = (
 )
 _V2_SCALAR_FIELDS = site_v2.V2_SCALARS
 _V2_ARRAY_FIELDS = tuple(name for arrays in site_v2.V2_ARRAYS.values() for name in arrays)
+_V3_ARRAY_FIELDS = tuple(name for arrays in site_v3.V3_ARRAYS.values() for name in arrays)
 _ARRAY_FIELDS = (
     "floor_height_m",
     "ap_bssid",
@@ -71,7 +74,9 @@ def vector_site() -> site_t:
     """A small site touching every corner: a negative lowest floor, geo-reference, BSSIDs at both
     ends of the 48-bit range, an AP with no entry (AP 2) and an RP with none (RP 5); walls on two
     floors, a door and stairs over three floors, beacons at both ends of the id range, one with its
-    own RSSI at 1 m and the others NaN (the site's)."""
+    own RSSI at 1 m and the others NaN (the site's); two buildings (a square and a triangle), the door
+    leading outdoors, the stairs with steps and endpoints, a link between them, three contexts
+    (outdoor by GNSS, a Wi-Fi floor of A with two APs, a BLE floor of B with one beacon)."""
     return sitefile.new_site(
         name="vector site \u00fc",
         source="tests/vectors/gen_site_vectors.py",
@@ -119,6 +124,29 @@ def vector_site() -> site_t:
         ble_rssi_1m_dbm=-59.0,
         ble_path_loss_exponent=2.25,
         ble_range_sigma_db=5.5,
+        building_name=["A", "B"],
+        outline_x_m=[0.0, 10.0, 10.0, 0.0, 20.0, 30.0, 25.0],
+        outline_y_m=[-5.0, -5.0, 8.0, 8.0, 0.0, 0.0, 7.5],
+        outline_building=[0, 0, 0, 0, 1, 1, 1],
+        port_building=[0, 0],
+        port_outdoor=[1, 0],
+        port_steps=[0, 24],
+        port_lo_x_m=[5.0, 2.0],
+        port_lo_y_m=[0.0, 3.5],
+        port_hi_x_m=[5.0, 4.0],
+        port_hi_y_m=[0.0, 4.5],
+        link_a=[0],
+        link_b=[1],
+        context_kind=[site_t.CONTEXT_OUTDOOR, site_t.CONTEXT_FLOOR, site_t.CONTEXT_FLOOR],
+        context_building=[-1, 0, 1],
+        context_floor=[0, 0, 1],
+        context_scheme=[pose_t.SCHEME_EKF, pose_t.SCHEME_EKF, pose_t.SCHEME_PARTICLE],
+        context_method=[fix_t.METHOD_GNSS, fix_t.METHOD_WIFI, fix_t.METHOD_BLE],
+        context_cdd_method=[fix_t.METHOD_GNSS, fix_t.METHOD_WIFI, fix_t.METHOD_BLE],
+        context_cdd_min_hits=[1, 2, 1],
+        cdd_context=[1, 1, 2],
+        cdd_id=[0x000000000001, 0x0A1B2C3D4E5F, 0xBEAC20230001],
+        cdd_min_dbm=[-62.5, -70.0, -75.25],
     )
 
 
@@ -181,8 +209,9 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
     out = [
         ("magic", frame(payload, magic=b"SFSITX\0\x01"), "magic", None),
         ("magic_zero", frame(payload, magic=bytes(8)), "magic", None),
-        ("version", frame(payload, version=3), "version", None),
+        ("version", frame(payload, version=4), "version", None),
         ("version_1", frame(payload, version=1), "version", None),
+        ("version_2", frame(payload, version=2), "version", None),
         ("reserved", frame(payload, reserved=7), "reserved", None),
         ("length_long", frame(payload, length=len(payload) + 1), "length", None),
         ("length_short", frame(payload, length=len(payload) - 3), "length", None),
@@ -223,6 +252,7 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("fix_length_zero", _edited(fix_bias_length_m=0.0), "field", None),
         ("fix_white_share", _edited(fix_white_share=1.5), "field", None),
         *v2_variants(),
+        *v3_variants(),
     ]
     return out
 
@@ -253,6 +283,52 @@ def v2_variants() -> list[tuple[str, bytes, str, str | None]]:
     ]
 
 
+def v3_variants() -> list[tuple[str, bytes, str, str | None]]:
+    """One invalid file per version-3 rule (io/site_v3.py's order)."""
+    nan, inf = float("nan"), float("inf")
+    kinds = [site_t.CONTEXT_OUTDOOR, site_t.CONTEXT_FLOOR, site_t.CONTEXT_FLOOR]
+    return [
+        ("outline_building_range", _edited(outline_building=[0, 0, 0, 0, 1, 1, 2]), "field", None),
+        ("outline_inf", _edited(outline_y_m=[-5.0, -5.0, 8.0, inf, 0.0, 0.0, 7.5]), "field", None),
+        ("outline_not_consecutive", _edited(outline_building=[0, 0, 1, 0, 1, 1, 1]), "field", None),
+        ("outline_too_few", _edited(outline_building=[0, 0, 0, 0, 0, 1, 1]), "field", None),
+        ("port_building_range", _edited(port_building=[0, 2]), "field", None),
+        ("port_outdoor", _edited(port_outdoor=[2, 0]), "field", None),
+        ("port_steps_negative", _edited(port_steps=[-1, 24]), "field", None),
+        ("port_stairs_no_steps", _edited(port_steps=[0, 0]), "field", None),
+        ("port_end_nan", _edited(port_hi_y_m=[0.0, nan]), "field", None),
+        ("link_range", _edited(link_b=[2]), "field", None),
+        ("link_self", _edited(link_b=[0]), "field", None),
+        ("context_kind", _edited(context_kind=[site_t.CONTEXT_OUTDOOR, 4, site_t.CONTEXT_FLOOR]), "field", None),
+        ("context_outdoor_building", _edited(context_building=[0, 0, 1]), "field", None),
+        ("context_building_range", _edited(context_building=[-1, 0, 2]), "field", None),
+        ("context_floor", _edited(context_floor=[0, 2, 1]), "field", None),
+        ("context_scheme", _edited(context_scheme=[6, pose_t.SCHEME_CONTROLLER, 7]), "field", None),
+        ("context_method", _edited(context_method=[2, fix_t.METHOD_LANDMARK, 4]), "field", None),
+        ("context_cdd_method", _edited(context_cdd_method=[2, 1, fix_t.METHOD_PORT]), "field", None),
+        ("context_min_hits", _edited(context_cdd_min_hits=[1, 0, 1]), "field", None),
+        (
+            "context_two_outdoor",
+            _edited(context_kind=[site_t.CONTEXT_OUTDOOR, site_t.CONTEXT_OUTDOOR, kinds[2]], context_building=[-1, -1, 1]),
+            "field",
+            None,
+        ),
+        ("context_duplicate", _edited(context_building=[-1, 1, 1], context_floor=[0, 1, 1]), "field", None),
+        ("cdd_context_range", _edited(cdd_context=[1, 1, 3]), "field", None),
+        ("cdd_order", _edited(cdd_context=[1, 2, 1]), "field", None),
+        ("cdd_id_range", _edited(cdd_id=[1, 1 << 48, 5]), "field", None),
+        ("cdd_dbm_inf", _edited(cdd_min_dbm=[-62.5, -inf, -75.25]), "field", None),
+        ("cdd_gnss", _edited(cdd_context=[0, 1, 2]), "field", None),
+    ]
+
+
+def dump_v3(site: site_t) -> str:
+    lines = []
+    for name in _V3_ARRAY_FIELDS:
+        lines.append(" ".join([name, *(v if isinstance(v, str) else repr(v) for v in getattr(site, name))]))
+    return "\n".join(lines) + "\n"
+
+
 def dump_v2(site: site_t) -> str:
     lines = [f"{name} {getattr(site, name)!r}" for name in _V2_SCALAR_FIELDS]
     for name in _V2_ARRAY_FIELDS:
@@ -280,6 +356,8 @@ def main(out_dir: str) -> int:
         f.write(dump(sitefile.read_site(path)))
     with open(os.path.join(out_dir, "site_v2.txt"), "w", encoding="utf-8") as f:
         f.write(dump_v2(sitefile.read_site(path)))
+    with open(os.path.join(out_dir, "site_v3.txt"), "w", encoding="utf-8") as f:
+        f.write(dump_v3(sitefile.read_site(path)))
     rows = []
     for name, data, kind, c_text in variants():
         vpath = os.path.join(out_dir, "variants", name + ".sfsite")

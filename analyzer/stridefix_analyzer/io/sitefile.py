@@ -4,7 +4,7 @@ Layout (all header integers little-endian)::
 
     offset  size  field
          0     8  magic            b"SFSITE\\0\\x01"
-         8     4  format version   uint32, 2 (version 1 files are refused: rebuild them)
+         8     4  format version   uint32, 3 (version 1 and 2 files are refused: rebuild them)
         12     4  payload length   uint32, bytes after the header (file size − 24)
         16     4  payload CRC-32   uint32, IEEE 802.3 (zlib.crc32) of the payload
         20     4  reserved         uint32, 0
@@ -23,8 +23,9 @@ order and word their messages alike, so a file rejected by one is rejected by th
    ``lowest_floor`` … ``lowest_floor + n_floors − 1`` and ``rp_scans`` ≥ 1; entries with AP and RP
    indices in range, strictly sorted by (ap, rp), finite mean, finite std ≥ 0, and
    1 ≤ count ≤ ``rp_scans`` of their RP; then the version-2 content (:mod:`.site_v2`: geo altitude
-   and rotation, walls, ports, beacons and the BLE path-loss model). Every array's length must equal
-   its count.
+   and rotation, walls, ports, beacons and the BLE path-loss model), then the version-3 content
+   (:mod:`.site_v3`: outlines, port extras, links, contexts, constellations). Every array's length
+   must equal its count.
 
 Errors: :class:`SiteFileError` (``path: what``), with ``kind`` one of :data:`ERROR_KINDS`.
 Cost: one read of the file, O(n_ap + n_rp + n_entries) checks.
@@ -51,10 +52,10 @@ from stridefix_analyzer.io.site_v2 import (
     validate_geo,
     validate_plan,
 )
-from stridefix_analyzer.io.site_v3 import fill_port_defaults
+from stridefix_analyzer.io.site_v3 import fill_port_defaults, init_v3_fields, set_v3_counts, validate_contexts
 
 MAGIC = b"SFSITE\0\x01"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 HEADER = struct.Struct("<8sIIII")
 HEADER_SIZE = HEADER.size  # 24
 #: Largest payload either reader accepts [bytes] (the firmware allocates the whole file).
@@ -199,6 +200,7 @@ def validate_site(site: site_t) -> None:
             )
     try:
         validate_plan(site, site.lowest_floor, top_floor)
+        validate_contexts(site, site.lowest_floor, top_floor)
     except SiteV2ValidationError as exc:
         raise SiteValidationError(str(exc)) from None
 
@@ -265,11 +267,12 @@ def decode_site_file(data: bytes, path: str = "<site>") -> site_t:
             "magic",
             f"bad magic {magic.hex(' ')}, expected {MAGIC.hex(' ')} (not a StrideFix site file)",
         )
-    if version == 1:
+    if version in (1, 2):
         raise SiteFileError(
             path,
             "version",
-            f"format version 1, this build reads {FORMAT_VERSION}: rebuild it with `stridefix radiomap build`",
+            f"format version {version}, this build reads {FORMAT_VERSION}: "
+            f"rebuild it with `stridefix radiomap build`",
         )
     if version != FORMAT_VERSION:
         raise SiteFileError(
@@ -354,6 +357,7 @@ def new_site(**fields: Any) -> site_t:
     s.has_fix_model, s.fix_floor_cov_m2, s.fix_cov_per_acc2 = False, [0.0, 0.0, 0.0], [1.0, 0.0, 1.0]
     s.fix_bias_sigma_m, s.fix_bias_length_m, s.fix_white_share = 0.0, 10.0, 1.0
     init_v2_fields(s)
+    init_v3_fields(s)
     for name, value in fields.items():
         if not hasattr(s, name):
             raise AttributeError(f"site_t has no field {name!r}")
@@ -373,4 +377,5 @@ def set_counts(site: site_t) -> site_t:
     site.n_entries = len(site.entry_ap)
     set_v2_counts(site)
     fill_port_defaults(site)
+    set_v3_counts(site)
     return site

@@ -1,5 +1,5 @@
 """Site file version 2: every rule of io/site_v2.py rejects its variant with its own words (the C
-reader is held to the same words by test_site.c), version-1 files are refused with the rebuild hint,
+reader is held to the same words by test_site.c), version-1 and -2 files are refused with the rebuild hint,
 and a site without version-2 content round-trips empty."""
 
 from __future__ import annotations
@@ -59,13 +59,14 @@ def test_every_v2_rule_has_a_variant():
     assert sorted(EXPECTED) == sorted(n for n, *_ in _V.v2_variants())
 
 
-def test_version_1_refused_with_rebuild_hint():
+@pytest.mark.parametrize("version", [1, 2])
+def test_old_versions_refused_with_rebuild_hint(version):
     payload = sitefile.encode_site_file(_V.vector_site())[sitefile.HEADER_SIZE :]
     with pytest.raises(SiteFileError) as info:
-        sitefile.decode_site_file(_V.frame(payload, version=1), "old.sfsite")
+        sitefile.decode_site_file(_V.frame(payload, version=version), "old.sfsite")
     assert info.value.kind == "version"
     assert str(info.value) == (
-        "old.sfsite: format version 1, this build reads 2: rebuild it with `stridefix radiomap build`"
+        f"old.sfsite: format version {version}, this build reads 3: rebuild it with `stridefix radiomap build`"
     )
 
 

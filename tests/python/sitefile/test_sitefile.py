@@ -68,7 +68,7 @@ def test_header_layout(tmp_path, vector_site):
     sitefile.write_site(path, vector_site)
     data = path.read_bytes()
     magic, version, length, crc, reserved = struct.unpack_from("<8sIIII", data)
-    assert (magic, version, reserved) == (b"SFSITE\0\x01", 2, 0)
+    assert (magic, version, reserved) == (b"SFSITE\0\x01", 3, 0)
     assert length == len(data) - 24
     assert crc == zlib.crc32(data[24:])
     assert data[24:] == vector_site.encode()
@@ -107,7 +107,7 @@ def test_variant_rejected(tmp_path, name, data, kind, c_text):
     "field,offset,value,kind,text",
     [
         ("magic", 0, b"XFSITE\0\x01", "magic", "bad magic 58 46 53 49 54 45 00 01"),
-        ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 2"),
+        ("version", 8, struct.pack("<I", 7), "version", "format version 7, this reader supports 3"),
         ("length", 12, struct.pack("<I", 5), "length", "length mismatch (trailing bytes): header says 5"),
         ("crc", 16, struct.pack("<I", 0x12345678), "crc", "CRC-32 mismatch: header says 0x12345678"),
         ("reserved", 20, struct.pack("<I", 1), "reserved", "reserved header field is 0x00000001"),
