@@ -2,8 +2,8 @@
  *
  * One input (firmware/board/sf_input.h: candump file, stdin, SocketCAN or a raw-sensor LCM log) gives
  * timed samples; each is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch
- * (feed()): every absolute source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes; the core's
- * steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
+ * (feed()): every absolute source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes, then the
+ * multi-scheme controller's CONTEXT events (drain_contexts); the core's steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
  * optionally, live LCM. Bad input is counted and skipped, never fatal; counts go into HEALTH and the
  * exit summary. The scheme names come from pose_t.SCHEME_* through the core's registry.
  * Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h) and the run closes as at the end of
@@ -29,6 +29,7 @@
 #include "sf_publish.h"
 #include "sf_rx_lcm.h"
 #include "sf_signals.h"
+#include "sf_summary.h"
 #include "sf_site.h"
 #include "sf_particle_mem.h"
 #include "sf_workspace.h"
@@ -117,6 +118,10 @@ static void write_pose(daemon_t *const d)
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
+    sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8), with every scheme only */
+    if (d->params.output_scheme < 0 && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p)) {
+        sf_publish_pose(d->out, d->host_t_us, &p);
+    }
     d->last_pose_t_us = st.t_us;
     d->last_pose_floor = st.floor;
 }
@@ -204,6 +209,25 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     }
 }
 
+/* The controller's events after an input (sf_estimator_next_context): each CONTEXT, a stairs
+ * recalibration's METHOD_PORT audits as FIX, then the POSE. */
+static void drain_contexts(daemon_t *const d)
+{
+    sf_context_event_t ev;
+    sf_fix_t fix;
+    bool has_fix;
+    sf_fix_audit_t audits[sf_scheme_count];
+    int n;
+    while (sf_estimator_next_context(&d->est, &d->params, &ev, &fix, &has_fix, audits, &n)) {
+        sf_publish_context(d->out, d->host_t_us, &ev, &d->site, &d->params);
+        if (n > 0) {
+            publish_fixes(d, sf_fix_port, n, has_fix, audits); /* and the POSE */
+        } else {
+            write_pose(d);
+        }
+    }
+}
+
 /* The one place where samples reach the estimator, whichever input they came from. No default: a
  * kind added to SF_RX_KINDS without a case here stops the build (-Wswitch, -Werror). */
 static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
@@ -228,6 +252,7 @@ static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
     case sf_rx_landmark: on_landmark(d, &ev->u.landmark); break;
     case sf_rx_none: break;
     }
+    drain_contexts(d);
 }
 
 static double monotonic_us(void)
@@ -300,49 +325,6 @@ static int run(daemon_t *const d)
     }
     write_health(d);
     return status;
-}
-
-static void summary(const daemon_t *const d, const sf_lcm_out_counters_t *const oc, const double wall_s)
-{
-    sf_input_counters_t ic;
-    sf_input_counters(d->in, &ic);
-    const sf_rx_counters_t *const c = &ic.rx;
-    sf_estimator_status_t st;
-    sf_estimator_status(&d->est, &st);
-    fprintf(stderr,
-            "stridefixd: %" PRIu64 " frames (%" PRIu64 " ok): %" PRIu64 " bad syntax, %" PRIu64 " unknown id, %" PRIu64
-            " truncated, %" PRIu64 " decode errors, %" PRIu64 " seq gaps, %" PRIu64 " unsynced, %" PRIu64
-            " unpaired IMU halves, %" PRIu64 " incomplete scans\n",
-            ic.frames_total, c->frames_ok, ic.bad_syntax, c->unknown_id, c->bad_length, c->decode_errors,
-            c->seq_gaps, c->unsynced, c->imu_unpaired, c->wifi_incomplete);
-    fprintf(stderr,
-            "stridefixd: faults: %" PRIu64 " duplicates, %" PRIu64 " late, %" PRIu64 " corrupt seq, %" PRIu64
-            " silences, %" PRIu64 " board restarts, %" PRIu64 " BOARD_TIME not believed, %" PRIu64
-            " board time jumps; samples refused: %" PRIu32 " out of range, %" PRIu32 " jumps, %" PRIu32
-            " out of order; %" PRIu32 " walk gaps bridged\n",
-            c->duplicates, c->late, c->seq_rejected, c->silences, c->board_restarts, c->board_time_rejected,
-            c->board_time_jumps, st.samples_out_of_range, st.samples_jumped, st.samples_out_of_order, st.gaps_bridged);
-    fprintf(stderr,
-            "stridefixd: %" PRIu64 " IMU, %" PRIu64 " MAG, %" PRIu64 " BARO, %" PRIu64 " WIFI, %" PRIu64
-            " GNSS; %d steps; log %s: %" PRIu64 " events, %.2f MB, %" PRIu64 " dropped; %.2f s\n",
-            c->imu, c->mag, c->baro, c->wifi, c->gnss, (int)st.step_count, d->opt.no_log ? "(none)" : d->log_path,
-            oc->events, (double)oc->bytes / 1e6, oc->drops, wall_s);
-    const sf_publish_sources_t *const src = &d->sources;
-    fprintf(stderr,
-            "stridefixd: sources: %" PRIu64 " BLE scans (%" PRIu64 " advertisements, %" PRIu64
-            " dropped from full windows), %" PRIu64 " LANDMARK; fixes made of offered: Wi-Fi %" PRIu64
-            " of %" PRIu64 ", GNSS %" PRIu64 " of %" PRIu64 ", BLE %" PRIu64 " of %" PRIu64 ", landmark %" PRIu64
-            " of %" PRIu64 "\n",
-            c->ble, c->ble_adverts, c->ble_dropped, c->landmark, src->made[sf_fix_wifi], src->offered[sf_fix_wifi],
-            src->made[sf_fix_gnss], src->offered[sf_fix_gnss], src->made[sf_fix_ble], src->offered[sf_fix_ble],
-            src->made[sf_fix_landmark], src->offered[sf_fix_landmark]);
-    if (!d->opt.no_log) {
-        fprintf(stderr,
-                "stridefixd: log detail: %" PRIu64 " files, %" PRIu64 " events written (%" PRIu64
-                " of them CONFIG copies heading a rotated file), %" PRIu64 " bytes written; %" PRIu64
-                " events dropped, %" PRIu64 " bytes\n",
-                oc->files, oc->events, oc->header_copies, oc->bytes, oc->drops, oc->drop_bytes);
-    }
 }
 
 /* Opens the log and the live LCM: --log as given, or the first default name in --log-dir that is
@@ -460,7 +442,12 @@ static int serve(daemon_t *const d)
         fprintf(stderr, "stridefixd: stopped by signal %d (%s); the log is closed\n", stop_signal,
                 strsignal(stop_signal));
     }
-    summary(d, &oc, (monotonic_us() - t0) * 1e-6);
+    sf_input_counters_t ic;
+    sf_input_counters(d->in, &ic);
+    sf_estimator_status_t st;
+    sf_estimator_status(&d->est, &st);
+    sf_summary_print(stderr, &ic, &st, &d->sources, &oc, d->opt.no_log ? NULL : d->log_path,
+                     (monotonic_us() - t0) * 1e-6);
     char why[512];
     if (status == 0 && sf_input_nothing_valid(d->in, why, sizeof why)) {
         fprintf(stderr, "stridefixd: %s\n", why);

@@ -2,9 +2,11 @@
 #include "sf_publish.h"
 
 #include <stdio.h>
+#include <string.h>
 
 #include "sf_channels.h"
 #include "stridefix_config_t.h"
+#include "stridefix_context_t.h"
 #include "stridefix_fix_t.h"
 #include "stridefix_health_t.h"
 #include "stridefix_pose_t.h"
@@ -65,6 +67,108 @@ void sf_publish_fix(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_fi
     SF_LCM_WRITE(out, SF_CHANNEL_FIX, log_t_us, stridefix_fix_t, &msg);
 }
 
+/* A context in words: "outdoor", "building 1", "floor 2 of building 0"; "none". */
+static void context_words(char *const buf, const size_t size, const sf_context_map_t *const map, const int ctx)
+{
+    if (ctx < 0 || ctx >= map->n_contexts) {
+        snprintf(buf, size, "none");
+    } else if (map->kind[ctx] == sf_context_outdoor) {
+        snprintf(buf, size, "outdoor");
+    } else if (map->kind[ctx] == sf_context_building) {
+        snprintf(buf, size, "building %d", (int)map->building[ctx]);
+    } else {
+        snprintf(buf, size, "floor %d of building %d", (int)map->floor[ctx], (int)map->building[ctx]);
+    }
+}
+
+static const char *method_words(const int method, const int hits, const char **const members)
+{
+    *members = hits == 1 ? "member" : "members";
+    switch (method) {
+    case sf_fix_wifi: *members = hits == 1 ? "AP" : "APs"; return "Wi-Fi";
+    case sf_fix_ble: *members = hits == 1 ? "beacon" : "beacons"; return "BLE";
+    case sf_fix_gnss: *members = "fix"; return "GNSS";
+    default: return "none";
+    }
+}
+
+static const char *port_words(const int kind)
+{
+    return kind == sf_port_door ? "door" : kind == sf_port_stairs ? "stairs" : kind == sf_port_elevator ? "elevator" : "port";
+}
+
+void sf_publish_context(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_context_event_t *const ev,
+                        const sf_site_t *const site, const sf_params_t *const params)
+{
+    const sf_context_map_t *const map = &site->contexts;
+    char now[64], id[160], text[320];
+    context_words(now, sizeof now, map, ev->context);
+    const char *members;
+    const char *const by = method_words(ev->cls_method, ev->cls_hits, &members);
+    if (ev->cls_method != 0) {
+        snprintf(id, sizeof id, "%s unique (%s, %d %s)", now, by, (int)ev->cls_hits, members);
+    } else {
+        snprintf(id, sizeof id, "%d of %d candidates identified", (int)ev->cls_identified, (int)ev->cls_candidates);
+    }
+    const char *const rule = sf_controller_rule_text(ev->rule);
+    int required = 0;
+    if (ev->rule == sf_ctl_rule_stairs && ev->port >= 0 && ev->port < site->ports.n_ports) {
+        required = map->port_steps[ev->port];
+    } else if (ev->rule == sf_ctl_rule_door) {
+        required = params->controller_door_steps;
+    } else if (ev->rule == sf_ctl_rule_elevator) {
+        required = params->controller_elevator_walk_steps;
+    }
+    switch (ev->rule) {
+    case sf_ctl_rule_near_port:
+        snprintf(text, sizeof text, "%s: %s port %d, %d candidate contexts", rule, port_words(ev->port_kind),
+                 (int)ev->port, (int)ev->cls_candidates);
+        break;
+    case sf_ctl_rule_stairs:
+    case sf_ctl_rule_door:
+        snprintf(text, sizeof text, "%s: %d of %d steps, %s%s%s", rule, (int)ev->steps_in_transition, required, id,
+                 ev->cls_method == 0 ? ": by the outline, " : "", ev->cls_method == 0 ? now : "");
+        break;
+    case sf_ctl_rule_elevator:
+        snprintf(text, sizeof text, "%s: walking again (%d steps), %s", rule, required, id);
+        break;
+    case sf_ctl_rule_left_port:
+        snprintf(text, sizeof text, "%s: %s after %d steps, %s", rule, now, (int)ev->steps_in_transition, id);
+        break;
+    default: snprintf(text, sizeof text, "%s: %s", rule, id); break;
+    }
+    if (ev->recalibrated) {
+        const size_t used = strlen(text);
+        snprintf(text + used, sizeof text - used, ", recalibrated to (%.1f, %.1f)", ev->recal_x_m, ev->recal_y_m);
+    }
+    stridefix_context_t msg = {.t_us = ev->t_us,
+                               .state = ev->state,
+                               .context = ev->context,
+                               .prev_context = ev->prev_context,
+                               .kind = ev->kind,
+                               .building = ev->building,
+                               .floor = ev->floor,
+                               .scheme = ev->scheme,
+                               .method = ev->method,
+                               .port = ev->port,
+                               .port_kind = ev->port_kind,
+                               .rule = ev->rule,
+                               .rule_text = text,
+                               .switched = ev->switched,
+                               .steps_in_transition = ev->steps_in_transition,
+                               .cls_candidates = ev->cls_candidates,
+                               .cls_identified = ev->cls_identified,
+                               .cls_method = ev->cls_method,
+                               .cls_hits = ev->cls_hits,
+                               .recalibrated = ev->recalibrated,
+                               .recal_x_m = ev->recal_x_m,
+                               .recal_y_m = ev->recal_y_m,
+                               .gnss_on = ev->gnss_on,
+                               .wifi_on = ev->wifi_on,
+                               .ble_on = ev->ble_on};
+    SF_LCM_WRITE(out, SF_CHANNEL_CONTEXT, log_t_us, stridefix_context_t, &msg);
+}
+
 void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const int64_t board_t_us,
                        const sf_input_counters_t *const in, const sf_estimator_status_t *const est,
                        const sf_publish_sources_t *const src, const sf_publish_loop_t *const loop)
@@ -118,6 +222,12 @@ void sf_publish_health(sf_lcm_out_t *const out, const int64_t log_t_us, const in
         .fixes_made_landmark = (int64_t)src->made[sf_fix_landmark],
         .steps = est->step_count,
         .mag_rejected = (int64_t)est->mag_rejected,
+        .context_transitions = (int64_t)est->context_transitions,
+        .context_switches = (int64_t)est->context_switches,
+        .context_recalibrations = (int64_t)est->context_recalibrations,
+        .gnss_on_s = (float)est->gnss_on_s,
+        .wifi_on_s = (float)est->wifi_on_s,
+        .ble_on_s = (float)est->ble_on_s,
         .log_events = (int64_t)oc.events,
         .log_bytes = (int64_t)oc.bytes,
         .log_drops = (int64_t)oc.drops,

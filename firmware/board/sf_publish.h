@@ -1,6 +1,6 @@
 /* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (one per scheme), FIX (the audit
  * record), HEALTH (input, estimator, fix-source and log counters) and CONFIG (the effective
- * parameters). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h, from the same kind table the
+ * parameters), CONTEXT (the multi-scheme controller's changes). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h, from the same kind table the
  * replay reads.
  *
  * Each call converts a core struct into its generated stridefix type and queues it on the log with the
@@ -21,9 +21,10 @@
 
 /* Absolute fixes by source, indexed by the fix method (sf_fix_*, = fix_t.METHOD_*): events offered
  * to the estimator and the fixes it made of them (HEALTH.fixes_offered_* / fixes_made_*). */
-#define SF_PUBLISH_METHOD_SLOTS 5
+#define SF_PUBLISH_METHOD_SLOTS 6
 _Static_assert((int)sf_fix_wifi < SF_PUBLISH_METHOD_SLOTS && (int)sf_fix_gnss < SF_PUBLISH_METHOD_SLOTS &&
-                   (int)sf_fix_ble < SF_PUBLISH_METHOD_SLOTS && (int)sf_fix_landmark < SF_PUBLISH_METHOD_SLOTS,
+                   (int)sf_fix_ble < SF_PUBLISH_METHOD_SLOTS && (int)sf_fix_landmark < SF_PUBLISH_METHOD_SLOTS &&
+                   (int)sf_fix_port < SF_PUBLISH_METHOD_SLOTS,
                "one slot per fix method");
 typedef struct {
     uint64_t offered[SF_PUBLISH_METHOD_SLOTS];
@@ -43,6 +44,14 @@ void sf_publish_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose)
 /* FIX: every field of the audit, accuracy_factor and drift included (0 unless the adaptive scheme
  * blended the fix). */
 void sf_publish_fix(sf_lcm_out_t *out, int64_t log_t_us, const sf_fix_audit_t *audit);
+
+/* CONTEXT: every field of the controller's event; rule_text is sf_controller_rule_text and the
+ * evidence in words (steps against the rule's count — the staircase's from the site, door_steps and
+ * elevator_walk_steps from the params —, the CLS's identification and its method, the recalibration),
+ * e.g. "stairs: the staircase's steps and a unique floor: 22 of 20 steps, floor 1 of building 0 unique
+ * (Wi-Fi, 4 APs), recalibrated to (12.0, 3.5)". The text is built on the stack (≤ 320 B). */
+void sf_publish_context(sf_lcm_out_t *out, int64_t log_t_us, const sf_context_event_t *ev, const sf_site_t *site,
+                        const sf_params_t *params);
 
 /* HEALTH at board time board_t_us; the log counters are read from out. */
 void sf_publish_health(sf_lcm_out_t *out, int64_t log_t_us, int64_t board_t_us, const sf_input_counters_t *in,

@@ -36,6 +36,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_cls.h"
 #include "sf_params.h"
 #include "sf_radiomap.h"
 #include "sf_types.h"
@@ -87,5 +88,86 @@ typedef struct {
 
 /* The words of a rule (context_t.rule_text is this plus the evidence): static text. */
 const char *sf_controller_rule_text(int rule);
+
+/* Pending CONTEXT events the controller holds between the caller's drains (one update makes at most
+ * two: an exit and the re-entry at the same port; when full the oldest is dropped and counted). */
+#define SF_CONTROLLER_EVENTS 4
+
+/* The controller's state: caller-owned, no pointer but the attached site (read-only, the caller's).
+ * Decisions in detail (the header comment above is the spec):
+ *   unique identification  exactly one candidate identified within controller.cls_window_s (after an
+ *                          elevator ride: identified since the ride, so the floors passed on the way
+ *                          do not count);
+ *   near a port            the position within radius + controller.port_margin_m of a port whose
+ *                          floors include the controller's floor (the nearest such port);
+ *   walking again          controller.elevator_walk_steps steps credited with activity walking after
+ *                          sf_activity_elevator was seen in the transition (sf_controller_activity);
+ *   stairs recalibration   the endpoint on the new floor: floor_hi's when the new floor is floor_hi,
+ *                          else floor_lo's;
+ *   door                   the unique identification, else context_of(the building whose outline
+ *                          holds the position, the floor), outside every outline the outdoor context;
+ *   floor                  the context's floor (floor and outdoor contexts), the estimator's
+ *                          (sf_ctl_motion_t.floor) in INIT and in a building context.
+ * Cost per update O(n_ports + n_contexts) (plus a neighbourhood, sf_cls.h, when a transition begins);
+ * per reading the CLS's. Memory: sizeof(sf_controller_t) = 1 440 B on x86-64 (at most 1 536 B,
+ * checked): the CLS's evidence (sf_cls_t, 1 048 B) and the event ring (4 × 72 B) are most of it. */
+typedef struct {
+    const sf_site_t *site; /* NULL: not attached */
+    bool active;           /* attached to a context map and controller.enabled */
+    int8_t init_scheme;
+    int8_t state;          /* sf_ctl_* */
+    int16_t context;       /* −1 in INIT */
+    int16_t floor;
+    int16_t port;          /* the transition's port, −1 outside one */
+    bool port_outdoor;     /* the transition's neighbourhood leads outdoors (GNSS on) */
+    bool elevator_seen;
+    int32_t steps_at_start; /* step count when the transition began */
+    int32_t walk_steps;     /* walking steps credited since the elevator was last seen */
+    int32_t step_count;     /* latest seen */
+    int64_t elevator_t_us;  /* the latest elevator activity seen in the transition */
+    bool has_t;
+    int64_t t_us;           /* latest update */
+    sf_cls_t cls;
+    double gnss_on_s, wifi_on_s, ble_on_s; /* time with each radio on under the policy [s] */
+    uint32_t transitions, switches, recalibrations, events_dropped; /* counters, never decrease */
+    int32_t ev_head, ev_n;
+    sf_context_event_t events[SF_CONTROLLER_EVENTS];
+} sf_controller_t;
+_Static_assert(sizeof(sf_controller_t) <= 1536, "sf_controller.h promises at most 1 536 B");
+
+/* Not attached, inactive (every source on, no events), INIT. Cannot fail. */
+void sf_controller_init(sf_controller_t *c, const sf_params_t *p);
+
+/* Checks the site's context map (indices in range, kinds, schemes < sf_scheme_count, methods, at
+ * most SF_CONTROLLER_MAX_CONTEXTS contexts, outlines of ≥ 3 consecutive vertices, port extras) and
+ * attaches it; active when n_contexts > 0 and controller.enabled = 1 (INIT, the CLS searching every
+ * context). SF_OK; SF_EINVAL for a NULL argument; SF_ERANGE (*what, may be NULL: a static text naming
+ * the first violated invariant) for a bad map, the controller then unattached and inactive. */
+int sf_controller_attach(sf_controller_t *c, const sf_params_t *p, const sf_site_t *site, const char **what);
+
+/* The raw readings, for the CLS (recorded only while it searches: INIT and TRANSITION). */
+void sf_controller_wifi(sf_controller_t *c, const sf_params_t *p, const sf_wifi_scan_t *scan);
+void sf_controller_ble(sf_controller_t *c, const sf_params_t *p, const sf_ble_scan_t *scan);
+void sf_controller_gnss(sf_controller_t *c, const sf_params_t *p, int64_t t_us, double accuracy_m);
+
+/* The activity at t_us (every IMU sample may give it; O(1)): an elevator ride in an elevator transition. */
+void sf_controller_activity(sf_controller_t *c, int64_t t_us, int8_t activity);
+
+/* One step of the state machine on the walk's motion; the radio-on times grow by the time since the
+ * previous update under the policy in force (every radio when inactive). Returns whether events were
+ * queued. */
+bool sf_controller_update(sf_controller_t *c, const sf_params_t *p, const sf_ctl_motion_t *m);
+
+/* Pops the oldest pending event into *ev; false when none. */
+bool sf_controller_next_event(sf_controller_t *c, sf_context_event_t *ev);
+
+/* Policy: whether a source (sf_fix_*) is on now (always when inactive; landmarks and port fixes always). */
+bool sf_controller_source_on(const sf_controller_t *c, int method);
+
+/* The scheme the primary pose follows (the context's LSD; controller.init_scheme in INIT), the
+ * controller's floor, whether it runs. */
+int sf_controller_scheme(const sf_controller_t *c);
+int16_t sf_controller_floor(const sf_controller_t *c);
+bool sf_controller_active(const sf_controller_t *c);
 
 #endif

@@ -5,6 +5,7 @@
 
 #include "sf_assert.h"
 #include "sf_error.h"
+#include "sf_estimator_internal.h"
 #include "sf_math.h"
 
 /* Every scheme starts at the config pose (truth-initialised runs, and runs without a site). */
@@ -30,6 +31,7 @@ void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
     e->y_m = p->init_y_m;
     e->heading_rad = p->init_heading_rad;
     sf_fingerprint_init(&e->fingerprint);
+    sf_controller_init(&e->controller, p);
     for (int s = 0; s < sf_scheme_count; s++) {
         (void)sf_fusion_init(&e->fusion[s], (int8_t)s);
     }
@@ -63,6 +65,9 @@ int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p
     }
     if (rc == SF_OK && site->radiomap.n_rp > 0) {
         rc = sf_fingerprint_prepare(ws, &site->radiomap, p);
+    }
+    if (rc == SF_OK) {
+        rc = sf_controller_attach(&e->controller, p, site, NULL);
     }
     if (rc != SF_OK) {
         return rc;
@@ -190,6 +195,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
     sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
     e->heading_rad = walk_heading(e, p);
+    sf_controller_activity(&e->controller, s->t_us, sf_activity_current(&e->activity));
 
     sf_step_event_t ev;
     if (!sf_steps_update(&e->steps, p, s->t_us, a_v, &ev)) {
@@ -211,6 +217,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
         move(e, p, &e->held_events[i], s->t_us, &steps[i]);
     }
     move(e, p, &ev, s->t_us, &steps[credited - 1]);
+    sf_estimator_run_controller(e, p, s->t_us);
     return credited;
 }
 
@@ -260,6 +267,15 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
 bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
                               sf_pose_t *const pose)
 {
+    if (scheme == sf_scheme_controller) {
+        const sf_controller_t *const c = &e->controller;
+        if (!sf_controller_active(c) || !sf_estimator_scheme_pose(e, p, sf_controller_scheme(c), pose)) {
+            return false;
+        }
+        pose->scheme = sf_scheme_controller;
+        pose->floor = sf_controller_floor(c);
+        return true;
+    }
     if (scheme < 0 || scheme >= sf_scheme_count) {
         return false;
     }
@@ -284,5 +300,13 @@ void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *c
                                       .gnss_refused = e->gnss_refused,
                                       .ble_scans = e->ble.scans,
                                       .ble_fixes = e->ble.fixes,
-                                      .landmarks_refused = e->landmarks_refused};
+                                      .landmarks_refused = e->landmarks_refused,
+                                      .controller_active = sf_controller_active(&e->controller),
+                                      .context_transitions = e->controller.transitions,
+                                      .context_switches = e->controller.switches,
+                                      .context_recalibrations = e->controller.recalibrations,
+                                      .context_off = e->context_off,
+                                      .gnss_on_s = e->controller.gnss_on_s,
+                                      .wifi_on_s = e->controller.wifi_on_s,
+                                      .ble_on_s = e->controller.ble_on_s};
 }

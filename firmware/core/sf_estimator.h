@@ -38,8 +38,20 @@
  * compares them all. Each scheme's pose is sf_estimator_scheme_pose; sf_estimator_pose is the PDR
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
+ * The multi-scheme controller (sf_controller.h; issue 14), when the site has a context map: every
+ * Wi-Fi, BLE and GNSS reading first goes to its CLS raw; a source the controller's policy keeps off
+ * then gives sf_scheme_count audits with reason CONTEXT_OFF and no fix (landmarks are never kept off);
+ * after each credited step and each absolute-source input the controller steps on the motion of the
+ * scheme it follows (its pose; without one the PDR track when the schemes started at the config pose)
+ * and the latest activity. Its events come out of sf_estimator_next_context, a stairs recalibration
+ * with its METHOD_PORT fix offered to every scheme like a landmark; a switch to a context on another
+ * floor renumbers the shared floor to the controller's (sf_floor_shift, as the floor vote does). The
+ * controller's primary pose is sf_estimator_scheme_pose(sf_scheme_controller). Without a context map
+ * nothing of this changes an output.
+ *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) ≈ 35.6 kB on x86-64 (i686 not rechecked), at most 36 KiB (checked); the
+ * Memory: sizeof(sf_estimator_t) ≈ 37.5 kB on x86-64 (i686 not rechecked), at most 38 KiB (checked): the
+ * controller is 1 440 B of it (sf_controller.h); the
  * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the eight schemes 4 224 B
  * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
  * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
@@ -54,6 +66,7 @@
 #include "sf_activity.h"
 #include "sf_attitude.h"
 #include "sf_ble.h"
+#include "sf_controller.h"
 #include "sf_fingerprint.h"
 #include "sf_floor.h"
 #include "sf_floor_vote.h"
@@ -112,8 +125,11 @@ typedef struct {
     double calib_pdr_x_m, calib_pdr_y_m;   /* the PDR track at the anchor */
     double calib_distance_m;               /* distance walked at the anchor */
     uint32_t stride_calibrations;
+    /* the multi-scheme controller (issue 14): inactive without a site's context map */
+    sf_controller_t controller;
+    uint32_t context_off; /* source inputs the controller's policy kept off (REASON_CONTEXT_OFF) */
 } sf_estimator_t;
-_Static_assert(sizeof(sf_estimator_t) <= 36 * 1024, "sf_estimator.h promises at most 36 KiB");
+_Static_assert(sizeof(sf_estimator_t) <= 38 * 1024, "sf_estimator.h promises at most 38 KiB");
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);
 
@@ -139,7 +155,8 @@ void sf_estimator_pose(const sf_estimator_t *est, sf_pose_t *pose);
  * workspace sized to its map (sf_fingerprint.h). Call once, right after sf_estimator_init, before any
  * input. Without a site there are no Wi-Fi fixes and every scheme starts at the config pose; with
  * one, schemes start at their first fix unless init_use_config_pose (truth-initialised).
- * SF_OK, or the error of sf_floor_set_heights / sf_fingerprint_prepare (bad site). */
+ * The site's context map attaches the controller (sf_controller_attach).
+ * SF_OK, or the error of sf_floor_set_heights / sf_fingerprint_prepare / sf_controller_attach (bad site). */
 int sf_estimator_attach_site(sf_estimator_t *est, const sf_params_t *p, const sf_site_t *site,
                              sf_fingerprint_workspace_t *ws);
 
@@ -182,7 +199,16 @@ int sf_estimator_ble(sf_estimator_t *est, const sf_params_t *p, const sf_ble_sca
 int sf_estimator_landmark(sf_estimator_t *est, const sf_params_t *p, const sf_landmark_t *landmark,
                           sf_fix_t *fix, bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
 
-/* The pose of one scheme; false while that scheme has no position yet (waiting for its first fix). */
+/* The controller's next pending CONTEXT event (sf_controller.h), false when none. For a stairs
+ * recalibration (ev->recalibrated) the METHOD_PORT fix at the endpoint (floor: the new floor, 1σ
+ * controller.recal_sigma_m) is offered to every scheme like a landmark (it votes on the floor):
+ * *fix, *has_fix and the audits (*n_audits = sf_scheme_count; 0 for any other event). */
+bool sf_estimator_next_context(sf_estimator_t *est, const sf_params_t *p, sf_context_event_t *ev, sf_fix_t *fix,
+                               bool *has_fix, sf_fix_audit_t audits[sf_scheme_count], int *n_audits);
+
+/* The pose of one scheme; false while that scheme has no position yet (waiting for its first fix).
+ * sf_scheme_controller: the pose of the scheme the active controller follows, with scheme =
+ * sf_scheme_controller and the controller's floor; false without an active controller. */
 bool sf_estimator_scheme_pose(const sf_estimator_t *est, const sf_params_t *p, int scheme, sf_pose_t *pose);
 
 /* What the board layer publishes about the estimator (HEALTH, POSE timing) without reading its
@@ -202,6 +228,10 @@ typedef struct {
     uint32_t gnss_offered, gnss_refused; /* GNSS fixes given to the estimator / refused (INACCURATE) */
     uint32_t ble_scans, ble_fixes;       /* BLE windows given (with beacons in the site) / fixes made */
     uint32_t landmarks_refused;          /* landmark events with a non-finite position or accuracy */
+    bool controller_active;              /* a context map is attached and controller.enabled */
+    uint32_t context_transitions, context_switches, context_recalibrations; /* sf_controller_t counters */
+    uint32_t context_off;                /* source inputs kept off by the controller's policy */
+    double gnss_on_s, wifi_on_s, ble_on_s; /* each radio's on-time under the policy [s] */
 } sf_estimator_status_t;
 
 /* Fills *status; cannot fail. */

@@ -1,12 +1,15 @@
 /* sf_estimator_fix.c — the estimator's absolute fixes (see sf_estimator.h): a Wi-Fi scan matched on
  * the radio map (sf_fingerprint), a GNSS fix through the geo-reference (sf_geo), a BLE scan ranged to
  * the site's beacons (sf_ble), a landmark as it is; each fix then votes on the floor and is offered to
- * every scheme (sf_fusion), and a Kalman-accepted Wi-Fi or landmark fix recalibrates the stride. */
+ * every scheme (sf_fusion), and a Kalman-accepted Wi-Fi or landmark fix recalibrates the stride.
+ * Around each: the controller's CLS gets the raw reading first, its policy may keep the source off
+ * (CONTEXT_OFF audits; never a landmark), and the controller steps after it (sf_estimator_context.c). */
 #include <math.h>
 
 #include "sf_ble.h"
 #include "sf_error.h"
 #include "sf_estimator.h"
+#include "sf_estimator_internal.h"
 #include "sf_geo.h"
 
 /* A Kalman-accepted fix: recalibrate K over the walk since the previous one (see sf_estimator.h). */
@@ -47,8 +50,8 @@ static void vote_floor(sf_estimator_t *const e, const sf_params_t *const p, cons
 }
 
 /* Every scheme judges the fix (one audit each); the floor vote first when the fix knows its floor. */
-static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix,
-                     const bool votes, sf_fix_audit_t audits[sf_scheme_count])
+int sf_estimator_offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix,
+                           const bool votes, sf_fix_audit_t audits[sf_scheme_count])
 {
     if (votes) { /* the fix votes before the schemes see it */
         vote_floor(e, p, fix);
@@ -73,8 +76,8 @@ static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const 
 }
 
 /* No fix from this input: each scheme records the refusal, nothing moves. */
-static int refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t method, const int16_t n_used,
-                  const int8_t reason, sf_fix_audit_t audits[sf_scheme_count])
+int sf_estimator_refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t method, const int16_t n_used,
+                        const int8_t reason, sf_fix_audit_t audits[sf_scheme_count])
 {
     const sf_fix_t none = {.t_us = t_us, .method = method, .floor = sf_floor_current(&e->floor), .n_ap_used = n_used};
     for (int s = 0; s < sf_scheme_count; s++) {
@@ -83,7 +86,7 @@ static int refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t meth
     return sf_scheme_count;
 }
 
-int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
+static int wifi_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
                       sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
 {
     *has_fix = false;
@@ -93,18 +96,16 @@ int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const
     const int16_t baro_floor = sf_floor_current(&e->floor);
     const int rc = sf_fingerprint_match(&e->fingerprint, p, &e->site->radiomap, e->ws, scan, baro_floor, true, fix);
     if (rc != SF_OK) {
-        return refuse(e, scan->t_us, sf_fix_wifi, (int16_t)e->fingerprint.audit.n_used, sf_fix_reason_too_few_aps,
+        return sf_estimator_refuse(e, scan->t_us, sf_fix_wifi, (int16_t)e->fingerprint.audit.n_used, sf_fix_reason_too_few_aps,
                       audits);
     }
     *has_fix = true;
-    return offer_fix(e, p, fix, true, audits);
+    return sf_estimator_offer_fix(e, p, fix, true, audits);
 }
 
-int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const sf_gnss_t *const gnss,
+static int gnss_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_gnss_t *const gnss,
                       sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
 {
-    *has_fix = false;
-    e->gnss_offered++;
     if (e->site == NULL || !e->site->geo.valid || p->gnss_use == 0) {
         return 0;
     }
@@ -113,16 +114,16 @@ int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const
     if (!(isfinite(acc_m) && acc_m >= 0.0 && acc_m <= p->gnss_max_accuracy_m) ||
         sf_geo_to_map(&e->site->geo, gnss->lat_deg, gnss->lon_deg, &x_m, &y_m) != SF_OK) {
         e->gnss_refused++;
-        return refuse(e, gnss->t_us, sf_fix_gnss, 0, sf_fix_reason_inaccurate, audits);
+        return sf_estimator_refuse(e, gnss->t_us, sf_fix_gnss, 0, sf_fix_reason_inaccurate, audits);
     }
     /* a GNSS fix knows no floor: it is on the caller's, and does not vote */
     *fix = (sf_fix_t){.t_us = gnss->t_us, .method = sf_fix_gnss, .x_m = x_m, .y_m = y_m,
                       .floor = sf_floor_current(&e->floor), .accuracy_m = fmax(acc_m, p->gnss_min_accuracy_m)};
     *has_fix = true;
-    return offer_fix(e, p, fix, false, audits);
+    return sf_estimator_offer_fix(e, p, fix, false, audits);
 }
 
-int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const sf_ble_scan_t *const scan,
+static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_ble_scan_t *const scan,
                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
 {
     *has_fix = false;
@@ -140,23 +141,74 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     }
     int32_t n_used = 0;
     if (sf_ble_fix(&e->ble, p, &e->site->beacons, scan, sf_floor_current(&e->floor), fix, &n_used) != SF_OK) {
-        return refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
+        return sf_estimator_refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
     }
     *has_fix = true;
-    return offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
+    return sf_estimator_offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
+}
+
+static int landmark_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_landmark_t *const lm,
+                          sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    if (!(isfinite(lm->x_m) && isfinite(lm->y_m) && isfinite(lm->accuracy_m) && lm->accuracy_m >= 0.0)) {
+        e->landmarks_refused++;
+        return sf_estimator_refuse(e, lm->t_us, sf_fix_landmark, 0, sf_fix_reason_inaccurate, audits);
+    }
+    /* a landmark needs no site: its position is in the map frame already */
+    *fix = (sf_fix_t){.t_us = lm->t_us, .method = sf_fix_landmark, .x_m = lm->x_m, .y_m = lm->y_m,
+                      .floor = lm->floor, .accuracy_m = lm->accuracy_m};
+    *has_fix = true;
+    return sf_estimator_offer_fix(e, p, fix, true, audits);
+}
+
+/* ---- the public inputs: CLS first, the controller's gate, the fix, the controller's step ---------- */
+
+int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const sf_wifi_scan_t *const scan,
+                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    sf_controller_wifi(&e->controller, p, scan);
+    int n;
+    if (!sf_estimator_context_off(e, sf_fix_wifi, scan->t_us, audits, &n)) {
+        n = wifi_fix(e, p, scan, fix, has_fix, audits);
+    }
+    sf_estimator_run_controller(e, p, scan->t_us);
+    return n;
+}
+
+int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const sf_gnss_t *const gnss,
+                      sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    e->gnss_offered++;
+    sf_controller_gnss(&e->controller, p, gnss->t_us, gnss->accuracy_m);
+    int n;
+    if (!sf_estimator_context_off(e, sf_fix_gnss, gnss->t_us, audits, &n)) {
+        n = gnss_fix(e, p, gnss, fix, has_fix, audits);
+    }
+    sf_estimator_run_controller(e, p, gnss->t_us);
+    return n;
+}
+
+int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const sf_ble_scan_t *const scan,
+                     sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
+{
+    *has_fix = false;
+    sf_controller_ble(&e->controller, p, scan);
+    int n;
+    if (!sf_estimator_context_off(e, sf_fix_ble, scan->t_us, audits, &n)) {
+        n = ble_fix(e, p, scan, fix, has_fix, audits);
+    }
+    sf_estimator_run_controller(e, p, scan->t_us);
+    return n;
 }
 
 int sf_estimator_landmark(sf_estimator_t *const e, const sf_params_t *const p, const sf_landmark_t *const lm,
                           sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count])
 {
     *has_fix = false;
-    if (!(isfinite(lm->x_m) && isfinite(lm->y_m) && isfinite(lm->accuracy_m) && lm->accuracy_m >= 0.0)) {
-        e->landmarks_refused++;
-        return refuse(e, lm->t_us, sf_fix_landmark, 0, sf_fix_reason_inaccurate, audits);
-    }
-    /* a landmark needs no site: its position is in the map frame already */
-    *fix = (sf_fix_t){.t_us = lm->t_us, .method = sf_fix_landmark, .x_m = lm->x_m, .y_m = lm->y_m,
-                      .floor = lm->floor, .accuracy_m = lm->accuracy_m};
-    *has_fix = true;
-    return offer_fix(e, p, fix, true, audits);
+    const int n = landmark_fix(e, p, lm, fix, has_fix, audits); /* a landmark overrides everything: never off */
+    sf_estimator_run_controller(e, p, lm->t_us);
+    return n;
 }

@@ -119,8 +119,8 @@ int32_t sf_floor_vote_fix(sf_floor_vote_t *const v, const sf_params_t *const p, 
         return 0; /* the fix's floor and the barometer agree on no start in the building */
     }
     const double ref = (double)p->fingerprint_accuracy_ref_aps;
-    /* a landmark's floor is known, not guessed: it alone decides (a full margin) */
-    const double w = fix->method == sf_fix_landmark ? p->floor_vote_margin : fmin(1.0, (double)fix->n_ap_used / ref);
+    /* a landmark's floor (or a port recalibration's) is known, not guessed: it alone decides (a full margin) */
+    const double w = sf_fix_is_known_position(fix->method) ? p->floor_vote_margin : fmin(1.0, (double)fix->n_ap_used / ref);
     v->score[s - v->lowest_floor] += w;
     v->votes++;
     if (v->pinned) {

@@ -138,7 +138,7 @@ static int8_t judge(const sf_fusion_t *const f, const sf_params_t *const p, cons
     }
     /* a landmark is not a measurement to doubt: the walker is there (a tag is read within centimetres,
      * on its floor), however far the dead reckoning has drifted */
-    if (fix->method == sf_fix_landmark) {
+    if (sf_fix_is_known_position(fix->method)) {
         return sf_fix_reason_accepted;
     }
     /* The floor: between floors no fix is of the map's floors; on a floor, the fix's floor is one vote
@@ -160,7 +160,7 @@ static bool fix_usable(const sf_fix_t *const fix)
 {
     const bool method_ok =
         fix->method == sf_fix_wifi || fix->method == sf_fix_gnss || fix->method == sf_fix_landmark ||
-        fix->method == sf_fix_ble;
+        fix->method == sf_fix_ble || fix->method == sf_fix_port;
     return method_ok && isfinite(fix->x_m) && isfinite(fix->y_m) && isfinite(fix->accuracy_m) &&
            fix->accuracy_m >= 0.0;
 }

@@ -75,7 +75,9 @@
  * (SCHEME_IGNORES): their rows stay the Wi-Fi-only comparisons they were. A landmark (the paper's NFC tag)
  * is where the walker is: every scheme that fuses accepts it whatever the gate says (and between
  * floors), the fixed-gain blends with α = 1, adaptive by its law (fusion_acc_landmark, default 1),
- * kalman and ekf by their gain with its tiny R.
+ * kalman and ekf by their gain with its tiny R. The multi-scheme controller's staircase-endpoint
+ * recalibration (METHOD_PORT, sf_controller.h) is a known position too and is taken the same way
+ * (sf_fix_is_known_position, sf_types.h).
  *
  * Control (when to fuse), for the blending schemes overwrite/static/adaptive/kalman, in this order:
  *   start        uninitialised: the first fix initialises (α = 1, var = R; reason INITIALISED), or

@@ -39,6 +39,7 @@ double sf_fusion_accuracy_factor(const sf_params_t *const p, const sf_fix_t *con
         return interp4(xs, vs, fix->accuracy_m);
     }
     case sf_fix_landmark:
+    case sf_fix_port: /* a staircase endpoint is a known position, like a landmark */
         return p->fusion_acc_landmark;
     default:
         return 0.0;

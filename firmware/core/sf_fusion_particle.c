@@ -130,7 +130,7 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
             audit->reason = sf_fix_reason_accepted;
             f->accepted++;
         }
-    } else if (fix->method == sf_fix_landmark) {
+    } else if (sf_fix_is_known_position(fix->method)) {
         reseed(f, p, fix, s.floor, audit); /* a known position: the whole cloud goes there */
     } else if (f->rejections >= p->fusion_max_rejections) {
         /* the fixes keep landing where no particle is: a new hypothesis beside the old one */

@@ -22,12 +22,12 @@ static double alpha_one(const sf_fusion_t *const f, const sf_params_t *const p, 
     return 1.0;
 }
 
-/* A landmark is where the walker is: α = 1 (the paper's NFC), whatever the fixed gain. */
+/* A landmark (or a port recalibration) is where the walker is: α = 1 (the paper's NFC), whatever the fixed gain. */
 static double alpha_static(const sf_fusion_t *const f, const sf_params_t *const p, const sf_fix_t *const fix,
                            const double r_m2, sf_fix_audit_t *const audit)
 {
     (void)f, (void)r_m2, (void)audit;
-    return fix->method == sf_fix_landmark ? 1.0 : p->fusion_static_alpha;
+    return sf_fix_is_known_position(fix->method) ? 1.0 : p->fusion_static_alpha;
 }
 
 /* Records the adaptive terms in the audit (FIX.accuracy_factor, FIX.drift). */

@@ -12,6 +12,7 @@
 #include <stdint.h>
 
 #include "sf_schemes.h"
+#include "sf_types.h"
 
 /* Rows are grouped by concern, one macro per core module, so each module's parameters sit together.
  *        section   name                 type     default  min      max      unit     meaning */
@@ -266,9 +267,24 @@
     X(particle, floor_mismatch_weight, double, 0.7,  0.0,     1.0,     "",      "weight factor per step of a particle not on the barometric floor (a flight of ~10 steps: x0.03; a 1-2 step barometer glitch: x0.5)") \
     X(particle, grid_cell_m,       double,  2.0,     0.1,     100.0,   "m",     "wall-index cell side (a room's scale: a 0.7 m step touches 1-3 cells)")
 
+/* sf_controller.h: the multi-scheme controller (Jäger, Süß, Becker §III-C). The door's 5 steps are
+ * the paper's; the rest are the gaps the paper leaves (port radius, identification window), set from
+ * the walk's physics: a step is ~0.7 m, a scan comes every 1-2 s. */
+#define SF_PARAMS_CONTROLLER(X)                                                                        \
+    X(controller, enabled,         int32_t, 1,       0,       1,       "",      "1 = the multi-scheme controller runs when the site has a context map (site file v3); 0 = every scheme side by side, every source on") \
+    X(controller, init_scheme,     int32_t, sf_scheme_ekf, 0, SF_SCHEME_COUNT - 1, "", "fusion scheme (pose_t.SCHEME_*) the primary pose follows before the CLS identifies a context (INIT)") \
+    X(controller, door_steps,      int32_t, 5,       1,       100,     "steps", "steps since a door transition began after which it ends (the paper's 5)") \
+    X(controller, elevator_walk_steps, int32_t, 2,   1,       100,     "steps", "walking steps after an elevator ride that say the user walks again (one gait cycle)") \
+    X(controller, port_margin_m,   double,  1.0,     0.0,     50.0,    "m",     "a position within a port's radius plus this is near the port (the fused position errs by about a metre there)") \
+    X(controller, port_leave_m,    double,  2.0,     0.0,     100.0,   "m",     "beyond radius + margin + this from the port the walker has left it (LEFT_PORT: the old context stays); about three steps") \
+    X(controller, cls_window_s,    double,  3.0,     0.1,     600.0,   "s",     "a CLS identification stays valid this long (two Wi-Fi scans or a few BLE windows)") \
+    X(controller, cls_gnss_accuracy_m, double, 10.0, 0.0,     1e4,     "m",     "a GNSS fix at or better than this accuracy identifies the outdoor context (open sky 2-5 m on a consumer receiver; the simulator's indoor-degraded GNSS reports >= 12 m)") \
+    X(controller, recal_sigma_m,   double,  1.0,     0.01,    100.0,   "m",     "1 sigma of the staircase-endpoint recalibration fix (a flight's landing is about a metre across)")
+
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \
-    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_PARTICLE(X) SF_PARAMS_OUTPUT(X)
+    SF_PARAMS_ACTIVITY(X) SF_PARAMS_FINGERPRINT(X) SF_PARAMS_BOARD_INPUT(X) SF_PARAMS_SOURCES(X) SF_PARAMS_FUSION(X) SF_PARAMS_EKF(X) SF_PARAMS_PARTICLE(X) SF_PARAMS_OUTPUT(X) \
+    SF_PARAMS_CONTROLLER(X)
 
 typedef struct {
 #define SF_PARAM_FIELD(sec, name, type, def, lo, hi, unit, text) type sec##_##name;

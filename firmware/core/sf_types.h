@@ -79,6 +79,14 @@ typedef struct {
 /* Fix methods (the fix's source), identical to fix_t.METHOD_*. */
 enum { sf_fix_wifi = 1, sf_fix_gnss = 2, sf_fix_landmark = 3, sf_fix_ble = 4, sf_fix_port = 5 };
 
+/* Whether a fix method is a known position rather than a measurement to doubt: a landmark (the
+ * paper's NFC tag) and the controller's staircase-endpoint recalibration (sf_controller.h), which
+ * every fusing scheme takes like a landmark (sf_fusion.h, Sources). */
+static inline bool sf_fix_is_known_position(const int method)
+{
+    return method == sf_fix_landmark || method == sf_fix_port;
+}
+
 /* An absolute position fix offered to the fusion. */
 typedef struct {
     int64_t t_us;

@@ -16,6 +16,17 @@ scenario's BLE model (``ble.path_loss_exponent``, ``ble.shadowing_db``) and the 
 power; each beacon keeps its own. A world without a geo-reference gets the default one of
 ``world_sources.GeoRef`` (rotation = its map rotation). Written by every ``stridefix sim`` run into
 ``DIR/building.toml``.
+
+A world with building outlines (world_parts.py, e.g. ``campus2``) adds the context map of
+docs/building.md (constructed as the analyzer's ``BuildingOutline`` and ``PortExtra``): one
+``[[building]]`` per outline (its rectangle's corners counter-clockwise, its floors); each wall on the
+floors of the building that holds it; and each port's extras — its name (``<building>-stairs``,
+``<building>-elevator``, the door's name), its building, ``outdoor = true`` for a door to the outside,
+a staircase's steps end to end (its risers) and its two ends (where the first flight starts on the
+lower floor and the last one ends on the upper floor), and its links: the ports reachable from it
+without passing another (every port of its building on a floor they share, and outdoors every door to
+the outside). No ``[[context]]``: the build's derivation fits the world (BLE on B's floor, Wi-Fi on
+A's, GNSS outdoors).
 """
 
 from __future__ import annotations
@@ -23,8 +34,11 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from stridefix_analyzer.radiomap.building import BuildingOutline, PortExtra, port_extra_lines
+
 from .scenario_sources import SOURCE_DEFAULTS
 from .world import World
+from .world_parts import building_of
 from .world_sources import GeoRef
 
 FORMAT = "stridefix-building 1"
@@ -33,6 +47,44 @@ DOOR_MARGIN_M = 0.5  # a door's port reaches this far beyond the door's half wid
 
 def _num(v: float) -> str:
     return repr(round(float(v), 6))
+
+
+def port_rows(world: World) -> list[tuple[str, float, float, float, list[int], PortExtra]]:
+    """The world's ports (kind, x, y, radius, floors) with their context-map extras (see above)."""
+    rows = []
+    for kind, x, y, r, floors in _ports(world):
+        o = building_of(world.outlines, x, y)
+        b = o.name if o is not None else None
+        extra = PortExtra(building=b)
+        if kind == "stairs":
+            st = world.stairs
+            extra.name, extra.steps = f"{b}-stairs", 2 * st.risers_per_flight
+            extra.end_lo, extra.end_hi = st.flight1_start, st.flight2_end
+        elif kind == "elevator":
+            extra.name = f"{b}-elevator"
+        rows.append((kind, x, y, r, floors, extra))
+    for row, d in zip(rows[len(rows) - len(world.doors) :], world.doors):  # (_ports: doors last)
+        row[5].name, row[5].outdoor = d.name, True
+    for *_, floors, extra in rows:
+        extra.links = [
+            e.name
+            for *_, fl, e in rows
+            if e is not extra
+            and ((e.building == extra.building and set(fl) & set(floors)) or (extra.outdoor and e.outdoor))
+        ]
+    return rows
+
+
+def outlines(world: World) -> list[BuildingOutline]:
+    return [BuildingOutline(o.name, o.corners(), list(o.floors)) for o in world.outlines]
+
+
+def _wall_floors(world: World, wall) -> list[int]:
+    """A wall's floors: its building's (both ends inside the outline), else every floor."""
+    for o in world.outlines:
+        if bool(o.holds(wall[0], wall[1])) and bool(o.holds(wall[2], wall[3])):
+            return list(o.floors)
+    return list(range(world.n_floors))
 
 
 def _ports(world: World) -> list[tuple[str, float, float, float, list[int]]]:
@@ -72,8 +124,12 @@ def building_text(world: World, ble: dict | None = None) -> str:
         f"path_loss_exponent = {_num(b['path_loss_exponent'])}",
         f"range_sigma_db = {_num(b['shadowing_db'])}",
     ]
+    walls = world.walls_m.tolist()
+    wall_floors = [_wall_floors(world, w) for w in walls]
     for floor in range(world.n_floors):
-        for x0, y0, x1, y1 in world.walls_m.tolist():
+        for (x0, y0, x1, y1), fl in zip(walls, wall_floors):
+            if floor not in fl:
+                continue
             lines += [
                 "",
                 "[[wall]]",
@@ -81,7 +137,11 @@ def building_text(world: World, ble: dict | None = None) -> str:
                 f"points = [[{_num(x0)}, {_num(y0)}], [{_num(x1)}, {_num(y1)}]]",
                 "closed = false",
             ]
-    for kind, x, y, r, floors in _ports(world):
+    for bo in outlines(world):
+        pts = ", ".join(f"[{_num(x)}, {_num(y)}]" for x, y in bo.outline)
+        lines += ["", "[[building]]", f'name = "{bo.name}"', f"outline = [{pts}]"]
+        lines.append(f"floors = [{', '.join(str(f) for f in bo.floors)}]")
+    for kind, x, y, r, floors, extra in port_rows(world):
         lines += [
             "",
             "[[port]]",
@@ -91,6 +151,8 @@ def building_text(world: World, ble: dict | None = None) -> str:
             f"radius_m = {_num(r)}",
             f"floors = [{', '.join(str(f) for f in floors)}]",
         ]
+        if world.outlines:
+            lines += port_extra_lines(extra, (x, y))
     for bc in world.beacons:
         lines += [
             "",

@@ -11,7 +11,8 @@ Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (
 heading = walking direction in the map frame, steps so far; source SIMULATION), ``sim_summary.json``
 ``init_truth.ini`` (the true start pose for the firmware), ``building.toml`` (the world's building
 description, building.py) and, for a world with beacons, GNSS or landmarks, ``sources.json`` (what
-they sent: ``Sources.as_dict``). On a route with reference points (the
+they sent: ``Sources.as_dict``); a world with building outlines adds to the summary its contexts and
+the walk's transitions with their truth times (transitions.py). On a route with reference points (the
 ``track``), one extra TRUTH with source WAYPOINT at the moment the walker passes each reference point
 (time interpolated to the µs between walker samples; x, y = the surveyed point), in time order
 with the 10 Hz messages (a SIMULATION message first when both fall on the same µs).
@@ -36,6 +37,7 @@ from .landmarks import LandmarkEvent, simulate_landmarks
 from .radio import Scan, simulate_scans
 from .scenario import Scenario
 from .sensors import IMU_RATE_HZ, SensorData, simulate_sensors
+from .transitions import contexts, transitions
 from .walker import ACTIVITIES, Walk, simulate_walk
 from .world import World
 from .worlds import load_world
@@ -241,6 +243,9 @@ class SimResult:
                 "gnss_fixes": len(self.sources.gnss),
                 "landmark_events": len(self.sources.landmarks),
             }
+        if self.world.outlines:  # several buildings: the truth of contexts and transitions (transitions.py)
+            extra["contexts"] = contexts(self.world)
+            extra["transitions"] = transitions(self.world, self.walk, self.board_time_start_ms * 1000)
         if "faults" in c:  # the ground truth of what the faults damaged (faults.FaultRecord)
             extra["faults"] = c["faults"]
         else:  # faults off: the summary of a clean run stays as it was before faults existed

@@ -48,13 +48,13 @@ from .world_parts import LegSpec, Outline, SurveyPart
 from .world_sources import Beacon, Door, GeoRef
 
 A_RECT = (0.0, 0.0, 32.0, 24.0)
-B_RECT = (90.0, 4.0, 114.0, 20.0)
+B_RECT = (90.0, 4.5, 114.0, 20.5)
 A_FLOORS = (0, 1, 2)
 LOOP_X_M, LOOP_Y_M = (8.0, 26.0), (4.0, 20.0)  # A's corridor centre line
-B_CORRIDOR_Y_M = (11.0, 13.0)
+B_CORRIDOR_Y_M = (11.5, 13.5)
 DOORS = (
     Door("A-door", 32.0, 12.0, 1.6, floor=0, landmark_id=1),
-    Door("B-door", 90.0, 12.0, 1.6, floor=0, landmark_id=2),
+    Door("B-door", 90.0, 12.5, 1.6, floor=0, landmark_id=2),
 )
 STAIRS = Stairs(
     door_y_m=12.0,
@@ -67,7 +67,7 @@ STAIRS = Stairs(
 ELEVATOR = Elevator(x_m=4.25, door_y_m=17.5)
 ELEVATOR_WAIT_XY_M = (6.3, 17.5)  # in front of the elevator room, outside the cab's port
 # the outdoor path from A's door to B's door
-PATH_M = ((32.0, 12.0), (38.0, 12.0), (46.0, 4.0), (76.0, 4.0), (84.0, 12.0), (90.0, 12.0))
+PATH_M = ((32.0, 12.0), (38.0, 12.0), (46.0, 4.0), (76.0, 4.0), (84.0, 12.5), (90.0, 12.5))
 WAIT_FLOOR1_S, WAIT_FLOOR2_S = 10.0, 14.0  # waiting at the elevator door for the cab
 
 
@@ -79,14 +79,14 @@ def _walls() -> np.ndarray:
     w += _rect(x0 - 1.0, y0 - 1.0, x1 + 1.0, y1 + 1.0, outer)  # corridor, outer edge
     inner = [(side, x, 1.0) for side in ("bottom", "top") for x in (13.0, 21.0)]
     w += _rect(x0 + 1.0, y0 + 1.0, x1 - 1.0, y1 - 1.0, inner)  # corridor, inner edge
-    w += [(9.0, 12.0, 25.0, 12.0), (17.0, 5.0, 17.0, 19.0)]  # inner block: spine, partition
-    w += [(0.0, 7.0, 7.0, 7.0), (0.0, 14.0, 7.0, 14.0), (0.0, 21.0, 7.0, 21.0)]  # west rooms
+    w += [(9.0, 11.5, 25.0, 11.5), (17.0, 5.0, 17.0, 19.0)]  # inner block: spine, partition
+    w += [(0.0, 7.0, 7.0, 7.0), (0.0, 14.5, 7.0, 14.5), (0.0, 21.0, 7.0, 21.0)]  # west rooms
     w += [(16.0, 0.0, 16.0, 3.0), (16.0, 21.0, 16.0, 24.0)]  # south and north strips
     w += [(27.0, 9.0, 32.0, 9.0), (27.0, 15.0, 32.0, 15.0)]  # the lobby's sides
     w.append((3.5, 8.2, 3.5, 11.5))  # stairwell: between the flights
     w += _rect(3.0, 16.25, 5.5, 18.75, [("right", 17.5, 1.0)])  # elevator shaft, door east
     bx0, by0, bx1, by1 = B_RECT
-    w += _rect(*B_RECT, [("left", 12.0, 1.6)])  # B's exterior, its door
+    w += _rect(*B_RECT, [("left", 12.5, 1.6)])  # B's exterior, its door
     ys, yn = B_CORRIDOR_Y_M
     rooms = [(x, 1.0) for x in (94.0, 102.0, 110.0)]
     w += _line_x(bx0, bx1, yn, rooms) + _line_x(bx0, bx1, ys, rooms)
@@ -111,16 +111,16 @@ def _aps() -> tuple[AccessPoint, ...]:
 
 def _beacons() -> tuple[Beacon, ...]:
     spec = [
-        (92.0, 19.8, -59.0),
-        (102.0, 19.8, -61.0),
-        (112.0, 19.8, -58.0),
-        (113.8, 16.0, -60.0),
-        (113.8, 8.0, -62.0),
-        (112.0, 4.2, -57.0),
-        (102.0, 4.2, -59.0),
-        (92.0, 4.2, -56.0),
-        (98.0, 12.9, -60.0),
-        (106.0, 11.1, -58.0),
+        (92.0, 20.3, -59.0),
+        (102.0, 20.3, -61.0),
+        (112.0, 20.3, -58.0),
+        (113.8, 16.5, -60.0),
+        (113.8, 8.5, -62.0),
+        (112.0, 4.7, -57.0),
+        (102.0, 4.7, -59.0),
+        (92.0, 4.7, -56.0),
+        (98.0, 13.4, -60.0),
+        (106.0, 11.6, -58.0),
     ]
     return tuple(
         Beacon(mac=0x02_00_00_00_01_00 + i + 1, x_m=x, y_m=y, rssi_1m_dbm=p)
@@ -134,8 +134,8 @@ def _survey_points() -> np.ndarray:
     loop = [(x, y) for y in (y0, y1) for x in xs] + [(x, y) for x in (x0, x1) for y in ys]
     lobby = [(x, y) for x in (28.0, 30.0) for y in (10.0, 12.0, 14.0)]
     a = [(x, y, float(f)) for f in A_FLOORS for x, y in loop + lobby]
-    b = [(x, 12.0, 0.0) for x in np.arange(92.0, 112.0 + 1e-9, 2.0)]
-    b += [(x, y, 0.0) for x in (108.0, 110.0, 112.0) for y in (14.0, 16.0, 18.0)]
+    b = [(x, 12.5, 0.0) for x in np.arange(92.0, 112.0 + 1e-9, 2.0)]
+    b += [(x, y, 0.0) for x in (108.0, 110.0, 112.0) for y in (14.5, 16.5, 18.5)]
     return np.asarray(a + b, float)
 
 
@@ -161,7 +161,7 @@ def _legs() -> tuple[LegSpec, ...]:
     rise = st.flight_rise_m
     leg2 = [cab, (x0, el.door_y_m)] + lap_to_cab
     leg3 = [cab, (x0, el.door_y_m), (x0, y1), (x1, y1), (x1, 12.0)] + list(PATH_M)
-    leg3 += [(110.0, 12.0), (110.0, 16.0)]
+    leg3 += [(110.0, 12.5), (110.0, 16.5)]
     return (
         LegSpec(
             tuple(leg1),
@@ -185,7 +185,7 @@ def campus2_world(map_rotation_deg: float = 20.0) -> World:
         walls_m=_walls(),
         aps=_aps(),
         loop_corners_m=np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]),
-        start_xy_m=(112.0, 18.0),  # the survey starts in B's north-east room
+        start_xy_m=(112.0, 18.5),  # the survey starts in B's north-east room
         map_rotation_deg=map_rotation_deg,
         n_floors=len(A_FLOORS),
         stairs=STAIRS,

@@ -600,7 +600,7 @@ static void test_bad_data(void **state)
     sf_fix_audit_t a;
     const sf_fix_t bad[] = {
         wifi(11.0, NAN, 0.0, 2.0, 5),     wifi(11.0, 0.0, INFINITY, 2.0, 5), wifi(11.0, 0.0, 0.0, -1.0, 5),
-        wifi(11.0, 0.0, 0.0, NAN, 5),     fix_at(11.0, 0, 0.0, 0.0, 0, 1.0, 0), fix_at(11.0, 5, 1.0, 1.0, 0, 1.0, 0),
+        wifi(11.0, 0.0, 0.0, NAN, 5),     fix_at(11.0, 0, 0.0, 0.0, 0, 1.0, 0), fix_at(11.0, 6, 1.0, 1.0, 0, 1.0, 0), /* 6: no method (5 is METHOD_PORT) */
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         assert_int_equal(sf_fusion_fix(&f, &p, &bad[i], 0, &a), SF_ERANGE);

@@ -299,7 +299,12 @@ def v3_variants() -> list[tuple[str, bytes, str, str | None]]:
         ("port_end_nan", _edited(port_hi_y_m=[0.0, nan]), "field", None),
         ("link_range", _edited(link_b=[2]), "field", None),
         ("link_self", _edited(link_b=[0]), "field", None),
-        ("context_kind", _edited(context_kind=[site_t.CONTEXT_OUTDOOR, 4, site_t.CONTEXT_FLOOR]), "field", None),
+        (
+            "context_kind",
+            _edited(context_kind=[site_t.CONTEXT_OUTDOOR, 4, site_t.CONTEXT_FLOOR]),
+            "field",
+            None,
+        ),
         ("context_outdoor_building", _edited(context_building=[0, 0, 1]), "field", None),
         ("context_building_range", _edited(context_building=[-1, 0, 2]), "field", None),
         ("context_floor", _edited(context_floor=[0, 2, 1]), "field", None),
@@ -309,7 +314,10 @@ def v3_variants() -> list[tuple[str, bytes, str, str | None]]:
         ("context_min_hits", _edited(context_cdd_min_hits=[1, 0, 1]), "field", None),
         (
             "context_two_outdoor",
-            _edited(context_kind=[site_t.CONTEXT_OUTDOOR, site_t.CONTEXT_OUTDOOR, kinds[2]], context_building=[-1, -1, 1]),
+            _edited(
+                context_kind=[site_t.CONTEXT_OUTDOOR, site_t.CONTEXT_OUTDOOR, kinds[2]],
+                context_building=[-1, -1, 1],
+            ),
             "field",
             None,
         ),

@@ -58,7 +58,11 @@ V3_ARRAYS = {
     "n_cdd": ("cdd_context", "cdd_id", "cdd_min_dbm"),
 }
 #: Context kinds (``site_t.CONTEXT_*``) and their names in building descriptions and summaries.
-CONTEXT_KINDS = {site_t.CONTEXT_OUTDOOR: "outdoor", site_t.CONTEXT_BUILDING: "building", site_t.CONTEXT_FLOOR: "floor"}
+CONTEXT_KINDS = {
+    site_t.CONTEXT_OUTDOOR: "outdoor",
+    site_t.CONTEXT_BUILDING: "building",
+    site_t.CONTEXT_FLOOR: "floor",
+}
 #: The absolute methods a context's scheme fuses and its CLS recognises it by (``fix_t.METHOD_*``).
 CONTEXT_METHODS = {fix_t.METHOD_WIFI: "wifi", fix_t.METHOD_GNSS: "gnss", fix_t.METHOD_BLE: "ble"}
 _METHOD_TEXT = "wifi (1), gnss (2) or ble (4)"
@@ -104,7 +108,9 @@ def _validate_port_extras(site: site_t, n_buildings: int) -> None:
         if steps < 0:
             raise _bad(f"port {i}: port_steps {steps} is negative")
         if steps == 0 and site.port_kind[i] == site_t.PORT_STAIRS and site.n_contexts > 0:
-            raise _bad(f"port {i}: stairs with port_steps 0 (a staircase needs its step count when the site has contexts)")
+            raise _bad(
+                f"port {i}: stairs with port_steps 0 (a staircase needs its step count when the site has contexts)"
+            )
         lx, ly, hx, hy = site.port_lo_x_m[i], site.port_lo_y_m[i], site.port_hi_x_m[i], site.port_hi_y_m[i]
         if not finite(lx, ly, hx, hy):
             raise _bad(f"port {i}: endpoints ({lx:g}, {ly:g}) - ({hx:g}, {hy:g}) not finite")
@@ -136,7 +142,9 @@ def _validate_context_rows(site: site_t, n_buildings: int, lowest: int, top: int
         if not lowest <= f <= top:
             raise _bad(f"context {i}: floor {f} outside {lowest}..{top}")
         if not 0 <= scheme < pose_t.SCHEME_CONTROLLER:
-            raise _bad(f"context {i}: scheme {scheme} is not a fusion scheme (0..{pose_t.SCHEME_CONTROLLER - 1})")
+            raise _bad(
+                f"context {i}: scheme {scheme} is not a fusion scheme (0..{pose_t.SCHEME_CONTROLLER - 1})"
+            )
         if method not in CONTEXT_METHODS:
             raise _bad(f"context {i}: method {method} is not {_METHOD_TEXT}")
         if cdd_method not in CONTEXT_METHODS:
@@ -159,7 +167,9 @@ def _validate_cdd(site: site_t) -> None:
         if not 0 <= c < site.n_contexts:
             raise _bad(f"cdd {i}: context {c} outside 0..{site.n_contexts - 1}")
         if i > 0 and c < site.cdd_context[i - 1]:
-            raise _bad(f"cdd {i}: context {c} below cdd {i - 1}'s {site.cdd_context[i - 1]} (must be non-decreasing)")
+            raise _bad(
+                f"cdd {i}: context {c} below cdd {i - 1}'s {site.cdd_context[i - 1]} (must be non-decreasing)"
+            )
         if not 0 <= ident < ID_LIMIT:
             raise _bad(f"cdd {i}: id {ident} outside 0..2^48-1")
         if not finite(dbm):

@@ -1,6 +1,7 @@
 """The building description ``building.toml`` (docs/building.md): geo-reference, BLE model, walls,
 ports and beacons of a user's own building, merged into a site file by ``stridefix radiomap build
---building FILE``.
+--building FILE``; since issue 14 also the context map's tables ([[building]], the [[port]] extras,
+[[context]]: :mod:`.building_contexts`, built into the site by :mod:`.contexts`).
 
 :func:`read_building` parses and checks it (tomllib); every error names the file, the entry
 (``[[wall]] 3``) and the field. :func:`merge_building` writes it into a ``site_t`` (walls per segment,
@@ -22,6 +23,27 @@ import tomllib
 
 from stridefix_analyzer.datasets.gsd_convert import project
 from stridefix_analyzer.datasets.rawwalk import bssid_to_int
+from stridefix_analyzer.radiomap.building_contexts import (
+    PORT_EXTRA_KEYS,
+    BuildingOutline,
+    ContextSpec,
+    PortExtra,
+    context_tables_toml,
+    parse_context_tables,
+    parse_port_extra,
+    port_extra_lines,
+)
+
+__all__ = [
+    "Building",
+    "BuildingError",
+    "BuildingOutline",
+    "ContextSpec",
+    "PortExtra",
+    "building_toml",
+    "merge_building",
+    "read_building",
+]
 
 FORMAT = "stridefix-building 1"
 PORT_KIND_CODES = {"door": 1, "stairs": 2, "elevator": 3}
@@ -40,13 +62,18 @@ class Building:
     walls: list[tuple[float, float, float, float, int]] = dataclasses.field(default_factory=list)
     ports: list[tuple[int, float, float, float, int, int]] = dataclasses.field(default_factory=list)
     beacons: list[tuple[int, float, float, int, float]] = dataclasses.field(default_factory=list)
+    buildings: list[BuildingOutline] = dataclasses.field(default_factory=list)
+    port_extras: list[PortExtra] = dataclasses.field(default_factory=list)  # [] or one per ports row
+    contexts: list[ContextSpec] = dataclasses.field(default_factory=list)
 
     def floors(self) -> set[int]:
-        """Every floor a wall, port or beacon names."""
+        """Every floor a wall, port, beacon, building or context names."""
         out = {w[4] for w in self.walls} | {b[3] for b in self.beacons}
         for p in self.ports:
             out |= set(range(p[4], p[5] + 1))
-        return out
+        for b in self.buildings:
+            out |= set(b.floors)
+        return out | {c.floor for c in self.contexts if c.floor is not None}
 
 
 def _num(path: str, entry: str, table: dict[str, Any], key: str, default: float | None = None) -> float:
@@ -135,11 +162,16 @@ def _walls(path: str, doc: dict[str, Any]) -> list[tuple[float, float, float, fl
     return out
 
 
-def _ports(path: str, doc: dict[str, Any]) -> list[tuple[int, float, float, float, int, int]]:
+def _ports(
+    path: str, doc: dict[str, Any]
+) -> tuple[list[tuple[int, float, float, float, int, int]], list[PortExtra | None], list[str]]:
+    """The ports' rows, their extras (None: none given) and their kinds' names."""
     out = []
+    extras: list[PortExtra | None] = []
+    kinds: list[str] = []
     for i, p in enumerate(doc.get("port", [])):
         entry = f"[[port]] {i + 1}"
-        _unknown(path, entry, p, {"kind", "x_m", "y_m", "radius_m", "floors"})
+        _unknown(path, entry, p, {"kind", "x_m", "y_m", "radius_m", "floors"} | PORT_EXTRA_KEYS)
         kind = p.get("kind")
         if kind not in PORT_KIND_CODES:
             raise BuildingError(f"{path}: {entry}: kind: {kind!r} is not one of door, stairs, elevator")
@@ -160,7 +192,9 @@ def _ports(path: str, doc: dict[str, Any]) -> list[tuple[int, float, float, floa
                 f"{path}: {entry}: floors: {kind} must join at least two floors, got {floors}"
             )
         out.append((PORT_KIND_CODES[kind], x, y, r, min(floors), max(floors)))
-    return out
+        extras.append(parse_port_extra(path, entry, p, kind, BuildingError))
+        kinds.append(kind)
+    return out, extras, kinds
 
 
 def _beacons(
@@ -214,14 +248,28 @@ def read_building(path: str | os.PathLike[str]) -> Building:
         raise BuildingError(f"{path}: not TOML: {exc}") from None
     if doc.get("format") != FORMAT:
         raise BuildingError(f"{path}: format: {doc.get('format')!r}, expected {FORMAT!r}")
-    _unknown(path, "top level", doc, {"format", "geo", "ble", "wall", "port", "beacon"})
+    _unknown(
+        path, "top level", doc, {"format", "geo", "ble", "wall", "port", "beacon", "building", "context"}
+    )
     geo = _geo(path, doc)
-    return Building(geo, _ble(path, doc), _walls(path, doc), _ports(path, doc), _beacons(path, doc, geo))
+    ports, extras, kinds = _ports(path, doc)
+    buildings, port_extras, contexts = parse_context_tables(path, doc, extras, kinds, BuildingError)
+    return Building(
+        geo,
+        _ble(path, doc),
+        _walls(path, doc),
+        ports,
+        _beacons(path, doc, geo),
+        buildings,
+        port_extras,
+        contexts,
+    )
 
 
 def merge_building(site: Any, building: Building, source: str = "") -> dict[str, int]:
     """Write the building's content into ``site`` (replacing walls, ports, beacons; geo and BLE model
     when given). Returns the counts merged. Floors outside the site's are the site file's error."""
+    from stridefix_analyzer.io.site_v3 import V3_ARRAYS
     from stridefix_analyzer.io.sitefile import set_counts
 
     if building.geo is not None:
@@ -237,6 +285,8 @@ def merge_building(site: Any, building: Building, source: str = "") -> dict[str,
         cols = list(zip(*building.ports))
         site.port_kind, site.port_x_m, site.port_y_m, site.port_radius_m = (list(c) for c in cols[:4])
         site.port_floor_lo, site.port_floor_hi = list(cols[4]), list(cols[5])
+        for name in V3_ARRAYS["n_ports"]:
+            setattr(site, name, [])  # the old ports' extras: neutral ones (or contexts.py's) instead
     if building.beacons:
         rows = sorted(building.beacons)
         site.beacon_id = [r[0] for r in rows]
@@ -253,7 +303,9 @@ def merge_building(site: Any, building: Building, source: str = "") -> dict[str,
 
 
 def building_toml(b: Building) -> str:
-    """``building.toml`` text of ``b`` (one [[wall]] per segment; beacons by x_m, y_m)."""
+    """``building.toml`` text of ``b`` (one [[wall]] per segment; beacons by x_m, y_m; the context
+    map's [[building]], port extras and [[context]] when given): :func:`read_building` of it gives
+    ``b`` again."""
     names = {v: k for k, v in PORT_KIND_CODES.items()}
     out = [f'format = "{FORMAT}"']
     if b.geo:
@@ -262,13 +314,18 @@ def building_toml(b: Building) -> str:
         out += ["", "[ble]", *(f"{k} = {v!r}" for k, v in b.ble.items())]
     for x0, y0, x1, y1, f in b.walls:
         out += ["", "[[wall]]", f"floor = {f}", f"points = [[{x0!r}, {y0!r}], [{x1!r}, {y1!r}]]"]
-    for kind, x, y, r, lo, hi in b.ports:
+    if b.port_extras and len(b.port_extras) != len(b.ports):
+        raise ValueError(f"{len(b.port_extras)} port extras for {len(b.ports)} ports (give none or one each)")
+    for i, (kind, x, y, r, lo, hi) in enumerate(b.ports):
         floors = ", ".join(str(f) for f in range(lo, hi + 1))
         out += ["", "[[port]]", f'kind = "{names[kind]}"', f"x_m = {x!r}", f"y_m = {y!r}"]
         out += [f"radius_m = {r!r}", f"floors = [{floors}]"]
+        if b.port_extras:
+            out += port_extra_lines(b.port_extras[i], (x, y))
     for ident, x, y, f, rssi in b.beacons:
         mac = ":".join(f"{(ident >> s) & 0xFF:02X}" for s in range(40, -1, -8))
         out += ["", "[[beacon]]", f'id = "{mac}"', f"x_m = {x!r}", f"y_m = {y!r}", f"floor = {f}"]
         if not np.isnan(rssi):
             out.append(f"rssi_1m_dbm = {rssi!r}")
+    out += context_tables_toml(b.buildings, b.contexts)
     return "\n".join(out) + "\n"

@@ -19,6 +19,7 @@ from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
 from stridefix_analyzer.radiomap.build import MODES, build_site
 from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
+from stridefix_analyzer.radiomap.contexts import ContextMapError, build_context_map, context_map_summary
 from stridefix_analyzer.radiomap.floorplan import FloorPlanError
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
 from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
@@ -146,7 +147,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         metavar="FILE",
         help="building description (building.toml, docs/building.md): geo-reference, BLE model, "
-        "walls, ports and beacons merged into the site",
+        "walls, ports and beacons merged into the site; with [[building]] entries also the "
+        "multi-scheme controller's context map",
     )
     b.add_argument(
         "--beacon-table",
@@ -254,9 +256,12 @@ def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
     if getattr(args, "floor_plan", None):
         summary["floor_plan"] = add_floor_plan(site, recordings, args)
     if getattr(args, "building", None):
-        summary["building"] = merge_building(
-            site, read_building(args.building), os.path.basename(args.building)
-        )
+        building = read_building(args.building)
+        summary["building"] = merge_building(site, building, os.path.basename(args.building))
+        if building.buildings:
+            from stridefix_analyzer.radiomap.beacons import place_readings
+
+            summary["context_map"] = build_context_map(site, building, place_readings(recordings))
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     summary["bytes"] = write_site(args.out, site)
     return site, summary
@@ -272,11 +277,21 @@ def run(args: argparse.Namespace) -> int:
             print(f"wrote {args.out} ({summary['bytes']} bytes)")
         else:
             site = read_site(args.site)
-            print(format_summary(site_summary(site)))
+            shown = site_summary(site)
+            if site.n_contexts:
+                shown["context_map"] = context_map_summary(site)
+            print(format_summary(shown))
             if args.png:
                 plot_site(site, args.png)
                 print(f"wrote {args.png}")
-    except (LogReadError, RadioMapInputError, SiteFileError, BuildingError, FloorPlanError) as exc:
+    except (
+        LogReadError,
+        RadioMapInputError,
+        SiteFileError,
+        BuildingError,
+        FloorPlanError,
+        ContextMapError,
+    ) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     return 0

@@ -68,6 +68,8 @@ def format_summary(s: dict) -> str:
             lines.append(
                 "  table ↔ MAC " + ", ".join(f"{n}={m or '?'}" for n, m in b["table_matched"].items())
             )
+    if s.get("context_map"):
+        lines += format_context_map(s["context_map"])
     lines.append(f"floors      {s['n_floors']} from {s['lowest_floor']}")
     for f, info in s["floors"].items():
         text = f"  floor {f:>3}  h {info['height_m']:6.2f} m  {info['rps']:5d} RPs  {info['aps']:4d} APs"
@@ -83,6 +85,47 @@ def format_summary(s: dict) -> str:
     return "\n".join(lines)
 
 
+def format_context_map(m: dict) -> list[str]:
+    """Lines of a context map summary (:func:`~.contexts.context_map_summary` or a build's): each
+    context with its LSD and CDD and member count, a warning for each the CLS cannot identify, and
+    the ports with their extras when given."""
+    cs = m["contexts"]
+    lines = [
+        f"contexts    {len(cs)} in {len(m['buildings'])} building(s) ({', '.join(m['buildings'])}), "
+        f"{m['n_links']} port links, {m['n_cdd']} constellation members"
+    ]
+    for i, c in enumerate(cs):
+        where = c["kind"] if c["building"] is None else f"{c['kind']} {c['building']}"
+        cdd = f"CDD {c['cdd_method']}"
+        if c["cdd_method"] != "gnss":
+            cdd += f": {c['members']} members, {c['min_hits']} to hear"
+            cdd += f" (from {c['cdd_from']})" if "cdd_from" in c else ""
+        lines.append(f"  {i:>2} {where:<16} floor {c['floor']:>3}  LSD {c['scheme']} + {c['method']}  {cdd}")
+    for i, c in enumerate(cs):
+        if not c["identifiable"]:
+            lines.append(
+                f"  warning: context {i} ({c['kind']} {c['building']} floor {c['floor']}) has no constellation "
+                f"member: the CLS cannot identify it"
+            )
+    for i, p in enumerate(m.get("ports", [])):
+        lo, hi = p["floors"]
+        text = f"  port {i:>2} {p['kind']:<8} floors {lo}..{hi}  building {p['building'] or '-'}"
+        text += "  outdoor" if p["outdoor"] else ""
+        text += f"  {p['steps']} steps" if p["steps"] else ""
+        text += f"  linked to {', '.join(str(k) for k in p['links'])}" if p["links"] else ""
+        lines.append(text)
+    return lines
+
+
+def _outlines(site: site_t) -> list[tuple[str, list[tuple[float, float]]]]:
+    """(name, vertices) of each building of the site's context map."""
+    b = np.asarray(site.outline_building)
+    return [
+        (name, [(site.outline_x_m[i], site.outline_y_m[i]) for i in np.flatnonzero(b == k)])
+        for k, name in enumerate(site.building_name)
+    ]
+
+
 def _site_floors(site: site_t) -> list[int]:
     """Floors with anything to draw (RPs, walls, beacons, ports), else the lowest."""
     used = set(np.asarray(site.rp_floor).tolist()) | set(np.asarray(site.wall_floor).tolist())
@@ -95,14 +138,14 @@ def _site_floors(site: site_t) -> list[int]:
 
 def plot_site(site: site_t, png_path: str) -> None:
     """PNG of the site per floor (one panel each): walls (grey lines), RPs coloured by the number of
-    APs heard, beacons (triangles with their ids' last two bytes) and ports (circles: door green,
-    stairs orange, elevator purple)."""
+    APs heard, beacons (triangles with their ids' last two bytes), ports (circles: door green,
+    stairs orange, elevator purple) and the buildings' outlines (dashed blue, named)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
-    from matplotlib.patches import Circle
+    from matplotlib.patches import Circle, Polygon
 
     rp_floor = np.asarray(site.rp_floor)
     n_aps = np.bincount(np.asarray(site.entry_rp, dtype=np.int64), minlength=site.n_rp)
@@ -155,6 +198,12 @@ def plot_site(site: site_t, png_path: str) -> None:
                         zorder=3,
                     )
                 )
+        for name, vertices in _outlines(site):
+            ax.add_patch(
+                Polygon(vertices, closed=True, fill=False, ls="--", color="tab:blue", lw=1.2, zorder=1)
+            )
+            ax.annotate(name, vertices[0], fontsize=8, color="tab:blue")
+            ax.autoscale()
         ax.set_title(
             f"floor {f}: {int(sel.sum())} RPs, {len(w)} walls, {int(np.sum(beacon_floor == f))} beacons"
         )

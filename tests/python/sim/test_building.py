@@ -19,12 +19,19 @@ def test_building_round_trips_the_world(name):
     ble = builtin_scenario("campus").data["ble"]
     doc = tomllib.loads(building_text(world, ble))
     assert doc["format"] == FORMAT
-    # walls: every segment once per floor, coordinates as the world has them (to 1 µm)
+    # walls: every segment once per floor of its building (a world without outlines: every floor),
+    # coordinates as the world has them (to 1 µm)
     walls = doc["wall"]
-    assert len(walls) == len(world.walls_m) * world.n_floors
+    floors_of = [
+        next((o.floors for o in world.outlines if o.holds(w[0], w[1]) and o.holds(w[2], w[3])), None)
+        for w in world.walls_m
+    ]
+    assert all(f is not None for f in floors_of) or not world.outlines
     for f in range(world.n_floors):
+        on = [fl is None or f in fl for fl in floors_of]
         got = np.array([[*w["points"][0], *w["points"][1]] for w in walls if w["floor"] == f])
-        np.testing.assert_allclose(got, world.walls_m, atol=1e-6)
+        np.testing.assert_allclose(got, world.walls_m[on], atol=1e-6)
+    assert len(walls) == sum(world.n_floors if fl is None else len(fl) for fl in floors_of)
     assert all(w["closed"] is False and len(w["points"]) == 2 for w in walls)
     # ports: stairs, elevator, each door to the outside
     kinds = [p["kind"] for p in doc.get("port", [])]

@@ -102,8 +102,12 @@ def test_builtin_named_scenarios():
         "aadr2015_survey",
         "campus",
         "campus_survey",
+        "campus2",
+        "campus2_survey",
     }
     assert builtin_scenario("campus")["world"]["name"] == "campus"
+    assert builtin_scenario("campus2")["walk"]["route"] == "legs"
+    assert builtin_scenario("campus2_survey")["survey"]["layout"] == "world"
     assert builtin_scenario("campus")["walk"]["route"] == "track"
     assert builtin_scenario("campus_survey")["survey"]["enabled"]
     assert resolve_scenario(None).data == resolve_scenario("default").data == DEFAULTS
