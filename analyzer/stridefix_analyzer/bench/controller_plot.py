@@ -43,7 +43,7 @@ def write_timeline(
     ax.set_yticks(range(len(keys)), keys)
     ax.set_xlabel("time since the walk's start [s]")
     ax.set_title(f"{title}: context over time (dotted: truth transitions, red = not detected in time)")
-    ax.legend(loc="upper left")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0))
     ax.grid(axis="x", alpha=0.3)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=100, bbox_inches="tight")
