@@ -18,7 +18,7 @@ help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
 	@echo "make lint   - ruff (lint + format check) on all Python, mypy on the analyzer (strict on io, datasets)"
-	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance; particle cost); writes out/bench/*.json"
+	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance; particle cost; controller); writes out/bench/*.json"
 	@echo "make reliability - the default SIL walk with each bus/board fault vs clean; out/bench/reliability.json"
 	@echo "make soak   - an 8-hour SIL walk with faults through stridefixd: RSS at 1 h and 8 h, events accounted"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
@@ -69,7 +69,7 @@ GSD ?= ../shared/data/gsd
 # Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
 	@status=0; \
-	for b in sil-pdr aadr2015 office-wifi particle-cost sources; do \
+	for b in sil-pdr aadr2015 office-wifi particle-cost sources controller; do \
 		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
 	done; \
 	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \

@@ -19,7 +19,16 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import fusion, particle_cost, realdata, reliability, sil_pdr, soak, sources
+from stridefix_analyzer.bench import (
+    controller,
+    fusion,
+    particle_cost,
+    realdata,
+    reliability,
+    sil_pdr,
+    soak,
+    sources,
+)
 from stridefix_analyzer.firmware import Firmware, FirmwareError, add_stridefixd_argument
 from stridefix_analyzer.stages import StageError
 
@@ -62,6 +71,13 @@ def _run_sources(args: argparse.Namespace, firmware: Firmware, seeds: list[int],
     print(sources.format_table(doc))
     print(f"wrote {out / 'sources.json'} ({doc['run_s']:.0f} s)")
     return sources.missed_targets(doc)
+
+
+def _run_controller(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    doc = controller.run_controller(seeds, firmware, out / "controller", args.sets)
+    print(controller.format_table(doc))
+    print(f"wrote {out / 'controller.json'} and {len(doc['timelines'])} timelines ({doc['run_s']:.0f} s)")
+    return controller.missed_targets(doc)
 
 
 def _run_real_targets(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
@@ -118,6 +134,7 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "aadr2015": (_run_aadr2015, "1,2,3,4,5"),
     "office-wifi": (_run_office, "1,2,3"),
     "sources": (_run_sources, "1,2,3"),
+    "controller": (_run_controller, "1,2,3,4,5,6,7,8,9,10"),
     "real-targets": (_run_real_targets, "1"),
     "reliability": (_run_reliability, "1"),
     "soak": (_run_soak, "1"),
@@ -150,7 +167,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "experiment (fusion schemes at the reference points); office-wifi: the fusion "
         "schemes on the default office walk with a surveyed radio map; sources: every scheme on the campus walk "
         "(indoor, door landmark, outdoor GNSS, door landmark, indoor): errors in and out, GNSS accuracy, "
-        "landmarks, wall crossings; real-targets: issue 11's "
+        "landmarks, wall crossings; controller: the multi-scheme controller against every fixed scheme on the "
+        "campus2 walks (error per true context, floor hit, transition latency, false switches, radios on); "
+        "real-targets: issue 11's "
         "targets on realbench results.json files (--results); reliability: the default walk with each bus "
         "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
         "accounting (make soak); particle-cost: the particle scheme's instructions per step under callgrind "
@@ -172,7 +191,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--seeds",
         default=None,
         metavar="LIST",
-        help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5)",
+        help="comma-separated seeds (default: 1,2,3; aadr2015: 1,2,3,4,5; controller: 1..10)",
     )
     p.add_argument(
         "--results",

@@ -8,7 +8,10 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
   ``health`` (last HEALTH fields), ``config`` (``version``, ``dbc_sha256``, ``params``) and
   ``warnings``. Non-finite numbers are written as ``null``.
   ``fix_sources`` (FIX records per scheme and per method, Wi-Fi, GNSS, BLE, landmark: offered,
-  accepted, rejected and rejected by reason; :mod:`stridefix_analyzer.scoring.fixsources`) and
+  accepted, rejected and rejected by reason; :mod:`stridefix_analyzer.scoring.fixsources`),
+  ``context`` when the logs hold CONTEXT (the multi-scheme controller's events, switches by rule,
+  time per context, radios-on seconds from the last HEALTH; :mod:`stridefix_analyzer.scoring.context`;
+  null without CONTEXT), and
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
@@ -38,6 +41,7 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
 from stridefix_analyzer.scoring.metrics import (
     IPIN_FLOOR_PENALTY_M,
@@ -52,7 +56,7 @@ METRICS_FILE = "metrics.json"
 SERIES_FILE = "analysis.npz"
 
 # channels the analysis needs decoded; the rest (IMU, MAG, ...) are only counted, which is faster
-_DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG")
+_DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG", "CONTEXT")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -118,10 +122,17 @@ def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> 
         decode_errors=data.decode_errors,
         health=data.health,
         fix_sources=fix_source_counts(data.table("FIX")),
+        context=context_summary(data.table("CONTEXT"), data.health, _end_us(data)),
         config={**data.versions, "params": data.config},
         warnings=data.warnings,
     )
     return json_ready(doc)
+
+
+def _end_us(data: LogData) -> int | None:
+    """The walk's end for the time per context [µs]: the last POSE (None without one)."""
+    pose = data.table("POSE")
+    return int(pose["t_us"][-1]) if pose is not None and len(pose) else None
 
 
 def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, str]:
@@ -218,6 +229,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))
     print(format_fix_sources(summary["fix_sources"]))
+    print(format_context_line(summary.get("context")))
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
         from stridefix_analyzer.io.tum import write_tum

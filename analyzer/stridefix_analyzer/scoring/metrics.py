@@ -27,8 +27,11 @@ from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 
-#: preference when several schemes have equally many POSE messages (first wins)
-_PRIMARY_PREFERENCE = ["adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
+#: preference when several schemes have equally many POSE messages (first wins); ``controller`` (the
+#: multi-scheme controller's pose, pose_t.SCHEME_CONTROLLER) is the product's primary pose and wins
+#: whenever it is present, whatever its count (it has none before the controller's first context)
+_PRIMARY_PREFERENCE = ["controller", "adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
+_ALWAYS_PRIMARY = "controller"
 
 #: percentiles reported, in percent
 PERCENTILES = (50, 75, 90, 95)
@@ -293,9 +296,10 @@ def score_scheme(
 def choose_primary(pose: Table, requested: int | None = None) -> int:
     """The scheme whose numbers go at the top level.
 
-    ``requested`` if given (it must occur in the log); else the scheme with most POSE messages,
-    ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only, then any other
-    scheme in id order (a scheme new to ``pose_t.lcm`` needs no row here).
+    ``requested`` if given (it must occur in the log); else ``controller`` when the log has its
+    POSE (the controller's pose is the product's primary pose); else the scheme with most POSE
+    messages, ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only, then
+    any other scheme in id order (a scheme new to ``pose_t.lcm`` needs no row here).
     """
     codes, counts = np.unique(pose["scheme"], return_counts=True)
     if requested is not None:
@@ -305,6 +309,9 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
                 f"{[scheme_name(c) for c in codes]}"
             )
         return int(requested)
+    names = [scheme_name(c) for c in codes]
+    if _ALWAYS_PRIMARY in names:
+        return int(codes[names.index(_ALWAYS_PRIMARY)])
 
     def rank(i: int):
         name = scheme_name(codes[i])

@@ -20,6 +20,7 @@ import numpy as np
 
 from stridefix_analyzer.scoring import plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
+from stridefix_analyzer.scoring.context import context_html
 from stridefix_analyzer.scoring.fixsources import fix_sources_html
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
 
@@ -210,6 +211,10 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         "<p class='note'>FIX records per scheme and source (every scheme judges every fix): offered, "
         "accepted, rejected and why.</p>",
         fix_sources_html(summary.get("fix_sources") or {}),
+        "<h2>Positioning context (multi-scheme controller)</h2>",
+        "<p class='note'>CONTEXT messages: every state change of the controller, the rule that fired "
+        "and its evidence; the primary pose follows the scheme of the context it selects.</p>",
+        context_html(summary.get("context")),
         "<h2>Logger health (last HEALTH report)</h2>",
         _kv_table(list(health.items()), ("counter", "value"))
         if health

@@ -1,0 +1,61 @@
+"""End to end, ``stridefix bench controller --seeds 1``: the campus2 survey, the site with its context
+map, one walk replayed through the real stridefixd with the controller and without, scored.
+
+GIVEN the whole chain (the simulator's campus2 world, ``radiomap build --building`` writing the context
+map, the firmware's controller) WHEN the bench runs one seed THEN controller.json has the controller's
+and the fixed schemes' errors per true context, a latency per transition of the walk, the switches
+judged, the radios' on-times, the per-rule CONTEXT counts, a timeline PNG, and every issue-14 target
+with a verdict. Skipped, with the piece named, while a branch of issue 14 is not merged yet."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from stridefix_analyzer.firmware import Firmware
+from stridefix_sim.scenario import BUILTIN
+
+
+def _missing(stridefixd: Path) -> str | None:
+    if "campus2" not in BUILTIN or "campus2_survey" not in BUILTIN:
+        return "the simulator has no campus2 / campus2_survey scenario (branch ctl-sim)"
+    exe = Path(sys.executable).with_name("stridefix")
+    help_text = subprocess.run(
+        [str(exe), "radiomap", "build", "--help"], capture_output=True, text=True
+    ).stdout
+    if "--building" not in help_text:
+        return "radiomap build takes no --building (branch ctl-site)"
+    if "controller.enabled" not in Firmware(stridefixd).params:
+        return "stridefixd has no controller (controller.enabled; branch ctl-core)"
+    return None
+
+
+def test_bench_controller_one_seed(stridefixd, cli, tmp_path):
+    why = _missing(stridefixd)
+    if why:
+        pytest.skip(why)
+    proc = cli("bench", "controller", "--seeds", "1", "--stridefixd", str(stridefixd), "--out", str(tmp_path))
+    assert proc.returncode in (0, 1), proc.stderr  # 1: a target missed, still a complete run
+    doc = json.loads((tmp_path / "controller.json").read_text())
+    table = doc["table"]
+    assert "controller" in table and len(table) >= 3, list(table)
+    # the walk visits outdoors, both buildings and A's three floors: each is a true context
+    contexts = set(table["controller"]["contexts"])
+    assert {"outdoor", "whole walk"} <= contexts and len(contexts) >= 5, contexts
+    for row in table.values():
+        assert row["contexts"]["whole walk"]["n"] > 100 and row["floor_hit_rate"] is not None
+    kinds = {t["kind"] for t in doc["transitions"]}
+    assert {"door", "stairs", "elevator"} <= kinds, doc["transitions"]
+    assert all(t["latency_s"] is None or -5.0 <= t["latency_s"] <= 30.0 for t in doc["transitions"])
+    assert doc["switches"] and all(
+        s["why"] in (None, "wrong context", "no transition") for s in doc["switches"]
+    )
+    # the policy keeps GNSS off indoors: less GNSS time than the fixed schemes' whole walk
+    assert 0.0 < doc["power_s"]["controller"]["gnss"] < doc["power_s"]["fixed"]["gnss"]
+    assert doc["events_by_rule"].get("cls_unlimited", 0) >= 1
+    assert Path(doc["timelines"][0]).read_bytes().startswith(b"\x89PNG")
+    assert {t["met"] for t in doc["targets"]} <= {True, False} and len(doc["targets"]) >= 5
+    assert ("TARGET MISSED" in proc.stdout) == (proc.returncode == 1)
