@@ -47,6 +47,8 @@ def _from_lcm() -> tuple[Scheme, ...]:
 SCHEMES: tuple[Scheme, ...] = _from_lcm()
 """Every scheme, in id order (the report order)."""
 NAMES: tuple[str, ...] = tuple(s.name for s in SCHEMES)
+FUSION_SCHEMES: tuple[Scheme, ...] = tuple(s for s in SCHEMES if s.id < pose_t.SCHEME_CONTROLLER)
+"""The fusion schemes: every scheme but the controller, which follows one (it judges no fix)."""
 _BY_ID = {s.id: s for s in SCHEMES}
 _BY_NAME = {s.name: s for s in SCHEMES}
 
@@ -78,6 +80,9 @@ def scheme_colour(code: int) -> str:
 
 PDR_ONLY: str = scheme_name(pose_t.SCHEME_PDR_ONLY)
 """The dead-reckoning baseline's name (its truth-initialised run is reported per data set)."""
+
+CONTROLLER: str = scheme_name(pose_t.SCHEME_CONTROLLER)
+"""The multi-scheme controller's primary pose: the pose of the fusion scheme its context selects."""
 
 WIFI_ONLY: str = scheme_name(pose_t.SCHEME_WIFI_ONLY)
 """The Wi-Fi baseline's name (it follows Wi-Fi fixes only: the other sources are not its fixes)."""

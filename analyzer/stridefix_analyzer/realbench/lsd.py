@@ -40,7 +40,7 @@ SITE_KEY = "controller_lsd_scheme"
 #: the scheme a fold gets when no choice can be made (fewer walks than the inner CV needs)
 DEFAULT_SCHEME = "ekf"
 #: the candidates: every fusion scheme (the controller itself is not one)
-CANDIDATES = tuple(s.name for s in schemes.SCHEMES if s.name != "controller")
+CANDIDATES = tuple(s.name for s in schemes.FUSION_SCHEMES)
 
 
 def scheme_pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> dict[str, np.ndarray]:

@@ -17,9 +17,9 @@ import lcm
 import numpy as np
 import pytest
 from stridefix import fix_t, pose_t, wifi_scan_t
-from stridefix_analyzer.schemes import SCHEMES
+from stridefix_analyzer.schemes import FUSION_SCHEMES as SCHEMES  # the controller judges no fix
 
-SCHEME_IDS = [s.id for s in SCHEMES]  # every scheme of pose_t.lcm
+SCHEME_IDS = [s.id for s in SCHEMES]  # every fusion scheme of pose_t.lcm
 
 
 def run_fw(stridefixd: Path, walk: Path, log: Path, *extra: str) -> subprocess.CompletedProcess:

@@ -18,7 +18,9 @@ import pytest
 from stridefix import fix_t, truth_t
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.io.sitefile import new_site, write_site
-from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.schemes import FUSION_SCHEMES
+
+NAMES = tuple(s.name for s in FUSION_SCHEMES)  # the schemes that judge fixes (not the controller)
 
 REPO = Path(__file__).resolve().parents[3]
 DBC = REPO / "firmware" / "board.dbc"
