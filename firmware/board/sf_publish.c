@@ -105,7 +105,12 @@ void sf_publish_context(sf_lcm_out_t *const out, const int64_t log_t_us, const s
     context_words(now, sizeof now, map, ev->context);
     const char *members;
     const char *const by = method_words(ev->cls_method, ev->cls_hits, &members);
-    if (ev->cls_method != 0) {
+    if (ev->floor_from_barometer) {
+        snprintf(id, sizeof id, "%s by the barometer (%d of %d candidates identified by the CLS)", now,
+                 (int)ev->cls_identified, (int)ev->cls_candidates);
+    } else if (ev->cls_method != 0 && ev->cls_identified > 1) {
+        snprintf(id, sizeof id, "%s by GNSS (open sky) over the %d identified", now, (int)ev->cls_identified);
+    } else if (ev->cls_method != 0) {
         snprintf(id, sizeof id, "%s unique (%s, %d %s)", now, by, (int)ev->cls_hits, members);
     } else {
         snprintf(id, sizeof id, "%d of %d candidates identified", (int)ev->cls_identified, (int)ev->cls_candidates);
@@ -125,9 +130,10 @@ void sf_publish_context(sf_lcm_out_t *const out, const int64_t log_t_us, const s
                  (int)ev->port, (int)ev->cls_candidates);
         break;
     case sf_ctl_rule_stairs:
-    case sf_ctl_rule_door:
+    case sf_ctl_rule_door:;
+        const bool outline = ev->rule == sf_ctl_rule_door && ev->cls_method == 0;
         snprintf(text, sizeof text, "%s: %d of %d steps, %s%s%s", rule, (int)ev->steps_in_transition, required, id,
-                 ev->cls_method == 0 ? ": by the outline, " : "", ev->cls_method == 0 ? now : "");
+                 outline ? ": by the outline, " : "", outline ? now : "");
         break;
     case sf_ctl_rule_elevator:
         snprintf(text, sizeof text, "%s: walking again (%d steps), %s", rule, required, id);
@@ -160,6 +166,7 @@ void sf_publish_context(sf_lcm_out_t *const out, const int64_t log_t_us, const s
                                .cls_identified = ev->cls_identified,
                                .cls_method = ev->cls_method,
                                .cls_hits = ev->cls_hits,
+                               .floor_from_barometer = ev->floor_from_barometer,
                                .recalibrated = ev->recalibrated,
                                .recal_x_m = ev->recal_x_m,
                                .recal_y_m = ev->recal_y_m,

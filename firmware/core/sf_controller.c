@@ -26,6 +26,7 @@ void sf_controller_init(sf_controller_t *const c, const sf_params_t *const p)
                            .state = sf_ctl_init,
                            .context = -1,
                            .floor = (int16_t)p->init_floor,
+                           .pose_floor = (int16_t)p->init_floor,
                            .port = -1};
 }
 
@@ -109,7 +110,7 @@ int sf_controller_scheme(const sf_controller_t *const c)
 
 int16_t sf_controller_floor(const sf_controller_t *const c)
 {
-    return c->floor;
+    return c->pose_floor;
 }
 
 bool sf_controller_source_on(const sf_controller_t *const c, const int method)
@@ -156,7 +157,8 @@ bool sf_controller_next_event(sf_controller_t *const c, sf_context_event_t *cons
 
 /* Every field of the event from the state after the change. */
 static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const int8_t rule, const int16_t prev,
-                 const sf_cls_result_t *const r, const bool recal, const double rx_m, const double ry_m)
+                 const sf_cls_result_t *const r, const bool recal, const double rx_m, const double ry_m,
+                 const bool by_baro)
 {
     const sf_context_map_t *const map = &c->site->contexts;
     const int16_t ctx = c->context;
@@ -174,11 +176,14 @@ static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const
         .port_kind = c->port >= 0 ? c->site->ports.kind[c->port] : 0,
         .rule = rule,
         .switched = ctx != prev,
-        .steps_in_transition = c->state == sf_ctl_transition || rule >= sf_ctl_rule_elevator ? m->step_count - c->steps_at_start : 0,
+        .steps_in_transition = c->state == sf_ctl_transition || rule >= sf_ctl_rule_elevator
+                                   ? m->step_count - (c->on_stairs ? c->steps_at_stairs : c->steps_at_start)
+                                   : 0,
         .cls_candidates = r->candidates,
         .cls_identified = r->identified,
         .cls_method = r->method,
         .cls_hits = r->hits,
+        .floor_from_barometer = by_baro,
         .recalibrated = recal,
         .recal_x_m = rx_m,
         .recal_y_m = ry_m,
@@ -227,18 +232,20 @@ static void begin_transition(sf_controller_t *const c, const sf_ctl_motion_t *co
     c->port = q;
     c->steps_at_start = m->step_count;
     c->elevator_seen = false;
+    c->on_stairs = false;
+    c->steps_at_stairs = m->step_count;
     c->walk_steps = 0;
     c->elevator_t_us = INT64_MIN;
     sf_cls_start(&c->cls, sf_cls_neighbourhood(c->site, q, &c->port_outdoor)); /* limited mode */
     c->transitions++;
     sf_cls_result_t r;
     sf_cls_result(&c->cls, INT64_MAX, &r); /* nothing identified yet: the candidates only */
-    emit(c, m, sf_ctl_rule_near_port, c->context, &r, false, 0.0, 0.0);
+    emit(c, m, sf_ctl_rule_near_port, c->context, &r, false, 0.0, 0.0, false);
 }
 
 /* TRANSITION → IN_CONTEXT (rule), with the new context (the old one for LEFT_PORT). */
 static void end_transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m,
-                           const int8_t rule, const int16_t to, const sf_cls_result_t *const r)
+                           const int8_t rule, const int16_t to, const sf_cls_result_t *const r, const bool by_baro)
 {
     const int16_t prev = c->context;
     const int16_t from_floor = c->floor;
@@ -258,7 +265,7 @@ static void end_transition(sf_controller_t *const c, const sf_params_t *const p,
         recal = true;
         c->recalibrations++;
     }
-    emit(c, m, rule, prev, r, recal, rx_m, ry_m);
+    emit(c, m, rule, prev, r, recal, rx_m, ry_m, by_baro);
     c->port = -1;
     /* still at the port after the exit: transition detection again at once (the paper) */
     const double x_m = recal ? rx_m : m->x_m, y_m = recal ? ry_m : m->y_m;
@@ -271,11 +278,45 @@ static void end_transition(sf_controller_t *const c, const sf_params_t *const p,
     }
 }
 
+/* The barometric floor's context (the motion's floor) when controller.floor_from_barometer, the
+ * transition's port joins that floor, the limited search has the context, and the CLS identified no
+ * context since since_us or identified this one among others (the barometer breaks the tie, it does
+ * not overrule a unique identification); −1 otherwise. */
+static int16_t baro_context(const sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m,
+                            const sf_cls_result_t *const r, const int64_t since_us)
+{
+    const int32_t q = c->port;
+    if (!p->controller_floor_from_barometer || m->floor < c->site->ports.floor_lo[q] ||
+        m->floor > c->site->ports.floor_hi[q]) {
+        return -1;
+    }
+    const int16_t ctx = sf_cls_context_of(&c->site->contexts, c->site->contexts.port_building[q], m->floor);
+    if (ctx < 0 || ctx >= SF_CONTROLLER_MAX_CONTEXTS || !(c->cls.candidates >> ctx & 1u)) {
+        return -1;
+    }
+    return r->identified == 0 || c->cls.evidence[ctx].t_us >= since_us ? ctx : -1;
+}
+
+/* The outdoor context when the CLS identified it by a GNSS fix since since_us, else −1. */
+static int16_t gnss_outdoor(const sf_controller_t *const c, const int64_t since_us)
+{
+    const sf_context_map_t *const map = &c->site->contexts;
+    for (int32_t i = 0; i < map->n_contexts && i < SF_CONTROLLER_MAX_CONTEXTS; i++) {
+        const sf_cls_evidence_t *const e = &c->cls.evidence[i];
+        if (map->kind[i] == sf_context_outdoor && (c->cls.candidates >> i & 1u) && e->t_us != INT64_MIN &&
+            e->t_us >= since_us && e->method == sf_fix_gnss) {
+            return (int16_t)i;
+        }
+    }
+    return -1;
+}
+
 static void transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
     const int32_t q = c->port;
     const int kind = c->site->ports.kind[q];
     const int32_t steps = m->step_count - c->steps_at_start;
+    const int32_t stair_steps = m->step_count - (c->on_stairs ? c->steps_at_stairs : c->steps_at_start);
     const int64_t window_us = (int64_t)(p->controller_cls_window_s * 1e6);
     int64_t since_us = m->t_us - window_us;
     if (kind == sf_port_elevator && c->elevator_seen && c->elevator_t_us >= since_us) {
@@ -283,28 +324,41 @@ static void transition(sf_controller_t *const c, const sf_params_t *const p, con
     }
     sf_cls_result_t r;
     sf_cls_result(&c->cls, since_us, &r);
+    /* a unique floor: the CLS's, else the barometer's when the port joins that floor */
+    const int16_t baro = baro_context(c, p, m, &r, since_us);
+    const int16_t floor_to = r.unique >= 0 ? r.unique : baro;
+    const bool by_baro = r.unique < 0 && baro >= 0;
     if (kind == sf_port_elevator && c->elevator_seen && c->walk_steps >= p->controller_elevator_walk_steps &&
-        r.unique >= 0) {
-        end_transition(c, p, m, sf_ctl_rule_elevator, r.unique, &r);
+        floor_to >= 0) {
+        end_transition(c, p, m, sf_ctl_rule_elevator, floor_to, &r, by_baro);
         return;
     }
-    if (kind == sf_port_stairs && steps >= c->site->contexts.port_steps[q] && r.unique >= 0) {
-        end_transition(c, p, m, sf_ctl_rule_stairs, r.unique, &r);
+    if (kind == sf_port_stairs && stair_steps >= c->site->contexts.port_steps[q] && floor_to >= 0) {
+        end_transition(c, p, m, sf_ctl_rule_stairs, floor_to, &r, by_baro);
         return;
     }
     if (kind == sf_port_door && steps >= p->controller_door_steps) {
         int16_t to = r.unique;
-        if (to < 0) { /* none or a tie (GNSS and a floor at an entrance): the outline that holds us */
+        const int16_t sky = r.identified >= 2 ? gnss_outdoor(c, since_us) : -1;
+        if (to < 0 && sky >= 0) {
+            /* a tie at an entrance with a GNSS fix among it: an accurate GNSS fix needs open sky,
+             * while Wi-Fi and BLE carry through a doorway, so the GNSS side wins (the paper leaves the
+             * tie open) */
+            to = sky;
+            r.method = sf_fix_gnss;
+            r.hits = c->cls.evidence[sky].hits;
+        }
+        if (to < 0) { /* none, or a tie without GNSS: the outline that holds us */
             const int32_t b = m->has_position ? sf_cls_building_at(&c->site->contexts, m->x_m, m->y_m) : -1;
             to = sf_cls_context_of(&c->site->contexts, b, c->floor);
             to = to >= 0 ? to : c->context;
         }
-        end_transition(c, p, m, sf_ctl_rule_door, to, &r);
+        end_transition(c, p, m, sf_ctl_rule_door, to, &r, false);
         return;
     }
     const double leave_m = (double)c->site->ports.radius_m[q] + p->controller_port_margin_m + p->controller_port_leave_m;
     if (m->has_position && port_distance_m(c, q, m->x_m, m->y_m) > leave_m) {
-        end_transition(c, p, m, sf_ctl_rule_left_port, c->context, &r);
+        end_transition(c, p, m, sf_ctl_rule_left_port, c->context, &r, false);
     }
 }
 
@@ -330,11 +384,17 @@ bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, 
         return false;
     }
     const int32_t before = c->ev_n + (int32_t)c->events_dropped;
+    const int16_t context_before = c->context;
     sf_controller_activity(c, m->t_us, m->activity);
     const int32_t new_steps = m->step_count > c->step_count ? m->step_count - c->step_count : 0;
     c->step_count = m->step_count;
     if (c->elevator_seen && m->activity == sf_activity_walking) {
         c->walk_steps += new_steps;
+    }
+    if (c->state == sf_ctl_transition && !c->on_stairs && new_steps > 0 &&
+        (m->activity == sf_activity_stairs_up || m->activity == sf_activity_stairs_down)) {
+        c->on_stairs = true; /* this update's steps are the first on the staircase */
+        c->steps_at_stairs = m->step_count - new_steps;
     }
     switch (c->state) {
     case sf_ctl_init: {
@@ -346,7 +406,7 @@ bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, 
             c->floor = floor_of(c, r.unique, m->floor);
             c->state = sf_ctl_in_context;
             sf_cls_stop(&c->cls);
-            emit(c, m, sf_ctl_rule_cls_unlimited, -1, &r, false, 0.0, 0.0);
+            emit(c, m, sf_ctl_rule_cls_unlimited, -1, &r, false, 0.0, 0.0, false);
         }
         break;
     }
@@ -362,6 +422,13 @@ bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, 
     }
     case sf_ctl_transition: transition(c, p, m); break;
     default: break;
+    }
+    c->pose_floor = c->floor;
+    /* (after a switch in this update the motion's floor is the one before the estimator followed) */
+    if (c->context == context_before && c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
+        c->site->ports.kind[c->port] != sf_port_door && m->floor >= c->site->ports.floor_lo[c->port] &&
+        m->floor <= c->site->ports.floor_hi[c->port]) {
+        c->pose_floor = m->floor;
     }
     return c->ev_n + (int32_t)c->events_dropped != before;
 }

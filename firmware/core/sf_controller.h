@@ -17,8 +17,8 @@
  *                           endpoint on the new floor (a METHOD_PORT fix offered to every scheme);
  *                 door      5 steps (controller.door_steps) since the transition began; the context is
  *                           then the CLS's unique identification, or, when the CLS names none or two
- *                           (the paper's unresolved tie at an entrance), the building outline that
- *                           holds the active scheme's position;
+ *                           (the paper's unresolved tie at an entrance), the GNSS side of a tie, else
+ *                           the building outline that holds the active scheme's position;
  *               leaving the port's neighbourhood without the rule's evidence keeps the old context
  *               (rule LEFT_PORT); still within the port after an exit re-enters TRANSITION.
  * GPS policy: GNSS is on in the outdoor context, at INIT, and in a transition at a port that leads
@@ -69,6 +69,7 @@ typedef struct {
     int16_t cls_candidates, cls_identified;
     int8_t cls_method;
     int16_t cls_hits;
+    bool floor_from_barometer; /* elevator, stairs: the CLS named none or several, the barometer decided */
     bool recalibrated;
     double recal_x_m, recal_y_m;
     bool gnss_on, wifi_on, ble_on;
@@ -102,12 +103,24 @@ const char *sf_controller_rule_text(int rule);
  *                          floors include the controller's floor (the nearest such port);
  *   walking again          controller.elevator_walk_steps steps credited with activity walking after
  *                          sf_activity_elevator was seen in the transition (sf_controller_activity);
+ *   staircase's steps      counted from the transition's first step with a stairs activity (the
+ *                          walker set foot on the staircase; the approach inside the port's disc
+ *                          does not count), from the transition's start when none was classified;
+ *   unique floor           (elevator, stairs) the CLS's unique identification; when it names none or
+ *                          several, the barometric floor (sf_ctl_motion_t.floor) if the port joins it:
+ *                          "with a barometer, vertical displacement gives the floor unambiguously"
+ *                          (the paper §III-C, [15]); the event says which (floor_from_barometer);
  *   stairs recalibration   the endpoint on the new floor: floor_hi's when the new floor is floor_hi,
  *                          else floor_lo's;
- *   door                   the unique identification, else context_of(the building whose outline
- *                          holds the position, the floor), outside every outline the outdoor context;
+ *   door                   the unique identification; a tie that holds the outdoor context identified
+ *                          by GNSS goes outdoors (an accurate fix needs open sky; Wi-Fi and BLE carry
+ *                          through a doorway); else context_of(the building whose outline holds the
+ *                          position, the floor), outside every outline the outdoor context;
  *   floor                  the context's floor (floor and outdoor contexts), the estimator's
- *                          (sf_ctl_motion_t.floor) in INIT and in a building context.
+ *                          (sf_ctl_motion_t.floor) in INIT and in a building context; the primary
+ *                          pose's (sf_controller_floor) is the barometric floor during a stairs or
+ *                          elevator transition when that is one of the port's floors (the floor
+ *                          changes there, the context only at the exit) and controller.floor_from_barometer.
  * Cost per update O(n_ports + n_contexts) (plus a neighbourhood, sf_cls.h, when a transition begins);
  * per reading the CLS's. Memory: sizeof(sf_controller_t) = 1 440 B on x86-64 (at most 1 536 B,
  * checked): the CLS's evidence (sf_cls_t, 1 048 B) and the event ring (4 × 72 B) are most of it. */
@@ -118,10 +131,13 @@ typedef struct {
     int8_t state;          /* sf_ctl_* */
     int16_t context;       /* −1 in INIT */
     int16_t floor;
+    int16_t pose_floor;    /* the primary pose's: the context's, the barometric floor on a staircase or in an elevator */
     int16_t port;          /* the transition's port, −1 outside one */
     bool port_outdoor;     /* the transition's neighbourhood leads outdoors (GNSS on) */
     bool elevator_seen;
+    bool on_stairs;          /* a stairs step was credited in this transition (sf_activity_stairs_*) */
     int32_t steps_at_start; /* step count when the transition began */
+    int32_t steps_at_stairs; /* step count before the transition's first stairs step */
     int32_t walk_steps;     /* walking steps credited since the elevator was last seen */
     int32_t step_count;     /* latest seen */
     int64_t elevator_t_us;  /* the latest elevator activity seen in the transition */

@@ -41,7 +41,7 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
     }
     /* a switch to a context on another floor: every scheme's floor follows the controller's (the body
      * stays where it is, its floor number changes, as when the floor vote renumbers) */
-    const int32_t shift = (int32_t)sf_controller_floor(c) - (int32_t)sf_floor_current(&e->floor);
+    const int32_t shift = (int32_t)c->floor - (int32_t)sf_floor_current(&e->floor); /* the context's floor */
     sf_floor_shift(&e->floor, shift, false);
 }
 

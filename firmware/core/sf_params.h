@@ -279,7 +279,8 @@
     X(controller, port_leave_m,    double,  2.0,     0.0,     100.0,   "m",     "beyond radius + margin + this from the port the walker has left it (LEFT_PORT: the old context stays); about three steps") \
     X(controller, cls_window_s,    double,  3.0,     0.1,     600.0,   "s",     "a CLS identification stays valid this long (two Wi-Fi scans or a few BLE windows)") \
     X(controller, cls_gnss_accuracy_m, double, 10.0, 0.0,     1e4,     "m",     "a GNSS fix at or better than this accuracy identifies the outdoor context (open sky 2-5 m on a consumer receiver; the simulator's indoor-degraded GNSS reports >= 12 m)") \
-    X(controller, recal_sigma_m,   double,  1.0,     0.01,    100.0,   "m",     "1 sigma of the staircase-endpoint recalibration fix (a flight's landing is about a metre across)")
+    X(controller, recal_sigma_m,   double,  1.0,     0.01,    100.0,   "m",     "1 sigma of the staircase-endpoint recalibration fix (a flight's landing is about a metre across)") \
+    X(controller, floor_from_barometer, int32_t, 1,  0,       1,       "",      "1 = at an elevator or stairs exit the barometric floor decides when the CLS names no floor or several (one of them); 0 = the CLS alone (the paper's literal rule)")
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \

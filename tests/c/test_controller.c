@@ -125,6 +125,7 @@ static int drain(sf_controller_t *const c, sf_context_event_t *const evs, const 
 static void setup(sf_controller_t *const c, sf_params_t *const p, const sf_site_t *const site)
 {
     sf_params_default(p);
+    p->controller_floor_from_barometer = 0; /* the paper's rules: the CLS alone names the floor */
     assert_int_equal(sf_controller_attach(c, p, site, NULL), SF_OK);
     assert_true(sf_controller_active(c));
 }
@@ -438,7 +439,8 @@ static void test_door(void **state)
     assert_true(ev[0].switched);
     assert_int_equal(ev[0].scheme, sf_scheme_ekf);
 
-    /* the paper's unresolved tie: GNSS and floor 0 both identified at the entrance → the outline */
+    /* the paper's unresolved tie: GNSS and floor 0 both identified at the entrance → the GNSS side,
+     * outdoors, wherever the position is (an accurate fix needs open sky; Wi-Fi carries through a door) */
     for (int inside = 0; inside <= 1; inside++) {
         sf_controller_t d;
         outdoors_at_door(&d, &p, &site);
@@ -449,6 +451,19 @@ static void test_door(void **state)
         assert_int_equal(drain(&d, ev, 4), 1);
         assert_int_equal(ev[0].rule, sf_ctl_rule_door);
         assert_int_equal(ev[0].cls_identified, 2);
+        assert_int_equal(ev[0].cls_method, sf_fix_gnss);
+        assert_int_equal(ev[0].context, 0);
+        assert_false(ev[0].switched);
+    }
+    /* nothing identified at 5 steps → the outline that holds the position decides */
+    for (int inside = 0; inside <= 1; inside++) {
+        sf_controller_t d;
+        outdoors_at_door(&d, &p, &site);
+        m = at(3500000, 10.0, inside ? 3.5 : -3.5, 0, 5, sf_activity_walking);
+        assert_true(sf_controller_update(&d, &p, &m));
+        assert_int_equal(drain(&d, ev, 4), 1);
+        assert_int_equal(ev[0].rule, sf_ctl_rule_door);
+        assert_int_equal(ev[0].cls_identified, 0);
         assert_int_equal(ev[0].cls_method, 0);
         assert_int_equal(ev[0].context, inside ? 1 : 0);
         assert_true(ev[0].switched == (inside != 0));
@@ -706,6 +721,116 @@ static void test_estimator_gate_and_port_fix(void **state)
     assert_false(has_fix);
 }
 
+/* ---- the barometer's floor and the staircase's own steps (our rules, sf_controller.h) -------------- */
+
+/* GIVEN an elevator transition with controller.floor_from_barometer = 1, WHEN the ride ends and the user
+ * walks again, THEN the barometric floor decides when the CLS identified nothing, breaks a tie it is
+ * part of, and never overrules a unique identification. */
+static void test_barometer_decides_the_floor(void **state)
+{
+    (void)state;
+    const sf_site_t site = campus();
+    sf_context_event_t ev[4];
+    /* nothing heard after the ride, the barometer on floor 2 → floor 2, by the barometer */
+    sf_controller_t c;
+    sf_params_t p;
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
+    sf_ctl_motion_t m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    (void)drain(&c, ev, 4);
+    ride(&c, 3 * S_US, 5 * S_US);
+    m = at(6 * S_US, 15.0, 14.0, 2, 1, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m)); /* one walking step: not yet walking again */
+    m = at(6500000, 15.0, 12.0, 2, 2, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].rule, sf_ctl_rule_elevator);
+    assert_int_equal(ev[0].context, 3);
+    assert_int_equal(ev[0].floor, 2);
+    assert_true(ev[0].floor_from_barometer);
+    assert_int_equal(ev[0].cls_identified, 0);
+
+    /* floors 1 and 2 heard together, the barometer on floor 2 → floor 2 (the tie broken) */
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
+    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    (void)drain(&c, ev, 4);
+    ride(&c, 3 * S_US, 5 * S_US);
+    hear_floors(&c, &p, 6 * S_US, 6u);
+    m = at(6 * S_US, 15.0, 12.0, 2, 2, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].context, 3);
+    assert_true(ev[0].floor_from_barometer);
+    assert_int_equal(ev[0].cls_identified, 2);
+
+    /* the same tie with the barometer on floor 0 (not among those heard) → no exit */
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
+    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    (void)drain(&c, ev, 4);
+    ride(&c, 3 * S_US, 5 * S_US);
+    hear_floors(&c, &p, 6 * S_US, 6u);
+    m = at(6 * S_US, 15.0, 13.0, 0, 2, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    assert_int_equal(c.state, sf_ctl_transition);
+
+    /* floor 1 unique, the barometer on floor 2 → floor 1: the CLS's unique identification wins */
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
+    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    (void)drain(&c, ev, 4);
+    ride(&c, 3 * S_US, 5 * S_US);
+    hear_floors(&c, &p, 6 * S_US, 2u);
+    m = at(6 * S_US, 15.0, 12.0, 2, 2, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].context, 2);
+    assert_false(ev[0].floor_from_barometer);
+}
+
+/* GIVEN a stairs transition begun on the approach, WHEN level steps then stairs steps are credited,
+ * THEN only the steps from the first stairs step count toward the staircase's 20. */
+static void test_stairs_count_from_the_first_stair(void **state)
+{
+    (void)state;
+    const sf_site_t site = campus();
+    sf_controller_t c;
+    sf_params_t p;
+    setup(&c, &p, &site);
+    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
+    sf_ctl_motion_t m = at(2 * S_US, 3.0, 15.0, 0, 100, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    sf_context_event_t ev[4];
+    (void)drain(&c, ev, 4);
+    /* 8 level steps inside the port's disc (the approach), floor 1 heard: no exit */
+    hear_floors(&c, &p, 5 * S_US, 2u);
+    m = at(5 * S_US, 4.0, 15.0, 0, 108, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    /* the first stairs step, then 18 more: 19 on the staircase (27 since the transition began) */
+    m = at(6 * S_US, 4.5, 15.0, 0, 109, sf_activity_stairs_up);
+    assert_false(sf_controller_update(&c, &p, &m));
+    hear_floors(&c, &p, 14 * S_US, 2u);
+    m = at(14 * S_US, 5.5, 15.0, 0, 127, sf_activity_stairs_up);
+    assert_false(sf_controller_update(&c, &p, &m));
+    /* the 20th step on the staircase → exit to floor 1, recalibrated */
+    m = at(14500000, 6.0, 15.0, 0, 128, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_true(sf_controller_next_event(&c, &ev[0]));
+    assert_int_equal(ev[0].rule, sf_ctl_rule_stairs);
+    assert_int_equal(ev[0].context, 2);
+    assert_int_equal(ev[0].steps_in_transition, 20);
+    assert_true(ev[0].recalibrated);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -719,6 +844,8 @@ int main(void)
         cmocka_unit_test(test_left_port),
         cmocka_unit_test(test_attach_checks_the_map),
         cmocka_unit_test(test_estimator_gate_and_port_fix),
+        cmocka_unit_test(test_barometer_decides_the_floor),
+        cmocka_unit_test(test_stairs_count_from_the_first_stair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
