@@ -15,6 +15,8 @@ const char *sf_controller_rule_text(const int rule)
     case sf_ctl_rule_elevator: return "elevator: walking again and a unique floor";
     case sf_ctl_rule_stairs: return "stairs: the staircase's steps and a unique floor";
     case sf_ctl_rule_door: return "door: steps since the transition began";
+    case sf_ctl_rule_lost: return "lost: no accurate GNSS fix outdoors, every context searched again";
+    case sf_ctl_rule_barometer: return "barometer: the floor changed away from any port";
     case sf_ctl_rule_left_port: return "left the port: the old context stays";
     default: return "unknown rule";
     }
@@ -26,8 +28,10 @@ void sf_controller_init(sf_controller_t *const c, const sf_params_t *const p)
                            .state = sf_ctl_init,
                            .context = -1,
                            .floor = (int16_t)p->init_floor,
-                           .pose_floor = (int16_t)p->init_floor,
-                           .port = -1};
+                           .port = -1,
+                           .gnss_good_t_us = INT64_MIN,
+                           .context_t_us = INT64_MIN,
+                           .disagree_t_us = INT64_MIN};
 }
 
 int sf_controller_attach(sf_controller_t *const c, const sf_params_t *const p, const sf_site_t *const site,
@@ -79,6 +83,9 @@ void sf_controller_gnss(sf_controller_t *const c, const sf_params_t *const p, co
 {
     if (c->active) {
         sf_cls_gnss(&c->cls, &c->site->contexts, t_us, accuracy_m, p->controller_cls_gnss_accuracy_m);
+        if (accuracy_m >= 0.0 && accuracy_m <= p->controller_cls_gnss_accuracy_m && t_us > c->gnss_good_t_us) {
+            c->gnss_good_t_us = t_us;
+        }
     }
 }
 
@@ -110,7 +117,17 @@ int sf_controller_scheme(const sf_controller_t *const c)
 
 int16_t sf_controller_floor(const sf_controller_t *const c)
 {
-    return c->pose_floor;
+    return c->floor;
+}
+
+int16_t sf_controller_pose_floor(const sf_controller_t *const c, const sf_params_t *const p, const int16_t baro_floor)
+{
+    if (c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
+        c->site->ports.kind[c->port] != sf_port_door && baro_floor >= c->site->ports.floor_lo[c->port] &&
+        baro_floor <= c->site->ports.floor_hi[c->port]) {
+        return baro_floor; /* on the staircase or in the cab the floor changes before the context does */
+    }
+    return c->floor;
 }
 
 bool sf_controller_source_on(const sf_controller_t *const c, const int method)
@@ -192,6 +209,13 @@ static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const
         .ble_on = sf_controller_source_on(c, sf_fix_ble),
     };
     c->switches += ev.switched ? 1u : 0u;
+    if (ev.switched) { /* the latest switch: its rule, and whether the barometer decided its floor */
+        c->last_rule = rule;
+        c->last_by_baro = by_baro;
+    }
+    if (ev.state == sf_ctl_in_context) {
+        c->context_t_us = m->t_us;
+    }
     push(c, &ev);
 }
 
@@ -311,6 +335,54 @@ static int16_t gnss_outdoor(const sf_controller_t *const c, const int64_t since_
     return -1;
 }
 
+/* IN_CONTEXT outdoors without an accurate GNSS fix for controller.context_lost_s: back to INIT with the
+ * unlimited CLS (rule LOST). */
+static bool lost_outdoors(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
+{
+    if (p->controller_context_lost_s <= 0.0 || c->site->contexts.kind[c->context] != sf_context_outdoor) {
+        return false;
+    }
+    const int64_t since_us = c->gnss_good_t_us > c->context_t_us ? c->gnss_good_t_us : c->context_t_us;
+    if ((double)(m->t_us - since_us) * 1e-6 < p->controller_context_lost_s) {
+        return false;
+    }
+    const int16_t prev = c->context;
+    c->state = sf_ctl_init;
+    c->context = -1;
+    sf_cls_start(&c->cls, sf_cls_all(&c->site->contexts));
+    sf_cls_result_t r;
+    sf_cls_result(&c->cls, INT64_MAX, &r);
+    emit(c, m, sf_ctl_rule_lost, prev, &r, false, 0.0, 0.0, false);
+    return true;
+}
+
+/* IN_CONTEXT near no port: a barometric floor of the same building held away from the context's floor
+ * for controller.floor_disagree_s means a stairs or elevator transition the position missed (rule
+ * BAROMETER); the floor context of that floor follows. */
+static void missed_transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
+{
+    const sf_context_map_t *const map = &c->site->contexts;
+    const int16_t to = map->kind[c->context] == sf_context_floor && m->floor != c->floor
+                           ? sf_cls_context_of(map, map->building[c->context], m->floor)
+                           : -1;
+    if (!p->controller_floor_from_barometer || p->controller_floor_disagree_s <= 0.0 || to < 0 ||
+        to == c->context || map->building[to] != map->building[c->context]) {
+        c->disagree_t_us = INT64_MIN;
+        return;
+    }
+    if (c->disagree_t_us == INT64_MIN) {
+        c->disagree_t_us = m->t_us;
+    }
+    if ((double)(m->t_us - c->disagree_t_us) * 1e-6 >= p->controller_floor_disagree_s) {
+        const int16_t prev = c->context;
+        c->context = to;
+        c->floor = floor_of(c, to, m->floor);
+        c->disagree_t_us = INT64_MIN;
+        sf_cls_result_t none = {.unique = -1};
+        emit(c, m, sf_ctl_rule_barometer, prev, &none, false, 0.0, 0.0, true);
+    }
+}
+
 static void transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
     const int32_t q = c->port;
@@ -339,7 +411,8 @@ static void transition(sf_controller_t *const c, const sf_params_t *const p, con
     }
     if (kind == sf_port_door && steps >= p->controller_door_steps) {
         int16_t to = r.unique;
-        const int16_t sky = r.identified >= 2 ? gnss_outdoor(c, since_us) : -1;
+        const int64_t fresh_us = m->t_us - (int64_t)(p->controller_cls_gnss_fresh_s * 1e6);
+        const int16_t sky = r.identified >= 2 ? gnss_outdoor(c, fresh_us > since_us ? fresh_us : since_us) : -1;
         if (to < 0 && sky >= 0) {
             /* a tie at an entrance with a GNSS fix among it: an accurate GNSS fix needs open sky,
              * while Wi-Fi and BLE carry through a doorway, so the GNSS side wins (the paper leaves the
@@ -384,7 +457,6 @@ bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, 
         return false;
     }
     const int32_t before = c->ev_n + (int32_t)c->events_dropped;
-    const int16_t context_before = c->context;
     sf_controller_activity(c, m->t_us, m->activity);
     const int32_t new_steps = m->step_count > c->step_count ? m->step_count - c->step_count : 0;
     c->step_count = m->step_count;
@@ -414,21 +486,20 @@ bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, 
         if (c->site->contexts.kind[c->context] == sf_context_building) {
             c->floor = m->floor;
         }
+        if (lost_outdoors(c, p, m)) {
+            break;
+        }
         const int16_t q = m->has_position ? near_port(c, p, m->x_m, m->y_m, c->floor) : -1;
         if (q >= 0) {
+            c->disagree_t_us = INT64_MIN;
             begin_transition(c, m, q);
+        } else {
+            missed_transition(c, p, m);
         }
         break;
     }
     case sf_ctl_transition: transition(c, p, m); break;
     default: break;
-    }
-    c->pose_floor = c->floor;
-    /* (after a switch in this update the motion's floor is the one before the estimator followed) */
-    if (c->context == context_before && c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
-        c->site->ports.kind[c->port] != sf_port_door && m->floor >= c->site->ports.floor_lo[c->port] &&
-        m->floor <= c->site->ports.floor_hi[c->port]) {
-        c->pose_floor = m->floor;
     }
     return c->ev_n + (int32_t)c->events_dropped != before;
 }

@@ -49,7 +49,9 @@ enum {
     sf_ctl_rule_elevator = 3,
     sf_ctl_rule_stairs = 4,
     sf_ctl_rule_door = 5,
-    sf_ctl_rule_left_port = 6
+    sf_ctl_rule_left_port = 6,
+    sf_ctl_rule_barometer = 7,
+    sf_ctl_rule_lost = 8
 };
 
 /* One CONTEXT message (context_t, field for field). */
@@ -110,6 +112,11 @@ const char *sf_controller_rule_text(int rule);
  *                          several, the barometric floor (sf_ctl_motion_t.floor) if the port joins it:
  *                          "with a barometer, vertical displacement gives the floor unambiguously"
  *                          (the paper §III-C, [15]); the event says which (floor_from_barometer);
+ *   lost outdoors          (context_lost_s) IN_CONTEXT outdoors without an accurate GNSS fix for that
+ *                          long → INIT, the unlimited CLS (rule LOST): a door decided wrong or missed;
+ *   missed transition      (floor_from_barometer) IN_CONTEXT in a floor context and near no port, the
+ *                          barometric floor held on another floor of the building for
+ *                          controller.floor_disagree_s → that floor's context (rule BAROMETER);
  *   stairs recalibration   the endpoint on the new floor: floor_hi's when the new floor is floor_hi,
  *                          else floor_lo's;
  *   door                   the unique identification; a tie that holds the outdoor context identified
@@ -118,7 +125,7 @@ const char *sf_controller_rule_text(int rule);
  *                          position, the floor), outside every outline the outdoor context;
  *   floor                  the context's floor (floor and outdoor contexts), the estimator's
  *                          (sf_ctl_motion_t.floor) in INIT and in a building context; the primary
- *                          pose's (sf_controller_floor) is the barometric floor during a stairs or
+ *                          pose's (sf_controller_pose_floor) is the barometric floor during a stairs or
  *                          elevator transition when that is one of the port's floors (the floor
  *                          changes there, the context only at the exit) and controller.floor_from_barometer.
  * Cost per update O(n_ports + n_contexts) (plus a neighbourhood, sf_cls.h, when a transition begins);
@@ -131,11 +138,15 @@ typedef struct {
     int8_t state;          /* sf_ctl_* */
     int16_t context;       /* −1 in INIT */
     int16_t floor;
-    int16_t pose_floor;    /* the primary pose's: the context's, the barometric floor on a staircase or in an elevator */
     int16_t port;          /* the transition's port, −1 outside one */
     bool port_outdoor;     /* the transition's neighbourhood leads outdoors (GNSS on) */
     bool elevator_seen;
-    bool on_stairs;          /* a stairs step was credited in this transition (sf_activity_stairs_*) */
+    bool on_stairs;
+    int64_t gnss_good_t_us;  /* the latest GNSS fix within controller.cls_gnss_accuracy_m */
+    int64_t context_t_us;    /* when the state last became IN_CONTEXT */
+    int8_t last_rule;        /* the rule of the latest switch */
+    bool last_by_baro;       /* ... and whether the barometer decided its floor */
+    int64_t disagree_t_us;   /* since when the barometric floor has differed from the context's (INT64_MIN: it agrees) */          /* a stairs step was credited in this transition (sf_activity_stairs_*) */
     int32_t steps_at_start; /* step count when the transition began */
     int32_t steps_at_stairs; /* step count before the transition's first stairs step */
     int32_t walk_steps;     /* walking steps credited since the elevator was last seen */
@@ -184,6 +195,8 @@ bool sf_controller_source_on(const sf_controller_t *c, int method);
  * controller's floor, whether it runs. */
 int sf_controller_scheme(const sf_controller_t *c);
 int16_t sf_controller_floor(const sf_controller_t *c);
+/* The primary pose's floor given the estimator's barometric floor now (see floor above). */
+int16_t sf_controller_pose_floor(const sf_controller_t *c, const sf_params_t *p, int16_t baro_floor);
 bool sf_controller_active(const sf_controller_t *c);
 
 #endif

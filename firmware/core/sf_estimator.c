@@ -273,7 +273,7 @@ bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *
             return false;
         }
         pose->scheme = sf_scheme_controller;
-        pose->floor = sf_controller_floor(c);
+        pose->floor = sf_controller_pose_floor(c, p, sf_floor_current(&e->floor));
         return true;
     }
     if (scheme < 0 || scheme >= sf_scheme_count) {

@@ -39,6 +39,11 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
     if (!queued || c->switches == switches) { /* no event, or none that switched */
         return;
     }
+    const bool vertical = c->last_rule == sf_ctl_rule_stairs || c->last_rule == sf_ctl_rule_elevator;
+    const bool counting = e->floor.started && !sf_floor_settled(&e->floor, p); /* a barometer mid-climb */
+    if (c->last_rule == sf_ctl_rule_barometer || (vertical && (c->last_by_baro || counting))) {
+        return; /* the barometer's own floor, or one still counting the climb: a shift would count it twice */
+    }
     /* a switch to a context on another floor: every scheme's floor follows the controller's (the body
      * stays where it is, its floor number changes, as when the floor vote renumbers) */
     const int32_t shift = (int32_t)c->floor - (int32_t)sf_floor_current(&e->floor); /* the context's floor */

@@ -280,7 +280,10 @@
     X(controller, cls_window_s,    double,  3.0,     0.1,     600.0,   "s",     "a CLS identification stays valid this long (two Wi-Fi scans or a few BLE windows)") \
     X(controller, cls_gnss_accuracy_m, double, 10.0, 0.0,     1e4,     "m",     "a GNSS fix at or better than this accuracy identifies the outdoor context (open sky 2-5 m on a consumer receiver; the simulator's indoor-degraded GNSS reports >= 12 m)") \
     X(controller, recal_sigma_m,   double,  1.0,     0.01,    100.0,   "m",     "1 sigma of the staircase-endpoint recalibration fix (a flight's landing is about a metre across)") \
-    X(controller, floor_from_barometer, int32_t, 1,  0,       1,       "",      "1 = at an elevator or stairs exit the barometric floor decides when the CLS names no floor or several (one of them); 0 = the CLS alone (the paper's literal rule)")
+    X(controller, floor_from_barometer, int32_t, 1,  0,       1,       "",      "1 = at an elevator or stairs exit the barometric floor decides when the CLS names no floor or several (one of them); 0 = the CLS alone (the paper's literal rule)") \
+    X(controller, floor_disagree_s, double, 0.0,     0.0,     3600.0,  "s",     "with floor_from_barometer: in a floor context, a barometric floor of the same building held this long away from the context's floor outside any port switches to that floor's context (a stairs or elevator transition the position missed; 10 s is a flight, 3 s a ride per floor); 0 = never, the default: the barometric floor itself errs on 3 of 10 campus2 walks, where the rule switched falsely") \
+    X(controller, context_lost_s,  double,  10.0,    0.0,     3600.0,  "s",     "in the outdoor context, this long without a GNSS fix within cls_gnss_accuracy_m sends the controller back to INIT (the CLS searches every context: the walker is indoors); 0 = never") \
+    X(controller, cls_gnss_fresh_s, double, 1.5,     0.0,     600.0,   "s",     "a GNSS identification breaks a tie at a door only this fresh (one 1 Hz receiver period and a half: a walker inside the door gets no accurate fix after it)")
 
 #define SF_PARAM_LIST(X) \
     SF_PARAMS_INIT(X) SF_PARAMS_GATE(X) SF_PARAMS_GAP(X) SF_PARAMS_ESTIMATOR(X) SF_PARAMS_ATTITUDE(X) SF_PARAMS_MAGCAL(X) SF_PARAMS_STEPS(X) \

@@ -831,6 +831,73 @@ static void test_stairs_count_from_the_first_stair(void **state)
     assert_true(ev[0].recalibrated);
 }
 
+/* GIVEN the outdoor context, WHEN no accurate GNSS fix comes for controller.context_lost_s, THEN LOST:
+ * back to INIT with every context searched, and the next unique identification is taken. */
+static void test_lost_outdoors(void **state)
+{
+    (void)state;
+    const sf_site_t site = campus();
+    sf_controller_t c;
+    sf_params_t p;
+    setup(&c, &p, &site);
+    sf_controller_gnss(&c, &p, 1 * S_US, 4.0);
+    sf_ctl_motion_t m = at(1 * S_US, 30.0, -10.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    sf_context_event_t ev[4];
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].context, 0);
+    sf_controller_gnss(&c, &p, 2 * S_US, 25.0); /* inaccurate: does not keep the context alive */
+    m = at(10 * S_US, 30.0, -10.0, 0, 10, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m)); /* 9 s without an accurate fix */
+    m = at(11500000, 30.0, -10.0, 0, 12, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].rule, sf_ctl_rule_lost);
+    assert_int_equal(ev[0].state, sf_ctl_init);
+    assert_int_equal(ev[0].prev_context, 0);
+    assert_int_equal(ev[0].context, -1);
+    assert_int_equal(ev[0].cls_candidates, 5); /* unlimited: every context */
+    assert_true(ev[0].gnss_on && ev[0].wifi_on && ev[0].ble_on);
+    hear_floors(&c, &p, 12 * S_US, 1u);
+    m = at(12 * S_US, 30.0, -10.0, 0, 13, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    assert_int_equal(drain(&c, ev, 4), 1);
+    assert_int_equal(ev[0].rule, sf_ctl_rule_cls_unlimited);
+    assert_int_equal(ev[0].context, 1);
+}
+
+/* GIVEN a floor context and controller.floor_disagree_s = 10 (off by default), WHEN the barometric
+ * floor holds another floor of the building away from every port, THEN after 10 s that floor's context
+ * (rule BAROMETER); a disagreement that ends before resets the clock. */
+static void test_barometer_missed_transition(void **state)
+{
+    (void)state;
+    const sf_site_t site = campus();
+    sf_controller_t c;
+    sf_params_t p;
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    p.controller_floor_disagree_s = 10.0;
+    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
+    sf_ctl_motion_t m = at(2 * S_US, 10.0, 10.0, 1, 5, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    m = at(4 * S_US, 10.0, 10.0, 0, 7, sf_activity_walking); /* agrees again: the clock restarts */
+    assert_false(sf_controller_update(&c, &p, &m));
+    m = at(5 * S_US, 10.0, 10.0, 1, 8, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    m = at(14 * S_US, 10.0, 10.0, 1, 18, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m)); /* 9 s */
+    m = at(15 * S_US, 10.0, 10.0, 1, 19, sf_activity_walking);
+    assert_true(sf_controller_update(&c, &p, &m));
+    sf_context_event_t ev;
+    assert_true(sf_controller_next_event(&c, &ev));
+    assert_int_equal(ev.rule, sf_ctl_rule_barometer);
+    assert_int_equal(ev.prev_context, 1);
+    assert_int_equal(ev.context, 2);
+    assert_int_equal(ev.floor, 1);
+    assert_true(ev.switched && ev.floor_from_barometer);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -846,6 +913,8 @@ int main(void)
         cmocka_unit_test(test_estimator_gate_and_port_fix),
         cmocka_unit_test(test_barometer_decides_the_floor),
         cmocka_unit_test(test_stairs_count_from_the_first_stair),
+        cmocka_unit_test(test_lost_outdoors),
+        cmocka_unit_test(test_barometer_missed_transition),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
