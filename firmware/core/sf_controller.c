@@ -1,26 +1,11 @@
-/* sf_controller.c — the multi-scheme controller's state machine, policy and context-map check (see
- * sf_controller.h; the CLS and the map's geometry: sf_cls.c). */
+/* sf_controller.c — the multi-scheme controller's state machine (see sf_controller.h; its policy:
+ * sf_controller_policy.c; the CLS and the map's geometry: sf_cls.c; the map's check: sf_context_check.c). */
 #include "sf_controller.h"
 
 #include <math.h>
 #include <stddef.h>
 
 #include "sf_error.h"
-
-const char *sf_controller_rule_text(const int rule)
-{
-    switch (rule) {
-    case sf_ctl_rule_cls_unlimited: return "CLS unlimited: one context identified";
-    case sf_ctl_rule_near_port: return "near port: transition detection begins";
-    case sf_ctl_rule_elevator: return "elevator: walking again and a unique floor";
-    case sf_ctl_rule_stairs: return "stairs: the staircase's steps and a unique floor";
-    case sf_ctl_rule_door: return "door: steps since the transition began";
-    case sf_ctl_rule_lost: return "lost: no accurate GNSS fix outdoors, every context searched again";
-    case sf_ctl_rule_barometer: return "barometer: the floor changed away from any port";
-    case sf_ctl_rule_left_port: return "left the port: the old context stays";
-    default: return "unknown rule";
-    }
-}
 
 void sf_controller_init(sf_controller_t *const c, const sf_params_t *const p)
 {
@@ -101,51 +86,6 @@ void sf_controller_activity(sf_controller_t *const c, const int64_t t_us, const 
         c->walk_steps = 0; /* walking again counts from the ride's end */
         c->elevator_t_us = t_us > c->elevator_t_us ? t_us : c->elevator_t_us;
     }
-}
-
-/* ---- policy -------------------------------------------------------------------------------------- */
-
-bool sf_controller_active(const sf_controller_t *const c)
-{
-    return c->active;
-}
-
-int sf_controller_scheme(const sf_controller_t *const c)
-{
-    return c->active && c->context >= 0 ? c->site->contexts.scheme[c->context] : c->init_scheme;
-}
-
-int16_t sf_controller_floor(const sf_controller_t *const c)
-{
-    return c->floor;
-}
-
-int16_t sf_controller_pose_floor(const sf_controller_t *const c, const sf_params_t *const p, const int16_t baro_floor)
-{
-    if (c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
-        c->site->ports.kind[c->port] != sf_port_door && baro_floor >= c->site->ports.floor_lo[c->port] &&
-        baro_floor <= c->site->ports.floor_hi[c->port]) {
-        return baro_floor; /* on the staircase or in the cab the floor changes before the context does */
-    }
-    return c->floor;
-}
-
-bool sf_controller_source_on(const sf_controller_t *const c, const int method)
-{
-    if (!c->active || method == sf_fix_landmark || method == sf_fix_port) {
-        return true;
-    }
-    const sf_context_map_t *const m = &c->site->contexts;
-    if (c->state == sf_ctl_init) {
-        return method == sf_fix_gnss || sf_cls_uses(m, c->cls.candidates, method); /* Table I: all on */
-    }
-    const bool lsd = c->context >= 0 && m->method[c->context] == method;
-    const bool outdoor = c->context >= 0 && m->kind[c->context] == sf_context_outdoor;
-    if (c->state == sf_ctl_in_context) {
-        return lsd || (method == sf_fix_gnss && outdoor);
-    }
-    /* a transition: the LSD, what the limited CLS needs, GNSS at a port with an outdoor neighbour */
-    return lsd || (method == sf_fix_gnss && (outdoor || c->port_outdoor)) || sf_cls_uses(m, c->cls.candidates, method);
 }
 
 /* ---- the state machine --------------------------------------------------------------------------- */
@@ -356,6 +296,18 @@ static bool lost_outdoors(sf_controller_t *const c, const sf_params_t *const p, 
     return true;
 }
 
+/* The building has a stairs or elevator port (a floor change there is the port rules' to see). */
+bool sf_controller_has_vertical_port(const sf_controller_t *const c, const int32_t building)
+{
+    const sf_ports_t *const ports = &c->site->ports;
+    for (int32_t q = 0; q < ports->n_ports; q++) {
+        if (ports->kind[q] != sf_port_door && c->site->contexts.port_building[q] == building) {
+            return true;
+        }
+    }
+    return false;
+}
+
 /* IN_CONTEXT near no port: a barometric floor of the same building held away from the context's floor
  * for controller.floor_disagree_s means a stairs or elevator transition the position missed (rule
  * BAROMETER); the floor context of that floor follows. */
@@ -365,7 +317,9 @@ static void missed_transition(sf_controller_t *const c, const sf_params_t *const
     const int16_t to = map->kind[c->context] == sf_context_floor && m->floor != c->floor
                            ? sf_cls_context_of(map, map->building[c->context], m->floor)
                            : -1;
-    if (!p->controller_floor_from_barometer || p->controller_floor_disagree_s <= 0.0 || to < 0 ||
+    const bool allowed = p->controller_barometer_rule == 2 ||
+                         (p->controller_barometer_rule == 1 && !sf_controller_has_vertical_port(c, map->building[c->context]));
+    if (!allowed || !p->controller_floor_from_barometer || p->controller_floor_disagree_s <= 0.0 || to < 0 ||
         to == c->context || map->building[to] != map->building[c->context]) {
         c->disagree_t_us = INT64_MIN;
         return;

@@ -195,7 +195,11 @@ bool sf_controller_source_on(const sf_controller_t *c, int method);
  * controller's floor, whether it runs. */
 int sf_controller_scheme(const sf_controller_t *c);
 int16_t sf_controller_floor(const sf_controller_t *c);
-/* The primary pose's floor given the estimator's barometric floor now (see floor above). */
+/* Whether the building (index) has a stairs or elevator port. */
+bool sf_controller_has_vertical_port(const sf_controller_t *c, int32_t building);
+/* The primary pose's floor given the estimator's barometric floor now (see floor above; in a floor
+ * context of a building without a stairs or elevator port, with controller.barometer_rule ≥ 1, the
+ * barometric floor: nothing else there sees the floor change, the context follows it by BAROMETER). */
 int16_t sf_controller_pose_floor(const sf_controller_t *c, const sf_params_t *p, int16_t baro_floor);
 bool sf_controller_active(const sf_controller_t *c);
 

@@ -50,10 +50,10 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
     sf_floor_shift(&e->floor, shift, false);
 }
 
-bool sf_estimator_context_off(sf_estimator_t *const e, const int8_t method, const int64_t t_us,
+bool sf_estimator_context_off(sf_estimator_t *const e, const sf_params_t *const p, const int8_t method, const int64_t t_us,
                               sf_fix_audit_t audits[sf_scheme_count], int *const n)
 {
-    if (sf_controller_source_on(&e->controller, method)) {
+    if (!p->controller_gate_sources || sf_controller_source_on(&e->controller, method)) {
         return false;
     }
     e->context_off++;

@@ -170,7 +170,7 @@ int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const
     *has_fix = false;
     sf_controller_wifi(&e->controller, p, scan);
     int n;
-    if (!sf_estimator_context_off(e, sf_fix_wifi, scan->t_us, audits, &n)) {
+    if (!sf_estimator_context_off(e, p, sf_fix_wifi, scan->t_us, audits, &n)) {
         n = wifi_fix(e, p, scan, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, scan->t_us);
@@ -184,7 +184,7 @@ int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const
     e->gnss_offered++;
     sf_controller_gnss(&e->controller, p, gnss->t_us, gnss->accuracy_m);
     int n;
-    if (!sf_estimator_context_off(e, sf_fix_gnss, gnss->t_us, audits, &n)) {
+    if (!sf_estimator_context_off(e, p, sf_fix_gnss, gnss->t_us, audits, &n)) {
         n = gnss_fix(e, p, gnss, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, gnss->t_us);
@@ -197,7 +197,7 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     *has_fix = false;
     sf_controller_ble(&e->controller, p, scan);
     int n;
-    if (!sf_estimator_context_off(e, sf_fix_ble, scan->t_us, audits, &n)) {
+    if (!sf_estimator_context_off(e, p, sf_fix_ble, scan->t_us, audits, &n)) {
         n = ble_fix(e, p, scan, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, scan->t_us);

@@ -22,7 +22,7 @@ int sf_estimator_refuse(sf_estimator_t *e, int64_t t_us, int8_t method, int16_t 
 void sf_estimator_run_controller(sf_estimator_t *e, const sf_params_t *p, int64_t t_us);
 
 /* Whether the controller keeps this source off now; if so, *n = the CONTEXT_OFF audits written. */
-bool sf_estimator_context_off(sf_estimator_t *e, int8_t method, int64_t t_us,
+bool sf_estimator_context_off(sf_estimator_t *e, const sf_params_t *p, int8_t method, int64_t t_us,
                               sf_fix_audit_t audits[sf_scheme_count], int *n);
 
 #endif

@@ -639,6 +639,7 @@ static void test_estimator_gate_and_port_fix(void **state)
     static sf_fingerprint_workspace_t ws;
     sf_params_t p;
     sf_params_default(&p);
+    p.controller_gate_sources = 1; /* the paper's one method at a time: what is off is withheld */
     p.init_use_config_pose = 1; /* every scheme starts at the foot of the stairs, floor 0 */
     p.init_x_m = 5.0;
     p.init_y_m = 15.0;
@@ -878,6 +879,7 @@ static void test_barometer_missed_transition(void **state)
     setup(&c, &p, &site);
     p.controller_floor_from_barometer = 1;
     p.controller_floor_disagree_s = 10.0;
+    p.controller_barometer_rule = 2; /* everywhere: the test building has stairs and an elevator */
     enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
     sf_ctl_motion_t m = at(2 * S_US, 10.0, 10.0, 1, 5, sf_activity_walking);
     assert_false(sf_controller_update(&c, &p, &m));
