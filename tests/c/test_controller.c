@@ -898,6 +898,18 @@ static void test_barometer_missed_transition(void **state)
     assert_int_equal(ev.context, 2);
     assert_int_equal(ev.floor, 1);
     assert_true(ev.switched && ev.floor_from_barometer);
+
+    /* the default (barometer_rule 1): building A has stairs and an elevator, so their rules alone
+     * change its floor, and the primary pose keeps the context's floor */
+    setup(&c, &p, &site);
+    p.controller_floor_from_barometer = 1;
+    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
+    m = at(2 * S_US, 10.0, 10.0, 1, 5, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    m = at(30 * S_US, 10.0, 10.0, 1, 40, sf_activity_walking);
+    assert_false(sf_controller_update(&c, &p, &m));
+    assert_int_equal(c.context, 1);
+    assert_int_equal(sf_controller_pose_floor(&c, &p, 1), 0);
 }
 
 int main(void)

@@ -306,7 +306,9 @@ def build_context_map(
             has_ble = bool(np.any(in_b & (bfl == f)))
             mapped = bool(np.any(in_w & (wall_floor == f)))
             scheme, method = lsd(
-                ("floor", b.name, f), "ble" if has_ble else "wifi", MAPPED_SCHEME if mapped else DEFAULT_SCHEME
+                ("floor", b.name, f),
+                "ble" if has_ble else "wifi",
+                MAPPED_SCHEME if mapped else DEFAULT_SCHEME,
             )
             contexts.append(
                 _Context(

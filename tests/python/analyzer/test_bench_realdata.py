@@ -43,7 +43,10 @@ def test_targets_met_missed_and_not_run(tmp_path):
     assert math.isnan(by["site2/F3 [first fix] ekf mean <= 10"]["value"])
     assert "realbench site2/F3 [first fix] ekf mean <= 10: not run" in missed
     assert by["gsd/building 100 [true start] pdr_only mean <= 6"]["met"]
-    assert "realbench gsd/building 100 Trial51 [first fix] ekf floor_hit_rate >= 0.99: 0.9 (bound 0.99)" in missed
+    assert (
+        "realbench gsd/building 100 Trial51 [first fix] ekf floor_hit_rate >= 0.99: 0.9 (bound 0.99)"
+        in missed
+    )
 
 
 def test_bad_file_is_named(tmp_path):
