@@ -724,6 +724,19 @@ static void test_estimator_gate_and_port_fix(void **state)
 
 /* ---- the barometer's floor and the staircase's own steps (our rules, sf_controller.h) -------------- */
 
+/* GIVEN a walker on floor 0 of A who rode the elevator (3–5 s) with controller.floor_from_barometer. */
+static void ridden(sf_controller_t *const c, sf_params_t *const p, const sf_site_t *const site)
+{
+    setup(c, p, site);
+    p->controller_floor_from_barometer = 1;
+    enter_floor(c, p, 1 * S_US, 0, 15.0, 12.0);
+    const sf_ctl_motion_t m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
+    assert_true(sf_controller_update(c, p, &m));
+    sf_context_event_t ev[4];
+    (void)drain(c, ev, 4);
+    ride(c, 3 * S_US, 5 * S_US);
+}
+
 /* GIVEN an elevator transition with controller.floor_from_barometer = 1, WHEN the ride ends and the user
  * walks again, THEN the barometric floor decides when the CLS identified nothing, breaks a tie it is
  * part of, and never overrules a unique identification. */
@@ -732,17 +745,11 @@ static void test_barometer_decides_the_floor(void **state)
     (void)state;
     const sf_site_t site = campus();
     sf_context_event_t ev[4];
-    /* nothing heard after the ride, the barometer on floor 2 → floor 2, by the barometer */
     sf_controller_t c;
     sf_params_t p;
-    setup(&c, &p, &site);
-    p.controller_floor_from_barometer = 1;
-    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
-    sf_ctl_motion_t m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
-    (void)drain(&c, ev, 4);
-    ride(&c, 3 * S_US, 5 * S_US);
-    m = at(6 * S_US, 15.0, 14.0, 2, 1, sf_activity_walking);
+    /* nothing heard after the ride, the barometer on floor 2 → floor 2, by the barometer */
+    ridden(&c, &p, &site);
+    sf_ctl_motion_t m = at(6 * S_US, 15.0, 14.0, 2, 1, sf_activity_walking);
     assert_false(sf_controller_update(&c, &p, &m)); /* one walking step: not yet walking again */
     m = at(6500000, 15.0, 12.0, 2, 2, sf_activity_walking);
     assert_true(sf_controller_update(&c, &p, &m));
@@ -754,13 +761,7 @@ static void test_barometer_decides_the_floor(void **state)
     assert_int_equal(ev[0].cls_identified, 0);
 
     /* floors 1 and 2 heard together, the barometer on floor 2 → floor 2 (the tie broken) */
-    setup(&c, &p, &site);
-    p.controller_floor_from_barometer = 1;
-    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
-    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
-    (void)drain(&c, ev, 4);
-    ride(&c, 3 * S_US, 5 * S_US);
+    ridden(&c, &p, &site);
     hear_floors(&c, &p, 6 * S_US, 6u);
     m = at(6 * S_US, 15.0, 12.0, 2, 2, sf_activity_walking);
     assert_true(sf_controller_update(&c, &p, &m));
@@ -770,26 +771,14 @@ static void test_barometer_decides_the_floor(void **state)
     assert_int_equal(ev[0].cls_identified, 2);
 
     /* the same tie with the barometer on floor 0 (not among those heard) → no exit */
-    setup(&c, &p, &site);
-    p.controller_floor_from_barometer = 1;
-    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
-    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
-    (void)drain(&c, ev, 4);
-    ride(&c, 3 * S_US, 5 * S_US);
+    ridden(&c, &p, &site);
     hear_floors(&c, &p, 6 * S_US, 6u);
     m = at(6 * S_US, 15.0, 13.0, 0, 2, sf_activity_walking);
     assert_false(sf_controller_update(&c, &p, &m));
     assert_int_equal(c.state, sf_ctl_transition);
 
     /* floor 1 unique, the barometer on floor 2 → floor 1: the CLS's unique identification wins */
-    setup(&c, &p, &site);
-    p.controller_floor_from_barometer = 1;
-    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
-    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
-    (void)drain(&c, ev, 4);
-    ride(&c, 3 * S_US, 5 * S_US);
+    ridden(&c, &p, &site);
     hear_floors(&c, &p, 6 * S_US, 2u);
     m = at(6 * S_US, 15.0, 12.0, 2, 2, sf_activity_walking);
     assert_true(sf_controller_update(&c, &p, &m));
