@@ -186,6 +186,16 @@ def model_of(residuals: Sequence[np.ndarray]) -> dict[str, Any] | None:
     }
 
 
+def model_sets(fields: dict[str, Any]) -> list[str]:
+    """The --set list (KEYS) that gives the firmware the model of ``fields`` (site_t fix-model fields)
+    without a site that carries it: the same numbers the site would hold."""
+    f_xx, f_xy, f_yy = fields["fix_floor_cov_m2"]
+    m_xx, m_xy, m_yy = fields["fix_cov_per_acc2"]
+    values = (m_xx, m_yy, m_xy, f_xx, f_yy, f_xy)
+    values += (fields["fix_bias_sigma_m"], fields["fix_bias_length_m"], fields["fix_white_share"])
+    return [f"{k}={v:.9g}" for k, v in zip(KEYS, values, strict=True)]
+
+
 def measure(
     walks: list[dict[str, Any]],
     sites: Callable[[Any, list[dict[str, Any]], str, Path], list[str] | None],

@@ -167,7 +167,14 @@ class Measured:
             {f"{axis.name}_site_fields": f, f"{axis.name}_correlated_sigma_m": c}
             for f, c in zip(fields, sigma_c, strict=True)
         ]
-        return Choice(["measured"] * n, {f"{axis.name}_model": report}, extra, walk_site_fields=fields)
+        # later inner-CV rows (the controller's scheme) replay with each block's model as settings,
+        # so the ekf is judged there with what its fold sites give it (block a: i % n_blocks, the
+        # blocks of select.block_replays; the model of block a was measured without block a)
+        n_blocks = min(rs.DEFAULT_BLOCKS, n)
+        sets = {a: fixmodel.model_sets(f) for a in range(n_blocks) for f in fields[a::n_blocks][:1] if f}
+        return Choice(
+            ["measured"] * n, {f"{axis.name}_model": report}, extra, block_sets=sets, walk_site_fields=fields
+        )
 
 
 @dataclasses.dataclass(frozen=True)

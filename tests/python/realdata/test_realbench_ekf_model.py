@@ -96,3 +96,29 @@ def test_variance_law_separates_floor_and_accuracy_part():
     # an error that ignores the accuracy is all floor
     f, m = fixmodel.variance_law(rng.normal(0.0, 3.0, 20000) ** 2, acc**2)
     assert f == pytest.approx(9.0, rel=0.1) and m == fixmodel.MIN_PER_ACC2 or m < 0.05
+
+
+def test_model_sets_give_the_firmware_the_site_fields_numbers():
+    """The --set form of a measured model (for inner-CV replays on sites without it): every ekf.fix_*
+    key once, each with the number the site field holds."""
+    fields = {
+        "has_fix_model": True,
+        "fix_floor_cov_m2": [1.5, 0.25, 2.5],
+        "fix_cov_per_acc2": [0.5, -0.125, 0.75],
+        "fix_bias_sigma_m": 1.25,
+        "fix_bias_length_m": 12.0,
+        "fix_white_share": 0.625,
+    }
+    sets = dict(kv.split("=") for kv in fixmodel.model_sets(fields))
+    assert list(sets) == list(fixmodel.KEYS)
+    assert {k: float(v) for k, v in sets.items()} == {
+        "ekf.fix_var_x_per_acc2": 0.5,
+        "ekf.fix_var_y_per_acc2": 0.75,
+        "ekf.fix_cov_xy_per_acc2": -0.125,
+        "ekf.fix_floor_xx_m2": 1.5,
+        "ekf.fix_floor_yy_m2": 2.5,
+        "ekf.fix_floor_xy_m2": 0.25,
+        "ekf.fix_bias_sigma_m": 1.25,
+        "ekf.fix_bias_length_m": 12.0,
+        "ekf.fix_white_share": 0.625,
+    }
