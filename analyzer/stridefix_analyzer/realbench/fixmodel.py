@@ -191,8 +191,8 @@ def model_sets(fields: dict[str, Any]) -> list[str]:
     without a site that carries it: the same numbers the site would hold."""
     f_xx, f_xy, f_yy = fields["fix_floor_cov_m2"]
     m_xx, m_xy, m_yy = fields["fix_cov_per_acc2"]
-    values = (m_xx, m_yy, m_xy, f_xx, f_yy, f_xy)
-    values += (fields["fix_bias_sigma_m"], fields["fix_bias_length_m"], fields["fix_white_share"])
+    bias = (fields["fix_bias_sigma_m"], fields["fix_bias_length_m"], fields["fix_white_share"])
+    values = (m_xx, m_yy, m_xy, f_xx, f_yy, f_xy, *bias)
     return [f"{k}={v:.9g}" for k, v in zip(KEYS, values, strict=True)]
 
 
