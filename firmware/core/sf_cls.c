@@ -45,7 +45,7 @@ static void constellations(sf_cls_t *const cls, const sf_context_map_t *const ma
     int16_t hits[SF_CONTROLLER_MAX_CONTEXTS] = {0};
     for (int32_t k = 0; k < map->n_cdd; k++) {
         const int32_t ctx = map->cdd_context[k];
-        if (ctx < 0 || ctx >= n_contexts(map) || (cls->candidates & bit(ctx)) == 0 || map->cdd_method[ctx] != method) {
+        if (ctx >= n_contexts(map) || !sf_cls_searches(cls, ctx) || map->cdd_method[ctx] != method) {
             continue;
         }
         for (int32_t j = 0; j < n; j++) {
@@ -83,10 +83,21 @@ void sf_cls_gnss(sf_cls_t *const cls, const sf_context_map_t *const map, const i
         return;
     }
     for (int32_t i = 0; i < n_contexts(map); i++) {
-        if ((cls->candidates & bit(i)) != 0 && map->cdd_method[i] == sf_fix_gnss) {
+        if (sf_cls_searches(cls, i) && map->cdd_method[i] == sf_fix_gnss) {
             identify(cls, i, t_us, 1, sf_fix_gnss);
         }
     }
+}
+
+bool sf_cls_searches(const sf_cls_t *const cls, const int32_t context)
+{
+    return context >= 0 && context < SF_CONTROLLER_MAX_CONTEXTS && (cls->candidates & bit(context)) != 0;
+}
+
+bool sf_cls_identified(const sf_cls_t *const cls, const int32_t context, const int64_t since_us)
+{
+    return sf_cls_searches(cls, context) && cls->evidence[context].t_us != INT64_MIN &&
+           cls->evidence[context].t_us >= since_us;
 }
 
 void sf_cls_result(const sf_cls_t *const cls, const int64_t since_us, sf_cls_result_t *const r)
@@ -94,11 +105,11 @@ void sf_cls_result(const sf_cls_t *const cls, const int64_t since_us, sf_cls_res
     *r = (sf_cls_result_t){.unique = -1};
     int32_t last = -1;
     for (int32_t i = 0; i < SF_CONTROLLER_MAX_CONTEXTS; i++) {
-        if ((cls->candidates & bit(i)) == 0) {
+        if (!sf_cls_searches(cls, i)) {
             continue;
         }
         r->candidates++;
-        if (cls->evidence[i].t_us != INT64_MIN && cls->evidence[i].t_us >= since_us) {
+        if (sf_cls_identified(cls, i, since_us)) {
             r->identified++;
             last = i;
         }

@@ -74,6 +74,10 @@ void sf_cls_gnss(sf_cls_t *cls, const sf_context_map_t *map, int64_t t_us, doubl
 /* The candidates identified at or after since_us. */
 void sf_cls_result(const sf_cls_t *cls, int64_t since_us, sf_cls_result_t *result);
 
+/* Context i is a candidate of the search; ... and was identified at since_us or later. */
+bool sf_cls_searches(const sf_cls_t *cls, int32_t context);
+bool sf_cls_identified(const sf_cls_t *cls, int32_t context, int64_t since_us);
+
 /* Masks: every context; a port's neighbourhood (*leads_outdoor: a port of it leads outdoors). */
 uint64_t sf_cls_all(const sf_context_map_t *map);
 uint64_t sf_cls_neighbourhood(const sf_site_t *site, int32_t port, bool *leads_outdoor);

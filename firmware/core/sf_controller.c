@@ -112,6 +112,13 @@ bool sf_controller_next_event(sf_controller_t *const c, sf_context_event_t *cons
     return true;
 }
 
+/* The step count the transition's steps count from: the first stairs step's on a staircase, else the
+ * transition's start (sf_controller.h, "staircase's steps"). */
+static int32_t steps_from(const sf_controller_t *const c)
+{
+    return c->on_stairs ? c->steps_at_stairs : c->steps_at_start;
+}
+
 /* Every field of the event from the state after the change. */
 static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const int8_t rule, const int16_t prev,
                  const sf_cls_result_t *const r, const bool recal, const double rx_m, const double ry_m,
@@ -134,7 +141,7 @@ static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const
         .rule = rule,
         .switched = ctx != prev,
         .steps_in_transition = c->state == sf_ctl_transition || rule >= sf_ctl_rule_elevator
-                                   ? m->step_count - (c->on_stairs ? c->steps_at_stairs : c->steps_at_start)
+                                   ? m->step_count - steps_from(c)
                                    : 0,
         .cls_candidates = r->candidates,
         .cls_identified = r->identified,
@@ -178,7 +185,7 @@ static int16_t near_port(const sf_controller_t *const c, const sf_params_t *cons
     int16_t best = -1;
     double best_excess = INFINITY;
     for (int32_t q = 0; q < ports->n_ports; q++) {
-        if (floor < ports->floor_lo[q] || floor > ports->floor_hi[q]) {
+        if (!sf_port_joins(ports, q, floor)) {
             continue;
         }
         const double excess = port_distance_m(c, q, x_m, y_m) - (double)ports->radius_m[q];
@@ -234,7 +241,7 @@ static void end_transition(sf_controller_t *const c, const sf_params_t *const p,
     /* still at the port after the exit: transition detection again at once (the paper) */
     const double x_m = recal ? rx_m : m->x_m, y_m = recal ? ry_m : m->y_m;
     if (rule != sf_ctl_rule_left_port && (m->has_position || recal)) {
-        const bool still = c->floor >= c->site->ports.floor_lo[q] && c->floor <= c->site->ports.floor_hi[q] &&
+        const bool still = sf_port_joins(&c->site->ports, q, c->floor) &&
                            port_distance_m(c, q, x_m, y_m) <= (double)c->site->ports.radius_m[q] + p->controller_port_margin_m;
         if (still) {
             begin_transition(c, m, (int16_t)q);
@@ -250,15 +257,14 @@ static int16_t baro_context(const sf_controller_t *const c, const sf_params_t *c
                             const sf_cls_result_t *const r, const int64_t since_us)
 {
     const int32_t q = c->port;
-    if (!p->controller_floor_from_barometer || m->floor < c->site->ports.floor_lo[q] ||
-        m->floor > c->site->ports.floor_hi[q]) {
+    if (!p->controller_floor_from_barometer || !sf_port_joins(&c->site->ports, q, m->floor)) {
         return -1;
     }
     const int16_t ctx = sf_cls_context_of(&c->site->contexts, c->site->contexts.port_building[q], m->floor);
-    if (ctx < 0 || ctx >= SF_CONTROLLER_MAX_CONTEXTS || !(c->cls.candidates >> ctx & 1u)) {
+    if (ctx < 0 || !sf_cls_searches(&c->cls, ctx)) {
         return -1;
     }
-    return r->identified == 0 || c->cls.evidence[ctx].t_us >= since_us ? ctx : -1;
+    return r->identified == 0 || sf_cls_identified(&c->cls, ctx, since_us) ? ctx : -1;
 }
 
 /* The outdoor context when the CLS identified it by a GNSS fix since since_us, else −1. */
@@ -266,9 +272,8 @@ static int16_t gnss_outdoor(const sf_controller_t *const c, const int64_t since_
 {
     const sf_context_map_t *const map = &c->site->contexts;
     for (int32_t i = 0; i < map->n_contexts && i < SF_CONTROLLER_MAX_CONTEXTS; i++) {
-        const sf_cls_evidence_t *const e = &c->cls.evidence[i];
-        if (map->kind[i] == sf_context_outdoor && (c->cls.candidates >> i & 1u) && e->t_us != INT64_MIN &&
-            e->t_us >= since_us && e->method == sf_fix_gnss) {
+        if (map->kind[i] == sf_context_outdoor && sf_cls_identified(&c->cls, i, since_us) &&
+            c->cls.evidence[i].method == sf_fix_gnss) {
             return (int16_t)i;
         }
     }
@@ -342,7 +347,7 @@ static void transition(sf_controller_t *const c, const sf_params_t *const p, con
     const int32_t q = c->port;
     const int kind = c->site->ports.kind[q];
     const int32_t steps = m->step_count - c->steps_at_start;
-    const int32_t stair_steps = m->step_count - (c->on_stairs ? c->steps_at_stairs : c->steps_at_start);
+    const int32_t stair_steps = m->step_count - steps_from(c);
     const int64_t window_us = (int64_t)(p->controller_cls_window_s * 1e6);
     int64_t since_us = m->t_us - window_us;
     if (kind == sf_port_elevator && c->elevator_seen && c->elevator_t_us >= since_us) {

@@ -39,8 +39,7 @@ int16_t sf_controller_floor(const sf_controller_t *const c)
 int16_t sf_controller_pose_floor(const sf_controller_t *const c, const sf_params_t *const p, const int16_t baro_floor)
 {
     if (c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
-        c->site->ports.kind[c->port] != sf_port_door && baro_floor >= c->site->ports.floor_lo[c->port] &&
-        baro_floor <= c->site->ports.floor_hi[c->port]) {
+        c->site->ports.kind[c->port] != sf_port_door && sf_port_joins(&c->site->ports, c->port, baro_floor)) {
         return baro_floor; /* on the staircase or in the cab the floor changes before the context does */
     }
     const sf_context_map_t *const map = &c->site->contexts;

@@ -80,6 +80,12 @@ typedef struct {
     const int16_t *floor_hi; /* [n_ports], ≥ floor_lo */
 } sf_ports_t;
 
+/* Port q joins `floor` (floor_lo ≤ floor ≤ floor_hi). */
+static inline bool sf_port_joins(const sf_ports_t *const ports, const int32_t q, const int32_t floor)
+{
+    return floor >= ports->floor_lo[q] && floor <= ports->floor_hi[q];
+}
+
 /* BLE beacons (site file v2), ids (48-bit MAC) strictly ascending so a reading's beacon is found by
  * binary search, with the site's log-distance path-loss model RSSI(d) = rssi_1m_dbm − 10·n·log10(d)
  * (n = path_loss_exponent; a beacon's own rssi_1m_dbm when finite, else the site's). */
