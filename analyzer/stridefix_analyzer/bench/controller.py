@@ -40,6 +40,7 @@ from stridefix import pose_t
 from stridefix_analyzer import schemes
 from stridefix_analyzer.bench import controller_score as cs
 from stridefix_analyzer.bench import fusion
+from stridefix_analyzer.bench import targets as target_rows
 from stridefix_analyzer.bench.controller_plot import write_timeline
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
@@ -398,18 +399,10 @@ def format_table(doc: dict[str, Any]) -> str:
         + ", ".join(f"{r} {p[CONTROLLER][r]:.0f} / {p['fixed'][r]:.0f}" for r in RADIOS)
         + f"; CONTEXT events by rule: {doc['events_by_rule']}"
     )
-    lines.append("targets:")
-    for tg in doc["targets"]:
-        v = tg["value"]
-        vs = "n/a" if v is None else (f"{v:.3f}" if isinstance(v, float) else str(v))
-        lines.append(f"  {'MET   ' if tg['met'] else 'MISSED'} {tg['figure']} = {vs} (target {tg['target']})")
+    lines += target_rows.table_lines(doc["targets"])
     return "\n".join(lines)
 
 
 def missed_targets(doc: dict[str, Any]) -> list[str]:
     """One line per missed target (figure, value, target)."""
-    return [
-        f"controller: {tg['figure']} = {'n/a' if tg['value'] is None else tg['value']} (target {tg['target']})"
-        for tg in doc["targets"]
-        if not tg["met"]
-    ]
+    return target_rows.missed_lines("controller", doc["targets"])

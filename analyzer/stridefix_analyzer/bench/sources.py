@@ -43,6 +43,7 @@ from stridefix_sim.world_sources import inside
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.bench import fusion
+from stridefix_analyzer.bench import targets as target_rows
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import Table, read_table
 from stridefix_analyzer.scoring.analyze import run_analyze
@@ -303,18 +304,10 @@ def format_table(doc: dict[str, Any]) -> str:
             f"{_f(r['gnss_mean_sigma_m'])}{_f(r['landmark_max_m'], '9.2f')}"
             f"{'-' if r['wall_crossings'] is None else r['wall_crossings']:>7} {fixes}"
         )
-    lines.append("targets:")
-    for tg in doc["targets"]:
-        v = tg["value"]
-        vs = "n/a" if v is None else (f"{v:.3f}" if isinstance(v, float) else str(v))
-        lines.append(f"  {'MET   ' if tg['met'] else 'MISSED'} {tg['figure']} = {vs} (target {tg['target']})")
+    lines += target_rows.table_lines(doc["targets"])
     return "\n".join(lines)
 
 
 def missed_targets(doc: dict[str, Any]) -> list[str]:
-    out = []
-    for tg in doc["targets"]:
-        if not tg["met"]:
-            v = tg["value"]
-            out.append(f"sources: {tg['figure']} = {'n/a' if v is None else v} (target {tg['target']})")
-    return out
+    """One line per missed target (figure, value, target)."""
+    return target_rows.missed_lines("sources", doc["targets"])

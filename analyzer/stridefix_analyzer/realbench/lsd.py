@@ -20,7 +20,6 @@ Cost: (n_blocks − 1) replays of every walk (one per walk and block pair, not o
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -117,19 +116,11 @@ def choose_lsd(
             continue
         for name, e in r["errors"].items():
             pooled[r["a"]][name].append(e)
+    choice, blocks = rs.choose_per_block(pooled, CANDIDATES, DEFAULT_SCHEME, "waypoints")
     report: dict[str, Any] = {
         "chosen_by": f"cross-validation in the training walks ({n_blocks} blocks, mean POSE error at "
         "waypoints, every scheme in one replay)",
-        "blocks": {},
+        "blocks": blocks,
         "failures": failures[:10],
     }
-    choice = {}
-    for a in range(n_blocks):
-        means = {}
-        for n in CANDIDATES:
-            e = np.concatenate(pooled[a][n]) if pooled[a][n] else np.zeros(0)
-            means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, "waypoints": int(len(e))}
-        finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
-        choice[a] = min(finite, key=lambda n: finite[n]) if finite else DEFAULT_SCHEME
-        report["blocks"][str(a)] = {"candidates": means, "chosen": choice[a]}
     return [choice[block[i]] for i in range(len(sub))], report

@@ -237,17 +237,28 @@ def select(
         "failures": failures[:10],
         "block_of_walk": block,
     }
-    choice_of_block = {}
-    for a in range(n_blocks):
+    choice_of_block, report["blocks"] = choose_per_block(pooled, names, names[0], "fixes")
+    report["choice_of_block"] = choice_of_block
+    return [choice_of_block[block[i]] for i in range(len(sub))], report
+
+
+def choose_per_block(
+    pooled: Mapping[int, Mapping[str, list[np.ndarray]]], names: Sequence[str], default: str, count_key: str
+) -> tuple[dict[int, str], dict[str, Any]]:
+    """Per block a of ``pooled`` (block → candidate → error arrays [m]): every candidate's pooled mean
+    error and count (under ``count_key``), and the candidate with the lowest finite mean (``default``
+    when none has one; ties: the order of ``names``). Returns (choice per block, the blocks' report)."""
+    choice: dict[int, str] = {}
+    blocks: dict[str, Any] = {}
+    for a in pooled:
         means = {}
         for n in names:
             e = np.concatenate(pooled[a][n]) if pooled[a][n] else np.zeros(0)
-            means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, "fixes": int(len(e))}
+            means[n] = {"mean_m": float(e.mean()) if len(e) else math.nan, count_key: int(len(e))}
         finite = {n: m["mean_m"] for n, m in means.items() if math.isfinite(m["mean_m"])}
-        choice_of_block[a] = min(finite, key=lambda n: finite[n]) if finite else names[0]
-        report["blocks"][str(a)] = {"candidates": means, "chosen": choice_of_block[a]}
-    report["choice_of_block"] = choice_of_block
-    return [choice_of_block[block[i]] for i in range(len(sub))], report
+        choice[a] = min(finite, key=lambda n: finite[n]) if finite else default
+        blocks[str(a)] = {"candidates": means, "chosen": choice[a]}
+    return choice, blocks
 
 
 class _InProcess:
