@@ -248,6 +248,23 @@ static void test_near_port_of_its_floor_only(void **state)
     assert_int_equal(c2.port, 2);
 }
 
+/* GIVEN IN_CONTEXT on floor 0 of A (identified at 1 s), WHEN the position is at (x_m, y_m) at 2 s with
+ * `steps` credited, THEN one event: NEAR_PORT (drained; the caller's `ev`, if given, gets it). */
+static void at_port(sf_controller_t *const c, sf_params_t *const p, const sf_site_t *const site, const double x_m,
+                    const double y_m, const int32_t steps, sf_context_event_t *const ev)
+{
+    setup(c, p, site);
+    enter_floor(c, p, 1 * S_US, 0, x_m, y_m - 3.0);
+    const sf_ctl_motion_t m = at(2 * S_US, x_m, y_m, 0, steps, sf_activity_walking);
+    assert_true(sf_controller_update(c, p, &m));
+    sf_context_event_t got[4];
+    assert_int_equal(drain(c, got, 4), 1);
+    assert_int_equal(got[0].rule, sf_ctl_rule_near_port);
+    if (ev != NULL) {
+        *ev = got[0];
+    }
+}
+
 /* ---- ELEVATOR ------------------------------------------------------------------------------------ */
 
 static void ride(sf_controller_t *const c, const int64_t from_us, const int64_t to_us)
@@ -263,13 +280,10 @@ static void test_elevator(void **state)
     const sf_site_t site = campus();
     sf_controller_t c;
     sf_params_t p;
-    setup(&c, &p, &site);
-    enter_floor(&c, &p, 1 * S_US, 0, 15.0, 12.0);
-    sf_ctl_motion_t m = at(2 * S_US, 15.0, 15.0, 0, 10, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
     sf_context_event_t ev[4];
-    assert_int_equal(drain(&c, ev, 4), 1);
+    at_port(&c, &p, &site, 15.0, 15.0, 10, &ev[0]);
     assert_int_equal(ev[0].port, 2);
+    sf_ctl_motion_t m;
     assert_int_equal(ev[0].cls_candidates, 3);
     /* floor 2 heard before the ride: walking and a "unique floor", but no ride yet → no exit */
     hear_floors(&c, &p, 2500000, 4u);
@@ -306,10 +320,7 @@ static void test_elevator(void **state)
 
     /* no unique floor after the ride: floors 1 and 2 heard together → no exit */
     sf_controller_t d;
-    setup(&d, &p, &site);
-    enter_floor(&d, &p, 1 * S_US, 0, 15.0, 12.0);
-    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&d, &p, &m));
+    at_port(&d, &p, &site, 15.0, 15.0, 0, NULL);
     ride(&d, 3 * S_US, 5 * S_US);
     hear_floors(&d, &p, 6 * S_US, 6u);
     m = at(6 * S_US, 15.0, 13.0, 0, 3, sf_activity_walking);
@@ -318,11 +329,7 @@ static void test_elevator(void **state)
 
     /* self-neighbourhood: the ride ends on floor 0 again → the same context, no switch */
     sf_controller_t e;
-    setup(&e, &p, &site);
-    enter_floor(&e, &p, 1 * S_US, 0, 15.0, 12.0);
-    m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&e, &p, &m));
-    (void)drain(&e, ev, 4);
+    at_port(&e, &p, &site, 15.0, 15.0, 0, NULL);
     ride(&e, 3 * S_US, 5 * S_US);
     hear_floors(&e, &p, 6 * S_US, 1u);
     m = at(6 * S_US, 15.0, 12.0, 0, 2, sf_activity_walking);
@@ -342,12 +349,9 @@ static void test_stairs(void **state)
     const sf_site_t site = campus();
     sf_controller_t c;
     sf_params_t p;
-    setup(&c, &p, &site);
-    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
-    sf_ctl_motion_t m = at(2 * S_US, 3.0, 15.0, 0, 100, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
+    at_port(&c, &p, &site, 3.0, 15.0, 100, NULL);
     sf_context_event_t ev[4];
-    assert_int_equal(drain(&c, ev, 4), 1);
+    sf_ctl_motion_t m;
     /* 19 of 20 steps with floor 1 unique: no exit */
     hear_floors(&c, &p, 10 * S_US, 2u);
     m = at(10 * S_US, 5.0, 15.0, 0, 119, sf_activity_stairs_up);
@@ -378,11 +382,7 @@ static void test_stairs(void **state)
 
     /* up and down again: 20 steps ending on floor 0 → no switch, no recalibration */
     sf_controller_t d;
-    setup(&d, &p, &site);
-    enter_floor(&d, &p, 1 * S_US, 0, 10.0, 10.0);
-    m = at(2 * S_US, 5.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&d, &p, &m));
-    (void)drain(&d, ev, 4);
+    at_port(&d, &p, &site, 5.0, 15.0, 0, NULL);
     hear_floors(&d, &p, 20 * S_US, 1u);
     m = at(20 * S_US, 5.0, 15.0, 0, 20, sf_activity_walking);
     assert_true(sf_controller_update(&d, &p, &m));
@@ -478,12 +478,9 @@ static void test_limited_mode_ignores_other_contexts(void **state)
     const sf_site_t site = campus();
     sf_controller_t c;
     sf_params_t p;
-    setup(&c, &p, &site);
-    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
-    sf_ctl_motion_t m = at(2 * S_US, 5.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
+    at_port(&c, &p, &site, 5.0, 15.0, 0, NULL);
     sf_context_event_t ev[4];
-    (void)drain(&c, ev, 4);
+    sf_ctl_motion_t m;
     /* floor 2 (not reachable by these stairs), B's beacons and a good GNSS fix: none are candidates */
     hear_floors(&c, &p, 10 * S_US, 4u);
     const int64_t beacons[] = {0x401, 0x402};
@@ -727,13 +724,8 @@ static void test_estimator_gate_and_port_fix(void **state)
 /* GIVEN a walker on floor 0 of A who rode the elevator (3–5 s) with controller.floor_from_barometer. */
 static void ridden(sf_controller_t *const c, sf_params_t *const p, const sf_site_t *const site)
 {
-    setup(c, p, site);
+    at_port(c, p, site, 15.0, 15.0, 0, NULL);
     p->controller_floor_from_barometer = 1;
-    enter_floor(c, p, 1 * S_US, 0, 15.0, 12.0);
-    const sf_ctl_motion_t m = at(2 * S_US, 15.0, 15.0, 0, 0, sf_activity_walking);
-    assert_true(sf_controller_update(c, p, &m));
-    sf_context_event_t ev[4];
-    (void)drain(c, ev, 4);
     ride(c, 3 * S_US, 5 * S_US);
 }
 
@@ -795,12 +787,9 @@ static void test_stairs_count_from_the_first_stair(void **state)
     const sf_site_t site = campus();
     sf_controller_t c;
     sf_params_t p;
-    setup(&c, &p, &site);
-    enter_floor(&c, &p, 1 * S_US, 0, 10.0, 10.0);
-    sf_ctl_motion_t m = at(2 * S_US, 3.0, 15.0, 0, 100, sf_activity_walking);
-    assert_true(sf_controller_update(&c, &p, &m));
+    at_port(&c, &p, &site, 3.0, 15.0, 100, NULL);
     sf_context_event_t ev[4];
-    (void)drain(&c, ev, 4);
+    sf_ctl_motion_t m;
     /* 8 level steps inside the port's disc (the approach), floor 1 heard: no exit */
     hear_floors(&c, &p, 5 * S_US, 2u);
     m = at(5 * S_US, 4.0, 15.0, 0, 108, sf_activity_walking);
