@@ -12,7 +12,12 @@ random walk, not one constant); per walk w, its stride scale s_w. Rows (σ in th
   displacement in the walk's own frame):  r = ((p_j − p_i) − s_w·R(θ_i)·d) / σ_step,
   σ_step = step_sigma0_m + step_sigma_per_m·‖d‖ (2 residuals);
 * **heading** (the same consecutive points): r = (θ_j − θ_i) / (σ_θ·√max(Δt, 0.1 s)) (1 residual);
-* **scale** (per walk): r = (s_w − s0) / σ_s, s0 the stride scale of the training walks (or 1);
+* **scale** (per walk): r = (s_w − s0) / σ_s;
+* **heading prior** (the first point of each walk): r = (θ − θ0) / σ_θ0 (no wrap: the initial θ is
+  put within π of θ0). s0, σ_s, θ0, σ_θ0 are the *fleet's* stride scale and heading bias with their
+  spread, learned from the anchors alone (:func:`fleet_priors`): a walk with one anchor has no
+  heading of its own, and on hand-held phones the bias spreads ±35° between walks, so the prior is
+  weak but it is what the crowd knows;
 * **anchor** (a known position every K-th truth point: beacon, landmark, surveyed waypoint):
   r = (p_a − q_a) / σ_anchor (2 residuals);
 * **range** (Wi-Fi loop closures between points of *different* walks on the same floor, from a
@@ -30,6 +35,7 @@ between the walk's DR and its anchors; s = s0.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -52,7 +58,6 @@ class GraphSettings:
     heading_sigma_rad_per_sqrt_s: float = 0.05
     step_sigma0_m: float = 0.3
     step_sigma_per_m: float = 0.1
-    scale_sigma: float = 0.3
     anchor_sigma_m: float = 0.5
     loss: str = "cauchy"
     loss_scale: float = 1.0
@@ -60,6 +65,52 @@ class GraphSettings:
     wifi_per_point: int = 3
     #: Wi-Fi rows only where the model's distance is at most this [m] (near places are what it knows).
     wifi_max_range_m: float = 10.0
+
+
+@dataclasses.dataclass(frozen=True)
+class FleetPriors:
+    """Stride scale and heading bias of the fleet's walks, with their spread (module docstring)."""
+
+    scale: float = 1.0
+    scale_sigma: float = 0.3
+    heading_rad: float = 0.0
+    heading_sigma_rad: float = math.pi
+    walks_used: int = 0
+
+
+#: A walk tells its scale and heading only when its anchors span at least this [m].
+MIN_ANCHOR_SPAN_M = 5.0
+
+
+def fleet_priors(points: Points, is_anchor: np.ndarray, n_walks: int) -> FleetPriors:
+    """Median and robust spread (1.4826·MAD) of the per-walk 2-D similarity (scale, rotation) that
+    maps each walk's dead reckoning onto its own anchors; walks whose anchors span < 5 m say nothing.
+    Uses the anchors only, never the other truth points."""
+    scales, heads = [], []
+    for k in range(n_walks):
+        ak = np.flatnonzero((points.walk == k) & is_anchor)
+        if len(ak) < 2:
+            continue
+        A = points.truth_xy_m[ak] - points.truth_xy_m[ak].mean(axis=0)
+        B = points.dr_xy_m[ak] - points.dr_xy_m[ak].mean(axis=0)
+        span_a, span_b = np.sqrt(np.sum(A * A)), np.sqrt(np.sum(B * B))
+        if span_a < MIN_ANCHOR_SPAN_M or span_b < 1e-6:
+            continue
+        scales.append(span_a / span_b)
+        heads.append(_procrustes_heading(points.dr_xy_m[ak], points.truth_xy_m[ak]))
+    if len(scales) < 3:
+        return FleetPriors(walks_used=len(scales))
+    s, h = np.asarray(scales), np.asarray(heads)
+    h0 = float(np.angle(np.mean(np.exp(1j * h))))  # circular mean, then a robust centre near it
+    h = h0 + np.angle(np.exp(1j * (h - h0)))
+    h_med = float(np.median(h))
+    return FleetPriors(
+        scale=float(np.median(s)),
+        scale_sigma=max(1.4826 * float(np.median(np.abs(s - np.median(s)))), 0.05),
+        heading_rad=h_med,
+        heading_sigma_rad=max(1.4826 * float(np.median(np.abs(h - h_med))), math.radians(5.0)),
+        walks_used=len(scales),
+    )
 
 
 @dataclasses.dataclass
@@ -78,6 +129,9 @@ class GraphProblem:
     head_sigma_rad: np.ndarray  # (h,)
     scale_prior: np.ndarray  # (W,)
     scale_sigma: np.ndarray  # (W,)
+    hprior_idx: np.ndarray  # (p,) int64
+    hprior_rad: np.ndarray  # (p,)
+    hprior_sigma_rad: np.ndarray  # (p,)
     anchor_idx: np.ndarray  # (a,) int64
     anchor_xy_m: np.ndarray  # (a, 2)
     anchor_sigma_m: np.ndarray  # (a,)
@@ -98,6 +152,7 @@ class GraphProblem:
             "steps": int(len(self.step_i)),
             "heading": int(len(self.head_i)),
             "scale": int(self.n_walks),
+            "heading_prior": int(len(self.hprior_idx)),
             "wifi": int(len(self.pair_i)),
         }
 
@@ -123,12 +178,13 @@ def build_graph(
     *,
     anchors: str | np.ndarray = "every:4",
     settings: GraphSettings = GraphSettings(),
-    scale_prior: float = 1.0,
+    priors: FleetPriors | None = None,
     wifi_rows: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> GraphProblem:
     """The graph of ``points`` (module docstring).
 
     ``anchors``: ``every:K`` or a (n,) bool mask of anchored points (their truth is the anchor).
+    ``priors``: the fleet's scale and heading (default: learned here by :func:`fleet_priors`).
     ``wifi_rows``: (i, j, range_m, sigma_m) loop closures, e.g. from :func:`.graph_wifi.wifi_rows`.
     """
     if settings.loss not in LOSSES:
@@ -144,12 +200,18 @@ def build_graph(
     d = points.dr_xy_m[j] - points.dr_xy_m[i]
     dt_s = (points.t_us[j] - points.t_us[i]) * 1e-6
     x0 = _initial_guess(points, is_anchor)
-    th0 = np.zeros(n)
+    fp = fleet_priors(points, is_anchor, n_walks) if priors is None else priors
+    th0 = np.full(n, fp.heading_rad)
+    first = np.zeros(0, np.int64)
     for k in range(n_walks):
         ids = np.flatnonzero(points.walk == k)
+        if len(ids) == 0:
+            continue
+        first = np.append(first, ids[0])
         ak = ids[is_anchor[ids]]
         if len(ak) >= 2:
-            th0[ids] = _procrustes_heading(points.dr_xy_m[ak], points.truth_xy_m[ak])
+            h = _procrustes_heading(points.dr_xy_m[ak], points.truth_xy_m[ak])
+            th0[ids] = fp.heading_rad + math.remainder(h - fp.heading_rad, 2 * math.pi)
     if wifi_rows is None:
         wi = wj = np.zeros(0, np.int64)
         wb = ws = np.zeros(0)
@@ -166,8 +228,11 @@ def build_graph(
         head_i=i.astype(np.int64),
         head_j=j.astype(np.int64),
         head_sigma_rad=settings.heading_sigma_rad_per_sqrt_s * np.sqrt(np.maximum(dt_s, 0.1)),
-        scale_prior=np.full(n_walks, float(scale_prior)),
-        scale_sigma=np.full(n_walks, settings.scale_sigma),
+        scale_prior=np.full(n_walks, fp.scale),
+        scale_sigma=np.full(n_walks, fp.scale_sigma),
+        hprior_idx=first,
+        hprior_rad=np.full(len(first), fp.heading_rad),
+        hprior_sigma_rad=np.full(len(first), fp.heading_sigma_rad),
         anchor_idx=a.astype(np.int64),
         anchor_xy_m=np.ascontiguousarray(points.truth_xy_m[a], float),
         anchor_sigma_m=np.full(len(a), settings.anchor_sigma_m),
@@ -179,5 +244,5 @@ def build_graph(
         loss_scale=float(settings.loss_scale),
         init_xy_m=x0,
         init_heading_rad=th0,
-        init_scale=np.full(n_walks, float(scale_prior)),
+        init_scale=np.full(n_walks, fp.scale),
     )

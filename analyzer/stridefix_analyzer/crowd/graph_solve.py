@@ -64,18 +64,21 @@ def _layout(g: GraphProblem):
     base += h
     scale_rows, scale_cols = base + np.arange(W), sc + np.arange(W)
     base += W
+    hp = len(g.hprior_idx)
+    hp_rows, hp_cols = base + np.arange(hp), th + g.hprior_idx
+    base += hp
     anc_rows = base + np.arange(2 * a)
     anc_cols = np.stack([2 * g.anchor_idx, 2 * g.anchor_idx + 1], 1).ravel()
     base += 2 * a
     rng_rows = np.repeat(base + np.arange(r), 4)
     rng_cols = np.stack([2 * g.pair_i, 2 * g.pair_i + 1, 2 * g.pair_j, 2 * g.pair_j + 1], 1).ravel()
     base += r
-    rows = np.concatenate([step_rows, head_rows, scale_rows, anc_rows, rng_rows])
-    cols = np.concatenate([step_cols, head_cols, scale_cols, anc_cols, rng_cols])
+    rows = np.concatenate([step_rows, head_rows, scale_rows, hp_rows, anc_rows, rng_rows])
+    cols = np.concatenate([step_cols, head_cols, scale_cols, hp_cols, anc_cols, rng_cols])
     return rows, cols, base, 3 * n + W
 
 
-def solve_graph_scipy(g: GraphProblem, max_nfev: int = 200) -> GraphSolution:
+def solve_graph_scipy(g: GraphProblem, max_nfev: int = 1000) -> GraphSolution:
     """The scipy twin (module docstring)."""
     n, W = g.n_points, g.n_walks
     i, j, w, d = g.step_i, g.step_j, g.step_walk, g.step_dxy_m
@@ -107,6 +110,7 @@ def solve_graph_scipy(g: GraphProblem, max_nfev: int = 200) -> GraphSolution:
                 step[:, 1],
                 (th[g.head_j] - th[g.head_i]) / hs,
                 (s - g.scale_prior) / g.scale_sigma,
+                (th[g.hprior_idx] - g.hprior_rad) / g.hprior_sigma_rad,
                 ((p[g.anchor_idx] - g.anchor_xy_m) / g.anchor_sigma_m[:, None]).ravel(),
                 rt,
             ]
@@ -122,7 +126,7 @@ def solve_graph_scipy(g: GraphProblem, max_nfev: int = 200) -> GraphSolution:
         vx = np.stack([inv, -inv, dx_dth, ux_s], 1).ravel()
         vy = np.stack([inv, -inv, dy_dth, uy_s], 1).ravel()
         vh = np.stack([1.0 / hs, -1.0 / hs], 1).ravel()
-        vs = 1.0 / g.scale_sigma
+        vs = 1.0 / g.scale_sigma  # (W,)
         va = np.repeat(1.0 / g.anchor_sigma_m, 2)
         with np.errstate(invalid="ignore", divide="ignore"):
             f = np.where(np.abs(rt) > 1e-12, drho * rr / rt, 1.0)
@@ -131,7 +135,7 @@ def solve_graph_scipy(g: GraphProblem, max_nfev: int = 200) -> GraphSolution:
         uy = np.where(dist >= 1e-12, dp[:, 1] / safe, 0.0)
         k = -f / bs  # ∂r/∂p_i = −u/σ, ∂r/∂p_j = +u/σ
         vr = np.stack([k * ux, k * uy, -k * ux, -k * uy], 1).ravel()
-        vals = np.concatenate([vx, vy, vh, np.broadcast_to(vs, (g.n_walks,)), va, vr])
+        vals = np.concatenate([vx, vy, vh, vs, 1.0 / g.hprior_sigma_rad, va, vr])
         return sp.csr_matrix((vals, (rows, cols)), shape=(m, nx))
 
     x0 = np.concatenate([g.init_xy_m.ravel(), g.init_heading_rad, g.init_scale])
@@ -171,6 +175,9 @@ def solve_graph_native(g: GraphProblem, max_iterations: int = 200) -> GraphSolut
         g.head_sigma_rad,
         g.scale_prior,
         g.scale_sigma,
+        g.hprior_idx,
+        g.hprior_rad,
+        g.hprior_sigma_rad,
         g.anchor_idx,
         g.anchor_xy_m,
         g.anchor_sigma_m,
