@@ -62,7 +62,8 @@ def _common(p, solve_opts: bool) -> None:
         "--model",
         default=None,
         metavar="model.json",
-        help="distance model from `crowd fit` (needed unless --ranges pdr)",
+        help="pair model from `crowd models` or `crowd fit` (needed for --ranges wifi/both/hybrid; "
+        "with graph it adds Wi-Fi loop closures)",
     )
     p.add_argument(
         "--anchors",
@@ -72,10 +73,11 @@ def _common(p, solve_opts: bool) -> None:
     )
     p.add_argument(
         "--ranges",
-        choices=RANGES,
-        default="both",
-        help="pdr; wifi; both = PDR + filtered Wi-Fi rows; hybrid = PDR rows filtered "
-        "by Wi-Fi (the thesis's PDR + Wi-Fi) (default both)",
+        choices=("graph",) + RANGES,
+        default="graph",
+        help="graph = the crowd graph: PDR steps with stride scale and heading bias per walk, "
+        "anchors, and Wi-Fi loop closures when --model is given (default); the thesis's range "
+        "problems: pdr; wifi; both = PDR + filtered Wi-Fi rows; hybrid = PDR rows filtered by Wi-Fi",
     )
     p.add_argument(
         "--pdr-span",

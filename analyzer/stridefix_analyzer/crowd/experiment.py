@@ -11,7 +11,7 @@ from their truth; every scored walk (and a held-out walk) is replayed with each 
 ``--msindoor DIR`` (a floor folder, or the msindoor root for every floor): each trace is imported
 (``stridefix_analyzer.datasets.msindoor``, cached) and replayed through ``stridefixd``. The first
 ``--limit`` traces (sorted by name) are scored; the model and stride scale come from the floor's other
-traces. Anchors: every other waypoint; error at the held-out waypoints. The floor's model is also fitted
+traces. Anchors: every 4th waypoint (``--anchors``); error at the other waypoints. The floor's model is also fitted
 on all its traces and reported.
 
 Stride scale: Σ‖truth_{k+1} − truth_k‖ / Σ‖DR_{k+1} − DR_k‖ over consecutive truth points of the
@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.crowd.experiment_graph import graph_rows
 from stridefix_analyzer.crowd.fit import fit_walks, format_model
 from stridefix_analyzer.crowd.positions import solve_walks
 from stridefix_analyzer.crowd.sites import build_crowd_sites
@@ -116,9 +117,10 @@ def _table_row(
 
 
 def run_table(
-    walks, model, anchors: str, solver: str, band: str, scale: float, progress=print
+    walks, model, anchors: str, solver: str, band: str, scale: float, progress=print, wifi_models=()
 ) -> tuple[list[dict], dict]:
-    """Every row of :data:`ROWS` on ``walks``; returns (rows, positions of each row)."""
+    """Every row of :data:`ROWS` on ``walks``, then the graph rows (:mod:`.experiment_graph`, with
+    each of ``wifi_models``); returns (rows, positions of each thesis row)."""
     out, positions = [], {}
     for key, label, tm, ts, opts in ROWS:
         opts = dict(opts)
@@ -144,12 +146,13 @@ def run_table(
         _table_row("anchors_interp", "reference: anchors only, linear in time", None, None, e, rows, "-", 0.0)
         | {"problem": {}}
     )
+    out += graph_rows(walks, anchors, solver, band, wifi_models, progress)
     return out, positions
 
 
 def format_table(rows: list[dict]) -> str:
     head = (
-        f"{'method':<55}{'mean m':>8}{'std m':>8}{'p90 m':>8}{'n':>6}{'rows':>9}"
+        f"{'method':<64}{'mean m':>8}{'std m':>8}{'p90 m':>8}{'n':>6}{'rows':>9}"
         f"{'thesis mean':>13}{'thesis std':>11}"
     )
     lines = [head]
@@ -159,8 +162,9 @@ def format_table(rows: list[dict]) -> str:
             return f"{v:>{w}.2f}" if v is not None else f"{'-':>{w}}"
 
         nrows = r["rows"]["pdr"] + r["rows"]["wifi"]
+        label = r["label"] if nrows or r["key"] == "anchors_interp" else r["label"] + " [0 rows: = anchors]"
         lines.append(
-            f"{r['label']:<55}{f(r['mean_m'])}{f(r['std_m'])}{f(r['p90_m'])}"
+            f"{label:<64}{f(r['mean_m'])}{f(r['std_m'])}{f(r['p90_m'])}"
             f"{r['n'] or 0:>6}{nrows:>9}{f(r['thesis_mean_m'], 13)}{f(r['thesis_std_m'], 11)}"
         )
     return "\n".join(lines)
@@ -243,8 +247,8 @@ def run_sil(args, progress) -> dict:
     model, _ = fit_walks(fit_w, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps)
     scale = stride_scale(fit_w)
     progress("model (fit walkers " + ",".join(map(str, fit_seeds)) + "): " + format_model(model))
-    progress(f"stride scale {scale:.4f}; table on {len(walks)} walkers, anchors every:4")
-    rows, positions = run_table(walks, model, "every:4", args.solver, args.band, scale, progress)
+    progress(f"stride scale {scale:.4f}; table on {len(walks)} walkers, anchors {args.anchors}")
+    rows, positions = run_table(walks, model, args.anchors, args.solver, args.band, scale, progress)
     # radio map from the crowd vs from the truth, scored wifi_only
     best = min((r for r in rows if r["key"] in ("hybrid_w", "both_w")), key=lambda r: r["mean_m"])
     xy, points, _ = positions[best["key"]]
@@ -356,7 +360,7 @@ def run_msindoor(args, progress) -> dict:
             f"{[round(v, 4) for v in model.params]}; stride scale {scale:.3f}; "
             f"table on {len(scored)} walks"
         )
-        rows, _ = run_table(scored, model, "every-other-waypoint", args.solver, args.band, scale, progress)
+        rows, _ = run_table(scored, model, args.anchors, args.solver, args.band, scale, progress)
         docs.append(
             {
                 "floor": label,
@@ -389,6 +393,12 @@ def add_arguments(p) -> None:
     p.add_argument("--fit-seeds", default="101,102", help="SIL model-fitting walkers")
     p.add_argument("--heldout-seeds", default="201", help="SIL walkers only replayed on the maps")
     p.add_argument("--duration-s", type=float, default=None, help="SIL: cut each walk (s)")
+    p.add_argument(
+        "--anchors",
+        default="every:4",
+        metavar="every:K",
+        help="known truth points per walk: every K-th scan point (SIL) or waypoint (msindoor) (default every:4, the thesis)",
+    )
     p.add_argument(
         "--limit",
         type=int,
@@ -430,7 +440,7 @@ def run_experiment(args) -> int:
             f"scale {doc['stride_scale']:.3f}"
         )
         print(
-            f"SIL: {len(doc['seeds'])} walkers of {doc['scenario']}, anchors every 4th scan "
+            f"SIL: {len(doc['seeds'])} walkers of {doc['scenario']}, anchors {args.anchors} scan "
             f"point, error at the other scan points; solver {doc['rows'][0]['solver']}"
         )
         print(format_table(doc["rows"]))
@@ -450,8 +460,8 @@ def run_experiment(args) -> int:
                 f"{m['rmse_m']:.2f} m, R² {m['r2']:.3f}, {m['n_pairs']} pairs"
             )
             print(
-                f"{f['floor']}: {len(f['scored_walks'])} walks, anchors every other waypoint, "
-                f"error at the held-out waypoints; solver {f['rows'][0]['solver']}"
+                f"{f['floor']}: {len(f['scored_walks'])} walks, anchors {args.anchors} waypoints, "
+                f"error at the other waypoints; solver {f['rows'][0]['solver']}"
             )
             print(format_table(f["rows"]))
         path = Path(args.out) / "msindoor.json"

@@ -67,6 +67,9 @@ class GraphSettings:
     wifi_max_range_m: float = 10.0
 
 
+DEFAULT_SETTINGS = GraphSettings()
+
+
 @dataclasses.dataclass(frozen=True)
 class FleetPriors:
     """Stride scale and heading bias of the fleet's walks, with their spread (module docstring)."""
@@ -177,7 +180,7 @@ def build_graph(
     n_walks: int,
     *,
     anchors: str | np.ndarray = "every:4",
-    settings: GraphSettings = GraphSettings(),
+    settings: GraphSettings = DEFAULT_SETTINGS,
     priors: FleetPriors | None = None,
     wifi_rows: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> GraphProblem:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from stridefix_analyzer.crowd.graph import (
+    DEFAULT_SETTINGS,
     FleetPriors,
     GraphProblem,
     GraphSettings,
@@ -80,7 +81,13 @@ def choose_heading_sigma(
         g = build_graph(points, n_walks, anchors=keep, settings=s, priors=priors)
         xy = solve_graph(g, solver).xy_m
         e = np.hypot(*(xy[held] - points.truth_xy_m[held]).T)
-        rows.append({"heading_sigma_rad_per_sqrt_s": float(sig), "heldout_anchor_mean_m": float(e.mean()), "n": int(e.size)})
+        rows.append(
+            {
+                "heading_sigma_rad_per_sqrt_s": float(sig),
+                "heldout_anchor_mean_m": float(e.mean()),
+                "n": int(e.size),
+            }
+        )
     best = min(rows, key=lambda r: r["heldout_anchor_mean_m"])
     return best["heading_sigma_rad_per_sqrt_s"], rows
 
@@ -89,7 +96,7 @@ def solve_walks_graph(
     walks: list[Walk],
     *,
     anchors: str = "every:4",
-    settings: GraphSettings = GraphSettings(),
+    settings: GraphSettings = DEFAULT_SETTINGS,
     learn_heading_sigma: bool = True,
     wifi_model: Any = None,
     band: str = DEFAULT_BAND,

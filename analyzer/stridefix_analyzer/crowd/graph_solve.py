@@ -80,7 +80,7 @@ def _layout(g: GraphProblem):
 
 def solve_graph_scipy(g: GraphProblem, max_nfev: int = 1000) -> GraphSolution:
     """The scipy twin (module docstring)."""
-    n, W = g.n_points, g.n_walks
+    n = g.n_points
     i, j, w, d = g.step_i, g.step_j, g.step_walk, g.step_dxy_m
     ss, hs = g.step_sigma_m, g.head_sigma_rad
     pi, pj, b, bs = g.pair_i, g.pair_j, g.range_m, g.range_sigma_m

@@ -71,7 +71,9 @@ def wifi_rows(points: Points, scans: ScanSet, model, settings: GraphSettings, in
     return a[first], b[first], d[first], s[first]
 
 
-def add_wifi_rows(g: GraphProblem, points: Points, scans: ScanSet, model, settings: GraphSettings) -> GraphProblem:
+def add_wifi_rows(
+    g: GraphProblem, points: Points, scans: ScanSet, model, settings: GraphSettings
+) -> GraphProblem:
     """``g`` with the loop closures of :func:`wifi_rows` as its range rows."""
     i, j, d, s = wifi_rows(points, scans, model, settings, g.init_xy_m)
     return dataclasses.replace(

@@ -76,8 +76,32 @@ def solve_walks(
     return xy, points, prob, res
 
 
+def solve_graph_args(args: argparse.Namespace, walks: list[Walk]) -> tuple[Any, Any, Any, dict[str, Any]]:
+    """The crowd graph (:mod:`.graph_run`) with the options of ``crowd solve``: steps + anchors, and
+    Wi-Fi loop closures when ``--model`` names a pair model (``crowd models`` / ``crowd fit``)."""
+    from stridefix_analyzer.crowd.graph_run import solve_walks_graph  # noqa: PLC0415 - import cycle
+
+    model = None
+    if args.model:
+        from stridefix_analyzer.crowd.models import read_pair_model  # noqa: PLC0415
+
+        model = read_pair_model(args.model)
+    run = solve_walks_graph(walks, anchors=args.anchors, wifi_model=model, band=args.band, solver=args.solver)
+    r = run.info["rows"]
+    res = {
+        "problem": {"points": run.n, "ranges": "graph", "anchors": args.anchors} | run.info,
+        "solver": run.info["solver"],
+        "error": error_stats(run.xy_m, run.points, run),
+        "build_s": run.info["build_s"],
+        "rows": {"anchors": r["anchors"], "pdr": r["steps"], "wifi": r["wifi"]},
+    }
+    return run.xy_m, run.points, run, res
+
+
 def solve_args(args: argparse.Namespace, walks: list[Walk]) -> tuple[Any, Any, Any, dict[str, Any]]:
     """:func:`solve_walks` with the options of ``crowd solve`` / ``crowd radiomap``."""
+    if args.ranges == "graph":
+        return solve_graph_args(args, walks)
     return solve_walks(
         walks,
         read_model(args.model) if args.model else None,
@@ -120,6 +144,18 @@ def run_solve(args: argparse.Namespace) -> dict[str, Any]:
 
 def format_solve(res: dict) -> str:
     p, s, e, r = res["problem"], res["solver"], res["error"], res["rows"]
+    if p["ranges"] == "graph":
+        g, pr = p["rows"], p["priors"]
+        lines = [
+            f"problem  graph of {p['points']} points: {g['anchors']} anchors ({p['anchors']}), {g['steps']} "
+            f"step rows, {g['heading']} heading rows, {g['heading_prior']} heading priors, {g['scale']} "
+            f"stride scales, {g['wifi']} Wi-Fi rows ({p['wifi_model'] or 'no pair model'}); learned from the "
+            f"anchors: fleet scale {pr['scale']:.2f} ± {pr['scale_sigma']:.2f}, heading bias "
+            f"{math.degrees(pr['heading_rad']):.0f}° ± {math.degrees(pr['heading_sigma_rad']):.0f}° "
+            f"({pr['walks_used']} walks), σ_θ {p['settings']['heading_sigma_rad_per_sqrt_s']:g} rad/√s",
+            f"solver   {s['solver']} ({s['solve_s']:.2f} s)" + (f"; {s['note']}" if "note" in s else ""),
+        ]
+        return "\n".join(lines + _error_line(e))
     lines = [
         f"problem  {p['points']} points, {r['anchors']} anchors ({p['anchors']}), "
         f"{r['pdr']} PDR rows (span {p['pdr_span']}, {p['pdr_metric']}), {r['wifi']} Wi-Fi rows; "
@@ -131,14 +167,18 @@ def format_solve(res: dict) -> str:
         ),
         f"solver   {s['solver']} ({s['solve_s']:.2f} s)" + (f"; {s['note']}" if "note" in s else ""),
     ]
-    if e.get("n"):
-        lines.append(
-            f"error    at {e['n']} non-anchor truth points: mean {e['mean_m']:.2f} m, std "
-            f"{e['std_m']:.2f} m, median {e['median_m']:.2f} m, p90 {e['p90_m']:.2f} m, "
-            f"RMSE {e['rmse_m']:.2f} m (incl. anchors, as the thesis: mean "
-            f"{e['mean_all_m']:.2f} m)"
-        )
-    return "\n".join(lines)
+    return "\n".join(lines + _error_line(e))
+
+
+def _error_line(e: dict) -> list[str]:
+    if not e.get("n"):
+        return []
+    return [
+        f"error    at {e['n']} non-anchor truth points: mean {e['mean_m']:.2f} m, std "
+        f"{e['std_m']:.2f} m, median {e['median_m']:.2f} m, p90 {e['p90_m']:.2f} m, "
+        f"RMSE {e['rmse_m']:.2f} m (incl. anchors, as the thesis: mean "
+        f"{e['mean_all_m']:.2f} m)"
+    ]
 
 
 def write_positions(path: str, xy, points, prob) -> None:

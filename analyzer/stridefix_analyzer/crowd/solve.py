@@ -37,6 +37,7 @@ import dataclasses
 import math
 import re
 import time
+from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -402,7 +403,18 @@ def solve(prob: Problem, solver: str = "auto") -> tuple[np.ndarray, dict]:
     return xy, info
 
 
-def error_stats(xy: np.ndarray, points: Points, prob: Problem) -> dict:
+class Anchored(Protocol):
+    """What :func:`error_stats` reads of a solve: which points were anchors (a :class:`Problem` or a
+    :class:`.graph_run.GraphRun`)."""
+
+    @property
+    def anchor_index(self) -> np.ndarray: ...
+
+    @property
+    def n(self) -> int: ...
+
+
+def error_stats(xy: np.ndarray, points: Points, prob: Anchored) -> dict:
     """Errors at the non-anchor truth points (and, for thesis parity, over all truth points)."""
     is_anchor = np.zeros(prob.n, bool)
     is_anchor[prob.anchor_index] = True
