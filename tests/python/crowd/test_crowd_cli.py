@@ -80,3 +80,16 @@ def test_crowd_radiomap_writes_sites(fitted, sil_walks, cli, tmp_path):
 def test_missing_model_is_a_usage_error(sil_walks, cli, tmp_path):
     proc = cli("crowd", "solve", *sil_walks, "--ranges", "wifi", "--out", str(tmp_path))
     assert proc.returncode == 2 and "model" in proc.stderr
+
+
+def test_solve_default_is_the_graph_and_names_its_rows(sil_walks, cli, tmp_path):
+    """GIVEN three SIL walkers WHEN crowd solve runs with its defaults THEN it solves the graph
+    (steps + anchors every 4th scan point), says so with its row counts, and the error at the
+    other scan points stays within a few metres."""
+    proc = cli("crowd", "solve", *sil_walks, "--out", str(tmp_path))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((tmp_path / "solve.json").read_text())
+    rows = doc["problem"]["rows"]
+    assert doc["problem"]["ranges"] == "graph" and rows["steps"] > 50 and rows["anchors"] > 10
+    assert "step rows" in proc.stdout and "stride scales" in proc.stdout
+    assert doc["error"]["n"] > 30 and doc["error"]["mean_m"] < 3.0
