@@ -4,23 +4,25 @@ point that ``crowd solve``, ``crowd radiomap``, the experiment and realbench's c
 Anchors are every K-th truth point of each walk (what a crowd walk carries: a beacon, a landmark, a
 surveyed waypoint); the truth of the other points is never read here, only by :func:`.solve.
 error_stats` afterwards. What the graph cannot take from physics it learns from the anchors too:
-the fleet's stride scale and heading bias (:func:`.graph.fleet_priors`) and how fast the heading bias
-wanders (:func:`choose_heading_sigma`, cross-validation on the anchors: every other anchor of each
-walk is held out, the walk solved from the rest, the held-out anchors scored). A unit in the field
+the fleet's stride scale and heading bias (:func:`.graph.fleet_priors`) how fast the heading bias
+wanders (:func:`choose_heading_sigma`) and whether a pair model's Wi-Fi loop closures help, both by
+cross-validation on the anchors: every other anchor of each walk is held out, the walks solved
+from the rest, the held-out anchors scored. A unit in the field
 and a crowd map both have anchors and nothing else.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from stridefix_analyzer.crowd.graph import (
     DEFAULT_SETTINGS,
-    FleetPriors,
     GraphProblem,
     GraphSettings,
     anchor_mask,
@@ -28,6 +30,7 @@ from stridefix_analyzer.crowd.graph import (
     fleet_priors,
 )
 from stridefix_analyzer.crowd.graph_solve import solve_graph
+from stridefix_analyzer.crowd.graph_wifi import add_wifi_rows
 from stridefix_analyzer.crowd.solve import Points, make_points, parse_anchors
 from stridefix_analyzer.crowd.walks import DEFAULT_BAND, ScanSet, Walk, pool_scans
 
@@ -55,39 +58,53 @@ class GraphRun:
         return self.problem.n_points
 
 
-def choose_heading_sigma(
-    points: Points,
-    n_walks: int,
-    is_anchor: np.ndarray,
-    settings: GraphSettings,
-    priors: FleetPriors,
-    solver: str = "auto",
-    grid=HEADING_SIGMA_GRID,
-) -> tuple[float, list[dict[str, Any]]]:
-    """σ_θ of ``grid`` with the lowest mean error at held-out anchors (module docstring); the
-    settings' own value when no walk has a second anchor to hold out."""
+def split_anchors(points: Points, n_walks: int, is_anchor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(kept, held out): every other anchor of each walk, its first kept."""
     keep = np.zeros_like(is_anchor)
     held = np.zeros_like(is_anchor)
     for k in range(n_walks):
         ak = np.flatnonzero((points.walk == k) & is_anchor)
         keep[ak[::2]] = True
         held[ak[1::2]] = True
+    return keep, held
+
+
+def anchor_cv_error(
+    points: Points, n_walks: int, is_anchor: np.ndarray, make: Callable[..., GraphProblem], solver: str
+) -> dict[str, Any]:
+    """Mean error at the held-out anchors of the graph ``make(keep, priors)`` built on the kept ones
+    (fleet priors re-learned from the kept anchors: the held-out ones teach nothing)."""
+    keep, held = split_anchors(points, n_walks, is_anchor)
     if not held.any():
-        return settings.heading_sigma_rad_per_sqrt_s, []
-    priors = fleet_priors(points, keep, n_walks)  # the held-out anchors teach nothing
+        return {"heldout_anchor_mean_m": math.nan, "n": 0}
+    xy = solve_graph(make(keep, fleet_priors(points, keep, n_walks)), solver).xy_m
+    e = np.hypot(*(xy[held] - points.truth_xy_m[held]).T)
+    return {"heldout_anchor_mean_m": float(e.mean()), "n": int(e.size)}
+
+
+def choose_heading_sigma(
+    points: Points,
+    n_walks: int,
+    is_anchor: np.ndarray,
+    settings: GraphSettings,
+    solver: str = "auto",
+    grid=HEADING_SIGMA_GRID,
+) -> tuple[float, list[dict[str, Any]]]:
+    """σ_θ of ``grid`` with the lowest mean error at held-out anchors (module docstring); the
+    settings' own value when no walk has a second anchor to hold out."""
     rows = []
     for sig in grid:
         s = dataclasses.replace(settings, heading_sigma_rad_per_sqrt_s=float(sig))
-        g = build_graph(points, n_walks, anchors=keep, settings=s, priors=priors)
-        xy = solve_graph(g, solver).xy_m
-        e = np.hypot(*(xy[held] - points.truth_xy_m[held]).T)
+
+        def make(keep, priors, s=s):
+            return build_graph(points, n_walks, anchors=keep, settings=s, priors=priors)
+
         rows.append(
-            {
-                "heading_sigma_rad_per_sqrt_s": float(sig),
-                "heldout_anchor_mean_m": float(e.mean()),
-                "n": int(e.size),
-            }
+            {"heading_sigma_rad_per_sqrt_s": float(sig)}
+            | anchor_cv_error(points, n_walks, is_anchor, make, solver)
         )
+    if not rows[0]["n"]:
+        return settings.heading_sigma_rad_per_sqrt_s, []
     best = min(rows, key=lambda r: r["heldout_anchor_mean_m"])
     return best["heading_sigma_rad_per_sqrt_s"], rows
 
@@ -99,26 +116,43 @@ def solve_walks_graph(
     settings: GraphSettings = DEFAULT_SETTINGS,
     learn_heading_sigma: bool = True,
     wifi_model: Any = None,
+    wifi: str = "auto",
     band: str = DEFAULT_BAND,
     solver: str = "auto",
 ) -> GraphRun:
     """Build the graph of ``walks`` and solve it. ``wifi_model``: a fitted pair model giving
-    loop-closure rows (:mod:`.graph_wifi`), or None for none. ``learn_heading_sigma``: choose σ_θ by
-    anchor cross-validation (else the settings' value)."""
+    loop-closure rows (:mod:`.graph_wifi`), or None for none; ``wifi``: ``auto`` = keep its rows only
+    when they lower the held-out anchor error, ``on`` = always. ``learn_heading_sigma``: choose σ_θ
+    by anchor cross-validation (else the settings' value)."""
     t0 = time.perf_counter()
     scans = pool_scans(walks, band)
     points = make_points(walks, scans)
     is_anchor = anchor_mask(points, len(walks), parse_anchors(anchors))
     priors = fleet_priors(points, is_anchor, len(walks))
+    n_walks = len(walks)
     cv: list[dict[str, Any]] = []
     if learn_heading_sigma:
-        sig, cv = choose_heading_sigma(points, len(walks), is_anchor, settings, priors, solver)
+        sig, cv = choose_heading_sigma(points, n_walks, is_anchor, settings, solver)
         settings = dataclasses.replace(settings, heading_sigma_rad_per_sqrt_s=sig)
-    g = build_graph(points, len(walks), anchors=is_anchor, settings=settings, priors=priors)
+    g = build_graph(points, n_walks, anchors=is_anchor, settings=settings, priors=priors)
+    wifi_cv: dict[str, Any] = {}
     if wifi_model is not None:
-        from stridefix_analyzer.crowd.graph_wifi import add_wifi_rows  # noqa: PLC0415
 
-        g = add_wifi_rows(g, points, scans, wifi_model, settings)
+        def make(keep, pri, with_wifi):
+            gk = build_graph(points, n_walks, anchors=keep, settings=settings, priors=pri)
+            return add_wifi_rows(gk, points, scans, wifi_model, settings) if with_wifi else gk
+
+        if wifi == "auto":
+            for label, flag in (("without", False), ("with", True)):
+                wifi_cv[label] = anchor_cv_error(
+                    points, n_walks, is_anchor, lambda k, p, f=flag: make(k, p, f), solver
+                )
+            e_with, e_without = (wifi_cv[k]["heldout_anchor_mean_m"] for k in ("with", "without"))
+            wifi_cv["used"] = bool(e_with < e_without)  # NaN (nothing held out) compares False
+        else:
+            wifi_cv["used"] = wifi == "on"
+        if wifi_cv["used"]:
+            g = add_wifi_rows(g, points, scans, wifi_model, settings)
     build_s = time.perf_counter() - t0
     sol = solve_graph(g, solver)
     info = {
@@ -128,6 +162,7 @@ def solve_walks_graph(
         "priors": dataclasses.asdict(priors),
         "heading_sigma_cv": cv,
         "wifi_model": getattr(wifi_model, "name", None) if wifi_model is not None else None,
+        "wifi_cv": wifi_cv,
         "solver": sol.info,
         "build_s": build_s,
         "scale": [float(s) for s in sol.scale],

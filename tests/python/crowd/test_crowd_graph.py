@@ -113,8 +113,7 @@ def test_drifting_bias_beats_interpolation_and_cv_prefers_a_looser_heading():
     is_anchor = np.zeros(len(pts.t_us), bool)
     for k in range(5):
         is_anchor[np.flatnonzero(pts.walk == k)[::10]] = True
-    fp = fleet_priors(pts, is_anchor, 5)
-    sig, rows = choose_heading_sigma(pts, 5, is_anchor, GraphSettings(), fp, solver="scipy")
+    sig, rows = choose_heading_sigma(pts, 5, is_anchor, GraphSettings(), solver="scipy")
     assert len(rows) == 5 and sig > 0.02
     g = build_graph(pts, 5, anchors=is_anchor, settings=GraphSettings(heading_sigma_rad_per_sqrt_s=sig))
     sol = gs.solve_graph_scipy(g)
