@@ -73,6 +73,10 @@ bench: build
 		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
 	done; \
 	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \
+	if [ -d "$(MSINDOOR)" ]; then \
+		$(PY) -m stridefix_analyzer.cli crowd experiment --msindoor $(MSINDOOR) --check-targets \
+			--stridefixd $(STRIDEFIXD) --out out/bench/crowd || status=1; \
+	fi; \
 	results=""; \
 	for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
 		if [ -d "$$floor" ]; then \
