@@ -164,25 +164,12 @@ def _spearman(x: np.ndarray, y: np.ndarray) -> float:
     return float(spearmanr(x[ok], y[ok])[0])
 
 
-def select_model(
-    walks: list[Walk],
-    candidates: Sequence[str | mm.Candidate] | None = None,
-    folds: int = DEFAULT_FOLDS,
-    band: str = DEFAULT_BAND,
-    score_positions: ScoreFn | None = None,
-    progress: Callable[[str], None] | None = None,
-    sample_pairs: int = DEFAULT_SAMPLE_PAIRS,
-) -> Selection:
-    """Fit every candidate on K−1 folds, score it on the held-out pairs, choose (module docstring)."""
-    cands = parse_candidates(candidates)
-    if len(walks) < 2:
-        raise CrowdInputError(f"held-out selection needs at least 2 walks, got {len(walks)}")
-    K = max(2, min(int(folds), len(walks)))
-    say = progress or (lambda s: None)
-    fw = walk_folds(walks, K)
+def score_candidates(bins, sample: dict, K: int, cands: list[mm.Candidate], say: Callable[[str], None]):
+    """Held-out scores of ``cands`` from :func:`bin_by_fold`'s bins and sample (module docstring).
+
+    Returns (rows sorted by held-out R², best first; candidates fitted on all pairs; per candidate
+    its K fold models (None where the fit failed); all-pair bins per feature)."""
     names = tuple(dict.fromkeys(c.feature for c in cands))
-    bins, sample, info = bin_by_fold(walks, fw, K, names, band, sample_pairs)
-    say(f"binned {info['pairs']} pairs of {info['scans']} scans, {K} folds")
     cat_of = _cat_index(K)
     n_cat = int(cat_of.max()) + 1
     fold_models: dict[str, list[mm.FittedModel | None]] = {c.name: [] for c in cands}
@@ -241,6 +228,29 @@ def select_model(
             row["error"] = str(exc)
         rows.append(row)
     rows.sort(key=lambda r: -r["heldout_r2"] if math.isfinite(r["heldout_r2"]) else math.inf)
+    return rows, fitted, fold_models, all_bins
+
+
+def select_model(
+    walks: list[Walk],
+    candidates: Sequence[str | mm.Candidate] | None = None,
+    folds: int = DEFAULT_FOLDS,
+    band: str = DEFAULT_BAND,
+    score_positions: ScoreFn | None = None,
+    progress: Callable[[str], None] | None = None,
+    sample_pairs: int = DEFAULT_SAMPLE_PAIRS,
+) -> Selection:
+    """Fit every candidate on K−1 folds, score it on the held-out pairs, choose (module docstring)."""
+    cands = parse_candidates(candidates)
+    if len(walks) < 2:
+        raise CrowdInputError(f"held-out selection needs at least 2 walks, got {len(walks)}")
+    K = max(2, min(int(folds), len(walks)))
+    say = progress or (lambda s: None)
+    fw = walk_folds(walks, K)
+    names = tuple(dict.fromkeys(c.feature for c in cands))
+    bins, sample, info = bin_by_fold(walks, fw, K, names, band, sample_pairs)
+    say(f"binned {info['pairs']} pairs of {info['scans']} scans, {K} folds")
+    rows, fitted, fold_models, all_bins = score_candidates(bins, sample, K, cands, say)
     ok = [r for r in rows if r["name"] in fitted and math.isfinite(r["heldout_r2"])]
     if not ok:
         raise CrowdInputError("no candidate could be fitted and scored on held-out walks")
