@@ -3,6 +3,10 @@
 ``fit``        dissimilarity → distance model g(d) = max(X1, X2 + X3·d) from walks with ground truth:
                every scan pair on a floor (positions interpolated on the truth), exact streaming
                binning, bounded least squares on the bins → ``model.json`` + ``model_fit.png``.
+``models``     every candidate dissimilarity → distance model (feature × form × n* strata, the thesis's
+               as the reference row) fitted on K−1 folds of walks and scored on the held-out one
+               (R², RMSE, rank correlation); the best by held-out R² → ``models.json`` + ``models.png``
+               (:mod:`.select_model`).
 ``solve``      2-D positions of the points of a set of walks from anchors (a subset of the truth
                points) and range rows from PDR and/or the Wi-Fi model → ``solve.json``,
                ``positions.csv``, ``solve.png``; error at the non-anchor truth points.
@@ -29,6 +33,7 @@ from stridefix_analyzer.crowd import experiment
 from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd.fit import run_fit
 from stridefix_analyzer.crowd.positions import run_solve
+from stridefix_analyzer.crowd.select_model import DEFAULT_FOLDS, run_models
 from stridefix_analyzer.crowd.sites import run_radiomap
 from stridefix_analyzer.crowd.solve import RANGES, SOLVERS
 from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError
@@ -38,6 +43,7 @@ from stridefix_analyzer.io.logread import LogReadError
 # action -> its command (experiment returns its own exit status)
 ACTIONS: dict[str, Callable[[argparse.Namespace], Any]] = {
     "fit": run_fit,
+    "models": run_models,
     "solve": run_solve,
     "radiomap": run_radiomap,
 }
@@ -145,6 +151,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=1,
         help="pairs sharing fewer APs are excluded (default 1, the thesis); the model "
         "file records it and solve uses it",
+    )
+    mo = sub.add_parser("models", help="candidate models chosen by held-out fit → models.json + plot")
+    _common(mo, False)
+    mo.add_argument("--out", required=True, metavar="DIR")
+    mo.add_argument(
+        "--folds", type=int, default=DEFAULT_FOLDS, help=f"folds by walk (default {DEFAULT_FOLDS})"
+    )
+    mo.add_argument(
+        "--candidates",
+        nargs="+",
+        default=None,
+        metavar="FORM/FEATURE[@n*]",
+        help="only these candidates (default all), e.g. thesis/common_sum isotonic/cosine@n*",
     )
     s = sub.add_parser("solve", help="positions of the walks' points from anchors + ranges")
     _common(s, True)

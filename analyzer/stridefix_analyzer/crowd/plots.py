@@ -81,3 +81,48 @@ def plot_solution(
     os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
     fig.savefig(png_path, dpi=110)
     plt.close(fig)
+
+
+def plot_models(sel, png_path: str, display_bins: int = 40) -> None:
+    """Per feature: binned true distance (mean ± 1 std) vs the feature, with the curves of the
+    unstratified candidates fitted on all walks, labelled with their held-out R² (:mod:`.select_model`)."""
+    from stridefix_analyzer.crowd.features import FEATURES
+    from stridefix_analyzer.crowd.models import form_predict, merge_bins
+
+    plt = _plt()
+    feats = list(sel.bins)
+    cols = min(3, len(feats))
+    rows_n = (len(feats) + cols - 1) // cols
+    fig, axes = plt.subplots(
+        rows_n, cols, figsize=(5 * cols, 3.8 * rows_n), squeeze=False, constrained_layout=True
+    )
+    r2 = {r["name"]: r["heldout_r2"] for r in sel.rows}
+    for ax, feat in zip(axes.ravel(), feats, strict=False):
+        b = merge_bins(sel.bins[feat], FEATURES[feat][1])
+        if not b.used().any():
+            continue
+        b = b.coarsen(max(1, len(b.count) // display_bins))
+        mx, md, sd, _ = b.means()
+        ax.fill_between(mx, md - sd, md + sd, color="tab:blue", alpha=0.15)
+        ax.plot(mx, md, "o", ms=3, color="tab:blue", label="mean distance per bin")
+        xs = np.linspace(0.0, float(mx.max()), 300)
+        for name, m in sel.fitted.items():
+            if m.feature != feat or len(m.params) != 1:
+                continue
+            lw = 2.5 if name == sel.best.name else 1.2
+            ax.plot(
+                xs,
+                form_predict(m.form, m.params[0], xs),
+                lw=lw,
+                label=f"{m.form}: held-out R² {r2[name]:.2f}",
+            )
+        ax.set_xlabel(f"{feat} [{FEATURES[feat][0]}]")
+        ax.set_ylabel("true distance [m]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in axes.ravel()[len(feats) :]:
+        ax.axis("off")
+    fig.suptitle(f"candidates, best {sel.best.name} ({sel.chosen_by})")
+    os.makedirs(os.path.dirname(os.path.abspath(png_path)), exist_ok=True)
+    fig.savefig(png_path, dpi=100)
+    plt.close(fig)
