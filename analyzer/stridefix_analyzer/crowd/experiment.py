@@ -31,9 +31,10 @@ from typing import Any
 import numpy as np
 
 from stridefix_analyzer.bench.targets import missed_lines, table_lines
-from stridefix_analyzer.crowd.experiment_graph import graph_rows
+from stridefix_analyzer.crowd.experiment_graph import graph_rows, select_pair_model
 from stridefix_analyzer.crowd.experiment_targets import solve_targets
 from stridefix_analyzer.crowd.fit import fit_walks, format_model
+from stridefix_analyzer.crowd.models import ThesisAdapter
 from stridefix_analyzer.crowd.positions import solve_walks
 from stridefix_analyzer.crowd.sites import build_crowd_sites
 from stridefix_analyzer.crowd.solve import error_stats
@@ -362,7 +363,9 @@ def run_msindoor(args, progress) -> dict:
             f"{[round(v, 4) for v in model.params]}; stride scale {scale:.3f}; "
             f"table on {len(scored)} walks"
         )
-        rows, _ = run_table(scored, model, args.anchors, args.solver, args.band, scale, progress)
+        sel = select_pair_model(fitting, args.anchors, args.solver, args.band, progress)
+        wifi_models = [(sel.best.name, sel.best), ("thesis/common_sum, reference", ThesisAdapter(model))]
+        rows, _ = run_table(scored, model, args.anchors, args.solver, args.band, scale, progress, wifi_models)
         docs.append(
             {
                 "floor": label,
@@ -371,6 +374,7 @@ def run_msindoor(args, progress) -> dict:
                 "fit_traces": len(fitting),
                 "model_all_traces": model_all.to_json(),
                 "model_used": model.to_json(),
+                "pair_models": {"chosen": sel.best.name, "chosen_by": sel.chosen_by, "rows": sel.rows},
                 "stride_scale": scale,
                 "rows": rows,
                 "prepare_s": prep_s,

@@ -24,7 +24,7 @@ def graph_rows(
         ("graph", "graph: PDR steps + anchors (scale, heading bias per walk)", None)
     ] + [(f"graph_wifi:{name}", f"graph: + Wi-Fi loop closures ({name})", m) for name, m in wifi_models]:
         t0 = time.perf_counter()
-        run = solve_walks_graph(walks, anchors=anchors, wifi_model=model, band=band, solver=solver)
+        run = solve_walks_graph(walks, anchors=anchors, wifi_model=model, wifi="on", band=band, solver=solver)
         e = error_stats(run.xy_m, run.points, run)
         r = run.info["rows"]
         out.append(
@@ -52,3 +52,21 @@ def graph_rows(
             f"σ_θ {run.info['settings']['heading_sigma_rad_per_sqrt_s']:g} rad/√s)"
         )
     return out
+
+
+def select_pair_model(fit_walks, anchors: str, solver: str, band: str, progress=print):
+    """The pair model for the Wi-Fi rows, chosen on the fitting walks only (never the scored ones):
+    every candidate of :mod:`.select_model` by held-out R², the top 3 then by the solved position
+    error of the held-out fold's walks (graph with that fold's model, loop closures on)."""
+    from stridefix_analyzer.crowd.select_model import format_table, select_model  # noqa: PLC0415
+
+    def score(model, held_walks) -> float:
+        run = solve_walks_graph(
+            held_walks, anchors=anchors, wifi_model=model, wifi="on", band=band, solver=solver
+        )
+        return float(error_stats(run.xy_m, run.points, run).get("mean_m", float("nan")))
+
+    usable = [w for w in fit_walks if len(w.step_t_us) and len(w.truth_t_us) >= 3 and w.n_scans]
+    sel = select_model(usable, band=band, score_positions=score)
+    progress(format_table(sel))
+    return sel

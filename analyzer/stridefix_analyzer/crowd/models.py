@@ -358,3 +358,17 @@ def model_from_json(doc: dict) -> Any:
         sig = doc.get("sigma")
         return ThesisAdapter(cm.DistanceModel.from_json(doc), sig if isinstance(sig, dict) else None)
     return FittedModel.from_json(doc)
+
+
+def read_pair_model(path: str) -> Any:
+    """The pair model of a file written by ``crowd models`` (its best candidate) or ``crowd fit``."""
+    import json  # noqa: PLC0415
+
+    from stridefix_analyzer.crowd.walks import CrowdInputError  # noqa: PLC0415
+
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+        return model_from_json(doc["best"] if isinstance(doc, dict) and "best" in doc else doc)
+    except (OSError, ValueError, TypeError, KeyError) as exc:
+        raise CrowdInputError(f"{path}: cannot read a pair model ({type(exc).__name__}: {exc})") from exc
