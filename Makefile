@@ -18,7 +18,7 @@ help:
 	@echo "make demo   - install what is missing, build, run the default SIL walk, write $(DEMO_OUT)/report.html"
 	@echo "make test   - install what is missing, build, run every test (C, Python, end to end), lint and gates"
 	@echo "make lint   - ruff (lint + format check) on all Python, mypy on the analyzer (strict on io, datasets)"
-	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance; particle cost; controller); writes out/bench/*.json"
+	@echo "make bench  - benchmarks (SIL PDR at each pace; real-data PDR distance, fusion and crowd-built map; particle cost; controller); writes out/bench/*.json"
 	@echo "make reliability - the default SIL walk with each bus/board fault vs clean; out/bench/reliability.json"
 	@echo "make soak   - an 8-hour SIL walk with faults through stridefixd: RSS at 1 h and 8 h, events accounted"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
@@ -86,6 +86,10 @@ bench: build
 			$(PY) -m stridefix_analyzer.cli realbench --format msindoor "$$floor" --true-start --quiet \
 				--stridefixd $(STRIDEFIXD) --out out/bench/realbench/$$name-fusion/results.json || status=1; \
 			results="$$results out/bench/realbench/$$name-fusion/results.json"; \
+			$(PY) -m stridefix_analyzer.cli realbench crowd-map --format msindoor "$$floor" --quiet \
+				--stridefixd $(STRIDEFIXD) --cache out/bench/realbench/$$name-fusion/cache \
+				--out out/bench/realbench/$$name-crowd-map/results.json || status=1; \
+			results="$$results out/bench/realbench/$$name-crowd-map/results.json"; \
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
 	done; \
 	if [ -d "$(GSD)" ]; then \

@@ -10,8 +10,9 @@
 ``solve``      2-D positions of the points of a set of walks from anchors (a subset of the truth
                points) and range rows from PDR and/or the Wi-Fi model → ``solve.json``,
                ``positions.csv``, ``solve.png``; error at the non-anchor truth points.
-``radiomap``   a site file built from the solved positions instead of the truth (the walk-mode builder
-               of ``stridefix radiomap``); ``--truth-site`` also writes the truth-built one.
+``radiomap``   a site file built from the graph-solved positions (anchors every K-th truth point + the
+               walk's steps, :mod:`.graph_run`) instead of the truth (the walk-mode builder of
+               ``stridefix radiomap``); ``--truth-site`` also writes the truth-built one.
 ``experiment`` the thesis's table in SIL (``--sil``) or on msindoor walks (``--msindoor DIR``), see
                :mod:`.experiment`.
 
@@ -32,6 +33,7 @@ from typing import Any
 from stridefix_analyzer.crowd import experiment
 from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd.fit import run_fit
+from stridefix_analyzer.crowd.graph_solve import SOLVERS as GRAPH_SOLVERS
 from stridefix_analyzer.crowd.positions import run_solve
 from stridefix_analyzer.crowd.select_model import DEFAULT_FOLDS, run_models
 from stridefix_analyzer.crowd.sites import run_radiomap
@@ -168,8 +170,22 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     s = sub.add_parser("solve", help="positions of the walks' points from anchors + ranges")
     _common(s, True)
     s.add_argument("--out", required=True, metavar="DIR")
-    r = sub.add_parser("radiomap", help="site file from solved positions (+ a truth-built one)")
-    _common(r, True)
+    r = sub.add_parser(
+        "radiomap", help="site file from graph-solved positions (anchors + steps; + a truth-built one)"
+    )
+    _common(r, False)
+    r.add_argument(
+        "--anchors",
+        default="every:4",
+        metavar="every:K|every-other-waypoint",
+        help="known truth points per walk (default every:4, the thesis)",
+    )
+    r.add_argument(
+        "--solver",
+        choices=GRAPH_SOLVERS,
+        default="auto",
+        help="graph solver: native (Ceres), scipy, or auto = native when importable (default)",
+    )
     r.add_argument("--out", required=True, metavar="SITE.sfsite")
     r.add_argument(
         "--truth-site",

@@ -4,6 +4,7 @@ calls the benchmark modules).
 ``fusion`` (the default: ``stridefix realbench --format NAME DIR... --out results.json``): every fusion
 scheme, leave one walk out (:mod:`.fusion`); ``--format`` is any registered data set.
 ``pdr-distance``: step detection + Weinberg length against the distance walked (:mod:`.pdr_distance`).
+``crowd-map``: fusion's folds replayed on the truth-built and on a crowd-built site (:mod:`.crowdmap`).
 Exit status: 0 done, 1 nothing could be scored, 2 bad usage or unreadable input.
 """
 
@@ -37,7 +38,7 @@ from stridefix_analyzer.realbench.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_analyzer.realbench.summary import format_tables
 from stridefix_analyzer.realbench.walks import RealbenchError
 
-BENCHES = ("fusion", "pdr-distance")
+BENCHES = ("fusion", "pdr-distance", "crowd-map")
 
 
 def with_default_bench(argv: list[str]) -> list[str]:
@@ -60,6 +61,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     )
     sub = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
     add_fusion_parser(sub)
+    add_crowd_map_parser(sub)
     d = sub.add_parser(
         "pdr-distance",
         help="segment distance from steps + Weinberg length, K leave-one-walk-out",
@@ -277,3 +279,76 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
     )
     scored = sum(s["n"] for g in doc["groups"] for s in g["summary"]["schemes"].values())
     return 0 if scored else 1
+
+
+def add_crowd_map_parser(sub: Any) -> None:
+    """Declare ``stridefix realbench crowd-map``."""
+    from stridefix_analyzer.crowd.graph_solve import SOLVERS as GRAPH_SOLVERS
+
+    d = sub.add_parser(
+        "crowd-map",
+        help="fix error on a crowd-built radio map (anchors only) next to the truth-built one",
+        description="The walks and leave-one-walk-out folds of realbench fusion; per fold two sites "
+        "from the training walks: the truth-built one (as fusion builds it) and the crowd-built one, "
+        "identical except that each training walk's scans sit at its graph-solved positions (anchors "
+        "every K-th waypoint + its steps). The held-out walk is replayed on both and scored. Writes "
+        "results.json and per-fold work folders beside it.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    d.add_argument("dirs", nargs="+", metavar="DIR", help="floor folders (msindoor: site1/F2)")
+    d.add_argument("--format", required=True, choices=datasets.names(), help="data set format")
+    d.add_argument("--out", required=True, metavar="results.json", help="JSON results file")
+    add_stridefixd_argument(d)
+    d.add_argument("--anchors", default="every:4", metavar="every:K", help="anchored waypoints per walk")
+    d.add_argument("--solver", choices=GRAPH_SOLVERS, default="auto", help="graph solver")
+    d.add_argument(
+        "--limit", type=int, default=None, metavar="N", help="only the first N walks of each group"
+    )
+    d.add_argument("--jobs", "-j", type=int, default=2, metavar="N", help="parallel workers")
+    d.add_argument("--cell-size-m", type=float, default=DEFAULT_CELL_SIZE_M, help="radio-map grid cell [m]")
+    d.add_argument("--min-count", type=int, default=DEFAULT_MIN_COUNT, help="radio map: min scans per entry")
+    d.add_argument(
+        "--set",
+        dest="param_sets",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="firmware parameter for every replay (stridefixd --set; repeatable)",
+    )
+    d.add_argument(
+        "--cache", default=None, metavar="DIR", help="import cache (default: <folder of results.json>/cache)"
+    )
+    d.add_argument("--reimport", action="store_true", help="ignore the cached imports")
+    d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+    d.set_defaults(_bench=_run_crowd_map_cli)
+
+
+def _run_crowd_map_cli(args: argparse.Namespace) -> int:
+    from stridefix_analyzer.crowd.solve import parse_anchors
+    from stridefix_analyzer.crowd.walks import CrowdInputError
+    from stridefix_analyzer.realbench.crowdmap import CrowdMapConfig, format_tables, run_crowd_map
+
+    try:
+        parse_anchors(args.anchors)
+        cfg = FusionConfig(
+            fmt=args.format,
+            dirs=args.dirs,
+            out_json=Path(args.out),
+            stridefixd=args.stridefixd,
+            limit=args.limit,
+            jobs=args.jobs,
+            reimport=args.reimport,
+            cell_size_m=args.cell_size_m,
+            min_count=args.min_count,
+            cache_dir=args.cache,
+            report=False,
+            quiet=args.quiet,
+            param_sets=args.param_sets,
+        )
+        doc = run_crowd_map(CrowdMapConfig(cfg, anchors=args.anchors, solver=args.solver))
+    except (RealbenchError, LogReadError, CrowdInputError) as exc:
+        print(f"stridefix realbench: error: {exc}", file=sys.stderr)
+        return input_error_status(exc)
+    print(format_tables(doc))
+    print(f"wrote {args.out} ({doc['run_s']['total']:.1f} s)")
+    return 0 if any(g["paired"] for g in doc["groups"]) else 1

@@ -113,19 +113,8 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     Returns the JSON document (non-finite numbers still NaN). Raises :class:`.walks.RealbenchError`.
     """
     t_start = time.perf_counter()
-    ds = dataset(cfg.fmt)
-    # the data set's own overrides first, the user's --set after them (the later one wins)
-    cfg = dataclasses.replace(cfg, param_sets=(*ds.firmware_sets, *cfg.param_sets))
-    fw = firmware(cfg.stridefixd or Firmware().path, cfg.param_sets)
-    age = ds.defaults.max_wifi_age_s if cfg.max_wifi_age_s is None else cfg.max_wifi_age_s
-    out_dir = cfg.out_json.parent if str(cfg.out_json.parent) else Path(".")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    groups = find_groups(ds, cfg.dirs, cfg.limit)
-    stream = open(os.devnull, "w") if cfg.quiet else sys.stderr
-    rows = tuning.axes(cfg.param_sets)
-    if not cfg.content.controller:
-        rows = tuple(a for a in rows if a.name != "lsd")
-    run = Run(cfg, ds, fw, rows, age, out_dir, stream)
+    run, groups = start_run(cfg)
+    cfg, fw, stream = run.cfg, run.firmware, run.stream
     walks, parts = prepare_walks(run, groups)  # phase 1
     t_prep = time.perf_counter() - t_start
     planned = [plan_group(run, p, walks) for p in parts]  # phase 2
@@ -156,6 +145,24 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     if cfg.quiet:
         stream.close()
     return doc
+
+
+def start_run(cfg: FusionConfig) -> tuple[Run, list[WalkGroup]]:
+    """The data set, the checked firmware, the tuning axes, the output folder and the progress stream
+    of a run, and its walk groups (shared with ``realbench crowd-map``). Raises RealbenchError."""
+    ds = dataset(cfg.fmt)
+    # the data set's own overrides first, the user's --set after them (the later one wins)
+    cfg = dataclasses.replace(cfg, param_sets=(*ds.firmware_sets, *cfg.param_sets))
+    fw = firmware(cfg.stridefixd or Firmware().path, cfg.param_sets)
+    age = ds.defaults.max_wifi_age_s if cfg.max_wifi_age_s is None else cfg.max_wifi_age_s
+    out_dir = cfg.out_json.parent if str(cfg.out_json.parent) else Path(".")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    groups = find_groups(ds, cfg.dirs, cfg.limit)
+    stream = open(os.devnull, "w") if cfg.quiet else sys.stderr
+    rows = tuning.axes(cfg.param_sets)
+    if not cfg.content.controller:
+        rows = tuple(a for a in rows if a.name != "lsd")
+    return Run(cfg, ds, fw, rows, age, out_dir, stream), groups
 
 
 def prepare_walks(run: Run, groups: list[WalkGroup]) -> tuple[list[dict[str, Any]], list[Part]]:

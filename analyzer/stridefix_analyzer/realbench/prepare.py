@@ -53,8 +53,9 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
         ``waypoint_t_us``, ``waypoint_xy_m``, ``step_t_us``, ``step_range_mps2``,
         ``step_length_m``), plus ``stats`` (WalkStats), ``rotation`` (per heading candidate,
         :func:`.heading.rotation_stats`), ``floor_heights``, ``floors`` (truth floors),
-        ``first_waypoint`` (t_us, x, y, floor), ``import_log`` and ``ble_placed`` (the BLE readings
-        placed on the truth, :func:`~stridefix_analyzer.radiomap.beacons.place_readings`).
+        ``first_waypoint`` (t_us, x, y, floor), ``import_log``, ``fw_log`` (the site-less replay) and
+        ``ble_placed`` (the BLE readings placed on the truth,
+        :func:`~stridefix_analyzer.radiomap.beacons.place_readings`).
     """
     from stridefix_analyzer.radiomap.beacons import place_readings
     from stridefix_analyzer.radiomap.build import RadioMapInputError, WalkStats, load_recordings
@@ -87,6 +88,7 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
             st = read_table(fw_log, "STEP")
             headings[name] = (st["t_us"], st["heading_rad"]) if st is not None else None
     fw_log = fw_dir / f"{trace.stem}.{first}.lcmlog"
+    walk["fw_log"] = str(fw_log)  # its STEP stream: the crowd-built map's dead reckoning (.crowdmap)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", LogTruncatedWarning)

@@ -57,16 +57,11 @@ def test_solve_reports_solver_and_bounded_error(fitted, sil_walks, cli, tmp_path
     assert "solver" in proc.stdout
 
 
-def test_crowd_radiomap_writes_sites(fitted, sil_walks, cli, tmp_path):
-    out, _ = fitted
+def test_crowd_radiomap_writes_sites(sil_walks, cli, tmp_path):
     proc = cli(
         "crowd",
         "radiomap",
         *sil_walks,
-        "--model",
-        str(out / "model.json"),
-        "--ranges",
-        "pdr",
         "--out",
         str(tmp_path / "crowd.sfsite"),
         "--truth-site",

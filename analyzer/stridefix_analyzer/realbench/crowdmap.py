@@ -1,0 +1,334 @@
+"""``stridefix realbench crowd-map``: the fix error on a radio map nobody surveyed, next to the surveyed one.
+
+Issue 15, item 3 (Kannan 2024, §4-5: a radio map from crowd walks with anchors every 4th waypoint).
+The walks, groups and folds are those of ``realbench fusion`` (:mod:`.fusion`: leave one walk out per
+floor) and so are its phases 1-2 (:func:`.fusion.prepare_walks`, :func:`.fusion.plan_group`). Each
+fold then gets two sites from its training walks:
+
+* **truth map**: exactly the fold site ``realbench fusion`` builds (scan positions interpolated on the
+  surveyed waypoints);
+* **crowd map**: identical (same rotation, floors, walls, geo-reference, chosen settings, firmware
+  ``--set``) except that each training walk's scan positions are its graph-solved positions
+  (:func:`~stridefix_analyzer.crowd.graph_run.solve_walks_graph`: every K-th waypoint an anchor, the
+  walk's site-less STEP stream between them, no Wi-Fi rows; :func:`~stridefix_analyzer.crowd.sites.
+  solved_truth`). Without Wi-Fi rows each walk's solve is independent of every other walk, so one
+  solve per walk serves every fold (no leak between folds).
+
+The held-out walk is replayed on each (:func:`.fold.run_fold`, the same protocol) and scored at its
+waypoints; the crowd positions' own error at the non-anchor waypoints is reported next to that of the
+anchors interpolated in time. Outputs: ``results.json`` (``benchmark: crowd-map``) and the per-fold
+work folders (``<walk>`` for the truth map, ``<walk>/crowd-map`` for the crowd map).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import json
+import math
+import os
+import sys
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any, TextIO
+
+from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.realbench.fold import STATS_KEYS, FoldJob, run_fold
+from stridefix_analyzer.realbench.fusion import FusionConfig, Run, plan_group, prepare_walks, start_run
+from stridefix_analyzer.realbench.progress import Progress
+from stridefix_analyzer.realbench.summary import summarize_group
+
+#: the schemes the console table shows (the JSON has every scheme): the Wi-Fi fix itself, and the ekf
+SHOWN = ("wifi_only", "ekf")
+MAPS = ("truth_map", "crowd_map")
+
+
+@dataclasses.dataclass(frozen=True)
+class CrowdMapConfig:
+    """``realbench crowd-map``: the fusion run's options plus the crowd solve's."""
+
+    fusion: FusionConfig
+    anchors: str = "every:4"
+    solver: str = "auto"
+
+
+@dataclasses.dataclass(frozen=True)
+class CrowdJob:
+    """One walk's crowd solve (sent to a worker): its site-less replay log and its imported log."""
+
+    walk: str
+    fw_log: str
+    import_log: str
+    anchors: str
+    solver: str
+    cell_size_m: float
+
+
+def crowd_walk(job: CrowdJob) -> dict[str, Any]:
+    """Solve one walk on the graph and return the walk-mode map statistics of its scans placed at the
+    solved positions (``stats``), the rows used and the position errors; ``error`` says why not."""
+    from stridefix_analyzer.crowd.graph_run import solve_walks_graph
+    from stridefix_analyzer.crowd.sites import graph_errors, solved_truth
+    from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
+    from stridefix_analyzer.io.logread import LogReadError
+    from stridefix_analyzer.radiomap.build import RadioMapInputError, Recording, load_recordings
+
+    t0 = time.perf_counter()
+    out: dict[str, Any] = {"walk": job.walk, "error": None}
+    try:
+        walks = load_walks([f"{job.fw_log},{job.import_log}"])
+        # band "all": every scan with an AP is a point of the graph, so each scan of the map gets
+        # its own solved position (without Wi-Fi rows the band changes nothing else)
+        run = solve_walks_graph(walks, anchors=job.anchors, band="all", solver=job.solver)
+        recs = load_recordings([job.import_log])
+    except (CrowdInputError, LogReadError, RadioMapInputError) as exc:
+        out["error"] = f"crowd solve failed: {exc}"
+        return out
+    truth = solved_truth(walks[0], 0, run.xy_m, run.points)
+    crowd = [Recording(r.files, r.wifi, r.wifi_ap, truth, r.ble) for r in recs]
+    out["stats"] = WalkStats.from_recordings(crowd, cell_size_m=job.cell_size_m)
+    out["rows"] = run.info["rows"]
+    out["solver"] = run.info["solver"].get("solver")
+    out["positions"] = graph_errors(run)
+    out["run_s"] = time.perf_counter() - t0
+    return out
+
+
+def _pair(jobs: tuple[FoldJob, FoldJob]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Both replays of one fold (truth map, crowd map), in one worker."""
+    return run_fold(jobs[0]), run_fold(jobs[1])
+
+
+def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
+    """Run the benchmark (module docstring); write ``cc.fusion.out_json``; return the document."""
+    t_start = time.perf_counter()
+    cfg = dataclasses.replace(cc.fusion, true_start=False, report=False)
+    run, groups = start_run(dataclasses.replace(cfg, quiet=True))  # fusion's own progress: silent
+    stream = open(os.devnull, "w") if cfg.quiet else sys.stderr
+    print(
+        f"realbench: crowd-map: preparing {sum(len(g.walks) for g in groups)} walks", file=stream, flush=True
+    )
+    walks, parts = prepare_walks(run, groups)  # phase 1
+    print(
+        f"realbench: crowd-map: choosing the folds' settings of {len(parts)} groups", file=stream, flush=True
+    )
+    planned = [plan_group(run, p, walks) for p in parts]  # phase 2
+    t_plan = time.perf_counter()
+    crowd = solve_crowd(run, walks, cc, stream)  # the crowd positions, one solve per walk
+    t_crowd = time.perf_counter()
+    pairs = []
+    for _, jobs in planned:
+        # a walk whose solve failed adds nothing to the crowd maps (reported per group)
+        empty = WalkStats.empty(run.cfg.cell_size_m)
+        stats = {j.index: crowd[j.index].get("stats", empty) for j in jobs}
+        total = WalkStats.total(list(stats.values()))
+        for j in jobs:
+            cj = dataclasses.replace(j, dir=j.dir / "crowd-map", total=total, held=stats[j.index])
+            pairs.append((j, cj))
+    results = run_pairs(run, pairs, stream)  # phase 3, both maps of a fold in one worker
+    groups_doc = [group_doc(p.label, info, jobs, results, crowd) for p, (info, jobs) in zip(parts, planned)]
+    doc = {
+        "benchmark": "crowd-map",
+        "format": cfg.fmt,
+        "dirs": [str(d) for d in cfg.dirs],
+        "anchors": cc.anchors,
+        "solver": cc.solver,
+        "inputs": "crowd map: per training walk its waypoints every "
+        f"{cc.anchors} (anchors) + its site-less STEP stream (no Wi-Fi rows); truth map: every waypoint",
+        "params": {
+            "cell_size_m": cfg.cell_size_m,
+            "min_count": cfg.min_count,
+            "firmware_sets": list(run.cfg.param_sets),
+            "limit": cfg.limit,
+            "jobs": cfg.jobs,
+        },
+        "stridefixd": {"path": str(run.firmware.path), "version": run.firmware.version()},
+        "groups": groups_doc,
+    }
+    doc["run_s"] = {
+        "prepare_plan": t_plan - t_start,
+        "crowd_solve": t_crowd - t_plan,
+        "folds": time.perf_counter() - t_crowd,
+        "total": time.perf_counter() - t_start,
+    }
+    with open(cfg.out_json, "w", encoding="utf-8") as f:
+        json.dump(json_ready(doc), f, indent=1, allow_nan=False)
+        f.write("\n")
+    run.stream.close()
+    if cfg.quiet:
+        stream.close()
+    return doc
+
+
+def solve_crowd(
+    run: Run, walks: list[dict[str, Any]], cc: CrowdMapConfig, stream: TextIO
+) -> dict[int, dict[str, Any]]:
+    """:func:`crowd_walk` of every prepared walk, in parallel (walk index → its result)."""
+    ok = [i for i, w in enumerate(walks) if not w["error"]]
+    crowd: dict[int, dict[str, Any]] = {}
+    prog = Progress("crowd solve", len(ok), stream)
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, run.cfg.jobs)) as pool:
+        futs = {
+            pool.submit(
+                crowd_walk,
+                CrowdJob(
+                    walks[i]["walk"],
+                    walks[i]["fw_log"],
+                    walks[i]["import_log"],
+                    cc.anchors,
+                    cc.solver,
+                    run.cfg.cell_size_m,
+                ),
+            ): i
+            for i in ok
+        }
+        for fut in concurrent.futures.as_completed(futs):
+            c = crowd[futs[fut]] = fut.result()
+            g = (c.get("positions") or {}).get("graph", {})
+            note = (
+                c["error"] or f"{c['rows']['anchors']} anchors, graph mean {g.get('mean_m', math.nan):.1f} m"
+            )
+            prog.step(f"{c['walk']}: {note}")
+    return crowd
+
+
+def run_pairs(
+    run: Run, pairs: list[tuple[FoldJob, FoldJob]], stream: TextIO
+) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
+    """Both replays of every fold, in parallel (walk → truth-map result, crowd-map result)."""
+    results: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
+    prog = Progress("fold", len(pairs), stream)
+    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, run.cfg.jobs)) as pool:
+        futs2 = {pool.submit(_pair, p): p[0].walk for p in pairs}
+        for fut in concurrent.futures.as_completed(futs2):
+            tr, cr = results[futs2[fut]] = fut.result()
+            note = (
+                tr["error"]
+                or cr["error"]
+                or " vs ".join(
+                    f"{m} {r['fixes'].get('wifi_only', {}).get('mean', math.nan):.1f} m"
+                    for m, r in (("truth", tr), ("crowd", cr))
+                )
+            )
+            prog.step(f"{futs2[fut]}: wifi_only {note}")
+    return results
+
+
+def _scores(r: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    return {s: {k: v[k] for k in STATS_KEYS} for s, v in (r.get("fixes") or {}).items()}
+
+
+def _site(r: Mapping[str, Any]) -> dict[str, Any]:
+    f = r.get("fold") or {}
+    return {k: f.get(k) for k in ("n_rp", "n_ap", "n_entries", "scans_used")}
+
+
+def _ratio(crowd: Mapping[str, Any], truth: Mapping[str, Any], scheme: str) -> float:
+    c, t = (crowd.get(scheme) or {}).get("mean"), (truth.get(scheme) or {}).get("mean")
+    return float(c) / float(t) if c is not None and t and math.isfinite(c) and math.isfinite(t) else math.nan
+
+
+def _pooled_positions(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """Mean position error over every non-anchor waypoint of the walks (per-walk means weighted by n)."""
+    out: dict[str, Any] = {}
+    for kind in ("graph", "interpolated"):
+        st = [r[kind] for r in rows if r.get(kind, {}).get("n")]
+        n = sum(s["n"] for s in st)
+        out[kind] = {"n": n, "mean_m": sum(s["n"] * s["mean_m"] for s in st) / n if n else math.nan}
+    return out
+
+
+def group_doc(
+    label: str,
+    info: Mapping[str, Any],
+    jobs: Sequence[FoldJob],
+    results: Mapping[str, tuple[dict[str, Any], dict[str, Any]]],
+    crowd: Mapping[int, Mapping[str, Any]],
+) -> dict[str, Any]:
+    """One group: per walk both maps' scores, their ratio and the crowd positions' error; the pooled
+    summaries (as ``realbench fusion`` pools them) over the walks scored on both maps."""
+    rows, paired_truth, paired_crowd = [], [], []
+    for j in jobs:
+        tr, cr = results[j.walk]
+        c = crowd.get(j.index, {})
+        row: dict[str, Any] = {
+            "walk": j.walk,
+            "error": tr["error"] or cr["error"] or c.get("error"),
+            "truth_map": _scores(tr),
+            "crowd_map": _scores(cr),
+            "sites": {"truth_map": _site(tr), "crowd_map": _site(cr)},
+            "crowd_rows": c.get("rows"),
+            "crowd_positions": c.get("positions"),
+        }
+        row["ratio"] = {s: _ratio(row["crowd_map"], row["truth_map"], s) for s in row["truth_map"]}
+        rows.append(row)
+        if not (tr["error"] or cr["error"]):
+            paired_truth.append(tr)
+            paired_crowd.append(cr)
+    truth_sum = summarize_group(paired_truth)["schemes"]
+    crowd_sum = summarize_group(paired_crowd)["schemes"]
+    n_rows: dict[str, int] = {}
+    for j in jobs:
+        for k, v in (crowd.get(j.index, {}).get("rows") or {}).items():
+            n_rows[k] = n_rows.get(k, 0) + int(v)
+    return {
+        "label": label,
+        "walks": info.get("walks"),
+        "ran": info.get("ran"),
+        "failed": info.get("failed"),
+        "paired": len(paired_truth),
+        "crowd_failed": [
+            {"walk": crowd[j.index]["walk"], "error": crowd[j.index]["error"]}
+            for j in jobs
+            if crowd.get(j.index, {}).get("error")
+        ],
+        "crowd_rows": n_rows,
+        "summary": {
+            "truth_map": truth_sum,
+            "crowd_map": crowd_sum,
+            "ratio": {s: _ratio(crowd_sum, truth_sum, s) for s in truth_sum},
+            "crowd_positions": _pooled_positions([r["crowd_positions"] or {} for r in rows]),
+        },
+        "walk_rows": rows,
+    }
+
+
+def format_tables(doc: Mapping[str, Any]) -> str:
+    """Per group: one line per walk and the pooled mean — truth map vs crowd map fix error of the
+    shown schemes, their ratio, and the crowd positions' error vs the interpolated anchors."""
+    lines = []
+    for g in doc["groups"]:
+        r = g["crowd_rows"]
+        lines.append(
+            f"crowd-map {g['label']}: {g['paired']} of {g['walks']} walks scored on both maps; crowd "
+            f"positions from {r.get('anchors', 0)} anchors ({doc['anchors']}), {r.get('steps', 0)} step "
+            f"rows, {r.get('wifi', 0)} Wi-Fi rows"
+        )
+        head = f"{'walk':<26}" + "".join(f" {s + ' truth':>15} {'crowd':>7} {'ratio':>6}" for s in SHOWN)
+        lines.append(head + f" {'pos graph':>10} {'interp':>7}")
+
+        def cells(truth: Mapping[str, Any], crowd: Mapping[str, Any], ratio: Mapping[str, Any]) -> str:
+            out = ""
+            for s in SHOWN:
+                t, c = (truth.get(s) or {}).get("mean", math.nan), (crowd.get(s) or {}).get("mean", math.nan)
+                out += f" {t:>15.2f} {c:>7.2f} {ratio.get(s, math.nan):>6.2f}"
+            return out
+
+        for w in g["walk_rows"]:
+            p = w.get("crowd_positions") or {}
+            pg = (p.get("graph") or {}).get("mean_m", math.nan)
+            pi = (p.get("interpolated") or {}).get("mean_m", math.nan)
+            tail = f"  ({w['error']})" if w["error"] else ""
+            lines.append(
+                f"{w['walk']:<26}{cells(w['truth_map'], w['crowd_map'], w['ratio'])} {pg:>10.2f} {pi:>7.2f}"
+                + tail
+            )
+        s = g["summary"]
+        cp = s["crowd_positions"]
+        lines.append(
+            f"{'pooled mean':<26}{cells(s['truth_map'], s['crowd_map'], s['ratio'])} "
+            f"{cp['graph']['mean_m']:>10.2f} {cp['interpolated']['mean_m']:>7.2f}"
+        )
+        lines.append("")
+    return "\n".join(lines)
