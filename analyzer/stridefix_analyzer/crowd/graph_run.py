@@ -52,7 +52,9 @@ def solve_walks_graph(
         from stridefix_analyzer.crowd.graph_wifi import wifi_rows  # noqa: PLC0415 - optional rows
 
         wifi = wifi_rows(points, scans, wifi_model, settings)
-    g = build_graph(points, len(walks), anchors=anchors, settings=settings, scale_prior=scale_prior, wifi_rows=wifi)
+    g = build_graph(
+        points, len(walks), anchors=anchors, settings=settings, scale_prior=scale_prior, wifi_rows=wifi
+    )
     build_s = time.perf_counter() - t0
     sol = solve_graph(g, solver)
     info = {
