@@ -48,11 +48,17 @@ class GroupData:
     xy_m: np.ndarray
 
 
+#: Block of the fit's pair blocks: 512 × 512 float32 temporaries (1 MB) stay in cache; measured on a
+#: 20 000-scan fleet: 13 ns/pair at 512, 23 at 1024, 30 at 2048 (large blocks page-fault on every
+#: temporary). model.bin_pairs keeps its own default (cm.DEFAULT_BLOCK).
+FIT_BLOCK = 512
+
+
 @dataclasses.dataclass
 class BinSettings:
     mode: str = cm.DEFAULT_MODE
     width_db: float = cm.DEFAULT_BIN_WIDTH_DB
-    block: int = cm.DEFAULT_BLOCK
+    block: int = FIT_BLOCK
     min_common: int = 1
 
 
