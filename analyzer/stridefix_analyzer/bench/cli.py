@@ -21,6 +21,7 @@ from typing import Any
 
 from stridefix_analyzer.bench import (
     controller,
+    crowd_scale,
     fusion,
     particle_cost,
     realdata,
@@ -127,6 +128,22 @@ def _run_particle_cost(
     return particle_cost.missed_targets(doc)
 
 
+def _run_crowd_scale(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del firmware  # no replay: a synthetic fleet of Walk objects
+    doc = crowd_scale.run_crowd_scale(
+        out,
+        n_scans=args.scans,
+        n_walks=args.walks,
+        scheduler=args.scheduler,
+        pair_fraction=args.pair_fraction,
+        solve_groups=args.solve_groups,
+        seed=seeds[0],
+    )
+    print(crowd_scale.format_table(doc))
+    print(f"wrote {out / 'crowd_scale.json'} ({doc['run_s']:.0f} s)")
+    return crowd_scale.missed_targets(doc)
+
+
 Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
 #: sub-bench name → (runner, default seeds)
 BENCHES: dict[str, tuple[Runner, str]] = {
@@ -139,7 +156,10 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "reliability": (_run_reliability, "1"),
     "soak": (_run_soak, "1"),
     "particle-cost": (_run_particle_cost, "1"),
+    "crowd-scale": (_run_crowd_scale, "1"),
 }
+#: benches that run no firmware (no --stridefixd needed)
+NO_FIRMWARE = {"crowd-scale"}
 
 
 class BenchUsageError(ValueError):
@@ -173,7 +193,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "targets on realbench results.json files (--results); reliability: the default walk with each bus "
         "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
         "accounting (make soak); particle-cost: the particle scheme's instructions per step under callgrind "
-        "(1 000 particles, 5 000 walls; target <= 1 million)",
+        "(1 000 particles, 5 000 walls; target <= 1 million); crowd-scale: the crowd fit and graph solve on a "
+        "synthetic fleet (100 000 scans / 500 walks) serially and on Dask 1 and 2 workers (target fit + solve "
+        "<= 300 s)",
     )
     p.add_argument(
         "--paces",
@@ -234,6 +256,36 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         help="soak: read the first peak RSS after this much input [h] (default: 1)",
     )
     p.add_argument(
+        "--scans",
+        type=int,
+        default=crowd_scale.DEFAULT_SCANS,
+        help="crowd-scale: scans of the fleet (default 100000)",
+    )
+    p.add_argument(
+        "--walks",
+        type=int,
+        default=crowd_scale.DEFAULT_WALKS,
+        help="crowd-scale: walks of the fleet (default 500)",
+    )
+    p.add_argument(
+        "--scheduler",
+        default="local",
+        metavar="local|tcp://HOST:PORT",
+        help="crowd-scale: Dask runs on LocalClusters of 1 and 2 workers, or on this scheduler (default local)",
+    )
+    p.add_argument(
+        "--pair-fraction",
+        type=float,
+        default=1.0,
+        help="crowd-scale: fit on an unbiased random subsample of this fraction of the pairs (default 1)",
+    )
+    p.add_argument(
+        "--solve-groups",
+        default="chunk:1",
+        metavar="floor|all|chunk:K",
+        help="crowd-scale: walks per solve task (default chunk:1, one walk per task)",
+    )
+    p.add_argument(
         "--no-calibration",
         action="store_true",
         help="skip the per-person stride calibration walk (use the configured default K)",
@@ -245,7 +297,8 @@ def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix bench``; returns the exit status (module docstring)."""
     firmware = Firmware(args.stridefixd)
     try:
-        firmware.check_executable()
+        if args.which not in NO_FIRMWARE:
+            firmware.check_executable()
     except FirmwareError as exc:
         print(f"stridefix bench: error: {exc}", file=sys.stderr)
         return 2

@@ -154,6 +154,26 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="pairs sharing fewer APs are excluded (default 1, the thesis); the model "
         "file records it and solve uses it",
     )
+    f.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="local|tcp://HOST:PORT",
+        help="run the pair blocks on Dask: 'local' = a LocalCluster of --workers processes, or a "
+        "scheduler address (default: serial; the bins are bit-identical either way)",
+    )
+    f.add_argument("--workers", type=int, default=2, help="--scheduler local: worker processes (default 2)")
+    f.add_argument(
+        "--pair-fraction",
+        type=float,
+        default=1.0,
+        help="fit on an unbiased random subsample of this fraction of the scan pairs (default 1 = all)",
+    )
+    f.add_argument(
+        "--precision",
+        choices=("float64", "float32"),
+        default="float64",
+        help="arithmetic of the pair blocks (float32: ~2x faster at fleet scale) (default float64)",
+    )
     mo = sub.add_parser("models", help="candidate models chosen by held-out fit → models.json + plot")
     _common(mo, False)
     mo.add_argument("--out", required=True, metavar="DIR")

@@ -256,33 +256,15 @@ def bin_pairs(
     R : (n, m) RSS [dBm], NaN = not heard.
     xy_m : (n, 2) true positions [m].
     group : (n,) int, optional — pairs only within a group (e.g. the floor); default one group.
+
+    Serial; :func:`.blocks.bin_pairs_tasks` runs the same block pairs on Dask (bit-identical bins).
     """
-    R = np.asarray(R, dtype=float)
-    xy = np.asarray(xy_m, dtype=float)
-    if xy.shape != (R.shape[0], 2):
-        raise ValueError(f"xy_m shape {xy.shape} does not match {R.shape[0]} scans")
-    bins = bins or PairBins(width=width_db)
-    group = np.zeros(len(R), np.int64) if group is None else np.asarray(group)
-    for g in np.unique(group):
-        sel = np.flatnonzero(group == g)
-        Rg = R[sel]
-        cols = np.isfinite(Rg).any(axis=0)
-        Rg, P = Rg[:, cols], xy[sel]
-        for i0, j0, D, keep in iter_pair_blocks(Rg, mode, block, min_common=min_common):
-            bi, bj = D.shape
-            tri = np.tri(bi, bj, -1, dtype=bool) if i0 == j0 else np.ones((bi, bj), bool)
-            bins.n_no_common += int(np.sum(tri & ~keep))
-            d2 = np.subtract.outer(P[i0 : i0 + bi, 0], P[j0 : j0 + bj, 0])
-            d2 *= d2
-            dy = np.subtract.outer(P[i0 : i0 + bi, 1], P[j0 : j0 + bj, 1])
-            dy *= dy
-            d2 += dy
-            if i0 != j0 and keep.all():
-                x, d2 = D.ravel(), d2.ravel()
-            else:
-                x, d2 = D[keep], d2[keep]
-            bins.add(x, np.sqrt(d2), d2)
-    return bins
+    # the block pairs as tasks merged in the serial order (.blocks; run here serially)
+    from stridefix_analyzer.crowd.blocks import BinSettings, bin_pairs_tasks  # noqa: PLC0415 - cycle
+
+    settings = BinSettings(mode=mode, width_db=width_db, block=block, min_common=min_common)
+    out, _info = bin_pairs_tasks(R, xy_m, group, settings, bins=bins or PairBins(width=width_db))
+    return out
 
 
 # --- the distance model -----------------------------------------------------------------------------
