@@ -1,6 +1,6 @@
-// sf_native_module.cpp - the Python module stridefix_native (pybind11) over sf_coord_solver.h.
-// Inputs are checked here for shape and dtype, then by sf_coord_validate for values; every problem found
-// is listed in one ValueError.
+// sf_native_module.cpp - the Python module stridefix_native (pybind11) over sf_coord_solver.h and
+// sf_graph_solver.h. Inputs are checked here for shape and dtype, then by sf_coord_validate /
+// sf_graph_validate for values; every problem found is listed in one ValueError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sf_coord_solver.h"
+#include "sf_graph_solver.h"
 
 namespace py = pybind11;
 
@@ -147,12 +148,81 @@ py::array_t<double> thesis_weights(py::handle ranges_m, double weight_slope, dou
   return py::array_t<double>(static_cast<py::ssize_t>(w.size()), w.data());
 }
 
+py::array_t<double> as_vec(const std::vector<double>& v) {
+  py::array_t<double> out(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), out.mutable_data());
+  return out;
+}
+
+// stridefix_native.solve_graph: the crowd graph of crowd/graph.py (GraphProblem's arrays, in its order).
+py::dict solve_graph(int64_t n_points, int64_t n_walks, py::handle step_i, py::handle step_j, py::handle step_walk,
+                     py::handle step_dxy_m, py::handle step_sigma_m, py::handle head_i, py::handle head_j,
+                     py::handle head_sigma_rad, py::handle scale_prior, py::handle scale_sigma,
+                     py::handle anchor_idx, py::handle anchor_xy_m, py::handle anchor_sigma_m, py::handle pair_i,
+                     py::handle pair_j, py::handle range_m, py::handle range_sigma_m, const std::string& loss,
+                     double loss_scale, py::handle init_xy, py::handle init_heading_rad, py::handle init_scale,
+                     int max_iterations, int num_threads) {
+  std::vector<std::string> problems;
+  sf::graph_problem_t g;
+  g.n_points = n_points;
+  g.n_walks = n_walks;
+  g.step_i = read_array<int64_t>(step_i, "step_i", 0, true, problems);
+  g.step_j = read_array<int64_t>(step_j, "step_j", 0, true, problems);
+  g.step_walk = read_array<int64_t>(step_walk, "step_walk", 0, true, problems);
+  g.step_dxy_m = read_array<double>(step_dxy_m, "step_dxy_m", 2, false, problems);
+  g.step_sigma_m = read_array<double>(step_sigma_m, "step_sigma_m", 0, false, problems);
+  g.head_i = read_array<int64_t>(head_i, "head_i", 0, true, problems);
+  g.head_j = read_array<int64_t>(head_j, "head_j", 0, true, problems);
+  g.head_sigma_rad = read_array<double>(head_sigma_rad, "head_sigma_rad", 0, false, problems);
+  g.scale_prior = read_array<double>(scale_prior, "scale_prior", 0, false, problems);
+  g.scale_sigma = read_array<double>(scale_sigma, "scale_sigma", 0, false, problems);
+  g.anchor_idx = read_array<int64_t>(anchor_idx, "anchor_idx", 0, true, problems);
+  g.anchor_xy_m = read_array<double>(anchor_xy_m, "anchor_xy_m", 2, false, problems);
+  g.anchor_sigma_m = read_array<double>(anchor_sigma_m, "anchor_sigma_m", 0, false, problems);
+  g.pair_i = read_array<int64_t>(pair_i, "pair_i", 0, true, problems);
+  g.pair_j = read_array<int64_t>(pair_j, "pair_j", 0, true, problems);
+  g.range_m = read_array<double>(range_m, "range_m", 0, false, problems);
+  g.range_sigma_m = read_array<double>(range_sigma_m, "range_sigma_m", 0, false, problems);
+  g.init_xy_m = read_array<double>(init_xy, "init_xy", 2, false, problems);
+  g.init_heading_rad = read_array<double>(init_heading_rad, "init_heading_rad", 0, false, problems);
+  g.init_scale = read_array<double>(init_scale, "init_scale", 0, false, problems);
+  g.loss = loss == "linear" ? "none" : loss;
+  g.loss_scale = loss_scale;
+  if (!problems.empty()) {
+    std::ostringstream os;
+    os << "solve_graph: " << problems.size() << " problem(s) with the input:";
+    for (const auto& p : problems) os << "\n  - " << p;
+    throw std::invalid_argument(os.str());
+  }
+  sf::graph_options_t opt;
+  opt.max_iterations = max_iterations;
+  opt.num_threads = num_threads;
+
+  sf::graph_result_t res;
+  {
+    py::gil_scoped_release release;  // the inputs are copied: other Python threads may run (and solve)
+    res = sf::sf_graph_solve(g, opt);
+  }
+  py::dict out;
+  out["xy"] = as_xy(res.xy_m);
+  out["heading_rad"] = as_vec(res.heading_rad);
+  out["scale"] = as_vec(res.scale);
+  out["cost"] = res.cost;
+  out["initial_cost"] = res.initial_cost;
+  out["iterations"] = res.iterations;
+  out["converged"] = res.converged;
+  out["time_s"] = res.time_s;
+  out["message"] = res.message;
+  return out;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(stridefix_native, mod) {
   mod.doc() =
       "StrideFix native code. The Kannan (2024) coordinate solver: 2-D positions from anchors and weighted "
-      "pairwise ranges, by nonlinear least squares on Ceres. The model is in analyzer/native/sf_coord_solver.h.";
+      "pairwise ranges, by nonlinear least squares on Ceres (analyzer/native/sf_coord_solver.h); and the crowd "
+      "graph solver: PDR steps, heading and scale, anchors and robust Wi-Fi ranges (sf_graph_solver.h).";
   mod.def("solve_coordinates", &solve_coordinates, py::arg("n_points"), py::arg("anchors_idx"),
           py::arg("anchors_xy"), py::arg("pairs"), py::arg("ranges_m"), py::arg("weights") = py::none(),
           py::kw_only(), py::arg("weight_slope") = py::none(), py::arg("weight_intercept_m") = py::none(),
@@ -191,5 +261,28 @@ Raises ValueError listing every problem with the input.)");
   mod.def("thesis_weights", &thesis_weights, py::arg("ranges_m"), py::arg("weight_slope") = 1.0,
           py::arg("weight_intercept_m") = 2.0,
           "w_k = 1 / (weight_slope * b_k + weight_intercept_m); ValueError unless every w_k is positive, finite.");
+  mod.def("solve_graph", &solve_graph, py::arg("n_points"), py::arg("n_walks"), py::arg("step_i"), py::arg("step_j"),
+          py::arg("step_walk"), py::arg("step_dxy_m"), py::arg("step_sigma_m"), py::arg("head_i"), py::arg("head_j"),
+          py::arg("head_sigma_rad"), py::arg("scale_prior"), py::arg("scale_sigma"), py::arg("anchor_idx"),
+          py::arg("anchor_xy_m"), py::arg("anchor_sigma_m"), py::arg("pair_i"), py::arg("pair_j"),
+          py::arg("range_m"), py::arg("range_sigma_m"), py::kw_only(), py::arg("loss") = "cauchy",
+          py::arg("loss_scale") = 1.0, py::arg("init_xy"), py::arg("init_heading_rad"), py::arg("init_scale"),
+          py::arg("max_iterations") = 200, py::arg("num_threads") = 1,
+          R"(Solve the crowd graph (analyzer/stridefix_analyzer/crowd/graph.py; model in sf_graph_solver.h).
+
+Unknowns: p_k (x, y) [m] and heading bias theta_k [rad] per point, stride scale s_w per walk. Minimises
+1/2 sum |r|^2 over step rows ((p_j - p_i) - s_w R(theta_i) d)/sigma, heading rows (theta_j - theta_i)/sigma,
+scale rows (s_w - s0_w)/sigma and anchor rows (p_a - q_a)/sigma, plus 1/2 sum rho(r^2) over range rows
+(b - |p_i - p_j|)/sigma, rho the robust loss ('none' | 'huber' | 'cauchy', scale loss_scale) on those only.
+
+Parameters are GraphProblem's arrays (k steps, h heading rows, W walks, a anchors, r pairs): step_i, step_j,
+step_walk (k,) int; step_dxy_m (k, 2); step_sigma_m (k,); head_i, head_j (h,) int; head_sigma_rad (h,);
+scale_prior, scale_sigma (W,); anchor_idx (a,) int; anchor_xy_m (a, 2); anchor_sigma_m (a,); pair_i, pair_j
+(r,) int; range_m, range_sigma_m (r,). Empty arrays are fine (e.g. no pairs). The start: init_xy (n, 2),
+init_heading_rad (n,), init_scale (W,). max_iterations: Ceres LM iterations; num_threads: Ceres threads.
+The GIL is released during the solve.
+
+Returns dict(xy (n, 2), heading_rad (n,), scale (W,), cost, initial_cost, iterations, converged, time_s,
+message). Raises ValueError listing every problem with the input.)");
   mod.attr("MIN_DIST_M") = sf::SF_COORD_MIN_DIST_M;
 }
