@@ -98,8 +98,8 @@ def graph_errors(run: GraphRun) -> dict[str, Any]:
     anchors interpolated in time (the graph's initial guess, what a map without PDR would use)."""
     prob = SimpleNamespace(anchor_index=run.problem.anchor_idx, n=run.problem.n_points)
     return {
-        "graph": error_stats(run.xy_m, run.points, prob),  # type: ignore[arg-type]
-        "interpolated": error_stats(run.problem.init_xy_m, run.points, prob),  # type: ignore[arg-type]
+        "graph": error_stats(run.xy_m, run.points, prob),
+        "interpolated": error_stats(run.problem.init_xy_m, run.points, prob),
     }
 
 
