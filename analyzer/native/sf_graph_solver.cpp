@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "sf_coord_solver.h"  // SF_COORD_MIN_DIST_M: the same coincident-points convention
+#include "sf_range_cost.h"  // the range row, shared with the coordinate solver (w = 1/sigma here)
 
 namespace sf {
 namespace {
@@ -112,44 +112,6 @@ class anchor_cost final : public ceres::SizedCostFunction<2, 2> {
   const double inv_;
 };
 
-// Range row: r = (b - |p_i - p_j|) / sigma. dr/dp_i = -u/sigma, dr/dp_j = +u/sigma, u = (p_i - p_j)/|.|;
-// u = -x when the points (nearly) coincide (sf_coord_solver.h).
-class range_cost final : public ceres::SizedCostFunction<1, 2, 2> {
- public:
-  range_cost(double range_m, double sigma_m) : range_m_(range_m), inv_(1.0 / sigma_m) {}
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const double* pi = parameters[0];
-    const double* pj = parameters[1];
-    const double dx = pi[0] - pj[0];
-    const double dy = pi[1] - pj[1];
-    const double d = std::hypot(dx, dy);
-    residuals[0] = (range_m_ - d) * inv_;
-    if (jacobians != nullptr) {
-      double ux = -1.0;
-      double uy = 0.0;
-      if (d >= SF_COORD_MIN_DIST_M) {
-        ux = dx / d;
-        uy = dy / d;
-      }
-      if (jacobians[0] != nullptr) {
-        jacobians[0][0] = -inv_ * ux;
-        jacobians[0][1] = -inv_ * uy;
-      }
-      if (jacobians[1] != nullptr) {
-        jacobians[1][0] = inv_ * ux;
-        jacobians[1][1] = inv_ * uy;
-      }
-    }
-    return true;
-  }
-
- private:
-  const double range_m_;
-  const double inv_;
-};
-
-// Collects the problems of one kind of row; each check adds at most one line with a count and the
-// first offending row, so a bad array of a million rows reads as one line.
 class checker {
  public:
   void add(const std::string& line) { problems_.push_back(line); }
@@ -342,7 +304,7 @@ graph_result_t sf_graph_solve(const graph_problem_t& g, const graph_options_t& o
                              nullptr, xy + 2 * g.anchor_idx[q]);
   }
   for (size_t q = 0; q < g.pair_i.size(); ++q) {
-    problem.AddResidualBlock(new range_cost(g.range_m[q], g.range_sigma_m[q]), loss.get(), xy + 2 * g.pair_i[q],
+    problem.AddResidualBlock(new range_cost(g.range_m[q], 1.0 / g.range_sigma_m[q]), loss.get(), xy + 2 * g.pair_i[q],
                              xy + 2 * g.pair_j[q]);
   }
 

@@ -55,6 +55,17 @@ std::vector<T> read_array(py::handle obj, const char* name, py::ssize_t cols, bo
   return std::vector<T>(c.data(), c.data() + c.size());
 }
 
+// The Ceres summary both solvers return (coord_result_t and graph_result_t share these fields).
+template <typename Result>
+void put_summary(py::dict& out, const Result& res) {
+  out["cost"] = res.cost;
+  out["initial_cost"] = res.initial_cost;
+  out["iterations"] = res.iterations;
+  out["converged"] = res.converged;
+  out["time_s"] = res.time_s;
+  out["message"] = res.message;
+}
+
 py::array_t<double> as_xy(const std::vector<double>& xy) {
   const auto n = static_cast<py::ssize_t>(xy.size() / 2);
   py::array_t<double> out({n, static_cast<py::ssize_t>(2)});
@@ -121,12 +132,7 @@ py::dict solve_coordinates(int64_t n_points, py::handle anchors_idx, py::handle 
   }
   py::dict out;
   out["xy"] = as_xy(res.xy_m);
-  out["cost"] = res.cost;
-  out["initial_cost"] = res.initial_cost;
-  out["iterations"] = res.iterations;
-  out["converged"] = res.converged;
-  out["time_s"] = res.time_s;
-  out["message"] = res.message;
+  put_summary(out, res);
   out["weights"] = py::array_t<double>(static_cast<py::ssize_t>(pr.weight_per_m.size()), pr.weight_per_m.data());
   if (full_report) out["report"] = res.report;
   return out;
@@ -207,12 +213,7 @@ py::dict solve_graph(int64_t n_points, int64_t n_walks, py::handle step_i, py::h
   out["xy"] = as_xy(res.xy_m);
   out["heading_rad"] = as_vec(res.heading_rad);
   out["scale"] = as_vec(res.scale);
-  out["cost"] = res.cost;
-  out["initial_cost"] = res.initial_cost;
-  out["iterations"] = res.iterations;
-  out["converged"] = res.converged;
-  out["time_s"] = res.time_s;
-  out["message"] = res.message;
+  put_summary(out, res);
   return out;
 }
 

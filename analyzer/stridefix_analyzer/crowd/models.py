@@ -43,6 +43,7 @@ import numpy as np
 from scipy.optimize import isotonic_regression, least_squares
 
 from stridefix_analyzer.crowd import model as cm
+from stridefix_analyzer.crowd.blocks import merge_bins
 from stridefix_analyzer.crowd.features import FEATURES, check_feature, features
 
 FORMS = ("thesis", "linear", "log", "saturating", "power", "isotonic")
@@ -79,24 +80,6 @@ REFERENCE = Candidate("common_sum", "thesis")
 
 
 # --- bins ----------------------------------------------------------------------------------------
-
-
-def merge_bins(parts: list[cm.PairBins], width: float) -> cm.PairBins:
-    """Sum of :class:`.model.PairBins` of the same width (exact: sums add)."""
-    out = cm.PairBins(width=width)
-    m = max((len(b.count) for b in parts), default=0)
-    out.count = np.zeros(m, np.int64)
-    out.sum_x, out.sum_d, out.sum_d2 = np.zeros(m), np.zeros(m), np.zeros(m)
-    for b in parts:
-        k = len(b.count)
-        out.count[:k] += b.count
-        out.sum_x[:k] += b.sum_x
-        out.sum_d[:k] += b.sum_d
-        out.sum_d2[:k] += b.sum_d2
-        out.min_d = min(out.min_d, b.min_d)
-        out.n_pairs += b.n_pairs
-        out.n_no_common += b.n_no_common
-    return out
 
 
 def bin_sse(bins: cm.PairBins, g: np.ndarray) -> float:
@@ -280,7 +263,7 @@ class FittedModel:
 def fit_candidate(cand: Candidate, strata_bins: list[cm.PairBins], min_common_aps: int = 1) -> FittedModel:
     """Fit ``cand`` on per-stratum bins (index = stratum of :data:`STRATA_EDGES`) of its feature."""
     width = FEATURES[cand.feature][1]
-    pooled = merge_bins(strata_bins, width)
+    pooled = merge_bins(strata_bins, width_db=width)
     p_all = fit_form(cand.form, pooled)
     s_all = fit_sigma(cand.form, p_all, pooled)
     params, sigma, used = [p_all], [s_all], ["pooled"]
@@ -312,7 +295,7 @@ def fit_candidate(cand: Candidate, strata_bins: list[cm.PairBins], min_common_ap
 def heldout_sse(m: FittedModel, strata_bins: list[cm.PairBins]) -> float:
     """SSE of ``m`` on the pairs of per-stratum bins (index = stratum of :data:`STRATA_EDGES`): each
     bin predicted at its mean feature, distance sums exact."""
-    parts = [merge_bins(strata_bins, FEATURES[m.feature][1])] if len(m.params) == 1 else strata_bins
+    parts = [merge_bins(strata_bins, width_db=FEATURES[m.feature][1])] if len(m.params) == 1 else strata_bins
     total = 0.0
     for p, b in zip(m.params, parts, strict=True):
         if b.used().any():

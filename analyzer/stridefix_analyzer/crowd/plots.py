@@ -86,8 +86,9 @@ def plot_solution(
 def plot_models(sel, png_path: str, display_bins: int = 40) -> None:
     """Per feature: binned true distance (mean ± 1 std) vs the feature, with the curves of the
     unstratified candidates fitted on all walks, labelled with their held-out R² (:mod:`.select_model`)."""
+    from stridefix_analyzer.crowd.blocks import merge_bins
     from stridefix_analyzer.crowd.features import FEATURES
-    from stridefix_analyzer.crowd.models import form_predict, merge_bins
+    from stridefix_analyzer.crowd.models import form_predict
 
     plt = _plt()
     feats = list(sel.bins)
@@ -98,7 +99,7 @@ def plot_models(sel, png_path: str, display_bins: int = 40) -> None:
     )
     r2 = {r["name"]: r["heldout_r2"] for r in sel.rows}
     for ax, feat in zip(axes.ravel(), feats, strict=False):
-        b = merge_bins(sel.bins[feat], FEATURES[feat][1])
+        b = merge_bins(sel.bins[feat], width_db=FEATURES[feat][1])
         if not b.used().any():
             continue
         b = b.coarsen(max(1, len(b.count) // display_bins))

@@ -31,6 +31,7 @@ from scipy.stats import spearmanr
 
 from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd import models as mm
+from stridefix_analyzer.crowd.blocks import merge_bins
 from stridefix_analyzer.crowd.features import FEATURES, iter_feature_blocks
 from stridefix_analyzer.crowd.walks import DEFAULT_BAND, CrowdInputError, Walk, pool_scans
 
@@ -154,7 +155,7 @@ def bin_by_fold(
 
 def _merge(bins_f, cats: list[int], width: float) -> list[cm.PairBins]:
     n_str = len(bins_f[0])
-    return [mm.merge_bins([bins_f[c][s] for c in cats], width) for s in range(n_str)]
+    return [merge_bins([bins_f[c][s] for c in cats], width_db=width) for s in range(n_str)]
 
 
 def _spearman(x: np.ndarray, y: np.ndarray) -> float:
@@ -183,7 +184,7 @@ def score_candidates(bins, sample: dict, K: int, cands: list[mm.Candidate], say:
         for feat in names:
             w = FEATURES[feat][1]
             tr, ho = _merge(bins[feat], without, w), _merge(bins[feat], with_f, w)
-            sst, N = mm.bin_sst(mm.merge_bins(ho, w))
+            sst, N = mm.bin_sst(merge_bins(ho, width_db=w))
             for c in (c for c in cands if c.feature == feat):
                 a = acc[c.name]
                 try:
