@@ -40,12 +40,12 @@ from stridefix import pose_t
 from stridefix_analyzer import schemes
 from stridefix_analyzer.bench import controller_score as cs
 from stridefix_analyzer.bench import fusion
-from stridefix_analyzer.bench import targets as target_rows
 from stridefix_analyzer.bench.controller_plot import write_timeline
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
 from stridefix_analyzer.io.sitefile import SiteFileError, read_site
+from stridefix_analyzer.scoring import targets as target_rows
 from stridefix_analyzer.scoring.analyze import run_analyze
 from stridefix_analyzer.scoring.context import context_summary, rule_name
 from stridefix_analyzer.scoring.metrics import scored_errors

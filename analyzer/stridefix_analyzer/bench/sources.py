@@ -43,9 +43,9 @@ from stridefix_sim.world_sources import inside
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.bench import fusion
-from stridefix_analyzer.bench import targets as target_rows
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import Table, read_table
+from stridefix_analyzer.scoring import targets as target_rows
 from stridefix_analyzer.scoring.analyze import run_analyze
 from stridefix_analyzer.stages import stridefix_exe
 

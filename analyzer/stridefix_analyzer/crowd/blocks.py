@@ -1,6 +1,6 @@
 """The pair-block work of the streaming binned fit as independent tasks, merged in a fixed order.
 
-:func:`.model.bin_pairs` streams every unordered scan pair (i > j) of a group (floor) through blocks of
+:func:`bin_pairs` streams every unordered scan pair (i > j) of a group (floor) through blocks of
 ``block`` × ``block`` scans; here each block pair (group, i0, j0) is a task that returns its own
 partial :class:`.model.PairBins`, and :func:`merge_bins` adds the partials in task order (group, then
 i0, then j0 — the order of the serial loop). Every sum is therefore accumulated in the same order
@@ -50,7 +50,7 @@ class GroupData:
 
 #: Block of the fit's pair blocks: 512 × 512 float32 temporaries (1 MB) stay in cache; measured on a
 #: 20 000-scan fleet: 13 ns/pair at 512, 23 at 1024, 30 at 2048 (large blocks page-fault on every
-#: temporary). model.bin_pairs keeps its own default (cm.DEFAULT_BLOCK).
+#: temporary). bin_pairs keeps its own default (cm.DEFAULT_BLOCK).
 FIT_BLOCK = 512
 
 
@@ -202,3 +202,29 @@ def bin_pairs_tasks(
             f"uniformly; seed {seed})"
         )
     return out, info
+
+
+def bin_pairs(
+    R: np.ndarray,
+    xy_m: np.ndarray,
+    group: np.ndarray | None = None,
+    mode: str = cm.DEFAULT_MODE,
+    width_db: float = cm.DEFAULT_BIN_WIDTH_DB,
+    block: int = cm.DEFAULT_BLOCK,
+    bins: cm.PairBins | None = None,
+    min_common: int = 1,
+) -> cm.PairBins:
+    """Stream every unordered scan pair (i > j) of the same ``group`` (floor) into :class:`.model.PairBins`.
+
+    Parameters
+    ----------
+    R : (n, m) RSS [dBm], NaN = not heard.
+    xy_m : (n, 2) true positions [m].
+    group : (n,) int, optional — pairs only within a group (e.g. the floor); default one group.
+
+    Serial; :func:`bin_pairs_tasks` runs the same block pairs on Dask (bit-identical bins).
+    """
+    # the block pairs as tasks merged in the serial order, run here serially
+    settings = BinSettings(mode=mode, width_db=width_db, block=block, min_common=min_common)
+    out, _info = bin_pairs_tasks(R, xy_m, group, settings, bins=bins or cm.PairBins(width=width_db))
+    return out

@@ -30,7 +30,6 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer.bench.targets import missed_lines, table_lines
 from stridefix_analyzer.crowd.experiment_graph import graph_rows, select_pair_model
 from stridefix_analyzer.crowd.experiment_targets import solve_targets
 from stridefix_analyzer.crowd.fit import fit_walks, format_model
@@ -40,6 +39,7 @@ from stridefix_analyzer.crowd.sites import build_crowd_sites
 from stridefix_analyzer.crowd.solve import error_stats
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
 from stridefix_analyzer.firmware import Firmware, add_stridefixd_argument
+from stridefix_analyzer.scoring.targets import missed_lines, table_lines
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
 DEFAULT_OUT = os.path.join("out", "crowd", "experiment")

@@ -10,7 +10,7 @@ GRAPH_VS_INTERP_MAX = 0.80
 
 
 def solve_targets(floors: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """One target row per floor (``{"figure", "value", "target", "met"}``, as bench/targets.py)."""
+    """One target row per floor (``{"figure", "value", "target", "met"}``, as scoring/targets.py)."""
     out = []
     for f in floors:
         rows = {r["key"]: r for r in f["rows"]}

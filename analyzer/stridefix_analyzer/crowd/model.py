@@ -239,34 +239,6 @@ class PairBins:
         return out
 
 
-def bin_pairs(
-    R: np.ndarray,
-    xy_m: np.ndarray,
-    group: np.ndarray | None = None,
-    mode: str = DEFAULT_MODE,
-    width_db: float = DEFAULT_BIN_WIDTH_DB,
-    block: int = DEFAULT_BLOCK,
-    bins: PairBins | None = None,
-    min_common: int = 1,
-) -> PairBins:
-    """Stream every unordered scan pair (i > j) of the same ``group`` (floor) into :class:`PairBins`.
-
-    Parameters
-    ----------
-    R : (n, m) RSS [dBm], NaN = not heard.
-    xy_m : (n, 2) true positions [m].
-    group : (n,) int, optional — pairs only within a group (e.g. the floor); default one group.
-
-    Serial; :func:`.blocks.bin_pairs_tasks` runs the same block pairs on Dask (bit-identical bins).
-    """
-    # the block pairs as tasks merged in the serial order (.blocks; run here serially)
-    from stridefix_analyzer.crowd.blocks import BinSettings, bin_pairs_tasks  # noqa: PLC0415 - cycle
-
-    settings = BinSettings(mode=mode, width_db=width_db, block=block, min_common=min_common)
-    out, _info = bin_pairs_tasks(R, xy_m, group, settings, bins=bins or PairBins(width=width_db))
-    return out
-
-
 # --- the distance model -----------------------------------------------------------------------------
 
 

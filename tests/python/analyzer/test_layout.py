@@ -169,9 +169,9 @@ LAYERS = (
     "datasets",
     "radiomap",
     "scoring",
+    "crowd",
     "realbench",
     "bench",
-    "crowd",
     "cli",
 )
 

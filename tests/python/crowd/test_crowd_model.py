@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
+from stridefix_analyzer.crowd import blocks
 from stridefix_analyzer.crowd import model as cm
 
 NAN = np.nan
@@ -63,7 +64,7 @@ def test_pair_blocks_cover_each_pair_once_without_no_common(random_scans, block)
 def test_streaming_binning_equals_brute_force(random_scans, mode):
     R, xy, floor = random_scans
     width = 0.5
-    bins = cm.bin_pairs(R, xy, floor, mode=mode, width_db=width, block=7)
+    bins = blocks.bin_pairs(R, xy, floor, mode=mode, width_db=width, block=7)
     # brute force: every pair i > j on the same floor with a common AP
     D = cm.dissimilarity(R, mode=mode)
     xs, ds, no_common = [], [], 0
@@ -158,8 +159,8 @@ def test_model_distance_is_floored_linear():
 
 def test_min_common_aps_excludes_pairs_sharing_fewer(hand_scans):
     D = cm.dissimilarity(hand_scans)  # thesis: one common AP is enough
-    bins1 = cm.bin_pairs(hand_scans, np.zeros((4, 2)))
-    bins2 = cm.bin_pairs(hand_scans, np.zeros((4, 2)), min_common=2)
+    bins1 = blocks.bin_pairs(hand_scans, np.zeros((4, 2)))
+    bins2 = blocks.bin_pairs(hand_scans, np.zeros((4, 2)), min_common=2)
     assert bins1.n_pairs == int(np.sum(np.isfinite(D[np.tril_indices(4, -1)])))
     # only (0,3) and (1,3) share two APs
     assert bins2.n_pairs == 2 and bins2.n_no_common == 4

@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from stridefix_analyzer.bench import crowd_scale
 from stridefix_analyzer.crowd import blocks as cbk
-from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd.fit import fit_walks
 from stridefix_analyzer.crowd.fleet import FleetSpec, make_fleet
 from stridefix_analyzer.crowd.parallel import dask_client, run_tasks
@@ -78,7 +77,7 @@ def test_bins_bit_identical_serial_and_dask(fleet, client):
     serial, info = cbk.bin_pairs_tasks(s.R, s.xy_m, s.floor, settings)
     assert info["block_pairs"] > 10  # several tasks, merged in order
     dask_bins, _ = cbk.bin_pairs_tasks(s.R, s.xy_m, s.floor, settings, client=client)
-    legacy = cm.bin_pairs(s.R, s.xy_m, s.floor, block=256)
+    legacy = cbk.bin_pairs(s.R, s.xy_m, s.floor, block=256)
     for b in (dask_bins, legacy):
         for k in ("count", "sum_x", "sum_d", "sum_d2"):
             assert np.array_equal(getattr(b, k), getattr(serial, k))
