@@ -75,10 +75,11 @@ class heading_cost final : public ceres::SizedCostFunction<1, 1, 1> {
   const double inv_;
 };
 
-// Scale prior: r = (s - s0) / sigma; parameter s_w.
-class scale_cost final : public ceres::SizedCostFunction<1, 1> {
+// One-parameter prior: r = (v - v0) / sigma. The scale prior (parameter s_w) and the heading prior
+// (parameter theta_k: the fleet's heading bias on a walk's first point) are both this row.
+class prior_cost final : public ceres::SizedCostFunction<1, 1> {
  public:
-  scale_cost(double prior, double sigma) : prior_(prior), inv_(1.0 / sigma) {}
+  prior_cost(double prior, double sigma) : prior_(prior), inv_(1.0 / sigma) {}
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     residuals[0] = (parameters[0][0] - prior_) * inv_;
     if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = inv_;
@@ -227,6 +228,13 @@ void sf_graph_validate(const graph_problem_t& g, const graph_options_t& opt) {
   c.finite("scale_prior", g.scale_prior);
   c.sigmas("scale_sigma", g.scale_sigma);
 
+  const size_t p = g.hprior_idx.size();
+  c.size("hprior_rad", g.hprior_rad.size(), p, "one per hprior_idx");
+  c.size("hprior_sigma_rad", g.hprior_sigma_rad.size(), p, "one per hprior_idx");
+  c.indices("hprior_idx", g.hprior_idx, n, "points");
+  c.finite("hprior_rad", g.hprior_rad);
+  c.sigmas("hprior_sigma_rad", g.hprior_sigma_rad);
+
   const size_t a = g.anchor_idx.size();
   c.size("anchor_xy_m", g.anchor_xy_m.size(), 2 * a, "2 per anchor_idx");
   c.size("anchor_sigma_m", g.anchor_sigma_m.size(), a, "one per anchor_idx");
@@ -297,7 +305,10 @@ graph_result_t sf_graph_solve(const graph_problem_t& g, const graph_options_t& o
     problem.AddResidualBlock(new heading_cost(g.head_sigma_rad[q]), nullptr, th + g.head_i[q], th + g.head_j[q]);
   }
   for (size_t w = 0; w < g.scale_prior.size(); ++w) {
-    problem.AddResidualBlock(new scale_cost(g.scale_prior[w], g.scale_sigma[w]), nullptr, sc + w);
+    problem.AddResidualBlock(new prior_cost(g.scale_prior[w], g.scale_sigma[w]), nullptr, sc + w);
+  }
+  for (size_t q = 0; q < g.hprior_idx.size(); ++q) {
+    problem.AddResidualBlock(new prior_cost(g.hprior_rad[q], g.hprior_sigma_rad[q]), nullptr, th + g.hprior_idx[q]);
   }
   for (size_t q = 0; q < g.anchor_idx.size(); ++q) {
     problem.AddResidualBlock(new anchor_cost(g.anchor_xy_m[2 * q], g.anchor_xy_m[2 * q + 1], g.anchor_sigma_m[q]),

@@ -9,9 +9,10 @@
 //   step      r = ((p_j - p_i) - s_w R(theta_i) d) / sigma          2 residuals, d = DR displacement i -> j
 //   heading   r = (theta_j - theta_i) / sigma                       1 residual (a random walk of the bias)
 //   scale     r = (s_w - s0_w) / sigma                              1 residual per walk
+//   hprior    r = (theta_k - theta0_k) / sigma                      1 residual (the fleet's heading bias)
 //   anchor    r = (p_a - q_a) / sigma                               2 residuals
 //   range     r = (b - |p_i - p_j|) / sigma                         1 residual, i and j of different walks
-//   cost      = 1/2 sum |r|^2 over step, heading, scale and anchor rows + 1/2 sum rho(r^2) over range rows,
+//   cost      = 1/2 sum |r|^2 over step, heading, scale, hprior and anchor rows + 1/2 sum rho(r^2) over range rows,
 //   rho       = identity ("none"), or Ceres's HuberLoss / CauchyLoss with scale loss_scale (sigma units),
 //               on the range rows ONLY: a fingerprint that looks like a far place must not pull a walk.
 // |p_i - p_j| below SF_COORD_MIN_DIST_M: the range Jacobian takes u = (p_i - p_j)/|.| as -x, the
@@ -43,6 +44,9 @@ struct graph_problem_t {
   std::vector<double> head_sigma_rad;              // h, > 0
   std::vector<double> scale_prior;                 // W, s0 of each walk
   std::vector<double> scale_sigma;                 // W, > 0
+  std::vector<int64_t> hprior_idx;                 // p, points with a heading prior
+  std::vector<double> hprior_rad;                  // p, theta0 of each
+  std::vector<double> hprior_sigma_rad;            // p, > 0
   std::vector<int64_t> anchor_idx;                 // a
   std::vector<double> anchor_xy_m;                 // a*2
   std::vector<double> anchor_sigma_m;              // a, > 0

@@ -164,6 +164,7 @@ py::array_t<double> as_vec(const std::vector<double>& v) {
 py::dict solve_graph(int64_t n_points, int64_t n_walks, py::handle step_i, py::handle step_j, py::handle step_walk,
                      py::handle step_dxy_m, py::handle step_sigma_m, py::handle head_i, py::handle head_j,
                      py::handle head_sigma_rad, py::handle scale_prior, py::handle scale_sigma,
+                     py::handle hprior_idx, py::handle hprior_rad, py::handle hprior_sigma_rad,
                      py::handle anchor_idx, py::handle anchor_xy_m, py::handle anchor_sigma_m, py::handle pair_i,
                      py::handle pair_j, py::handle range_m, py::handle range_sigma_m, const std::string& loss,
                      double loss_scale, py::handle init_xy, py::handle init_heading_rad, py::handle init_scale,
@@ -182,6 +183,9 @@ py::dict solve_graph(int64_t n_points, int64_t n_walks, py::handle step_i, py::h
   g.head_sigma_rad = read_array<double>(head_sigma_rad, "head_sigma_rad", 0, false, problems);
   g.scale_prior = read_array<double>(scale_prior, "scale_prior", 0, false, problems);
   g.scale_sigma = read_array<double>(scale_sigma, "scale_sigma", 0, false, problems);
+  g.hprior_idx = read_array<int64_t>(hprior_idx, "hprior_idx", 0, true, problems);
+  g.hprior_rad = read_array<double>(hprior_rad, "hprior_rad", 0, false, problems);
+  g.hprior_sigma_rad = read_array<double>(hprior_sigma_rad, "hprior_sigma_rad", 0, false, problems);
   g.anchor_idx = read_array<int64_t>(anchor_idx, "anchor_idx", 0, true, problems);
   g.anchor_xy_m = read_array<double>(anchor_xy_m, "anchor_xy_m", 2, false, problems);
   g.anchor_sigma_m = read_array<double>(anchor_sigma_m, "anchor_sigma_m", 0, false, problems);
@@ -264,7 +268,8 @@ Raises ValueError listing every problem with the input.)");
           "w_k = 1 / (weight_slope * b_k + weight_intercept_m); ValueError unless every w_k is positive, finite.");
   mod.def("solve_graph", &solve_graph, py::arg("n_points"), py::arg("n_walks"), py::arg("step_i"), py::arg("step_j"),
           py::arg("step_walk"), py::arg("step_dxy_m"), py::arg("step_sigma_m"), py::arg("head_i"), py::arg("head_j"),
-          py::arg("head_sigma_rad"), py::arg("scale_prior"), py::arg("scale_sigma"), py::arg("anchor_idx"),
+          py::arg("head_sigma_rad"), py::arg("scale_prior"), py::arg("scale_sigma"), py::arg("hprior_idx"),
+          py::arg("hprior_rad"), py::arg("hprior_sigma_rad"), py::arg("anchor_idx"),
           py::arg("anchor_xy_m"), py::arg("anchor_sigma_m"), py::arg("pair_i"), py::arg("pair_j"),
           py::arg("range_m"), py::arg("range_sigma_m"), py::kw_only(), py::arg("loss") = "cauchy",
           py::arg("loss_scale") = 1.0, py::arg("init_xy"), py::arg("init_heading_rad"), py::arg("init_scale"),
@@ -273,12 +278,12 @@ Raises ValueError listing every problem with the input.)");
 
 Unknowns: p_k (x, y) [m] and heading bias theta_k [rad] per point, stride scale s_w per walk. Minimises
 1/2 sum |r|^2 over step rows ((p_j - p_i) - s_w R(theta_i) d)/sigma, heading rows (theta_j - theta_i)/sigma,
-scale rows (s_w - s0_w)/sigma and anchor rows (p_a - q_a)/sigma, plus 1/2 sum rho(r^2) over range rows
+scale rows (s_w - s0_w)/sigma, heading-prior rows (theta_k - theta0_k)/sigma and anchor rows (p_a - q_a)/sigma, plus 1/2 sum rho(r^2) over range rows
 (b - |p_i - p_j|)/sigma, rho the robust loss ('none' | 'huber' | 'cauchy', scale loss_scale) on those only.
 
-Parameters are GraphProblem's arrays (k steps, h heading rows, W walks, a anchors, r pairs): step_i, step_j,
+Parameters are GraphProblem's arrays (k steps, h heading rows, W walks, p heading priors, a anchors, r pairs): step_i, step_j,
 step_walk (k,) int; step_dxy_m (k, 2); step_sigma_m (k,); head_i, head_j (h,) int; head_sigma_rad (h,);
-scale_prior, scale_sigma (W,); anchor_idx (a,) int; anchor_xy_m (a, 2); anchor_sigma_m (a,); pair_i, pair_j
+scale_prior, scale_sigma (W,); hprior_idx (p,) int; hprior_rad, hprior_sigma_rad (p,); anchor_idx (a,) int; anchor_xy_m (a, 2); anchor_sigma_m (a,); pair_i, pair_j
 (r,) int; range_m, range_sigma_m (r,). Empty arrays are fine (e.g. no pairs). The start: init_xy (n, 2),
 init_heading_rad (n,), init_scale (W,). max_iterations: Ceres LM iterations; num_threads: Ceres threads.
 The GIL is released during the solve.

@@ -161,9 +161,6 @@ def solve_graph_native(g: GraphProblem, max_iterations: int = 200) -> GraphSolut
     """``stridefix_native.solve_graph`` (C++/Ceres); raises when it is missing or fails."""
     import stridefix_native  # noqa: PLC0415 - optional
 
-    if len(g.hprior_idx):
-        # the Ceres twin has no heading-prior rows yet: solving without them would be another cost
-        raise NotImplementedError("stridefix_native.solve_graph has no heading-prior rows yet")
     t0 = time.perf_counter()
     out = stridefix_native.solve_graph(
         g.n_points,
@@ -178,6 +175,9 @@ def solve_graph_native(g: GraphProblem, max_iterations: int = 200) -> GraphSolut
         g.head_sigma_rad,
         g.scale_prior,
         g.scale_sigma,
+        g.hprior_idx,
+        g.hprior_rad,
+        g.hprior_sigma_rad,
         g.anchor_idx,
         g.anchor_xy_m,
         g.anchor_sigma_m,

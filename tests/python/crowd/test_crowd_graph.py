@@ -13,14 +13,21 @@ from stridefix_analyzer.crowd.graph_wifi import wifi_rows
 from stridefix_analyzer.crowd.solve import Points
 
 
-def _walks(rng, n_walks=4, n=60, scale=1.1, bias_rad=0.4, drift_rad_per_s=0.0):
-    """Curved walks (1 s apart); DR = the truth rotated by −bias(t) and divided by the scale."""
-    parts = []
+def _walks(rng, n_walks=4, n=60, scale=1.1, bias_rad=0.4, drift_rad_per_s=0.0, retrace=None):
+    """Curved walks (1 s apart); DR = the truth rotated by −bias(t) and divided by the scale.
+
+    ``bias_rad``: one bias for every walk, or one per walk. ``retrace=(k, m)``: walk k walks walk m's
+    path 1 m to its side (two walkers of one corridor: the pair a loop closure joins)."""
+    parts, paths = [], []
     for k in range(n_walks):
         heading = np.cumsum(rng.normal(0, 0.25, n)) + k
+        start = rng.uniform(-20, 20, 2)
+        if retrace is not None and k == retrace[0]:
+            heading, start = paths[retrace[1]][0], paths[retrace[1]][1] + np.array([0.0, 1.0])
+        paths.append((heading, start))
         step = np.column_stack([np.cos(heading), np.sin(heading)]) * 1.3
-        xy = np.cumsum(step, axis=0) + rng.uniform(-20, 20, 2)
-        b = bias_rad + drift_rad_per_s * np.arange(n)
+        xy = np.cumsum(step, axis=0) + start
+        b = np.broadcast_to(bias_rad, n_walks)[k] + drift_rad_per_s * np.arange(n)
         c, s = np.cos(-b), np.sin(-b)
         dstep = np.column_stack([c * step[:, 0] - s * step[:, 1], s * step[:, 0] + c * step[:, 1]]) / scale
         dr = np.cumsum(dstep, axis=0)
@@ -136,7 +143,9 @@ class _Oracle:
 
 def test_wifi_loop_closures_join_walks_and_fix_a_walk_with_one_anchor():
     rng = np.random.default_rng(5)
-    pts = _walks(rng, n_walks=4, n=60)
+    # walk 3's bias is far from the other walks' (the fleet prior): only the Wi-Fi rows can tell it
+    # and it walks walk 0's corridor, where the loop closures are
+    pts = _walks(rng, n_walks=4, n=60, bias_rad=np.array([0.3, 0.4, 0.5, 0.9]), retrace=(3, 0))
 
     class _Scans:  # fingerprint row = its index (the oracle reads it back)
         R = np.arange(len(pts.t_us), dtype=float)[:, None]
@@ -151,8 +160,10 @@ def test_wifi_loop_closures_join_walks_and_fix_a_walk_with_one_anchor():
     assert len(i) > 0 and np.all(pts.walk[i] != pts.walk[j]) and np.all(d <= 8.0)
     assert np.all(np.bincount(np.concatenate([i, j])) <= 2 * 3 + 6)
     w3 = pts.walk == 3
+    assert np.sum(w3[i] | w3[j]) >= 20  # walk 3 is joined to walk 0
     e0 = gs.solve_graph_scipy(g0).xy_m
     g1 = dataclasses.replace(g0, pair_i=i, pair_j=j, range_m=d, range_sigma_m=sig)
     e1 = gs.solve_graph_scipy(g1).xy_m
     err = [float(np.mean(np.hypot(*(e[w3] - pts.truth_xy_m[w3]).T))) for e in (e0, e1)]
-    assert err[1] < 0.5 * err[0]
+    assert err[0] > 2.0, err  # the heading is wrong without them
+    assert err[1] < 0.5 * err[0], err

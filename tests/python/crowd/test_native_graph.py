@@ -9,7 +9,6 @@ Run as a script for the Ceres vs scipy timing: ``python tests/python/crowd/test_
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 import time
 
@@ -55,8 +54,8 @@ def synthetic(
     """The graph of a synthetic crowd (module docstring) via :func:`build_graph`, its points, the true
     heading bias per point [rad] and the row indices of the outlier Wi-Fi rows.
 
-    ``exact``: no DR noise, a constant bias, no Wi-Fi noise, no outliers and the scale prior at the
-    truth, so the truth has cost 0."""
+    ``exact``: no DR noise, a constant bias, no Wi-Fi noise, no outliers and the scale and heading
+    priors at the truth, so the truth has cost 0."""
     rng = np.random.default_rng(seed)
     walk, t_us, truth, dr, bias = [], [], [], [], []
     for w in range(n_walks):
@@ -122,12 +121,10 @@ def synthetic(
         n_walks,
         anchors="every:4",
         settings=GraphSettings(loss=loss),
-        priors=FleetPriors(scale=SCALE_TRUE if exact else 1.0),
+        # exact: the scale and heading priors at the truth (a constant bias on every walk)
+        priors=FleetPriors(scale=SCALE_TRUE, heading_rad=BIAS_TRUE_RAD) if exact else FleetPriors(scale=1.0),
         wifi_rows=rows,
     )
-    # the Ceres twin has no heading-prior rows yet: compare the two on the rows both have
-    empty = np.zeros(0)
-    g = dataclasses.replace(g, hprior_idx=np.zeros(0, np.int64), hprior_rad=empty, hprior_sigma_rad=empty)
     return g, points, np.concatenate(bias), np.array(outl, np.int64)
 
 
@@ -141,6 +138,7 @@ def _err_m(sol: GraphSolution, points: Points) -> np.ndarray:
 @pytest.mark.parametrize("loss", ["cauchy", "huber", "none"])
 def test_ceres_and_scipy_twin_agree(loss):
     g, _, _, _ = synthetic(loss=loss)
+    assert len(g.hprior_idx) == g.n_walks  # every row kind is compared, the heading priors too
     nat = solve_graph_native(g)
     ref = solve_graph_scipy(g, max_nfev=2000)
     assert nat.info["converged"], nat.info["message"]
@@ -168,7 +166,8 @@ def test_empty_rows_work():
 def test_nothing_to_solve_returns_the_start():
     e_i, e_f = np.zeros(0, np.int64), np.zeros(0)
     out = _sn.solve_graph(
-        *(1, 0, e_i, e_i, e_i, np.zeros((0, 2)), e_f, e_i, e_i, e_f, e_f, e_f, e_i, np.zeros((0, 2)), e_f),
+        *(1, 0, e_i, e_i, e_i, np.zeros((0, 2)), e_f, e_i, e_i, e_f, e_f, e_f, e_i, e_f, e_f),
+        *(e_i, np.zeros((0, 2)), e_f),
         *(e_i, e_i, e_f, e_f),
         init_xy=np.array([[2.0, 3.0]]),
         init_heading_rad=np.array([0.5]),
@@ -224,6 +223,9 @@ def _kwargs(g: GraphProblem) -> dict:
         head_sigma_rad=g.head_sigma_rad,
         scale_prior=g.scale_prior,
         scale_sigma=g.scale_sigma,
+        hprior_idx=g.hprior_idx,
+        hprior_rad=g.hprior_rad,
+        hprior_sigma_rad=g.hprior_sigma_rad,
         anchor_idx=g.anchor_idx,
         anchor_xy_m=g.anchor_xy_m,
         anchor_sigma_m=g.anchor_sigma_m,
@@ -253,6 +255,7 @@ def test_validation_lists_every_value_problem():
     kw["anchor_xy_m"] = g.anchor_xy_m[:-1]  # one row short
     kw["scale_sigma"] = -g.scale_sigma
     kw["init_heading_rad"] = g.init_heading_rad[:-2]
+    kw["hprior_sigma_rad"] = np.zeros(len(g.hprior_idx))
     kw["loss"] = "tukey"
     kw["loss_scale"] = 0.0
     with pytest.raises(ValueError) as e:
@@ -267,11 +270,12 @@ def test_validation_lists_every_value_problem():
         "anchor_xy_m",
         "scale_sigma",
         "init_heading_rad",
+        "hprior_sigma_rad",
         "loss must be",
         "loss_scale",
     ):
         assert name in msg, (name, msg)
-    assert "10 problem(s)" in msg, msg
+    assert "11 problem(s)" in msg, msg
 
 
 def test_validation_lists_every_shape_and_dtype_problem():
