@@ -85,25 +85,26 @@ class FleetPriors:
 MIN_ANCHOR_SPAN_M = 5.0
 
 
-def fleet_priors(points: Points, is_anchor: np.ndarray, n_walks: int) -> FleetPriors:
-    """Median and robust spread (1.4826·MAD) of the per-walk 2-D similarity (scale, rotation) that
-    maps each walk's dead reckoning onto its own anchors; walks whose anchors span < 5 m say nothing.
-    Uses the anchors only, never the other truth points."""
-    scales, heads = [], []
-    for k in range(n_walks):
-        ak = np.flatnonzero((points.walk == k) & is_anchor)
-        if len(ak) < 2:
-            continue
-        A = points.truth_xy_m[ak] - points.truth_xy_m[ak].mean(axis=0)
-        B = points.dr_xy_m[ak] - points.dr_xy_m[ak].mean(axis=0)
-        span_a, span_b = np.sqrt(np.sum(A * A)), np.sqrt(np.sum(B * B))
-        if span_a < MIN_ANCHOR_SPAN_M or span_b < 1e-6:
-            continue
-        scales.append(span_a / span_b)
-        heads.append(_procrustes_heading(points.dr_xy_m[ak], points.truth_xy_m[ak]))
-    if len(scales) < 3:
-        return FleetPriors(walks_used=len(scales))
-    s, h = np.asarray(scales), np.asarray(heads)
+def walk_similarity(points: Points, is_anchor: np.ndarray, k: int) -> tuple[float, float] | None:
+    """(stride scale, heading bias [rad]) of the 2-D similarity that maps walk ``k``'s dead reckoning
+    onto its own anchors; None when its anchors span < 5 m (they say nothing). Anchors only."""
+    ak = np.flatnonzero((points.walk == k) & is_anchor)
+    if len(ak) < 2:
+        return None
+    A = points.truth_xy_m[ak] - points.truth_xy_m[ak].mean(axis=0)
+    B = points.dr_xy_m[ak] - points.dr_xy_m[ak].mean(axis=0)
+    span_a, span_b = np.sqrt(np.sum(A * A)), np.sqrt(np.sum(B * B))
+    if span_a < MIN_ANCHOR_SPAN_M or span_b < 1e-6:
+        return None
+    return float(span_a / span_b), _procrustes_heading(points.dr_xy_m[ak], points.truth_xy_m[ak])
+
+
+def priors_from(similarities: list[tuple[float, float]]) -> FleetPriors:
+    """Median and robust spread (1.4826·MAD) of per-walk (scale, heading) pairs
+    (:func:`walk_similarity`); the uninformative default below 3 walks."""
+    if len(similarities) < 3:
+        return FleetPriors(walks_used=len(similarities))
+    s, h = (np.asarray(v, float) for v in zip(*similarities))
     h0 = float(np.angle(np.mean(np.exp(1j * h))))  # circular mean, then a robust centre near it
     h = h0 + np.angle(np.exp(1j * (h - h0)))
     h_med = float(np.median(h))
@@ -112,8 +113,14 @@ def fleet_priors(points: Points, is_anchor: np.ndarray, n_walks: int) -> FleetPr
         scale_sigma=max(1.4826 * float(np.median(np.abs(s - np.median(s)))), 0.05),
         heading_rad=h_med,
         heading_sigma_rad=max(1.4826 * float(np.median(np.abs(h - h_med))), math.radians(5.0)),
-        walks_used=len(scales),
+        walks_used=len(similarities),
     )
+
+
+def fleet_priors(points: Points, is_anchor: np.ndarray, n_walks: int) -> FleetPriors:
+    """:func:`priors_from` the :func:`walk_similarity` of every walk that has one."""
+    sims = [walk_similarity(points, is_anchor, k) for k in range(n_walks)]
+    return priors_from([v for v in sims if v is not None])
 
 
 @dataclasses.dataclass

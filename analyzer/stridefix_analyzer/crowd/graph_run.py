@@ -23,13 +23,14 @@ import numpy as np
 
 from stridefix_analyzer.crowd.graph import (
     DEFAULT_SETTINGS,
+    FleetPriors,
     GraphProblem,
     GraphSettings,
     anchor_mask,
     build_graph,
     fleet_priors,
 )
-from stridefix_analyzer.crowd.graph_solve import solve_graph
+from stridefix_analyzer.crowd.graph_solve import GraphSolution, solve_graph
 from stridefix_analyzer.crowd.graph_wifi import add_wifi_rows
 from stridefix_analyzer.crowd.solve import Points, make_points, parse_anchors
 from stridefix_analyzer.crowd.walks import DEFAULT_BAND, ScanSet, Walk, pool_scans
@@ -48,6 +49,7 @@ class GraphRun:
     scans: ScanSet
     problem: GraphProblem
     info: dict[str, Any]
+    solution: GraphSolution  # xy_m with the headings and scales (what position_sigma_m linearises at)
 
     @property
     def anchor_index(self) -> np.ndarray:  # what .solve.error_stats reads
@@ -70,14 +72,21 @@ def split_anchors(points: Points, n_walks: int, is_anchor: np.ndarray) -> tuple[
 
 
 def anchor_cv_error(
-    points: Points, n_walks: int, is_anchor: np.ndarray, make: Callable[..., GraphProblem], solver: str
+    points: Points,
+    n_walks: int,
+    is_anchor: np.ndarray,
+    make: Callable[..., GraphProblem],
+    solver: str,
+    priors: FleetPriors | None = None,
 ) -> dict[str, Any]:
     """Mean error at the held-out anchors of the graph ``make(keep, priors)`` built on the kept ones
-    (fleet priors re-learned from the kept anchors: the held-out ones teach nothing)."""
+    (fleet priors re-learned from the kept anchors, so the held-out ones teach nothing; or the given
+    ``priors``, learned from a fleet of other walks)."""
     keep, held = split_anchors(points, n_walks, is_anchor)
     if not held.any():
         return {"heldout_anchor_mean_m": math.nan, "n": 0}
-    xy = solve_graph(make(keep, fleet_priors(points, keep, n_walks)), solver).xy_m
+    pri = fleet_priors(points, keep, n_walks) if priors is None else priors
+    xy = solve_graph(make(keep, pri), solver).xy_m
     e = np.hypot(*(xy[held] - points.truth_xy_m[held]).T)
     return {"heldout_anchor_mean_m": float(e.mean()), "n": int(e.size)}
 
@@ -89,6 +98,7 @@ def choose_heading_sigma(
     settings: GraphSettings,
     solver: str = "auto",
     grid=HEADING_SIGMA_GRID,
+    priors: FleetPriors | None = None,
 ) -> tuple[float, list[dict[str, Any]]]:
     """σ_θ of ``grid`` with the lowest mean error at held-out anchors (module docstring); the
     settings' own value when no walk has a second anchor to hold out."""
@@ -101,7 +111,7 @@ def choose_heading_sigma(
 
         rows.append(
             {"heading_sigma_rad_per_sqrt_s": float(sig)}
-            | anchor_cv_error(points, n_walks, is_anchor, make, solver)
+            | anchor_cv_error(points, n_walks, is_anchor, make, solver, priors)
         )
     if not rows[0]["n"]:
         return settings.heading_sigma_rad_per_sqrt_s, []
@@ -119,20 +129,24 @@ def solve_walks_graph(
     wifi: str = "auto",
     band: str = DEFAULT_BAND,
     solver: str = "auto",
+    priors: FleetPriors | None = None,
 ) -> GraphRun:
     """Build the graph of ``walks`` and solve it. ``wifi_model``: a fitted pair model giving
     loop-closure rows (:mod:`.graph_wifi`), or None for none; ``wifi``: ``auto`` = keep its rows only
     when they lower the held-out anchor error, ``on`` = always. ``learn_heading_sigma``: choose σ_θ
-    by anchor cross-validation (else the settings' value)."""
+    by anchor cross-validation (else the settings' value). ``priors``: the stride scale and heading
+    bias of a fleet of walks (e.g. a crowd map's other walks, :func:`.graph.priors_from`); default:
+    learned from ``walks``' own anchors (:func:`.graph.fleet_priors`)."""
     t0 = time.perf_counter()
     scans = pool_scans(walks, band)
     points = make_points(walks, scans)
     is_anchor = anchor_mask(points, len(walks), parse_anchors(anchors))
-    priors = fleet_priors(points, is_anchor, len(walks))
+    given = priors
+    priors = fleet_priors(points, is_anchor, len(walks)) if given is None else given
     n_walks = len(walks)
     cv: list[dict[str, Any]] = []
     if learn_heading_sigma:
-        sig, cv = choose_heading_sigma(points, n_walks, is_anchor, settings, solver)
+        sig, cv = choose_heading_sigma(points, n_walks, is_anchor, settings, solver, priors=given)
         settings = dataclasses.replace(settings, heading_sigma_rad_per_sqrt_s=sig)
     g = build_graph(points, n_walks, anchors=is_anchor, settings=settings, priors=priors)
     wifi_cv: dict[str, Any] = {}
@@ -145,7 +159,7 @@ def solve_walks_graph(
         if wifi == "auto":
             for label, flag in (("without", False), ("with", True)):
                 wifi_cv[label] = anchor_cv_error(
-                    points, n_walks, is_anchor, lambda k, p, f=flag: make(k, p, f), solver
+                    points, n_walks, is_anchor, lambda k, p, f=flag: make(k, p, f), solver, given
                 )
             e_with, e_without = (wifi_cv[k]["heldout_anchor_mean_m"] for k in ("with", "without"))
             wifi_cv["used"] = bool(e_with < e_without)  # NaN (nothing held out) compares False
@@ -167,4 +181,4 @@ def solve_walks_graph(
         "build_s": build_s,
         "scale": [float(s) for s in sol.scale],
     }
-    return GraphRun(sol.xy_m, points, scans, g, info)
+    return GraphRun(sol.xy_m, points, scans, g, info, sol)

@@ -93,6 +93,31 @@ def crowd_recordings(walks: list[Walk], xy: np.ndarray | None, points: Points) -
     return recs
 
 
+def scan_sigma_m(run: GraphRun, sigma_m: np.ndarray, k: int, scan_t_us: np.ndarray) -> np.ndarray:
+    """Posterior σ [m] (:func:`.graph_solve.position_sigma_m` of ``run``) of walk ``k`` at each scan
+    time: the point's own σ at a scan that is a point, else interpolated in time between the walk's
+    points (NaN for a walk without points)."""
+    sel = run.points.walk == k
+    t, s = run.points.t_us[sel], sigma_m[sel]
+    ok = np.isfinite(s)
+    if not ok.any():
+        return np.full(len(scan_t_us), np.nan)
+    return np.interp(np.asarray(scan_t_us, float), t[ok].astype(float), s[ok])
+
+
+def drop_uncertain_scans(rec: Recording, sigma_m: np.ndarray, max_sigma_m: float) -> tuple[Recording, int]:
+    """``rec`` without the scans whose position σ (``sigma_m``, one per scan) exceeds ``max_sigma_m``
+    (a NaN σ is unknown: dropped too), and how many were dropped. The AP rows follow their scans."""
+    keep = np.asarray(sigma_m, float) <= max_sigma_m
+    if max_sigma_m == np.inf or keep.all():
+        return rec, 0
+    new_row = np.cumsum(keep) - 1
+    ap_keep = keep[rec.wifi_ap["scan_row"]]
+    ap = rec.wifi_ap.rows(ap_keep)
+    ap = Table(ap.to_dict() | {"scan_row": new_row[ap["scan_row"]]})
+    return Recording(rec.files, rec.wifi.rows(keep), ap, rec.truth, rec.ble), int((~keep).sum())
+
+
 def graph_errors(run: GraphRun) -> dict[str, Any]:
     """The solve's error at the non-anchor truth points (:func:`.solve.error_stats`), and that of the
     anchors interpolated in time (the graph's initial guess, what a map without PDR would use)."""

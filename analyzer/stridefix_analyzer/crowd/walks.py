@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -155,14 +156,15 @@ def _make_walk(files: list[str], datas: list) -> Walk:
     )
 
 
-def load_walks(args: list[str]) -> list[Walk]:
-    """Group log arguments into walks (module docstring) and read them.
+def load_walks(args: Sequence[str | tuple[str, ...]]) -> list[Walk]:
+    """Group log arguments into walks (module docstring) and read them; a tuple of paths is one walk
+    as is (a file name may hold a comma).
 
     Raises LogReadError (unreadable file) or CrowdInputError (a walk lacks WIFI or TRUTH).
     """
     walks, rest = [], []
     for arg in args:
-        files = [f for f in str(arg).split(",") if f]
+        files = list(arg) if isinstance(arg, tuple) else [f for f in str(arg).split(",") if f]
         datas = [_read(f) for f in files]
         if len(files) > 1 or (datas[0].table("WIFI") and datas[0].table("TRUTH")):
             walks.append(_make_walk(files, datas))

@@ -11,6 +11,7 @@ Exit status: 0 done, 1 nothing could be scored, 2 bad usage or unreadable input.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
@@ -302,6 +303,13 @@ def add_crowd_map_parser(sub: Any) -> None:
     d.add_argument("--anchors", default="every:4", metavar="every:K", help="anchored waypoints per walk")
     d.add_argument("--solver", choices=GRAPH_SOLVERS, default="auto", help="graph solver")
     d.add_argument(
+        "--max-sigma-m",
+        type=float,
+        default=math.inf,
+        metavar="M",
+        help="crowd map: leave out scans whose solved position has a posterior sigma above M metres",
+    )
+    d.add_argument(
         "--limit", type=int, default=None, metavar="N", help="only the first N walks of each group"
     )
     d.add_argument("--jobs", "-j", type=int, default=2, metavar="N", help="parallel workers")
@@ -345,7 +353,9 @@ def _run_crowd_map_cli(args: argparse.Namespace) -> int:
             quiet=args.quiet,
             param_sets=args.param_sets,
         )
-        doc = run_crowd_map(CrowdMapConfig(cfg, anchors=args.anchors, solver=args.solver))
+        doc = run_crowd_map(
+            CrowdMapConfig(cfg, anchors=args.anchors, solver=args.solver, max_sigma_m=args.max_sigma_m)
+        )
     except (RealbenchError, LogReadError, CrowdInputError) as exc:
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return input_error_status(exc)

@@ -22,6 +22,7 @@ work folders (``<walk>`` for the truth map, ``<walk>/crowd-map`` for the crowd m
 
 from __future__ import annotations
 
+import collections
 import concurrent.futures
 import dataclasses
 import json
@@ -34,6 +35,7 @@ from typing import Any, TextIO
 
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.realbench.crowdfolds import Choice, CrowdJob, choice_doc, fold_stats, solve_folds
 from stridefix_analyzer.realbench.fold import STATS_KEYS, FoldJob, run_fold
 from stridefix_analyzer.realbench.fusion import FusionConfig, Run, plan_group, prepare_walks, start_run
 from stridefix_analyzer.realbench.progress import Progress
@@ -51,48 +53,8 @@ class CrowdMapConfig:
     fusion: FusionConfig
     anchors: str = "every:4"
     solver: str = "auto"
-
-
-@dataclasses.dataclass(frozen=True)
-class CrowdJob:
-    """One walk's crowd solve (sent to a worker): its site-less replay log and its imported log."""
-
-    walk: str
-    fw_log: str
-    import_log: str
-    anchors: str
-    solver: str
-    cell_size_m: float
-
-
-def crowd_walk(job: CrowdJob) -> dict[str, Any]:
-    """Solve one walk on the graph and return the walk-mode map statistics of its scans placed at the
-    solved positions (``stats``), the rows used and the position errors; ``error`` says why not."""
-    from stridefix_analyzer.crowd.graph_run import solve_walks_graph
-    from stridefix_analyzer.crowd.sites import graph_errors, solved_truth
-    from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
-    from stridefix_analyzer.io.logread import LogReadError
-    from stridefix_analyzer.radiomap.build import RadioMapInputError, Recording, load_recordings
-
-    t0 = time.perf_counter()
-    out: dict[str, Any] = {"walk": job.walk, "error": None}
-    try:
-        walks = load_walks([f"{job.fw_log},{job.import_log}"])
-        # band "all": every scan with an AP is a point of the graph, so each scan of the map gets
-        # its own solved position (without Wi-Fi rows the band changes nothing else)
-        run = solve_walks_graph(walks, anchors=job.anchors, band="all", solver=job.solver)
-        recs = load_recordings([job.import_log])
-    except (CrowdInputError, LogReadError, RadioMapInputError) as exc:
-        out["error"] = f"crowd solve failed: {exc}"
-        return out
-    truth = solved_truth(walks[0], 0, run.xy_m, run.points)
-    crowd = [Recording(r.files, r.wifi, r.wifi_ap, truth, r.ble) for r in recs]
-    out["stats"] = WalkStats.from_recordings(crowd, cell_size_m=job.cell_size_m)
-    out["rows"] = run.info["rows"]
-    out["solver"] = run.info["solver"].get("solver")
-    out["positions"] = graph_errors(run)
-    out["run_s"] = time.perf_counter() - t0
-    return out
+    #: scans whose solved position's posterior σ exceeds this [m] stay out of the crowd map (inf: none)
+    max_sigma_m: float = math.inf
 
 
 def _pair(jobs: tuple[FoldJob, FoldJob]) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -115,27 +77,53 @@ def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
     )
     planned = [plan_group(run, p, walks) for p in parts]  # phase 2
     t_plan = time.perf_counter()
-    crowd = solve_crowd(run, walks, cc, stream)  # the crowd positions, one solve per walk
+    crowd_jobs = {
+        i: CrowdJob(
+            w["walk"],
+            tuple(w["fw_logs"].items()),
+            w["import_log"],
+            cc.anchors,
+            cc.solver,
+            run.cfg.cell_size_m,
+            cc.max_sigma_m,
+        )
+        for i, w in enumerate(walks)
+        if not w["error"]
+    }
+    folds: dict[int, list[int]] = {}
+    for _, jobs in planned:
+        ids = [j.index for j in jobs]
+        folds |= {j.index: [i for i in ids if i != j.index and i in crowd_jobs] for j in jobs}
+    variants = list(next(a for a in run.axes if a.name == "heading").candidates)
+    choice, solved = solve_folds(crowd_jobs, folds, variants, run.cfg.jobs, stream)  # the crowd positions
     t_crowd = time.perf_counter()
     pairs = []
     for _, jobs in planned:
         # a walk whose solve failed adds nothing to the crowd maps (reported per group)
-        empty = WalkStats.empty(run.cfg.cell_size_m)
-        stats = {j.index: crowd[j.index].get("stats", empty) for j in jobs}
-        total = WalkStats.total(list(stats.values()))
+        ids = [j.index for j in jobs]
         for j in jobs:
+            stats = fold_stats(choice[j.index], solved, ids, run.cfg.cell_size_m)
+            total = WalkStats.total(list(stats.values()))
             cj = dataclasses.replace(j, dir=j.dir / "crowd-map", total=total, held=stats[j.index])
             pairs.append((j, cj))
     results = run_pairs(run, pairs, stream)  # phase 3, both maps of a fold in one worker
-    groups_doc = [group_doc(p.label, info, jobs, results, crowd) for p, (info, jobs) in zip(parts, planned)]
+    # each walk's own row: its solve with what the other walks taught (its own fold's choice)
+    own = {i: solved[c][i] for i, c in choice.items() if i in solved[c]}
+    groups_doc = [
+        group_doc(p.label, info, jobs, results, own, choice) for p, (info, jobs) in zip(parts, planned)
+    ]
     doc = {
         "benchmark": "crowd-map",
         "format": cfg.fmt,
         "dirs": [str(d) for d in cfg.dirs],
         "anchors": cc.anchors,
         "solver": cc.solver,
+        "max_sigma_m": cc.max_sigma_m,
         "inputs": "crowd map: per training walk its waypoints every "
-        f"{cc.anchors} (anchors) + its site-less STEP stream (no Wi-Fi rows); truth map: every waypoint",
+        f"{cc.anchors} (anchors) + its site-less STEP stream (no Wi-Fi rows), the heading variant and "
+        "fleet priors of the fold's training walks' anchors, scans with posterior sigma <= "
+        f"{cc.max_sigma_m} m; truth map: every waypoint",
+        "crowd_choices": len(set(choice.values())),
         "params": {
             "cell_size_m": cfg.cell_size_m,
             "min_count": cfg.min_count,
@@ -159,38 +147,6 @@ def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
     if cfg.quiet:
         stream.close()
     return doc
-
-
-def solve_crowd(
-    run: Run, walks: list[dict[str, Any]], cc: CrowdMapConfig, stream: TextIO
-) -> dict[int, dict[str, Any]]:
-    """:func:`crowd_walk` of every prepared walk, in parallel (walk index → its result)."""
-    ok = [i for i, w in enumerate(walks) if not w["error"]]
-    crowd: dict[int, dict[str, Any]] = {}
-    prog = Progress("crowd solve", len(ok), stream)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, run.cfg.jobs)) as pool:
-        futs = {
-            pool.submit(
-                crowd_walk,
-                CrowdJob(
-                    walks[i]["walk"],
-                    walks[i]["fw_log"],
-                    walks[i]["import_log"],
-                    cc.anchors,
-                    cc.solver,
-                    run.cfg.cell_size_m,
-                ),
-            ): i
-            for i in ok
-        }
-        for fut in concurrent.futures.as_completed(futs):
-            c = crowd[futs[fut]] = fut.result()
-            g = (c.get("positions") or {}).get("graph", {})
-            note = (
-                c["error"] or f"{c['rows']['anchors']} anchors, graph mean {g.get('mean_m', math.nan):.1f} m"
-            )
-            prog.step(f"{c['walk']}: {note}")
-    return crowd
 
 
 def run_pairs(
@@ -245,6 +201,7 @@ def group_doc(
     jobs: Sequence[FoldJob],
     results: Mapping[str, tuple[dict[str, Any], dict[str, Any]]],
     crowd: Mapping[int, Mapping[str, Any]],
+    choice: Mapping[int, Choice],
 ) -> dict[str, Any]:
     """One group: per walk both maps' scores, their ratio and the crowd positions' error; the pooled
     summaries (as ``realbench fusion`` pools them) over the walks scored on both maps."""
@@ -260,6 +217,7 @@ def group_doc(
             "sites": {"truth_map": _site(tr), "crowd_map": _site(cr)},
             "crowd_rows": c.get("rows"),
             "crowd_positions": c.get("positions"),
+            "crowd_choice": choice_doc(choice[j.index]) if j.index in choice else None,
         }
         row["ratio"] = {s: _ratio(row["crowd_map"], row["truth_map"], s) for s in row["truth_map"]}
         rows.append(row)
@@ -268,6 +226,7 @@ def group_doc(
             paired_crowd.append(cr)
     truth_sum = summarize_group(paired_truth)["schemes"]
     crowd_sum = summarize_group(paired_crowd)["schemes"]
+    dropped = sum(int(crowd.get(j.index, {}).get("dropped_uncertain", 0)) for j in jobs)
     n_rows: dict[str, int] = {}
     for j in jobs:
         for k, v in (crowd.get(j.index, {}).get("rows") or {}).items():
@@ -284,6 +243,10 @@ def group_doc(
             if crowd.get(j.index, {}).get("error")
         ],
         "crowd_rows": n_rows,
+        "crowd_scans_dropped_uncertain": dropped,
+        "crowd_heading_variants": dict(
+            collections.Counter(choice[j.index][0] for j in jobs if j.index in choice)
+        ),
         "summary": {
             "truth_map": truth_sum,
             "crowd_map": crowd_sum,

@@ -88,7 +88,9 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
             st = read_table(fw_log, "STEP")
             headings[name] = (st["t_us"], st["heading_rad"]) if st is not None else None
     fw_log = fw_dir / f"{trace.stem}.{first}.lcmlog"
-    walk["fw_log"] = str(fw_log)  # its STEP stream: the crowd-built map's dead reckoning (.crowdmap)
+    walk["fw_log"] = str(fw_log)
+    # every variant's STEP stream: the crowd-built map's dead reckoning (.crowdmap chooses one)
+    walk["fw_logs"] = {name: str(fw_dir / f"{trace.stem}.{name}.lcmlog") for name in job.heading_candidates}
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", LogTruncatedWarning)

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from stridefix_analyzer.io.sitefile import read_site
+from stridefix_analyzer.realbench.heading import HEADING_VARIANTS
 
 MSINDOOR_F2 = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "msindoor" / "site1" / "F2"
 
@@ -79,6 +80,10 @@ def test_crowd_map_scores_both_maps(crowd_map_small):
             row["crowd_map"]["wifi_only"]["mean"] / row["truth_map"]["wifi_only"]["mean"],
         )
         assert row["crowd_rows"]["anchors"] >= 1 and row["crowd_rows"]["wifi"] == 0
+        # what the fold's crowd learned from its training walks' anchors: a real heading variant
+        assert row["crowd_choice"]["heading_variant"] in HEADING_VARIANTS
+        assert row["crowd_choice"]["priors"]["heading_sigma_rad"] > 0
+    assert 1 <= doc["crowd_choices"] <= 4 and sum(g["crowd_heading_variants"].values()) == 4
     s = g["summary"]
     for scheme in ("wifi_only", "ekf"):
         assert 0.5 < s["ratio"][scheme] < 2.0  # generous: same walks, same protocol, nearby positions
