@@ -23,6 +23,21 @@ REPO = Path(__file__).resolve().parents[2]
 DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
 
 
+#: Heading variants a hand-held walk is replayed with. realbench uses, per fold, the one whose STEP
+#: headings agree best with the training walks' truth directions (realbench/heading.py); the crowd solves
+#: the one whose walks agree best on their heading bias at the anchors (crowd/graph.py). Two
+#: questions the firmware defaults answer for a body-worn board, not for every device: is the
+#: gait-learned mounting offset better than a fixed one (a hand-held phone: no), and does a
+#: magnetometer gate twice as wide keep more good samples than disturbed ones?
+_WIDE_MAG_GATE = ["attitude.mag_field_tol_ut=16", "attitude.mag_dip_tol_deg=16"]
+HEADING_VARIANTS = {
+    "learned": [],
+    "fixed": ["heading.learn_offset=0"],
+    "learned, wide mag gate": _WIDE_MAG_GATE,
+    "fixed, wide mag gate": ["heading.learn_offset=0"] + _WIDE_MAG_GATE,
+}
+
+
 class FirmwareError(RuntimeError):
     """stridefixd is missing, refused its arguments or failed; the message names the command."""
 

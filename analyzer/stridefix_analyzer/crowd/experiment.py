@@ -9,7 +9,10 @@ from their truth; every scored walk (and a held-out walk) is replayed with each 
 ``wifi_only`` by ``stridefix analyze``.
 
 ``--msindoor DIR`` (a floor folder, or the msindoor root for every floor): each trace is imported
-(``stridefix_analyzer.datasets.msindoor``, cached) and replayed through ``stridefixd``. The first
+(``stridefix_analyzer.datasets.msindoor``, cached) and replayed through ``stridefixd`` once per
+heading variant (``firmware.HEADING_VARIANTS``); the walks used are those of the variant the fitting
+traces agree on at their anchors (:func:`.graph.agreed_variant`: the smallest spread of per-walk
+heading bias, the truth between anchors never read). The first
 ``--limit`` traces (sorted by name) are scored; the model and stride scale come from the floor's other
 traces. Anchors: every 4th waypoint (``--anchors``); error at the other waypoints. The floor's model is also fitted
 on all its traces and reported.
@@ -21,7 +24,9 @@ fitting walks (the firmware's default Weinberg K is not the crowd's).
 from __future__ import annotations
 
 import concurrent.futures
+import dataclasses
 import json
+import math
 import os
 import sys
 import time
@@ -33,12 +38,14 @@ import numpy as np
 from stridefix_analyzer.crowd.experiment_graph import graph_rows, select_pair_model
 from stridefix_analyzer.crowd.experiment_targets import solve_targets
 from stridefix_analyzer.crowd.fit import fit_walks, format_model
+from stridefix_analyzer.crowd.graph import agreed_variant
+from stridefix_analyzer.crowd.graph_run import anchor_similarities
 from stridefix_analyzer.crowd.models import ThesisAdapter
 from stridefix_analyzer.crowd.positions import solve_walks
 from stridefix_analyzer.crowd.sites import build_crowd_sites
 from stridefix_analyzer.crowd.solve import error_stats
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
-from stridefix_analyzer.firmware import Firmware, add_stridefixd_argument
+from stridefix_analyzer.firmware import HEADING_VARIANTS, Firmware, add_stridefixd_argument
 from stridefix_analyzer.scoring.targets import missed_lines, table_lines
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
@@ -299,24 +306,48 @@ def format_fixes(fixes: list[dict]) -> str:
 
 
 def _ms_walk(trace: Path, cache: Path, firmware: Firmware) -> dict:
+    """Import one trace and replay it once per heading variant (cached); its walk specs per variant."""
     import warnings
 
     from stridefix_analyzer import datasets
 
-    log, fw = cache / f"{trace.stem}.lcmlog", cache / f"{trace.stem}.fw.lcmlog"
-    if not (log.is_file() and fw.is_file() and log.stat().st_mtime >= trace.stat().st_mtime):
+    log = cache / f"{trace.stem}.lcmlog"
+    fresh = log.is_file() and log.stat().st_mtime >= trace.stat().st_mtime
+    if not fresh:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             datasets.get("msindoor").import_walk(trace, log)
-        replay(
-            firmware,
-            f"stridefixd {trace.name}",
-            CrowdInputError,
-            input=f"lcmlog:{log}",
-            log=fw,
-            sets=datasets.get("msindoor").firmware_sets,
-        )
-    return {"trace": trace.name, "spec": f"{fw},{log}"}
+    specs = {}
+    for k, (variant, sets) in enumerate(HEADING_VARIANTS.items()):
+        fw = cache / f"{trace.stem}.fw{k}.lcmlog"
+        if not (fresh and fw.is_file() and fw.stat().st_mtime >= log.stat().st_mtime):
+            replay(
+                firmware,
+                f"stridefixd {trace.name} ({variant})",
+                CrowdInputError,
+                input=f"lcmlog:{log}",
+                log=fw,
+                sets=[*datasets.get("msindoor").firmware_sets, *sets],
+            )
+        specs[variant] = (str(fw), str(log))
+    return {"trace": trace.name, "specs": specs}
+
+
+def _agreed_walks(prepared: list[dict], n_fit_from: int, anchors: str):
+    """The walks of the heading variant the fitting walks (``prepared[n_fit_from:]``) agree on at
+    their anchors (:func:`.graph.agreed_variant`), the variant and its fleet priors."""
+    by_variant = {}
+    for variant in HEADING_VARIANTS:
+        walks = load_walks([p["specs"][variant] for p in prepared])
+        for w, p in zip(walks, prepared):
+            w.name = p["trace"]
+        by_variant[variant] = walks
+    sims = {
+        v: [s for s in anchor_similarities(ws[n_fit_from:], anchors) if s is not None]
+        for v, ws in by_variant.items()
+    }
+    variant, priors = agreed_variant(sims)
+    return by_variant[variant], variant, priors
 
 
 def _floors(root: Path) -> list[Path]:
@@ -347,9 +378,12 @@ def run_msindoor(args, progress) -> dict:
         with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs) as pool:
             prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces), [firmware] * len(traces)))
         prep_s = time.perf_counter() - t1
-        all_walks = load_walks([p["spec"] for p in prepared])
-        for w, p in zip(all_walks, prepared):
-            w.name = p["trace"]
+        fit_from = args.limit if args.limit and args.limit < len(prepared) else 0
+        all_walks, variant, priors = _agreed_walks(prepared, fit_from, args.anchors)
+        progress(
+            f"{label} heading variant the fitting walks agree on at their anchors: {variant} (heading "
+            f"bias spread {math.degrees(priors.heading_sigma_rad):.1f} deg over {priors.walks_used} walks)"
+        )
         scored = _usable(all_walks[: args.limit]) if args.limit else _usable(all_walks)
         fitting = all_walks[args.limit :] if args.limit and args.limit < len(all_walks) else all_walks
         model_all, _ = fit_walks(
@@ -376,6 +410,11 @@ def run_msindoor(args, progress) -> dict:
                 "model_used": model.to_json(),
                 "pair_models": {"chosen": sel.best.name, "chosen_by": sel.chosen_by, "rows": sel.rows},
                 "stride_scale": scale,
+                "heading_variant": {
+                    "chosen": variant,
+                    "by": "smallest heading-bias spread at the fitting walks' anchors",
+                    "priors": dataclasses.asdict(priors),
+                },
                 "rows": rows,
                 "prepare_s": prep_s,
             }

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -115,6 +116,19 @@ def priors_from(similarities: list[tuple[float, float]]) -> FleetPriors:
         heading_sigma_rad=max(1.4826 * float(np.median(np.abs(h - h_med))), math.radians(5.0)),
         walks_used=len(similarities),
     )
+
+
+def agreed_variant(similarities: Mapping[str, Sequence[tuple[float, float]]]) -> tuple[str, FleetPriors]:
+    """Of several dead-reckoning variants of the same walks (variant → the walks' :func:`walk_similarity`),
+    the one whose walks agree best on their heading bias (smallest robust spread: a heading the phone
+    keeps consistent from walk to walk is one the map's rotation corrects), with its
+    :func:`priors_from`. Needs 3 walks that tell; else the first variant, uninformed."""
+    best: tuple[str, FleetPriors] | None = None
+    for v, sims in similarities.items():
+        pri = priors_from(list(sims))
+        if pri.walks_used >= 3 and (best is None or pri.heading_sigma_rad < best[1].heading_sigma_rad):
+            best = (v, pri)
+    return best if best is not None else (next(iter(similarities)), priors_from([]))
 
 
 def fleet_priors(points: Points, is_anchor: np.ndarray, n_walks: int) -> FleetPriors:

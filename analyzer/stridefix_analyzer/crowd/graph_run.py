@@ -29,6 +29,7 @@ from stridefix_analyzer.crowd.graph import (
     anchor_mask,
     build_graph,
     fleet_priors,
+    walk_similarity,
 )
 from stridefix_analyzer.crowd.graph_solve import GraphSolution, solve_graph
 from stridefix_analyzer.crowd.graph_wifi import add_wifi_rows
@@ -58,6 +59,16 @@ class GraphRun:
     @property
     def n(self) -> int:
         return self.problem.n_points
+
+
+def anchor_similarities(walks: list[Walk], anchors: str) -> list[tuple[float, float] | None]:
+    """Each walk's :func:`.graph.walk_similarity` on its own anchors (every K-th truth point)."""
+    every = parse_anchors(anchors)
+    out = []
+    for w in walks:
+        points = make_points([w], pool_scans([w], "all"))
+        out.append(walk_similarity(points, anchor_mask(points, 1, every), 0))
+    return out
 
 
 def split_anchors(points: Points, n_walks: int, is_anchor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,7 +28,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any, TextIO
 
-from stridefix_analyzer.crowd.graph import FleetPriors, priors_from
+from stridefix_analyzer.crowd.graph import FleetPriors, agreed_variant
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench.progress import Progress
 
@@ -55,21 +55,18 @@ class CrowdJob:
 def walk_similarities(job: CrowdJob) -> dict[str, Any]:
     """Per heading variant, the walk's (scale, heading bias) on its own anchors, or None (too few
     anchors); ``error`` says why a walk has none at all."""
-    from stridefix_analyzer.crowd.graph import anchor_mask, walk_similarity
-    from stridefix_analyzer.crowd.solve import make_points, parse_anchors
-    from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks, pool_scans
+    from stridefix_analyzer.crowd.graph_run import anchor_similarities
+    from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
     from stridefix_analyzer.io.logread import LogReadError
 
     out: dict[str, Any] = {"walk": job.walk, "error": None, "sims": {}}
-    every = parse_anchors(job.anchors)
     for variant, fw_log in job.fw_logs:
         try:
             walks = load_walks([(fw_log, job.import_log)])
         except (CrowdInputError, LogReadError) as exc:
             out["error"] = f"crowd walk unreadable: {exc}"
             return out
-        points = make_points(walks, pool_scans(walks, "all"))
-        out["sims"][variant] = walk_similarity(points, anchor_mask(points, 1, every), 0)
+        out["sims"][variant] = anchor_similarities(walks, job.anchors)[0]
     return out
 
 
@@ -113,15 +110,9 @@ def crowd_walk(job: CrowdJob) -> dict[str, Any]:
 
 
 def choose(sims: Sequence[Mapping[str, Any]], variants: Sequence[str]) -> Choice:
-    """The heading variant whose walks agree best on their heading bias, and its fleet priors, from
-    the per-walk similarities ``sims`` of one fold's training walks (module docstring); the first
-    variant when none has three walks that tell (its priors then the uninformative default)."""
-    best: Choice | None = None
-    for v in variants:
-        pri = priors_from([s["sims"][v] for s in sims if s["sims"].get(v) is not None])
-        if pri.walks_used >= 3 and (best is None or pri.heading_sigma_rad < best[1].heading_sigma_rad):
-            best = (v, pri)
-    return best if best is not None else (variants[0], priors_from([]))
+    """:func:`~..crowd.graph.agreed_variant` of one fold's training walks (their per-walk
+    similarities ``sims``, :func:`walk_similarities`): the module docstring's choice."""
+    return agreed_variant({v: [s["sims"][v] for s in sims if s["sims"].get(v) is not None] for v in variants})
 
 
 def solve_folds(

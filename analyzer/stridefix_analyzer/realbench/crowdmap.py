@@ -11,8 +11,10 @@ fold then gets two sites from its training walks:
   ``--set``) except that each training walk's scan positions are its graph-solved positions
   (:func:`~stridefix_analyzer.crowd.graph_run.solve_walks_graph`: every K-th waypoint an anchor, the
   walk's site-less STEP stream between them, no Wi-Fi rows; :func:`~stridefix_analyzer.crowd.sites.
-  solved_truth`). Without Wi-Fi rows each walk's solve is independent of every other walk, so one
-  solve per walk serves every fold (no leak between folds).
+  solved_truth`), solved with what the fold's training walks' anchors teach: the heading variant they
+  agree on and its fleet priors (:mod:`.crowdfolds`). Without Wi-Fi rows each walk's solve reads no
+  other walk's scans; folds that learned the same share one solve per walk (no leak between folds:
+  the held-out walk's anchors never enter its fold's choice).
 
 The held-out walk is replayed on each (:func:`.fold.run_fold`, the same protocol) and scored at its
 waypoints; the crowd positions' own error at the non-anchor waypoints is reported next to that of the
@@ -267,6 +269,11 @@ def format_tables(doc: Mapping[str, Any]) -> str:
             f"crowd-map {g['label']}: {g['paired']} of {g['walks']} walks scored on both maps; crowd "
             f"positions from {r.get('anchors', 0)} anchors ({doc['anchors']}), {r.get('steps', 0)} step "
             f"rows, {r.get('wifi', 0)} Wi-Fi rows"
+        )
+        variants = ", ".join(f"{v} x{n}" for v, n in (g.get("crowd_heading_variants") or {}).items())
+        lines.append(
+            f"  learned per fold from the training walks' anchors: heading variant {variants or '-'}; "
+            f"{g.get('crowd_scans_dropped_uncertain', 0)} scans left out (sigma > {doc.get('max_sigma_m')} m)"
         )
         head = f"{'walk':<26}" + "".join(f" {s + ' truth':>15} {'crowd':>7} {'ratio':>6}" for s in SHOWN)
         lines.append(head + f" {'pos graph':>10} {'interp':>7}")

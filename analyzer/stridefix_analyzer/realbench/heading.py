@@ -19,23 +19,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from stridefix_analyzer.firmware import HEADING_VARIANTS  # noqa: F401 - the heading axis's candidates
+
 #: rotation learning: shortest segment, smallest step-heading resultant length, fewest steps
 ROT_MIN_SEGMENT_M = 4.0
 ROT_MIN_RESULTANT = 0.95
 ROT_MIN_STEPS = 3
-#: heading variants tried on the training walks of each fold: the one whose STEP headings agree best
-#: with the truth directions (largest pooled resultant length of heading − direction) is used. Two
-#: questions the firmware defaults answer for a body-worn board, not for every device: is the
-#: gait-learned mounting offset better than a fixed one (a hand-held phone: no), and does a
-#: magnetometer gate twice as wide keep more good samples than disturbed ones?
-_WIDE_MAG_GATE = ["attitude.mag_field_tol_ut=16", "attitude.mag_dip_tol_deg=16"]
-HEADING_VARIANTS = {
-    "learned": [],
-    "fixed": ["heading.learn_offset=0"],
-    "learned, wide mag gate": _WIDE_MAG_GATE,
-    "fixed, wide mag gate": ["heading.learn_offset=0"] + _WIDE_MAG_GATE,
-}
-
 RotationSums = dict[str, Any]
 """``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments``, ``segments`` of one walk (:func:`rotation_stats`)."""
 
