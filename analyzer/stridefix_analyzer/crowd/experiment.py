@@ -24,161 +24,23 @@ fitting walks (the firmware's default Weinberg K is not the crowd's).
 from __future__ import annotations
 
 import concurrent.futures
-import dataclasses
 import json
-import math
 import os
 import sys
 import time
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-
-from stridefix_analyzer.crowd.experiment_graph import graph_rows, select_pair_model
+from stridefix_analyzer.crowd.experiment_msindoor import run_msindoor
+from stridefix_analyzer.crowd.experiment_table import format_table, run_table, stride_scale
 from stridefix_analyzer.crowd.experiment_targets import solve_targets
 from stridefix_analyzer.crowd.fit import fit_walks, format_model
-from stridefix_analyzer.crowd.graph import agreed_variant
-from stridefix_analyzer.crowd.graph_run import anchor_similarities
-from stridefix_analyzer.crowd.models import ThesisAdapter
-from stridefix_analyzer.crowd.positions import solve_walks
 from stridefix_analyzer.crowd.sites import build_crowd_sites
-from stridefix_analyzer.crowd.solve import error_stats
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
-from stridefix_analyzer.firmware import HEADING_VARIANTS, Firmware, add_stridefixd_argument
+from stridefix_analyzer.firmware import Firmware, add_stridefixd_argument
 from stridefix_analyzer.scoring.targets import missed_lines, table_lines
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
 DEFAULT_OUT = os.path.join("out", "crowd", "experiment")
-
-# (key, label, thesis mean, thesis std, solve options)
-ROWS: list[tuple[str, str, float | None, float | None, dict[str, Any]]] = [
-    (
-        "pdr",
-        "PDR only, no weights/filtering",
-        10.0143,
-        5.097,
-        dict(ranges="pdr", pdr_span=0, weights=None, tau=None),
-    ),
-    ("pdr_w", "PDR only, weights", 3.1467, 2.602, dict(ranges="pdr", pdr_span=0, tau=None)),
-    (
-        "pdr_wf",
-        "PDR only, weights + filtering |i-j|<=2",
-        2.1653,
-        2.564,
-        dict(ranges="pdr", pdr_span=2, tau=None),
-    ),
-    ("wifi", "Wi-Fi only, no weights/filtering", 7.5489, 4.2453, dict(ranges="wifi", weights=None, tau=None)),
-    ("wifi_w", "Wi-Fi only, weights", 4.1095, 3.8607, dict(ranges="wifi", tau=None)),
-    ("wifi_wf", "Wi-Fi only, weights + filtering", 3.7228, 3.5579, dict(ranges="wifi")),
-    (
-        "hybrid",
-        "PDR + Wi-Fi (filtered PDR), no weights",
-        2.1124,
-        2.3614,
-        dict(ranges="hybrid", pdr_span=0, weights=None),
-    ),
-    ("hybrid_w", "PDR + Wi-Fi (filtered PDR), weights", 1.9189, 2.335, dict(ranges="hybrid", pdr_span=0)),
-    (
-        "both_w",
-        "ours: PDR consecutive + filtered Wi-Fi rows, weights",
-        None,
-        None,
-        dict(ranges="both", pdr_span=1),
-    ),
-]
-
-
-def stride_scale(walks) -> float:
-    """Σ truth chord / Σ DR chord over consecutive truth points of ``walks`` (module docstring)."""
-    num = den = 0.0
-    for w in walks:
-        t = w.scan_t_us if w.dense_truth else w.truth_t_us
-        xy, _ = w.place(t)
-        dr, _ = w.dead_reckoning(t)
-        ok = np.isfinite(xy[:, 0])
-        xy, dr = xy[ok], dr[ok]
-        num += float(np.sum(np.hypot(*np.diff(xy, axis=0).T)))
-        den += float(np.sum(np.hypot(*np.diff(dr, axis=0).T)))
-    return num / den if den > 0 else 1.0
-
-
-def _table_row(
-    key: str,
-    label: str,
-    thesis_mean_m: float | None,
-    thesis_std_m: float | None,
-    e: dict[str, Any],
-    rows: dict[str, int],
-    solver: str,
-    run_s: float,
-) -> dict[str, Any]:
-    """One row of the experiment's table: its error statistics next to the thesis's numbers."""
-    return {
-        "key": key,
-        "label": label,
-        "thesis_mean_m": thesis_mean_m,
-        "thesis_std_m": thesis_std_m,
-        **{k: e.get(k) for k in ("mean_m", "std_m", "median_m", "p90_m", "n", "mean_all_m")},
-        "rows": rows,
-        "solver": solver,
-        "run_s": run_s,
-    }
-
-
-def run_table(
-    walks, model, anchors: str, solver: str, band: str, scale: float, progress=print, wifi_models=()
-) -> tuple[list[dict], dict]:
-    """Every row of :data:`ROWS` on ``walks``, then the graph rows (:mod:`.experiment_graph`, with
-    each of ``wifi_models``); returns (rows, positions of each thesis row)."""
-    out, positions = [], {}
-    for key, label, tm, ts, opts in ROWS:
-        opts = dict(opts)
-        opts.setdefault("weights", (1.0, 2.0))
-        opts.setdefault("tau", 0.45)
-        opts.setdefault("pdr_span", 1)
-        t0 = time.perf_counter()
-        xy, points, prob, res = solve_walks(
-            walks, model, anchors=anchors, solver=solver, band=band, step_scale=scale, **opts
-        )
-        e = res["error"]
-        out.append(
-            _table_row(key, label, tm, ts, e, res["rows"], res["solver"]["solver"], time.perf_counter() - t0)
-            | {"problem": res["problem"]}
-        )
-        positions[key] = (xy, points, prob)
-        progress(f"  {label:<55} mean {e.get('mean_m', float('nan')):6.2f} m  ({out[-1]['run_s']:.1f} s)")
-    # reference: the initial guess alone (anchors interpolated linearly in time, no range rows)
-    xy, points, prob = positions[ROWS[0][0]]
-    e = error_stats(prob.x0, points, prob)
-    rows = {"anchors": int(len(prob.anchor_index)), "pdr": 0, "wifi": 0}
-    out.append(
-        _table_row("anchors_interp", "reference: anchors only, linear in time", None, None, e, rows, "-", 0.0)
-        | {"problem": {}}
-    )
-    out += graph_rows(walks, anchors, solver, band, wifi_models, progress)
-    return out, positions
-
-
-def format_table(rows: list[dict]) -> str:
-    head = (
-        f"{'method':<64}{'mean m':>8}{'std m':>8}{'p90 m':>8}{'n':>6}{'rows':>9}"
-        f"{'thesis mean':>13}{'thesis std':>11}"
-    )
-    lines = [head]
-    for r in rows:
-
-        def f(v, w=8):
-            return f"{v:>{w}.2f}" if v is not None else f"{'-':>{w}}"
-
-        nrows = r["rows"]["pdr"] + r["rows"]["wifi"]
-        label = r["label"] if nrows or r["key"] == "anchors_interp" else r["label"] + " [0 rows: = anchors]"
-        lines.append(
-            f"{label:<64}{f(r['mean_m'])}{f(r['std_m'])}{f(r['p90_m'])}"
-            f"{r['n'] or 0:>6}{nrows:>9}{f(r['thesis_mean_m'], 13)}{f(r['thesis_std_m'], 11)}"
-        )
-    return "\n".join(lines)
-
 
 # --- SIL ---------------------------------------------------------------------------------------------
 
@@ -300,126 +162,6 @@ def format_fixes(fixes: list[dict]) -> str:
         t, c = r["truth"]["mean_m"], r["crowd"]["mean_m"]
         lines.append(f"{r['kind'] + ' s' + str(r['seed']):<14}{t:>24.2f} m{c:>24.2f} m")
     return "\n".join(lines)
-
-
-# --- msindoor ----------------------------------------------------------------------------------------
-
-
-def _ms_walk(trace: Path, cache: Path, firmware: Firmware) -> dict:
-    """Import one trace and replay it once per heading variant (cached); its walk specs per variant."""
-    import warnings
-
-    from stridefix_analyzer import datasets
-
-    log = cache / f"{trace.stem}.lcmlog"
-    fresh = log.is_file() and log.stat().st_mtime >= trace.stat().st_mtime
-    if not fresh:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            datasets.get("msindoor").import_walk(trace, log)
-    specs = {}
-    for k, (variant, sets) in enumerate(HEADING_VARIANTS.items()):
-        fw = cache / f"{trace.stem}.fw{k}.lcmlog"
-        if not (fresh and fw.is_file() and fw.stat().st_mtime >= log.stat().st_mtime):
-            replay(
-                firmware,
-                f"stridefixd {trace.name} ({variant})",
-                CrowdInputError,
-                input=f"lcmlog:{log}",
-                log=fw,
-                sets=[*datasets.get("msindoor").firmware_sets, *sets],
-            )
-        specs[variant] = (str(fw), str(log))
-    return {"trace": trace.name, "specs": specs}
-
-
-def _agreed_walks(prepared: list[dict], n_fit_from: int, anchors: str):
-    """The walks of the heading variant the fitting walks (``prepared[n_fit_from:]``) agree on at
-    their anchors (:func:`.graph.agreed_variant`), the variant and its fleet priors."""
-    by_variant = {}
-    for variant in HEADING_VARIANTS:
-        walks = load_walks([p["specs"][variant] for p in prepared])
-        for w, p in zip(walks, prepared):
-            w.name = p["trace"]
-        by_variant[variant] = walks
-    sims = {
-        v: [s for s in anchor_similarities(ws[n_fit_from:], anchors) if s is not None]
-        for v, ws in by_variant.items()
-    }
-    variant, priors = agreed_variant(sims)
-    return by_variant[variant], variant, priors
-
-
-def _floors(root: Path) -> list[Path]:
-    if (root / "path_data_files").is_dir():
-        return [root]
-    floors = sorted(p.parent for p in root.glob("*/*/path_data_files"))
-    if not floors:
-        raise CrowdInputError(f"{root}: no <floor>/path_data_files or */*/path_data_files folder")
-    return floors
-
-
-def _usable(walks, min_truth: int = 3):
-    """Walks that can be scored: steps, ≥ ``min_truth`` waypoints, ≥ 1 scan."""
-    return [w for w in walks if len(w.step_t_us) and len(w.truth_t_us) >= min_truth and w.n_scans]
-
-
-def run_msindoor(args, progress) -> dict:
-    t0 = time.perf_counter()
-    firmware = Firmware(args.stridefixd)
-    docs = []
-    for floor in _floors(Path(args.msindoor)):
-        label = f"{floor.parent.name}/{floor.name}"
-        traces = sorted((floor / "path_data_files").glob("*.txt"))
-        cache = Path(args.out) / "msindoor" / f"{floor.parent.name}-{floor.name}"
-        cache.mkdir(parents=True, exist_ok=True)
-        progress(f"crowd experiment --msindoor {label}: importing and replaying {len(traces)} traces")
-        t1 = time.perf_counter()
-        with concurrent.futures.ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            prepared = list(pool.map(_ms_walk, traces, [cache] * len(traces), [firmware] * len(traces)))
-        prep_s = time.perf_counter() - t1
-        fit_from = args.limit if args.limit and args.limit < len(prepared) else 0
-        all_walks, variant, priors = _agreed_walks(prepared, fit_from, args.anchors)
-        progress(
-            f"{label} heading variant the fitting walks agree on at their anchors: {variant} (heading "
-            f"bias spread {math.degrees(priors.heading_sigma_rad):.1f} deg over {priors.walks_used} walks)"
-        )
-        scored = _usable(all_walks[: args.limit]) if args.limit else _usable(all_walks)
-        fitting = all_walks[args.limit :] if args.limit and args.limit < len(all_walks) else all_walks
-        model_all, _ = fit_walks(
-            all_walks, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps
-        )
-        model, _ = fit_walks(fitting, mode=args.dissimilarity, band=args.band, min_common=args.min_common_aps)
-        scale = stride_scale(_usable(fitting, 2))
-        progress(f"{label} model on all {len(all_walks)} traces: " + format_model(model_all))
-        progress(
-            f"{label} model on the {len(fitting)} non-scored traces: X = "
-            f"{[round(v, 4) for v in model.params]}; stride scale {scale:.3f}; "
-            f"table on {len(scored)} walks"
-        )
-        sel = select_pair_model(fitting, args.anchors, args.solver, args.band, progress)
-        wifi_models = [(sel.best.name, sel.best), ("thesis/common_sum, reference", ThesisAdapter(model))]
-        rows, _ = run_table(scored, model, args.anchors, args.solver, args.band, scale, progress, wifi_models)
-        docs.append(
-            {
-                "floor": label,
-                "traces": len(traces),
-                "scored_walks": [w.name for w in scored],
-                "fit_traces": len(fitting),
-                "model_all_traces": model_all.to_json(),
-                "model_used": model.to_json(),
-                "pair_models": {"chosen": sel.best.name, "chosen_by": sel.chosen_by, "rows": sel.rows},
-                "stride_scale": scale,
-                "heading_variant": {
-                    "chosen": variant,
-                    "by": "smallest heading-bias spread at the fitting walks' anchors",
-                    "priors": dataclasses.asdict(priors),
-                },
-                "rows": rows,
-                "prepare_s": prep_s,
-            }
-        )
-    return {"experiment": "msindoor", "floors": docs, "run_s": time.perf_counter() - t0}
 
 
 # --- command line ------------------------------------------------------------------------------------
