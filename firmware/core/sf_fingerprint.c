@@ -3,11 +3,11 @@
 
 #include <math.h>
 #include <stddef.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "sf_assert.h"
 #include "sf_error.h"
+#include "sf_sort.h"
 
 #define HALF_LOG_2PI 0.91893853320467274178
 
@@ -209,8 +209,8 @@ static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, 
         }
         n_scans++;
     }
-    /* cppcheck-suppress uninitvar ; qsort reads only the n readings written above (none when n = 0) */
-    qsort(readings, (size_t)n, sizeof readings[0], reading_cmp);
+    /* cppcheck-suppress uninitvar ; sf_sort reads only the n readings written above (none when n = 0) */
+    sf_sort(readings, n, sizeof readings[0], reading_cmp);
     fp->n_query = 0;
     fp->audit.n_scans_averaged = n_scans;
     for (int32_t i = 0; i < n;) {
