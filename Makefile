@@ -69,7 +69,7 @@ GSD ?= ../shared/data/gsd
 # Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
 	@status=0; \
-	for b in sil-pdr aadr2015 office-wifi particle-cost sources controller crowd-scale; do \
+	for b in sil-pdr aadr2015 office-wifi particle-cost perf sources controller crowd-scale; do \
 		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
 	done; \
 	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \

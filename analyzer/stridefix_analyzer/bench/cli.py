@@ -24,6 +24,7 @@ from stridefix_analyzer.bench import (
     crowd_scale,
     fusion,
     particle_cost,
+    perf,
     realdata,
     reliability,
     sil_pdr,
@@ -118,6 +119,14 @@ def _run_soak(args: argparse.Namespace, firmware: Firmware, seeds: list[int], ou
     return soak.missed_targets(doc)
 
 
+def _run_perf(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del args, seeds  # fixed walks of the harness and one simulated walk
+    doc = perf.run_perf(firmware, out)
+    print(perf.format_table(doc))
+    print(f"wrote {out / 'perf.json'}")
+    return perf.missed_targets(doc)
+
+
 def _run_particle_cost(
     args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path
 ) -> list[str]:
@@ -156,6 +165,7 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "reliability": (_run_reliability, "1"),
     "soak": (_run_soak, "1"),
     "particle-cost": (_run_particle_cost, "1"),
+    "perf": (_run_perf, "1"),
     "crowd-scale": (_run_crowd_scale, "1"),
 }
 #: benches that run no firmware (no --stridefixd needed)
@@ -193,7 +203,9 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "targets on realbench results.json files (--results); reliability: the default walk with each bus "
         "and board fault vs clean (make reliability); soak: an 8-hour walk with faults, RSS and event "
         "accounting (make soak); particle-cost: the particle scheme's instructions per step under callgrind "
-        "(1 000 particles, 5 000 walls; target <= 1 million); crowd-scale: the crowd fit and graph solve on a "
+        "(1 000 particles, 5 000 walls; target <= 1 million); perf: the core's instructions per IMU, MAG, BARO "
+        "sample and per Wi-Fi fix against map size under callgrind, state sizes, no heap, replay speed and peak "
+        "RSS against issue 16's budgets; crowd-scale: the crowd fit and graph solve on a "
         "synthetic fleet (100 000 scans / 500 walks) serially and on Dask 1 and 2 workers (target fit + solve "
         "<= 300 s)",
     )

@@ -1,0 +1,275 @@
+"""``stridefix bench perf``: the estimator core's cost and the logger's speed against issue 16's budgets.
+
+Each figure says how it was measured:
+
+* **instructions per call** (callgrind, repeatable on a noisy machine): the harness
+  ``tests/perf/core_cost.c`` (``sf_core_cost``, built beside ``stridefixd``) drives one core call at a
+  time; callgrind counts the instructions inside it (``--toggle-collect=FUNCTION``), divided by the
+  calls the harness reports. Sensors: a 120 s walk at the board's rates (IMU 100 Hz, MAG 50 Hz, BARO
+  20 Hz); "all core work per IMU sample" is the three calls' instructions over the IMU samples, and the
+  attitude filter's share is ``sf_attitude_update_imu`` + ``sf_attitude_update_mag``. Wi-Fi: 50 fixes
+  (``sf_fingerprint_match``) on synthetic maps of 100, 2 000 and 20 000 reference points of a building
+  that grows with the map (one AP per 40 m², ~31–42 heard per scan; the harness's docstring);
+* **state sizes**: ``sizeof`` printed by the harness (the radio map and the particle arrays are the
+  caller's memory, not in them);
+* **no heap in the core**: the ctest ``core_symbols`` check (``firmware/cmake/check_core_symbols.cmake``)
+  on ``libsf_core.a``;
+* **replay speed and peak RSS**: ``stridefix sim`` walks 10 minutes (default scenario), then
+  ``stridefixd`` replays the candump file into an LCM log (decode, estimate, log) by wall clock, on one
+  core; simulated seconds / wall seconds, and the daemon's peak RSS (its ``VmHWM``, polled).
+
+Peers (x-io Fusion, the ``ahrs`` package's Madgwick, scikit-learn's KNN) are not in this run yet: the
+attitude budget "≤ 1.5× Fusion" is reported as not measured, not as met. Writes ``perf.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from stridefix_analyzer.bench.soak import vm_hwm_kb
+from stridefix_analyzer.firmware import REPO, Firmware
+from stridefix_analyzer.stages import StageError, stridefix_exe
+
+SENSOR_SECONDS = 120
+WIFI_SIZES = (100, 2000, 20000)
+WIFI_SCANS = 50
+REPLAY_SECONDS = 600
+_COLLECTED = re.compile(r"Collected\s*:\s*(\d+)")
+
+#: issue 16's budgets: (key, figure, comparison, bound)
+BUDGETS = (
+    ("imu_all_ir", "all core work per IMU sample [instructions]", "<=", 1200),
+    ("wifi_2000_ir", "Wi-Fi fix at ~2 000 RPs [instructions]", "<=", 150_000),
+    ("wifi_scaling", "Wi-Fi fix at ~20 000 RPs / at ~2 000 RPs", "<=", 1.5),
+    ("estimator_B", "sizeof(sf_estimator_t) without the radio map [B]", "<=", 16 * 1024),
+    ("core_no_heap", "no heap, I/O or clock symbols in libsf_core.a", "==", True),
+    ("replay_x_realtime", "end-to-end replay speed [x real time]", ">=", 5000),
+    ("peak_rss_kB", "stridefixd peak RSS during the replay [kB]", "<=", 8 * 1024),
+)
+
+
+def harness_path(stridefixd: Path) -> Path:
+    """``sf_core_cost`` of the build tree that holds ``stridefixd`` (``build/firmware/stridefixd``)."""
+    return stridefixd.resolve().parents[1] / "tests" / "perf" / "sf_core_cost"
+
+
+def _harness_json(harness: Path, *args: str) -> dict[str, Any]:
+    proc = subprocess.run([str(harness), *args], capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        raise StageError(f"perf: {harness} {' '.join(args)} failed ({proc.returncode}): {proc.stderr[-400:]}")
+    return json.loads(proc.stdout)
+
+
+def _callgrind(harness: Path, functions: tuple[str, ...], args: tuple[str, ...], out: Path) -> int:
+    """Instructions inside ``functions`` (summed) over one run of the harness."""
+    valgrind = shutil.which("valgrind")
+    if valgrind is None:
+        raise StageError("perf: valgrind not found (apt-get install valgrind)")
+    cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={out}"]
+    cmd += [f"--toggle-collect={f}" for f in functions]
+    cmd += [str(harness), *args]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    m = _COLLECTED.search(proc.stderr)
+    if proc.returncode != 0 or m is None:
+        raise StageError(f"perf: {' '.join(cmd)} failed ({proc.returncode}): {proc.stderr[-400:]}")
+    return int(m.group(1))
+
+
+def measure_sensors(harness: Path, out: Path) -> dict[str, Any]:
+    args = ("sensors", str(SENSOR_SECONDS))
+    walk = _harness_json(harness, *args)
+    ir = {
+        name: _callgrind(harness, (fn,), args, out / f"perf.{name}.callgrind")
+        for name, fn in (
+            ("imu", "sf_estimator_imu"),
+            ("mag", "sf_estimator_mag"),
+            ("baro", "sf_estimator_baro"),
+        )
+    }
+    att = _callgrind(
+        harness, ("sf_attitude_update_imu", "sf_attitude_update_mag"), args, out / "perf.attitude.callgrind"
+    )
+    return {
+        "walk": walk,
+        "ir_per_imu_call": ir["imu"] / walk["imu"],
+        "ir_per_mag_call": ir["mag"] / walk["mag"],
+        "ir_per_baro_call": ir["baro"] / walk["baro"],
+        "ir_all_per_imu_sample": sum(ir.values()) / walk["imu"],
+        "ir_attitude_per_imu_sample": att / walk["imu"],
+    }
+
+
+def measure_wifi(harness: Path, out: Path) -> list[dict[str, Any]]:
+    rows = []
+    for n in WIFI_SIZES:
+        args = ("wifi", str(n), str(WIFI_SCANS))
+        built = _harness_json(harness, *args)
+        ir = _callgrind(harness, ("sf_fingerprint_match",), args, out / f"perf.wifi{n}.callgrind")
+        rows.append(built | {"ir_per_fix": ir / built["scans"]})
+        print(
+            f"bench perf: Wi-Fi fix at {built['n_rp']} RPs: {ir / built['scans']:,.0f} instructions",
+            file=sys.stderr,
+        )
+    return rows
+
+
+def check_no_heap(stridefixd: Path) -> dict[str, Any]:
+    lib = stridefixd.resolve().parent / "libsf_core.a"
+    script = REPO / "firmware" / "cmake" / "check_core_symbols.cmake"
+    nm = shutil.which("nm") or "nm"
+    proc = subprocess.run(
+        ["cmake", f"-DNM={nm}", f"-DLIB={lib}", "-P", str(script)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    return {
+        "met": proc.returncode == 0,
+        "message": (proc.stdout + proc.stderr).strip()[-400:],
+        "library": str(lib),
+    }
+
+
+def measure_replay(firmware: Firmware, out: Path) -> dict[str, Any]:
+    """The simulated walk replayed by stridefixd from its candump file; wall time and peak RSS."""
+    work = out / "perf_replay"
+    work.mkdir(parents=True, exist_ok=True)
+    sim = [stridefix_exe(), "sim", "--duration-s", str(REPLAY_SECONDS), "--out", str(work)]
+    proc = subprocess.run(sim, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        raise StageError(f"perf: {' '.join(sim)} failed ({proc.returncode}): {proc.stderr[-400:]}")
+    summary = json.loads((work / "sim_summary.json").read_text())
+    log = work / "stridefixd.lcmlog"
+    cmd = firmware.command(input=work / "board.candump", log=log)
+    t0 = time.perf_counter()
+    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    # peak RSS: the daemon's own VmHWM, polled (wait4's ru_maxrss would count the forked Python image
+    # the child was before its exec)
+    hwm = 0
+    while child.poll() is None:
+        hwm = max(hwm, vm_hwm_kb(child.pid) or 0)
+        time.sleep(0.005)
+    wall_s = time.perf_counter() - t0
+    assert child.stderr is not None
+    err = child.stderr.read()
+    if child.returncode != 0:
+        raise StageError(f"perf: {' '.join(cmd)} failed ({child.returncode}): {err.decode()[-400:]}")
+    walked_s = float(summary.get("duration_s") or REPLAY_SECONDS)
+    return {
+        "walk_s": walked_s,
+        "wall_s": wall_s,
+        "x_realtime": walked_s / wall_s,
+        "peak_rss_kB": hwm,
+        "peak_rss_method": "VmHWM of /proc/PID/status, polled every 5 ms",
+        "log_bytes": log.stat().st_size,
+        "command": " ".join(cmd),
+    }
+
+
+def judge(values: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each budget of :data:`BUDGETS` with its measured value (``values[key]``) and verdict."""
+    budgets = []
+    for key, figure, op, bound in BUDGETS:
+        v = values[key]
+        met = {"<=": v <= bound, ">=": v >= bound, "==": v == bound}[op]
+        budgets.append(
+            {"key": key, "figure": figure, "value": v, "budget": f"{op} {bound}", "met": bool(met)}
+        )
+    return budgets
+
+
+def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
+    """Every measurement (module docstring); writes ``OUT/perf.json``."""
+    harness = harness_path(firmware.path)
+    if not harness.is_file():
+        raise StageError(f"perf: {harness} not found (build it: make build)")
+    out.mkdir(parents=True, exist_ok=True)
+    print("bench perf: sensor calls under callgrind", file=sys.stderr, flush=True)
+    sensors = measure_sensors(harness, out)
+    wifi = measure_wifi(harness, out)
+    sizes = _harness_json(harness, "sizes")
+    heap = check_no_heap(firmware.path)
+    print(f"bench perf: replaying a {REPLAY_SECONDS} s simulated walk", file=sys.stderr, flush=True)
+    replay = measure_replay(firmware, out)
+    by_n = {w["n_rp"]: w for w in wifi}
+    mid = min(by_n, key=lambda n: abs(n - 2000))
+    big = max(by_n)
+    values = {
+        "imu_all_ir": sensors["ir_all_per_imu_sample"],
+        "wifi_2000_ir": by_n[mid]["ir_per_fix"],
+        "wifi_scaling": by_n[big]["ir_per_fix"] / by_n[mid]["ir_per_fix"],
+        "estimator_B": sizes["sf_estimator_t"],
+        "core_no_heap": heap["met"],
+        "replay_x_realtime": replay["x_realtime"],
+        "peak_rss_kB": replay["peak_rss_kB"],
+    }
+    budgets = []
+    for key, figure, op, bound in BUDGETS:
+        v = values[key]
+        met = {"<=": v <= bound, ">=": v >= bound, "==": v == bound}[op]
+        budgets.append(
+            {"key": key, "figure": figure, "value": v, "budget": f"{op} {bound}", "met": bool(met)}
+        )
+    doc = {
+        "harness": str(harness),
+        "sensors": sensors,
+        "wifi": wifi,
+        "sizes": sizes,
+        "core_no_heap": heap,
+        "replay": replay,
+        "budgets": budgets,
+        "not_measured": [
+            "attitude <= 1.5 x x-io Fusion's FusionAhrsUpdate (peer harness not built)",
+            "realbench <= 60 s per msindoor floor (see realbench results' run_s)",
+            "stridefix analyze of a 1-hour walk <= 3 s",
+        ],
+    }
+    (out / "perf.json").write_text(json.dumps(doc, indent=1))
+    return doc
+
+
+def format_table(doc: dict[str, Any]) -> str:
+    s = doc["sensors"]
+    lines = [
+        f"perf: core calls under callgrind ({s['walk']['seconds']:.0f} s walk: {s['walk']['imu']} IMU, "
+        f"{s['walk']['mag']} MAG, {s['walk']['baro']} BARO samples, {s['walk']['steps']} steps)",
+        f"  per IMU call {s['ir_per_imu_call']:,.0f}, per MAG call {s['ir_per_mag_call']:,.0f}, per BARO call "
+        f"{s['ir_per_baro_call']:,.0f}; attitude {s['ir_attitude_per_imu_sample']:,.0f} per IMU sample",
+        f"  {'Wi-Fi map':<28}{'RPs':>7}{'APs':>6}{'entries':>10}{'heard':>7}{'instr/fix':>12}{'err m':>7}",
+    ]
+    for w in doc["wifi"]:
+        lines.append(
+            f"  {'synthetic, 2 m grid':<28}{w['n_rp']:>7}{w['n_ap']:>6}{w['n_entries']:>10}{w['mean_heard']:>7.1f}"
+            f"{w['ir_per_fix']:>12,.0f}{w['mean_error_m']:>7.2f}"
+        )
+    r = doc["replay"]
+    lines.append(
+        f"  replay: {r['walk_s']:.0f} s walk in {r['wall_s']:.2f} s wall ({r['x_realtime']:,.0f}x real time), "
+        f"peak RSS {r['peak_rss_kB']:,} kB, log {r['log_bytes'] / 1e6:.1f} MB"
+    )
+    lines.append(f"  {'budget':<55}{'value':>14}  {'target':<12}")
+    for b in doc["budgets"]:
+        v = b["value"]
+        shown = (
+            str(v)
+            if isinstance(v, bool)
+            else f"{v:,.2f}"
+            if isinstance(v, float) and v < 100
+            else f"{v:,.0f}"
+        )
+        lines.append(f"  {b['figure']:<55}{shown:>14}  {b['budget']:<12}{'MET' if b['met'] else 'MISSED'}")
+    lines += [f"  not measured: {m}" for m in doc["not_measured"]]
+    return "\n".join(lines)
+
+
+def missed_targets(doc: dict[str, Any]) -> list[str]:
+    return [
+        f"perf: {b['figure']} = {b['value']} (budget {b['budget']})" for b in doc["budgets"] if not b["met"]
+    ]

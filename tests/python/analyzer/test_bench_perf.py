@@ -1,0 +1,84 @@
+"""``stridefix bench perf`` (bench/perf.py) and its harness ``sf_core_cost`` (tests/perf/core_cost.c):
+the harness drives the real core calls (steps come out of the walk, every fix lands near its scan),
+callgrind's count is read per call, and the budgets are judged from the figures, not hard-coded."""
+
+from __future__ import annotations
+
+import pytest
+from stridefix_analyzer.bench import perf
+from stridefix_analyzer.firmware import Firmware
+
+
+@pytest.fixture(scope="module")
+def harness(stridefixd):
+    path = perf.harness_path(stridefixd)
+    if not path.is_file():
+        pytest.fail(f"{path} not built: run `make build`")
+    return path
+
+
+def test_sensor_walk_runs_the_pdr_at_the_board_rates(harness):
+    """GIVEN 30 s at 100/50/20 Hz with a 1.8 Hz gait THEN every sample reached the core and the PDR
+    counted the gait's steps (the cost is of a working estimator, not of an idle one)."""
+    w = perf._harness_json(harness, "sensors", "30")
+    assert (w["imu"], w["mag"], w["baro"]) == (3000, 1500, 600)
+    assert 40 <= w["steps"] <= 56  # 28 s of walking at 1.8 Hz ≈ 50 steps, bouts confirmed
+
+
+def test_wifi_maps_grow_with_constant_density_and_fixes_land_near_the_scan(harness):
+    small = perf._harness_json(harness, "wifi", "100", "20")
+    big = perf._harness_json(harness, "wifi", "2000", "20")
+    assert small["n_rp"] == 100 and big["n_rp"] == 2025  # a square grid: 45²
+    assert 150 < big["n_ap"] < 250 and 25 < big["mean_heard"] < 45
+    for m in (small, big):
+        assert m["fixes"] == 20 and 0.0 <= m["mean_error_m"] < 8.0
+
+
+def test_callgrind_counts_the_matcher_per_fix(harness, tmp_path):
+    """GIVEN 5 fixes on the 100-RP map under callgrind THEN the matcher's instructions are counted, and
+    doubling the fixes roughly doubles them (per-call cost, not the harness's set-up)."""
+    ir5 = perf._callgrind(harness, ("sf_fingerprint_match",), ("wifi", "100", "5"), tmp_path / "a.cg")
+    ir10 = perf._callgrind(harness, ("sf_fingerprint_match",), ("wifi", "100", "10"), tmp_path / "b.cg")
+    assert 1_000 < ir5 / 5 < 5_000_000
+    assert 1.6 < ir10 / ir5 < 2.4
+
+
+def test_core_has_no_heap_symbols(stridefixd):
+    heap = perf.check_no_heap(stridefixd)
+    assert heap["met"], heap["message"]
+
+
+def test_replay_reads_its_own_rss_not_the_forked_python(stridefixd, tmp_path, monkeypatch):
+    monkeypatch.setattr(perf, "REPLAY_SECONDS", 30)
+    r = perf.measure_replay(Firmware(stridefixd), tmp_path)
+    assert r["walk_s"] == pytest.approx(30.0, abs=1.0)
+    assert r["x_realtime"] > 10.0 and r["log_bytes"] > 0
+    assert 0 < r["peak_rss_kB"] < 64 * 1024  # the daemon is a few MB; the Python parent is > 100 MB
+
+
+def test_budgets_are_judged_from_the_figures():
+    values = {
+        "imu_all_ir": 1199.0,
+        "wifi_2000_ir": 150_001.0,
+        "wifi_scaling": 1.5,
+        "estimator_B": 37552,
+        "core_no_heap": True,
+        "replay_x_realtime": 4999.0,
+        "peak_rss_kB": 4528,
+    }
+    doc = {"budgets": perf.judge(values)}
+    verdict = {b["key"]: b["met"] for b in doc["budgets"]}
+    assert verdict == {
+        "imu_all_ir": True,
+        "wifi_2000_ir": False,
+        "wifi_scaling": True,  # the bound itself meets "<="
+        "estimator_B": False,
+        "core_no_heap": True,
+        "replay_x_realtime": False,
+        "peak_rss_kB": True,
+    }
+    assert (
+        "perf: Wi-Fi fix at ~2 000 RPs [instructions] = 150001.0 (budget <= 150000)"
+        in perf.missed_targets(doc)
+    )
+    assert len(perf.missed_targets(doc)) == 3
