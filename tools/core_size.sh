@@ -23,7 +23,7 @@ met=true
 [ "$text" -le "$budget" ] || met=false
 printf '{"lib": "%s", "text_B": %d, "data_B": %d, "bss_B": %d, "budget_text_B": %d, "met": %s}\n' \
   "$lib" "$text" "$data" "$bss" "$budget" "$met" > "$out"
-echo "core size (ARM): text $text B ($((text * 100 / budget)) % of the $budget B budget), data $data B, bss $bss B -> $out"
+echo "core size (ARM): text $text B ($(((text * 100 + budget / 2) / budget)) % of the $budget B budget), data $data B, bss $bss B -> $out"
 if [ "$met" != true ]; then
   echo "core_size: FAILED: the core's text is $text B, over its budget of $budget B" >&2
   exit 1
