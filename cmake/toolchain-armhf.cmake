@@ -9,7 +9,8 @@ set(CMAKE_CXX_COMPILER ${SF_ARM_TRIPLE}-g++)
 
 # Libraries and headers: the cross C library lives in /usr/arm-linux-gnueabihf; the armhf cmocka is a
 # multiarch package (/usr/lib/arm-linux-gnueabihf, found through CMAKE_LIBRARY_ARCHITECTURE, which
-# CMake reads from the compiler). Never a host (x86-64) library; programs (cmake, python) are the host's.
+# CMake reads from the compiler); cmocka.h in /usr/include is one file for every architecture. Never a
+# host (x86-64) library; programs (cmake, python) are the host's.
 set(CMAKE_FIND_ROOT_PATH /usr/${SF_ARM_TRIPLE})
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 
