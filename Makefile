@@ -10,7 +10,7 @@ DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
 .PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
-	gates check-static check-clang check-asan reliability soak check-fuzz fuzz
+	gates check-static check-clang check-asan reliability soak check-fuzz fuzz check-arm
 
 all: build
 
@@ -30,7 +30,8 @@ help:
 	@echo "make check-asan   - firmware + C tests with ASan+UBSan and SF_ASSERT on into build-asan/, ctest"
 	@echo "make check-fuzz   - each libFuzzer harness of tests/fuzz for $(FUZZ_CHECK_SECONDS) s (clang, ASan+UBSan) into build-fuzz/"
 	@echo "make fuzz   - the same, $(FUZZ_SECONDS) s per harness (FUZZ_SECONDS=...; FUZZ_HARNESSES=\"site config\")"
-	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/, build-fuzz/ and out/"
+	@echo "make check-arm    - the core and its tests cross-built for the unit's 32-bit ARM into build-arm/, ctest under qemu, size <= 128 KiB text"
+	@echo "make clean  - remove $(BUILD)/, build-clang/, build-asan/, build-fuzz/, build-arm/ and out/"
 
 deps:
 	@BUILD=$(BUILD) VENV=$(VENV) tools/deps.sh
@@ -109,8 +110,8 @@ soak: build
 	$(PY) -m stridefix_analyzer.cli bench soak --stridefixd $(STRIDEFIXD) --out out/bench
 
 # Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
-# so it needs the build; the other two are separate build trees with their own compiler and flags.
-gates: check-static check-clang check-asan check-fuzz
+# so it needs the build; the others are separate build trees with their own compiler, flags or target.
+gates: check-static check-clang check-asan check-fuzz check-arm
 
 check-static: build
 	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
@@ -128,6 +129,20 @@ check-asan: deps
 	@$(call configure,build-asan,-DCMAKE_BUILD_TYPE=Debug -DSF_SANITIZE=ON -DSF_NATIVE=OFF)
 	@cmake --build build-asan -j $(JOBS)
 	cd build-asan && ctest --output-on-failure
+
+# The unit's processor (issue 16): the estimator core, the CAN codec and the core tests cross-compiled
+# for 32-bit ARM (Debian armhf, cmake/toolchain-armhf.cmake; SF_CORE_ONLY leaves out what needs LCM,
+# inih or Ceres), the tests run by ctest under qemu-arm, then the core's size against its text budget
+# (tools/core_size.sh, written to build-arm/core_size.json).
+ARM_BUILD ?= build-arm
+ARM_SIZE ?= arm-linux-gnueabihf-size
+CORE_TEXT_BUDGET_B ?= 131072
+check-arm: deps
+	@$(call configure,$(ARM_BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE) -DSF_CORE_ONLY=ON \
+		-DCMAKE_TOOLCHAIN_FILE=$(abspath cmake/toolchain-armhf.cmake))
+	@cmake --build $(ARM_BUILD) -j $(JOBS)
+	cd $(ARM_BUILD) && ctest --output-on-failure
+	@tools/core_size.sh $(ARM_SIZE) $(ARM_BUILD)/firmware/libsf_core.a $(ARM_BUILD)/core_size.json $(CORE_TEXT_BUDGET_B)
 
 # libFuzzer (README "Fuzzing"): clang with ASan+UBSan, SF_ASSERT live, -O1. Each harness starts from
 # tests/fuzz/corpus/<h> and crashers/<h> (read only) and grows build-fuzz/corpus/<h>; a finding is
@@ -160,4 +175,4 @@ fuzz: deps
 	$(call run_fuzzers,$(FUZZ_SECONDS))
 
 clean:
-	rm -rf $(BUILD) build-clang build-asan build-fuzz out
+	rm -rf $(BUILD) build-clang build-asan build-fuzz $(ARM_BUILD) out

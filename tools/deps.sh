@@ -13,6 +13,10 @@ BUILD=${BUILD:-build}
 # the libFuzzer runtime (make check-fuzz, make fuzz).
 DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev python3-dev cmake g++ gcc make pkg-config
       clang cppcheck libclang-rt-14-dev)
+# make check-arm: Debian's armhf cross toolchain (its C library, libc6-dev-armhf-cross, is only a
+# recommends of the cross gcc, so it is named), qemu's user-mode emulator and cmocka built for armhf,
+# a multiarch package: it needs the armhf architecture in dpkg (added below), the cross gcc does not.
+DEBS+=(crossbuild-essential-armhf libc6-dev-armhf-cross qemu-user libcmocka-dev:armhf)
 
 missing=()
 for p in "${DEBS[@]}"; do
@@ -22,8 +26,13 @@ if ! python3 -c 'import venv, ensurepip' 2>/dev/null; then missing+=(python3-ven
 if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   echo "deps: installing Debian packages: ${missing[*]}"
+  if [[ " ${missing[*]} " == *":armhf "* ]] && ! dpkg --print-foreign-architectures | grep -qx armhf; then
+    echo "deps: adding the armhf architecture to dpkg (for libcmocka-dev:armhf)"
+    $SUDO dpkg --add-architecture armhf
+  fi
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  # --no-remove: an armhf package must never take a host package away (apt stops with an error instead).
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends --no-remove "${missing[@]}"
 fi
 
 if [ ! -x "$VENV/bin/python" ]; then
