@@ -17,6 +17,8 @@ DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev
 # recommends of the cross gcc, so it is named), qemu's user-mode emulator and cmocka built for armhf,
 # a multiarch package: it needs the armhf architecture in dpkg (added below), the cross gcc does not.
 DEBS+=(crossbuild-essential-armhf libc6-dev-armhf-cross qemu-user libcmocka-dev:armhf)
+# valgrind: callgrind counts the core's instructions (bench perf, bench particle-cost and their tests).
+DEBS+=(valgrind)
 
 missing=()
 for p in "${DEBS[@]}"; do
