@@ -74,6 +74,9 @@
  * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
  * (E_Q = total entries of the used APs; one log and one division per entry for naive Bayes), and
  * O(T·k) to select among the T touched RPs — independent of the map size beyond E_Q and T ≤ n_rp.
+ * Measured (`stridefix bench perf`, WkNN defaults, synthetic 2 m grids, ~70 instructions per visited
+ * entry): 78 k instructions per fix at 100 RPs, 1.48 M at 2 025 RPs (34 APs heard, 20 k entries
+ * visited), 2.2 M at 20 164 RPs. The query is sorted by sf_sort (no qsort: it may allocate).
  * No heap, no I/O, no clock; deterministic (fixed summation order: APs by BSSID, entries by RP).
  *
  * Errors. sf_fingerprint_prepare: SF_EINVAL (NULL, empty map n_rp = 0 or n_ap = 0, workspace smaller than
