@@ -11,6 +11,7 @@
  *                               grows with the map: one AP per 40 m² (200 APs at 2 000 RPs), levels
  *                               −40 − 30·log10(d) dBm (+ 4 dB noise in the scans), an entry where the
  *                               mean is above −85 dBm, a scan hearing every AP above −80 dBm (~31).
+ *   core_cost samples SECONDS   the sensors walk's IMU and MAG samples as text, for a peer filter.
  *   core_cost sizes             sizeof of the core's state structs.
  *
  * Prints one JSON object (counts and what was built); exit 0, 2 on bad usage. The harness may use the
@@ -29,9 +30,40 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: core_cost sensors SECONDS | wifi N_RP SCANS | sizes\n");
+    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS | sizes\n");
     return 2;
 }
+
+/* The walk's samples (both modes read the same stream): IMU at 100 Hz, MAG at 50 Hz (the even IMU ticks),
+ * BARO at 20 Hz (every 5th). */
+typedef struct {
+    rng_t r;
+    gait_t g;
+} walk_t;
+
+static void walk_init(walk_t *const w, const double seconds)
+{
+    w->r = (rng_t){0x2545F4914F6CDD1DULL};
+    const int n_steps = (int)fmin(GAIT_MAX_STEPS, seconds * 1.8);
+    gait_make(&w->g, &k_normal, n_steps, 2.0, &w->r);
+}
+
+static sf_imu_sample_t walk_imu(walk_t *const w, const int64_t k)
+{
+    const double t = (double)k / 100.0;
+    /* the gait repeats when the walk is longer than GAIT_MAX_STEPS steps */
+    const double tg = fmod(t, w->g.t_s[w->g.n] + 2.0);
+    const double yaw_rate = 0.05 * sin(0.1 * t); /* a slow meander [rad/s] */
+    rng_t *const r = &w->r;
+    const sf_imu_sample_t s = {
+        k * 10000,
+        {0.05 * rng_gauss(r), 0.05 * rng_gauss(r), 9.81 + gait_accel(&w->g, tg) + 0.05 * rng_gauss(r)},
+        {0.002 * rng_gauss(r), 0.002 * rng_gauss(r), yaw_rate + 0.002 * rng_gauss(r)},
+    };
+    return s;
+}
+
+static const double k_field_ut[3] = {20.0 + 12.0, 0.0 - 7.0, -45.0 + 3.0}; /* 50 µT + hard iron */
 
 static int run_sensors(const double seconds)
 {
@@ -39,38 +71,46 @@ static int run_sensors(const double seconds)
     static sf_estimator_t est;
     sf_params_default(&p);
     sf_estimator_init(&est, &p);
-    rng_t r = {0x2545F4914F6CDD1DULL};
-    static gait_t g;
-    const int n_steps = (int)fmin(GAIT_MAX_STEPS, seconds * 1.8);
-    gait_make(&g, &k_normal, n_steps, 2.0, &r);
+    static walk_t w;
+    walk_init(&w, seconds);
     const int64_t n_imu = (int64_t)(seconds * 100.0);
     long imu = 0, mag = 0, baro = 0, steps = 0;
     for (int64_t k = 0; k < n_imu; k++) {
-        const double t = (double)k / 100.0;
-        const int64_t t_us = k * 10000;
-        /* the gait repeats when the walk is longer than GAIT_MAX_STEPS steps */
-        const double tg = fmod(t, g.t_s[g.n] + 2.0);
-        const double yaw_rate = 0.05 * sin(0.1 * t); /* a slow meander [rad/s] */
-        const sf_imu_sample_t s = {
-            t_us,
-            {0.05 * rng_gauss(&r), 0.05 * rng_gauss(&r), 9.81 + gait_accel(&g, tg) + 0.05 * rng_gauss(&r)},
-            {0.002 * rng_gauss(&r), 0.002 * rng_gauss(&r), yaw_rate + 0.002 * rng_gauss(&r)},
-        };
+        const sf_imu_sample_t s = walk_imu(&w, k);
         sf_step_t out[SF_ESTIMATOR_MAX_STEPS];
         steps += sf_estimator_imu(&est, &p, &s, out);
         imu++;
         if (k % 2 == 0) {
-            const double field[3] = {20.0 + 12.0, 0.0 - 7.0, -45.0 + 3.0}; /* 50 µT + hard iron */
-            sf_estimator_mag(&est, &p, t_us + 1000, field);
+            sf_estimator_mag(&est, &p, s.t_us + 1000, k_field_ut);
             mag++;
         }
         if (k % 5 == 0) {
-            sf_estimator_baro(&est, &p, t_us + 2000, 101325.0 + 2.0 * rng_gauss(&r));
+            sf_estimator_baro(&est, &p, s.t_us + 2000, 101325.0 + 2.0 * rng_gauss(&w.r));
             baro++;
         }
     }
     printf("{\"mode\": \"sensors\", \"seconds\": %.1f, \"imu\": %ld, \"mag\": %ld, \"baro\": %ld, \"steps\": %ld}\n",
            seconds, imu, mag, baro, steps);
+    return 0;
+}
+
+/* The same walk's IMU and MAG samples as text for a peer (one line per IMU sample: t_s, accel [m/s²],
+ * gyro [rad/s], field [µT] of the latest MAG sample), without the BARO draws' noise in between kept
+ * in step: the RNG draws the same sequence as run_sensors. */
+static int run_samples(const double seconds)
+{
+    static walk_t w;
+    walk_init(&w, seconds);
+    const int64_t n_imu = (int64_t)(seconds * 100.0);
+    for (int64_t k = 0; k < n_imu; k++) {
+        const sf_imu_sample_t s = walk_imu(&w, k);
+        printf("%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", (double)s.t_us * 1e-6, s.accel_mps2[0],
+               s.accel_mps2[1], s.accel_mps2[2], s.gyro_radps[0], s.gyro_radps[1], s.gyro_radps[2], k_field_ut[0],
+               k_field_ut[1], k_field_ut[2]);
+        if (k % 5 == 0) {
+            (void)rng_gauss(&w.r); /* the BARO sample's draw, so the IMU noise is run_sensors' */
+        }
+    }
     return 0;
 }
 
@@ -199,6 +239,10 @@ int main(const int argc, char **const argv)
     if (argc == 4 && strcmp(argv[1], "wifi") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
         return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans) : usage();
+    }
+    if (argc == 3 && strcmp(argv[1], "samples") == 0) {
+        const double s = atof(argv[2]);
+        return s > 0.0 ? run_samples(s) : usage();
     }
     if (argc == 2 && strcmp(argv[1], "sizes") == 0) {
         return run_sizes();

@@ -18,8 +18,11 @@ Each figure says how it was measured:
   ``stridefixd`` replays the candump file into an LCM log (decode, estimate, log) by wall clock, on one
   core; simulated seconds / wall seconds, and the daemon's peak RSS (its ``VmHWM``, polled).
 
-Peers (x-io Fusion, the ``ahrs`` package's Madgwick, scikit-learn's KNN) are not in this run yet: the
-attitude budget "≤ 1.5× Fusion" is reported as not measured, not as met. Writes ``perf.json``.
+The attitude peer is x-io Fusion (PyPI ``imufusion``, the C library compiled into its wheel): the same
+samples (``sf_core_cost samples``) through ``FusionAhrsUpdate`` (gyro + accelerometer + magnetometer on
+every IMU sample), counted by callgrind inside that function only; ours is ``sf_attitude_update_imu`` +
+``sf_attitude_update_mag`` per IMU sample (MAG at 50 Hz). The ``ahrs`` package's Madgwick and
+scikit-learn's KNN are not in this run yet. Writes ``perf.json``.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ _COLLECTED = re.compile(r"Collected\s*:\s*(\d+)")
 #: issue 16's budgets: (key, figure, comparison, bound)
 BUDGETS = (
     ("imu_all_ir", "all core work per IMU sample [instructions]", "<=", 1200),
+    ("attitude_vs_fusion", "attitude filter / x-io Fusion's update, per IMU sample", "<=", 1.5),
     ("wifi_2000_ir", "Wi-Fi fix at ~2 000 RPs [instructions]", "<=", 150_000),
     ("wifi_scaling", "Wi-Fi fix at ~20 000 RPs / at ~2 000 RPs", "<=", 1.5),
     ("estimator_B", "sizeof(sf_estimator_t) without the radio map [B]", "<=", 16 * 1024),
@@ -103,6 +107,52 @@ def measure_sensors(harness: Path, out: Path) -> dict[str, Any]:
         "ir_per_baro_call": ir["baro"] / walk["baro"],
         "ir_all_per_imu_sample": sum(ir.values()) / walk["imu"],
         "ir_attitude_per_imu_sample": att / walk["imu"],
+    }
+
+
+#: the peer: x-io Fusion's AHRS (PyPI imufusion, its compiled C library) on the harness's samples, one
+#: FusionAhrsUpdate (gyro + accelerometer + magnetometer) per IMU sample; callgrind counts inside it only
+_PEER = """
+import sys
+import imufusion
+import numpy as np
+d = np.loadtxt(sys.argv[1])
+ahrs = imufusion.Ahrs()
+ahrs.set_sample_period(0.01)
+deg = 180.0 / np.pi
+for row in d:
+    ahrs.update(row[4:7] * deg, row[1:4] / 9.80665, row[7:10])
+"""
+
+
+def measure_attitude_peer(harness: Path, out: Path) -> dict[str, Any]:
+    """Instructions per IMU sample of x-io Fusion's ``FusionAhrsUpdate`` on the sensors walk's samples."""
+    samples = out / "perf.samples.txt"
+    proc = subprocess.run(
+        [str(harness), "samples", str(SENSOR_SECONDS)], capture_output=True, text=True, check=False
+    )
+    if proc.returncode != 0:
+        raise StageError(f"perf: {harness} samples failed ({proc.returncode}): {proc.stderr[-400:]}")
+    samples.write_text(proc.stdout)
+    n = proc.stdout.count("\n")
+    script = out / "perf.fusion_peer.py"
+    script.write_text(_PEER)
+    valgrind = shutil.which("valgrind")
+    if valgrind is None:
+        raise StageError("perf: valgrind not found (apt-get install valgrind)")
+    cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={out / 'perf.fusion.callgrind'}"]
+    cmd += ["--toggle-collect=FusionAhrsUpdate", sys.executable, str(script), str(samples)]
+    run = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    m = _COLLECTED.search(run.stderr)
+    if run.returncode != 0 or m is None or int(m.group(1)) == 0:
+        raise StageError(f"perf: {' '.join(cmd)} failed ({run.returncode}): {run.stderr[-400:]}")
+    import imufusion  # noqa: PLC0415 - only to name the peer's version
+
+    version = getattr(imufusion, "__version__", None)
+    return {
+        "peer": f"x-io Fusion FusionAhrsUpdate (imufusion {version or '1.3.3'} wheel), gyro + accel + mag per sample",
+        "samples": n,
+        "ir_per_sample": int(m.group(1)) / n,
     }
 
 
@@ -193,6 +243,8 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     print("bench perf: sensor calls under callgrind", file=sys.stderr, flush=True)
     sensors = measure_sensors(harness, out)
+    print("bench perf: x-io Fusion on the same samples under callgrind", file=sys.stderr, flush=True)
+    peer = measure_attitude_peer(harness, out)
     wifi = measure_wifi(harness, out)
     sizes = _harness_json(harness, "sizes")
     heap = check_no_heap(firmware.path)
@@ -203,6 +255,7 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
     big = max(by_n)
     values = {
         "imu_all_ir": sensors["ir_all_per_imu_sample"],
+        "attitude_vs_fusion": sensors["ir_attitude_per_imu_sample"] / peer["ir_per_sample"],
         "wifi_2000_ir": by_n[mid]["ir_per_fix"],
         "wifi_scaling": by_n[big]["ir_per_fix"] / by_n[mid]["ir_per_fix"],
         "estimator_B": sizes["sf_estimator_t"],
@@ -220,13 +273,14 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
     doc = {
         "harness": str(harness),
         "sensors": sensors,
+        "attitude_peer": peer,
         "wifi": wifi,
         "sizes": sizes,
         "core_no_heap": heap,
         "replay": replay,
         "budgets": budgets,
         "not_measured": [
-            "attitude <= 1.5 x x-io Fusion's FusionAhrsUpdate (peer harness not built)",
+            "the ahrs package's Madgwick and scikit-learn's KNN as peers",
             "realbench <= 60 s per msindoor floor (see realbench results' run_s)",
             "stridefix analyze of a 1-hour walk <= 3 s",
         ],
@@ -241,7 +295,8 @@ def format_table(doc: dict[str, Any]) -> str:
         f"perf: core calls under callgrind ({s['walk']['seconds']:.0f} s walk: {s['walk']['imu']} IMU, "
         f"{s['walk']['mag']} MAG, {s['walk']['baro']} BARO samples, {s['walk']['steps']} steps)",
         f"  per IMU call {s['ir_per_imu_call']:,.0f}, per MAG call {s['ir_per_mag_call']:,.0f}, per BARO call "
-        f"{s['ir_per_baro_call']:,.0f}; attitude {s['ir_attitude_per_imu_sample']:,.0f} per IMU sample",
+        f"{s['ir_per_baro_call']:,.0f}; attitude {s['ir_attitude_per_imu_sample']:,.0f} per IMU sample, "
+        f"{doc['attitude_peer']['peer']}: {doc['attitude_peer']['ir_per_sample']:,.0f}",
         f"  {'Wi-Fi map':<28}{'RPs':>7}{'APs':>6}{'entries':>10}{'heard':>7}{'instr/fix':>12}{'err m':>7}",
     ]
     for w in doc["wifi"]:
