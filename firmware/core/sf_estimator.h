@@ -50,9 +50,10 @@
  * nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) ≈ 37.5 kB on x86-64 (i686 not rechecked), at most 38 KiB (checked): the
- * controller is 1 440 B of it (sf_controller.h); the
- * fingerprint's scan ring and query are most of it (sf_fingerprint_t, 24 992 B), the eight schemes 4 224 B
+ * Memory: sizeof(sf_estimator_t) = 25 304 B on x86-64 (i686 not rechecked), at most 25 KiB (checked): the
+ * controller is 1 480 B of it (sf_controller.h); the
+ * fingerprint's scan ring is half of it (sf_fingerprint_t, 12 744 B; the matcher's query scratch is in the
+ * caller's workspace, sf_fingerprint.h), the eight schemes 4 224 B
  * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
  * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
  * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`): ≈ 3 400 instructions per
@@ -131,7 +132,7 @@ typedef struct {
     sf_controller_t controller;
     uint32_t context_off; /* source inputs the controller's policy kept off (REASON_CONTEXT_OFF) */
 } sf_estimator_t;
-_Static_assert(sizeof(sf_estimator_t) <= 38 * 1024, "sf_estimator.h promises at most 38 KiB");
+_Static_assert(sizeof(sf_estimator_t) <= 25 * 1024, "sf_estimator.h promises at most 25 KiB");
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);
 

@@ -184,7 +184,8 @@ static int reading_cmp(const void *const a, const void *const b)
 }
 
 /* Builds fp->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
-static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map)
+static void build_query(sf_fingerprint_t *const fp, sf_fingerprint_workspace_t *const ws, const sf_params_t *const p,
+                        const sf_radiomap_t *const map)
 {
     SF_ASSERT(fp->count > 0); /* store_scan has just run */
     reading_t readings[SF_FINGERPRINT_QUERY_APS]; /* 16 kB of stack */
@@ -211,7 +212,7 @@ static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, 
     }
     /* cppcheck-suppress uninitvar ; sf_sort reads only the n readings written above (none when n = 0) */
     sf_sort(readings, n, sizeof readings[0], reading_cmp);
-    fp->n_query = 0;
+    ws->n_query = 0;
     fp->audit.n_scans_averaged = n_scans;
     for (int32_t i = 0; i < n;) {
         double sum = 0.0;
@@ -226,13 +227,13 @@ static void build_query(sf_fingerprint_t *const fp, const sf_params_t *const p, 
             fp->audit.n_unknown++;
             fp->readings_unknown++;
         } else {
-            fp->query_ap[fp->n_query] = a;
-            fp->query_rssi_dbm[fp->n_query] = sum / (double)(j - i);
-            fp->n_query++;
+            ws->query_ap[ws->n_query] = a;
+            ws->query_rssi_dbm[ws->n_query] = sum / (double)(j - i);
+            ws->n_query++;
         }
         i = j;
     }
-    fp->audit.n_used = fp->n_query;
+    fp->audit.n_used = ws->n_query;
 }
 
 /* ---- matching ------------------------------------------------------------------------------------- */
@@ -302,8 +303,8 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     for (int32_t i = 0; i < SF_FINGERPRINT_K_MAX; i++) {
         au->winner_rp[i] = -1;
     }
-    build_query(fp, p, map);
-    if (fp->n_query < p->fingerprint_min_aps) {
+    build_query(fp, ws, p, map);
+    if (ws->n_query < p->fingerprint_min_aps) {
         au->reason = sf_fp_too_few_aps;
         fp->rejected_too_few_aps++;
         return SF_ERANGE;
@@ -319,9 +320,9 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     const double sigma_floor = p->fingerprint_sigma_floor_db;
     double scan_sum = 0.0; /* WkNN fill: Σ (s − f)²; naive Bayes: Σ C_a */
     int32_t n_touched = 0;
-    for (int32_t qi = 0; qi < fp->n_query; qi++) {
-        const int32_t a = fp->query_ap[qi];
-        const double s = fp->query_rssi_dbm[qi];
+    for (int32_t qi = 0; qi < ws->n_query; qi++) {
+        const int32_t a = ws->query_ap[qi];
+        const double s = ws->query_rssi_dbm[qi];
         const double u = bayes ? s - fill : represent(s, fill, p->fingerprint_powed_beta);
         const double c_a = bayes ? log_p + log_normal(s, fill, sigma_floor) - log_not_p : 0.0;
         scan_sum += bayes ? c_a : u * u;
@@ -452,7 +453,7 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
         }
         const double spread = sws > 0.0 ? sqrt(ss / sws) : 0.0;
         const double acc_floor = p->fingerprint_accuracy_floor_m;
-        const double ratio = (double)p->fingerprint_accuracy_ref_aps / (double)fp->n_query;
+        const double ratio = (double)p->fingerprint_accuracy_ref_aps / (double)ws->n_query;
         au->spread_m = spread;
         fix->t_us = scan->t_us;
         fix->method = sf_fix_wifi;
@@ -460,7 +461,7 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
         fix->y_m = y;
         fix->floor = floor;
         fix->accuracy_m = sqrt(spread * spread + acc_floor * acc_floor) * (ratio > 1.0 ? sqrt(ratio) : 1.0);
-        fix->n_ap_used = (int16_t)fp->n_query;
+        fix->n_ap_used = (int16_t)ws->n_query;
         fp->fixes++;
     }
 

@@ -63,10 +63,11 @@
  * candidates on its floor with their posterior (naive Bayes: the posterior's own spread, so a split
  * posterior reads as poor accuracy even when the k best agree). It feeds the fusion's α and gate.
  *
- * Memory. sizeof(sf_fingerprint_t) = 24 992 B on x86-64 and i686, at most 25 KiB (checked): the ring of
- * 4 × 255 readings, the last query of up to 1020 APs, the audit; 16 320 B of stack (at most 16 KiB,
- * checked in sf_fingerprint.c) while the query is built.
- * Workspace: caller-owned arrays of n_rp each, SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
+ * Memory. sizeof(sf_fingerprint_t) = 12 744 B on x86-64, at most 12.5 KiB (checked): the ring of
+ * 4 × 255 readings and the audit; 16 320 B of stack (at most 16 KiB, checked in sf_fingerprint.c) while
+ * the query is built. The last query (up to 1020 APs, 12 240 B) is scratch in the workspace.
+ * Workspace: the query scratch (≈ 12.3 kB, fixed) and caller-owned arrays of n_rp each,
+ * SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
  * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
  * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
@@ -122,6 +123,11 @@ typedef struct {
     double fill_dbm, nb_p_min, min_rssi_dbm;    /* the parameters it was prepared with */
     int32_t map_level;
     double powed_beta;
+    /* scratch of sf_fingerprint_match, rebuilt by every call (so not the estimator's state): the last
+     * query, its used APs (map indices ascending) and their mean levels */
+    int32_t n_query;
+    int32_t query_ap[SF_FINGERPRINT_QUERY_APS];
+    double query_rssi_dbm[SF_FINGERPRINT_QUERY_APS];
 } sf_fingerprint_workspace_t;
 
 /* The record of the last match (published with the FIX message). */
@@ -157,16 +163,12 @@ typedef struct {
     sf_fingerprint_scan_slot_t ring[SF_FINGERPRINT_RING_SCANS];
     int32_t newest; /* ring index of the newest scan */
     int32_t count;  /* scans in the ring */
-    /* the last query: used APs (map indices ascending) and their mean levels */
-    int32_t n_query;
-    int32_t query_ap[SF_FINGERPRINT_QUERY_APS];
-    double query_rssi_dbm[SF_FINGERPRINT_QUERY_APS];
     sf_fingerprint_audit_t audit;
     /* counters, never decrease */
     uint32_t scans, fixes, rejected_too_few_aps, rejected_no_candidate;
     uint32_t readings_bad, readings_weak, readings_truncated, readings_unknown, backwards;
 } sf_fingerprint_t;
-_Static_assert(sizeof(sf_fingerprint_t) <= 25 * 1024, "sf_fingerprint.h promises at most 25 KiB");
+_Static_assert(sizeof(sf_fingerprint_t) <= 12 * 1024 + 512, "sf_fingerprint.h promises at most 12.5 KiB");
 
 /* Empty ring, zero counters. */
 void sf_fingerprint_init(sf_fingerprint_t *fp);

@@ -379,10 +379,10 @@ static void test_averaging(void **state)
     assert_int_equal(match3(&fp, &p, &map, &m, 1000000, 2, ba, ra, &fix), SF_ERANGE); /* 2 APs < 3 */
     assert_int_equal(match3(&fp, &p, &map, &m, 2000000, 2, bb, rb, &fix), SF_OK);
     assert_int_equal(fp.audit.n_scans_averaged, 2);
-    assert_int_equal(fp.n_query, 3);
-    assert_near(fp.query_rssi_dbm[0], -45.0, 0.0);
-    assert_near(fp.query_rssi_dbm[1], -62.0, 0.0);
-    assert_near(fp.query_rssi_dbm[2], -60.0, 0.0);
+    assert_int_equal(m.ws.n_query, 3);
+    assert_near(m.ws.query_rssi_dbm[0], -45.0, 0.0);
+    assert_near(m.ws.query_rssi_dbm[1], -62.0, 0.0);
+    assert_near(m.ws.query_rssi_dbm[2], -60.0, 0.0);
     assert_near(fix.x_m, 0.6294865025, 1e-9);
     assert_near(fix.y_m, 1.5248295278, 1e-9);
     assert_int_equal(fix.t_us, 2000000);
@@ -398,7 +398,7 @@ static void test_averaging(void **state)
     assert_int_equal(match3(&fp, &p, &map, &m, 1000000, 2, ba, ra, &fix), SF_ERANGE);
     assert_int_equal(match3(&fp, &p, &map, &m, 12000000, 2, bb, rb, &fix), SF_ERANGE);
     assert_int_equal(fp.audit.n_scans_averaged, 1);
-    assert_near(fp.query_rssi_dbm[0], -46.0, 0.0);
+    assert_near(m.ws.query_rssi_dbm[0], -46.0, 0.0);
 
     /* Time going backwards empties the ring. */
     sf_fingerprint_init(&fp);
@@ -416,7 +416,7 @@ static void test_averaging(void **state)
         assert_int_equal(match3(&fp, &p, &map, &m, 1000000 * (int64_t)(i + 1), 1, k_bssid, &v, &fix), SF_OK);
     }
     assert_int_equal(fp.audit.n_scans_averaged, 4);
-    assert_near(fp.query_rssi_dbm[0], -42.5, 0.0);
+    assert_near(m.ws.query_rssi_dbm[0], -42.5, 0.0);
 }
 
 /* A repeated BSSID keeps its strongest reading; more than SF_FINGERPRINT_SCAN_APS readings keep the strongest. */
@@ -449,7 +449,7 @@ static void test_duplicates_and_truncation(void **state)
     const int64_t bd[4] = {0x100, 0x200, 0x100, 0x300};
     const float rd[4] = {-50, -62, -45, -60};
     assert_int_equal(match3(&fp, &p, &map, &m, 2, 4, bd, rd, &fix), SF_OK);
-    assert_near(fp.query_rssi_dbm[0], -45.0, 0.0);
+    assert_near(m.ws.query_rssi_dbm[0], -45.0, 0.0);
     assert_near(fix.y_m, 1.5248295278, 1e-9);
 }
 
