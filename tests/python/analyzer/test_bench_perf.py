@@ -63,6 +63,7 @@ def test_replay_reads_its_own_rss_not_the_forked_python(stridefixd, tmp_path, mo
     assert r["walk_s"] == pytest.approx(30.0, abs=1.0)
     assert r["x_realtime"] > 10.0 and r["log_bytes"] > 0
     assert 0 < r["peak_rss_kB"] < 64 * 1024  # the daemon is a few MB; the Python parent is > 100 MB
+    assert r["analyze_s"] > 0
 
 
 def test_budgets_are_judged_from_the_figures():
@@ -75,6 +76,7 @@ def test_budgets_are_judged_from_the_figures():
         "core_no_heap": True,
         "replay_x_realtime": 4999.0,
         "peak_rss_kB": 4528,
+        "analyze_s": 6.9,
     }
     doc = {"budgets": perf.judge(values)}
     verdict = {b["key"]: b["met"] for b in doc["budgets"]}
@@ -87,9 +89,10 @@ def test_budgets_are_judged_from_the_figures():
         "core_no_heap": True,
         "replay_x_realtime": False,
         "peak_rss_kB": True,
+        "analyze_s": False,
     }
     assert (
         "perf: Wi-Fi fix at ~2 000 RPs [instructions] = 150001.0 (budget <= 150000)"
         in perf.missed_targets(doc)
     )
-    assert len(perf.missed_targets(doc)) == 4
+    assert len(perf.missed_targets(doc)) == 5
