@@ -94,7 +94,7 @@ void sf_activity_accel(sf_activity_t *const a, const sf_params_t *const p, const
         return;
     }
     const double dt_s = (double)(t_us - a->accel_t_us) * 1e-6;
-    const double k = -expm1(-dt_s / p->activity_var_tau_s);
+    const double k = sf_lp_gain(&a->var_gain, dt_s, p->activity_var_tau_s);
     a->mean_mps2 += k * (accel_v_mps2 - a->mean_mps2);
     a->meansq_m2ps4 += k * (accel_v_mps2 * accel_v_mps2 - a->meansq_m2ps4);
     a->accel_t_us = t_us;
@@ -189,7 +189,7 @@ void sf_activity_gyro(sf_activity_t *const a, const sf_params_t *const p, const 
         return;
     }
     const double dt_s = (double)(t_us - a->gyro_t_us) * 1e-6;
-    const double k = -expm1(-dt_s / p->activity_var_tau_s);
+    const double k = sf_lp_gain(&a->var_gain, dt_s, p->activity_var_tau_s);
     a->rotation_radps += k * (rate_radps - a->rotation_radps);
     for (int i = 0; i < 6; i++) {
         a->gyro_moment_r2ps2[i] += k * (outer[i] - a->gyro_moment_r2ps2[i]);

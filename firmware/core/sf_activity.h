@@ -63,13 +63,14 @@
  * position for it. While the class is still, the estimator also holds the position (zero-velocity).
  *
  * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v or gyro sample, one 3×3 eigenvalue (an acos,
- * two cos) per detection. Memory: sizeof(sf_activity_t) = 296 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
+ * two cos) per detection. Memory: sizeof(sf_activity_t) = 320 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
 #ifndef SF_ACTIVITY_H
 #define SF_ACTIVITY_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_math.h"
 #include "sf_params.h"
 #include "sf_steps.h"
 #include "sf_types.h"
@@ -99,6 +100,7 @@ typedef struct {
     int64_t gyro_t_us;         /* newest |ω| time */
     double rotation_radps;     /* EW mean of |ω| */
     double gyro_moment_r2ps2[6]; /* EW mean of ω ωᵀ (body): xx, yy, zz, xy, xz, yz */
+    sf_lp_gain_t var_gain;       /* the a_v and |ω| means' gain for the last dt (one IMU rate: one expm1) */
     uint32_t turning_steps;    /* detections refused as gestures (also in rejected_steps) */
     int64_t last_detection_t_us; /* newest detection that was not refused */
 } sf_activity_t;

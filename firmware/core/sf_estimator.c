@@ -95,10 +95,9 @@ int sf_estimator_attach_site(sf_estimator_t *const e, const sf_params_t *const p
     return SF_OK;
 }
 
-/* Walking direction in the map frame for the current device yaw. */
-static double walk_heading(const sf_estimator_t *const e, const sf_params_t *const p)
+/* Walking direction in the map frame for the device yaw (sf_attitude_yaw_rad of this sample). */
+static double walk_heading(const sf_estimator_t *const e, const sf_params_t *const p, const double yaw)
 {
-    const double yaw = sf_attitude_yaw_rad(&e->attitude);
     if (e->attitude.yaw_absolute) {
         return sf_heading_walk_rad(&e->heading, p, yaw);
     }
@@ -191,10 +190,12 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
     const double a_v = f_nav[2] - e->gravity_mps2;
     e->accel_v_mps2 = a_v;
 
-    sf_heading_update(&e->heading, p, s->t_us, f_nav, sf_attitude_yaw_rad(&e->attitude));
+    /* one atan2 per sample: the heading filter and the walking direction read the same yaw */
+    const double yaw = sf_attitude_yaw_rad(&e->attitude);
+    sf_heading_update(&e->heading, p, s->t_us, f_nav, yaw);
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
     sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
-    e->heading_rad = walk_heading(e, p);
+    e->heading_rad = walk_heading(e, p, yaw);
     sf_controller_activity(&e->controller, s->t_us, sf_activity_current(&e->activity));
 
     sf_step_event_t ev;
