@@ -10,18 +10,16 @@ second run, inside its fix call (``sf_fusion_fix_on_floor``). Writes ``particle_
 from __future__ import annotations
 
 import json
-import re
-import shutil
 import subprocess
 from pathlib import Path
 from typing import Any
 
+from stridefix_analyzer.bench import callgrind
 from stridefix_analyzer.stages import StageError
 
 TARGET_PER_STEP = 1_000_000
 STEPS = 400
 FIXES = STEPS // 4
-_COLLECTED = re.compile(r"Collected\s*:\s*(\d+)")
 
 
 def harness_path(stridefixd: Path) -> Path:
@@ -30,22 +28,7 @@ def harness_path(stridefixd: Path) -> Path:
 
 
 def _callgrind(harness: Path, function: str, out: Path) -> int:
-    valgrind = shutil.which("valgrind")
-    if valgrind is None:
-        raise StageError("particle-cost: valgrind not found (apt-get install valgrind)")
-    cmd = [
-        valgrind,
-        "--tool=callgrind",
-        f"--callgrind-out-file={out}",
-        f"--toggle-collect={function}",
-        str(harness),
-        str(STEPS),
-    ]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    m = _COLLECTED.search(proc.stderr)
-    if proc.returncode != 0 or m is None:
-        raise StageError(f"particle-cost: {' '.join(cmd)} failed ({proc.returncode}): {proc.stderr[-400:]}")
-    return int(m.group(1))
+    return callgrind.instructions([str(harness), str(STEPS)], [function], out, "particle-cost")
 
 
 def run_particle_cost(stridefixd: Path, out: Path) -> dict[str, Any]:

@@ -29,7 +29,6 @@ scikit-learn's KNN are not in this run yet. Writes ``perf.json``.
 from __future__ import annotations
 
 import json
-import re
 import shutil
 import subprocess
 import sys
@@ -37,6 +36,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from stridefix_analyzer.bench import callgrind
 from stridefix_analyzer.bench.soak import vm_hwm_kb
 from stridefix_analyzer.firmware import REPO, Firmware
 from stridefix_analyzer.stages import StageError, stridefix_exe
@@ -45,7 +45,6 @@ SENSOR_SECONDS = 120
 WIFI_SIZES = (100, 2000, 20000)
 WIFI_SCANS = 50
 REPLAY_SECONDS = 3600
-_COLLECTED = re.compile(r"Collected\s*:\s*(\d+)")
 
 #: issue 16's budgets: (key, figure, comparison, bound)
 BUDGETS = (
@@ -75,17 +74,7 @@ def _harness_json(harness: Path, *args: str) -> dict[str, Any]:
 
 def _callgrind(harness: Path, functions: tuple[str, ...], args: tuple[str, ...], out: Path) -> int:
     """Instructions inside ``functions`` (summed) over one run of the harness."""
-    valgrind = shutil.which("valgrind")
-    if valgrind is None:
-        raise StageError("perf: valgrind not found (apt-get install valgrind)")
-    cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={out}"]
-    cmd += [f"--toggle-collect={f}" for f in functions]
-    cmd += [str(harness), *args]
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    m = _COLLECTED.search(proc.stderr)
-    if proc.returncode != 0 or m is None:
-        raise StageError(f"perf: {' '.join(cmd)} failed ({proc.returncode}): {proc.stderr[-400:]}")
-    return int(m.group(1))
+    return callgrind.instructions([str(harness), *args], functions, out, "perf")
 
 
 def measure_sensors(harness: Path, out: Path) -> dict[str, Any]:
@@ -139,22 +128,23 @@ def measure_attitude_peer(harness: Path, out: Path) -> dict[str, Any]:
     n = proc.stdout.count("\n")
     script = out / "perf.fusion_peer.py"
     script.write_text(_PEER)
-    valgrind = shutil.which("valgrind")
-    if valgrind is None:
-        raise StageError("perf: valgrind not found (apt-get install valgrind)")
-    cmd = [valgrind, "--tool=callgrind", f"--callgrind-out-file={out / 'perf.fusion.callgrind'}"]
-    cmd += ["--toggle-collect=FusionAhrsUpdate", sys.executable, str(script), str(samples)]
-    run = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    m = _COLLECTED.search(run.stderr)
-    if run.returncode != 0 or m is None or int(m.group(1)) == 0:
-        raise StageError(f"perf: {' '.join(cmd)} failed ({run.returncode}): {run.stderr[-400:]}")
+    ir = callgrind.instructions(
+        [sys.executable, str(script), str(samples)],
+        ["FusionAhrsUpdate"],
+        out / "perf.fusion.callgrind",
+        "perf",
+    )
+    if ir == 0:
+        raise StageError(
+            "perf: callgrind counted no instruction inside FusionAhrsUpdate (imufusion not run?)"
+        )
     import imufusion  # noqa: PLC0415 - only to name the peer's version
 
     version = getattr(imufusion, "__version__", None)
     return {
         "peer": f"x-io Fusion FusionAhrsUpdate (imufusion {version or '1.3.3'} wheel), gyro + accel + mag per sample",
         "samples": n,
-        "ir_per_sample": int(m.group(1)) / n,
+        "ir_per_sample": ir / n,
     }
 
 
@@ -281,13 +271,7 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "peak_rss_kB": replay["peak_rss_kB"],
         "analyze_s": replay["analyze_s"],
     }
-    budgets = []
-    for key, figure, op, bound in BUDGETS:
-        v = values[key]
-        met = {"<=": v <= bound, ">=": v >= bound, "==": v == bound}[op]
-        budgets.append(
-            {"key": key, "figure": figure, "value": v, "budget": f"{op} {bound}", "met": bool(met)}
-        )
+    budgets = judge(values)
     doc = {
         "harness": str(harness),
         "sensors": sensors,
