@@ -75,11 +75,14 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
     walk["warnings"] += summary.get("warnings", [])[:5]
     first = next(iter(job.heading_candidates))
     headings = {}
+    # every variant's STEP stream: the crowd-built map's dead reckoning (.crowdfolds chooses one)
+    walk["fw_logs"] = fw_logs = {}
     for (
         name,
         sets,
     ) in job.heading_candidates.items():  # the first candidate's STEP stream also gives K and steps
         fw_log = fw_dir / f"{trace.stem}.{name}.lcmlog"
+        fw_logs[name] = str(fw_log)
         proc = job.firmware.run(input=f"lcmlog:{imp}", log=fw_log, sets=[*job.param_sets, *sets], check=False)
         if proc.returncode != 0:
             walk["error"] = f"stridefixd exit {proc.returncode}: {proc.stderr.strip()[-300:]}"
@@ -87,10 +90,7 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
         if name != first:
             st = read_table(fw_log, "STEP")
             headings[name] = (st["t_us"], st["heading_rad"]) if st is not None else None
-    fw_log = fw_dir / f"{trace.stem}.{first}.lcmlog"
-    walk["fw_log"] = str(fw_log)
-    # every variant's STEP stream: the crowd-built map's dead reckoning (.crowdmap chooses one)
-    walk["fw_logs"] = {name: str(fw_dir / f"{trace.stem}.{name}.lcmlog") for name in job.heading_candidates}
+    fw_log = Path(fw_logs[first])
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", LogTruncatedWarning)
