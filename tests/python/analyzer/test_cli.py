@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 from stridefix_analyzer import cli
 
 
@@ -21,3 +24,20 @@ def test_other_sub_commands_pass_unchanged(monkeypatch):
     assert cli.rewrite_argv(["analyze", "x"]) == ["analyze", "x"]  # a hook that cannot load is skipped
     assert cli.rewrite_argv(["report", "d"]) == ["report", "d"]
     assert cli.rewrite_argv([]) == []
+
+
+def test_running_one_sub_command_builds_only_its_parser():
+    # stridefix analyze of a 1-hour walk spent 1-3 s importing every sub-command's module (SciPy,
+    # Matplotlib, the crowd and bench layers) before reading a byte; issue 16 budgets the whole run
+    # at 3 s. A fresh interpreter, so that modules other tests imported do not count.
+    script = (
+        "import sys\n"
+        "from stridefix_analyzer import cli\n"
+        "p = cli.build_parser('analyze')\n"
+        "sub = next(a for a in p._actions if a.dest == 'command')\n"
+        "print(sorted(sub.choices), sorted({m.split('.')[0] for m in sys.modules} & {'scipy', 'matplotlib'}))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+    assert out.split("\n")[0] == "['analyze'] []"
+    every = next(a for a in cli.build_parser()._actions if a.dest == "command")
+    assert sorted(every.choices) == sorted(cli.SUBCOMMANDS)  # top-level help lists them all
