@@ -81,6 +81,30 @@ def _parse_record(f: BinaryIO, offset: int, size: int) -> tuple[str, bytes, int]
     return channel, f.read(data_len), end
 
 
+def check_readable(path: str) -> None:
+    """Raise :class:`LogReadError` naming ``path`` unless it is a readable regular file."""
+    if not os.path.exists(path):
+        raise LogReadError(path, "no such file")
+    if not os.path.isfile(path):
+        raise LogReadError(path, "not a regular file")
+    if not os.access(path, os.R_OK):
+        raise LogReadError(path, "permission denied")
+
+
+def file_counts(
+    path: str, size: int, events: int, trailing: int = 0, skipped: int = 0, salvaged: int = 0
+) -> dict[str, Any]:
+    """One file's entry of ``LogData.inputs`` (see :func:`read_file`)."""
+    return {
+        "path": path,
+        "bytes": size,
+        "events": events,
+        "truncated_bytes": trailing,
+        "skipped_bytes": skipped,
+        "salvaged_events": salvaged,
+    }
+
+
 def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[str, Any], list[str]]:
     """Pass every whole record of one log to ``on_event(channel, payload)``.
 
@@ -92,12 +116,7 @@ def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[s
     follows each record). So when it stops before the end of the file, the records from there on
     are salvaged by hand (sync word search + header check) and ``lcm.EventLog`` resumes after them.
     """
-    if not os.path.exists(path):
-        raise LogReadError(path, "no such file")
-    if not os.path.isfile(path):
-        raise LogReadError(path, "not a regular file")
-    if not os.access(path, os.R_OK):
-        raise LogReadError(path, "permission denied")
+    check_readable(path)
     try:
         log = lcm.EventLog(path, "r")
         raw = open(path, "rb")
@@ -143,14 +162,7 @@ def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[s
         log.close()
         raw.close()
     trailing = size - end_of_last
-    info: dict[str, Any] = {
-        "path": path,
-        "bytes": size,
-        "events": events,
-        "truncated_bytes": trailing,
-        "skipped_bytes": skipped,
-        "salvaged_events": salvaged,
-    }
+    info = file_counts(path, size, events, trailing, skipped, salvaged)
     if events == 0 and size > 0:
         with open(path, "rb") as f:
             head = f.read(4)

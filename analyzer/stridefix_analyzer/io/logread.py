@@ -28,8 +28,12 @@ added to a ``.lcm`` file appears here by itself; the list above is what the type
 
 ``CONFIG`` becomes the ``LogData.config`` key → value dict (plus ``LogData.versions``).
 
-Errors: a missing or unreadable file raises :class:`LogReadError` naming it (records are read by
-:mod:`.lcmfile`). Bad data is not an
+Reading: an intact file (one unbroken chain of records) is indexed with numpy (:mod:`.lcmindex`),
+only the channels asked for are decoded, and the fixed-layout ones all at once (:mod:`.lcmdecode`);
+any other file is read record by record, with salvage, by :mod:`.lcmfile`. Both give the same
+``LogData`` (``read_logs(..., indexed=False)`` forces the second; the tests compare them).
+
+Errors: a missing or unreadable file raises :class:`LogReadError` naming it. Bad data is not an
 error: unknown channels and messages that fail to decode are counted (by channel), and a log cut
 short reads up to its last whole record, with a warning in ``LogData.warnings``.
 """
@@ -47,7 +51,15 @@ import numpy as np
 import numpy.typing as npt
 
 from stridefix_analyzer.io.channels import CHANNELS, CONFIG_TYPE
-from stridefix_analyzer.io.lcmfile import LogReadError, LogTruncatedWarning, read_file
+from stridefix_analyzer.io.lcmdecode import decode_columns
+from stridefix_analyzer.io.lcmfile import (
+    LogReadError,
+    LogTruncatedWarning,
+    check_readable,
+    file_counts,
+    read_file,
+)
+from stridefix_analyzer.io.lcmindex import LogIndex, index_file
 
 __all__ = [
     "KNOWN_CHANNELS",
@@ -169,7 +181,10 @@ class _Collector:
 
     def __init__(self, decode: set[str]) -> None:
         self.decode = decode
-        self.rows: dict[str, list[Any]] = {ch: [] for ch in CHANNELS}
+        # channel -> its rows so far, in log order: lists of row tuples (decoded message by message)
+        # and dicts of columns (decoded at once from an indexed file, :mod:`.lcmdecode`)
+        self.chunks: dict[str, list[list[Any] | dict[str, Array]]] = {ch: [] for ch in CHANNELS}
+        self.n_rows = dict.fromkeys(CHANNELS, 0)
         self.wifi_aps: list[tuple[int, int, float, int]] = []  # (scan row, bssid, rssi_dbm, freq_mhz)
         self.data = LogData()
         # channel -> leading 8 payload bytes that are not this build's type hash -> count
@@ -181,8 +196,41 @@ class _Collector:
         if channel not in _KNOWN:
             d.unknown_channels[channel] = d.unknown_channels.get(channel, 0) + 1
             return
-        if channel not in self.decode:
-            return
+        if channel in self.decode:
+            self.decode_event(path, channel, payload)
+
+    def add_index(self, path: str, index: LogIndex) -> None:
+        """All records of one indexed file: the same counts, rows and errors as :meth:`add_event`
+        on each record in turn, with the fixed-layout channels decoded at once."""
+        d = self.data
+        for channel, n in index.counts().items():  # first-record order, as add_event meets them
+            d.messages[channel] = d.messages.get(channel, 0) + n
+            if channel not in _KNOWN:
+                d.unknown_channels[channel] = d.unknown_channels.get(channel, 0) + n
+        one_by_one: list[tuple[str, Array]] = []
+        for channel in index.channels:
+            if channel not in _KNOWN or channel not in self.decode:
+                continue
+            records = index.records_of(channel)
+            columns = None
+            if channel != "CONFIG":
+                spec = CHANNELS[channel]
+                at, size = index.payload_at[records], index.payload_len[records]
+                columns = decode_columns(spec.msg_type, spec.columns, index.data, at, size)
+            if columns is None:
+                one_by_one.append((channel, records))
+                continue
+            self.chunks[channel].append(columns)
+            self.n_rows[channel] += len(records)
+        # the rest in log order across channels: decode errors and CONFIG warnings keep their order
+        if one_by_one:
+            names = np.concatenate([np.full(len(r), i) for i, (_, r) in enumerate(one_by_one)])
+            records = np.concatenate([r for _, r in one_by_one])
+            for k in np.argsort(records, kind="stable"):
+                self.decode_event(path, one_by_one[names[k]][0], index.payload(int(records[k])))
+
+    def decode_event(self, path: str, channel: str, payload: bytes) -> None:
+        d = self.data
         try:
             if channel == "CONFIG":
                 self.add_config(CONFIG_TYPE.decode(payload), path)
@@ -198,11 +246,33 @@ class _Collector:
                 foreign[payload[:8]] = foreign.get(payload[:8], 0) + 1
             return
         if channel == "WIFI":
-            scan_row = len(self.rows["WIFI"])
+            scan_row = self.n_rows["WIFI"]
             self.wifi_aps.extend(
                 (scan_row, b, r, f) for b, r, f in zip(msg.bssid, msg.rssi_dbm, msg.freq_mhz)
             )
-        self.rows[channel].append(values)
+        chunks = self.chunks[channel]
+        if not chunks or not isinstance(chunks[-1], list):
+            chunks.append([])
+        chunks[-1].append(values)  # type: ignore[union-attr]
+        self.n_rows[channel] += 1
+
+    def columns(self, channel: str) -> dict[str, Array] | None:
+        """The channel's rows so far as columns (None without any)."""
+        if not self.n_rows[channel]:
+            return None
+        spec = CHANNELS[channel]
+        parts: list[dict[str, Array]] = []
+        for chunk in self.chunks[channel]:
+            if isinstance(chunk, dict):
+                parts.append(chunk)
+                continue
+            cols = list(zip(*chunk))
+            parts.append(
+                {name: np.asarray(col, dtype=dtype) for (name, dtype), col in zip(spec.columns.items(), cols)}
+            )
+        if len(parts) == 1:
+            return parts[0]
+        return {name: np.concatenate([p[name] for p in parts]) for name in spec.columns}
 
     def add_config(self, msg: Any, path: str) -> None:
         d = self.data
@@ -217,14 +287,11 @@ class _Collector:
 
     def finish(self) -> LogData:
         d = self.data
-        for channel, spec in CHANNELS.items():
-            rows = self.rows[channel]
-            if not rows:
+        for channel in CHANNELS:
+            columns = self.columns(channel)
+            if columns is None:
                 continue
-            cols = list(zip(*rows))
-            table = Table(
-                {name: np.asarray(col, dtype=dtype) for (name, dtype), col in zip(spec.columns.items(), cols)}
-            )
+            table = Table(columns)
             if channel == "WIFI":
                 # sort scans by time and renumber the AP rows' scan_row to match
                 order = np.argsort(table["t_us"], kind="stable")
@@ -261,7 +328,9 @@ class _Collector:
         return d
 
 
-def read_logs(paths: Iterable[str | os.PathLike[str]], decode: Iterable[str] | None = None) -> LogData:
+def read_logs(
+    paths: Iterable[str | os.PathLike[str]], decode: Iterable[str] | None = None, indexed: bool = True
+) -> LogData:
     """Read and merge LCM event logs.
 
     Parameters
@@ -272,6 +341,11 @@ def read_logs(paths: Iterable[str | os.PathLike[str]], decode: Iterable[str] | N
     decode : iterable of str, optional
         Channels to decode (default: all of :data:`KNOWN_CHANNELS`). Other channels are only
         counted in ``messages``, which is much faster for long IMU-heavy logs.
+    indexed : bool, default True
+        Locate the records of an intact file with :mod:`.lcmindex` and decode the fixed-layout
+        channels at once (:mod:`.lcmdecode`): ~10x faster, the same result. False reads every file
+        record by record through ``lcm.EventLog`` (what a damaged file gets anyway), the reference
+        the fast path is tested against.
 
     Returns
     -------
@@ -295,12 +369,28 @@ def read_logs(paths: Iterable[str | os.PathLike[str]], decode: Iterable[str] | N
         )
     collector = _Collector(wanted)
     for path in files:
-        info, notes = read_file(path, functools.partial(collector.add_event, path))
+        index = _index(path) if indexed else None
+        if index is not None:
+            # one unbroken chain of records: nothing to salvage, and lcm.EventLog would read the same
+            collector.add_index(path, index)
+            info, notes = file_counts(path, len(index.data), len(index)), list[str]()
+        else:
+            info, notes = read_file(path, functools.partial(collector.add_event, path))
         collector.data.inputs.append(info)
         for text in notes:
             collector.data.warnings.append(text)
             warnings.warn(text, LogTruncatedWarning, stacklevel=2)
     return collector.finish()
+
+
+def _index(path: str) -> LogIndex | None:
+    """The file's :class:`LogIndex`, or None to read it record by record (which also names the file
+    in any error)."""
+    check_readable(path)
+    try:
+        return index_file(path)
+    except OSError:
+        return None
 
 
 def _mismatch_text(channel: str, n: int) -> str:

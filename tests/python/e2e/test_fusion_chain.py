@@ -206,3 +206,14 @@ def test_the_analyzer_decodes_every_channel_of_a_site_run(walk):
     data = read_logs([walk["log"]])
     assert data.unknown_channels == {} and data.decode_errors == {}
     assert len(data.table("FIX")) > 0 and len(data.table("POSE")) > 0
+
+
+def test_fast_reader_reads_the_log_as_lcm_eventlog_does(walk, assert_reads_alike):
+    # the numpy reader (lcmindex + lcmdecode) on a real stridefixd log with every scheme's FIX audit
+    # records (reason texts of several lengths), POSE, WIFI and the simulator's truth: the same tables
+    # as record by record, for all channels, for analyze's and for realbench's FIX-only read
+    logs = [walk["log"], walk["dir"] / "truth.lcmlog"]
+    data = assert_reads_alike(logs)
+    assert len(data.tables["FIX"]) > 10 * len(SCHEMES) and len(set(data.tables["FIX"]["reason_text"])) > 1
+    assert_reads_alike(logs, ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG", "CONTEXT"))
+    assert_reads_alike([walk["log"]], ("FIX",))

@@ -50,6 +50,13 @@ def replay(stridefixd, default_walk, tmp_path_factory):
     return {"log": log, "proc": proc, "counts": counts, "health": health}
 
 
+def test_fast_reader_reads_the_log_as_lcm_eventlog_does(replay, default_walk, assert_reads_alike):
+    # the numpy reader on the default walk's replay (IMU, MAG, BARO, WIFI, STEP, POSE, HEALTH, CONFIG)
+    # and its truth: the same tables, counts and warnings as record by record
+    data = assert_reads_alike([replay["log"], default_walk["dir"] / "truth.lcmlog"])
+    assert len(data.tables["IMU"]) == default_walk["summary"]["imu_samples"]
+
+
 def test_every_imu_sample_is_logged(replay, default_walk):
     assert replay["counts"]["IMU"] == default_walk["summary"]["imu_samples"]
     assert replay["health"].imu_samples == default_walk["summary"]["imu_samples"]

@@ -137,6 +137,12 @@ def sources_run(tmp_path_factory, stridefixd, cli) -> dict:
     return {"dir": d, "sent": sent, "stderr": proc.stderr, "data": read_logs([d / "run.lcmlog"])}
 
 
+def test_fast_reader_reads_the_log_as_lcm_eventlog_does(sources_run, assert_reads_alike):
+    # BLE (variable-length arrays, decoded one by one), GNSS, LANDMARK and their FIX records
+    data = assert_reads_alike([sources_run["dir"] / "run.lcmlog"])
+    assert {"BLE", "GNSS", "LANDMARK", "FIX"} <= set(data.tables)
+
+
 def test_log_carries_the_new_raw_inputs(sources_run):
     """THEN the log has one LANDMARK event, a GNSS event per fix and one BLE scan per 1 s window
     (ble.window_ms), each beacon once in it at the level sent."""
