@@ -161,8 +161,10 @@ def _round_trips(msg_type: Any, layout: Layout) -> bool:
     return not layout.string or cols[layout.string][0] == getattr(decoded, layout.string)
 
 
+@functools.lru_cache(maxsize=1024)
 def _dtype(layout: Layout, size: int) -> np.dtype | None:
-    """The structured dtype of one ``size``-byte payload, or None when no string length fits."""
+    """The structured dtype of one ``size``-byte payload, or None when no string length fits
+    (cached: building it cost more than decoding the few FIX records of a short replay)."""
     names, formats, offsets = ["_fp"], [f"V{_FINGERPRINT_BYTES}"], [0]
     at = _FINGERPRINT_BYTES
 

@@ -5,9 +5,9 @@ without a Python step per record: it looks for the LCM sync word (0xEDA1DA01) at
 the record headers found there (int64 event number, int64 timestamp, int32 channel length, int32
 data length, all big-endian, then the channel name and the payload) and checks that they chain: the
 first record starts at byte 0, each ends where the next begins, the last ends at the end of the
-file. A log of 650 k records is indexed in well under 0.1 s, where ``lcm.EventLog`` took ~1 s just
-to hand over the records one by one; the caller then decodes only the channels it needs
-(:mod:`.lcmdecode` vectorises the fixed-layout ones).
+file. The 1-hour walk's log (650 k records, 62 MB) is indexed in 0.14 s of CPU, where
+``lcm.EventLog`` took 1.1 s just to hand over the records one by one; the caller then decodes only
+the channels it needs (:mod:`.lcmdecode` vectorises the fixed-layout ones).
 
 Anything else (a record cut short, junk between records, a sync word inside a payload that breaks
 the chain, a channel name that ``lcm.EventLog`` would read differently) gives ``None``: the caller
