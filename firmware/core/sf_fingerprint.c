@@ -7,6 +7,7 @@
 
 #include "sf_assert.h"
 #include "sf_error.h"
+#include "sf_fingerprint_internal.h"
 #include "sf_sort.h"
 
 #define HALF_LOG_2PI 0.91893853320467274178
@@ -62,12 +63,60 @@ void sf_fingerprint_init(sf_fingerprint_t *const fp)
     memset(fp, 0, sizeof *fp);
 }
 
+/* The WkNN level of entry i as matched: g(entry_level), or −1 when censored (the RP "does not hear" it). */
+static double entry_g(const sf_radiomap_t *const map, const int32_t i, const sf_params_t *const p)
+{
+    const double level = entry_level(map, i, p);
+    return level >= p->fingerprint_min_rssi_dbm
+               ? represent(level, p->fingerprint_fill_dbm, p->fingerprint_powed_beta)
+               : -1.0;
+}
+
+/* The pre-selection's arrays: every entry's g AP-major (float) and RP-major (a counting sort by RP that
+ * keeps the APs ascending within an RP, as the AP-major visit meets them), and an empty query. */
+static void prepare_preselect(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
+                              const sf_params_t *const p)
+{
+    int32_t *const cursor = ws->touched; /* scratch, zeroed again below */
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        cursor[r] = 0;
+    }
+    for (int32_t i = 0; i < map->n_entries; i++) {
+        cursor[map->entry_rp[i]]++;
+    }
+    ws->rp_entry_first[0] = 0;
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        ws->rp_entry_first[r + 1] = ws->rp_entry_first[r] + cursor[r];
+        cursor[r] = ws->rp_entry_first[r];
+    }
+    for (int32_t a = 0; a < map->n_ap; a++) {
+        ws->ap_query_w[a] = 0.0;
+        for (int32_t i = map->ap_first[a]; i < map->ap_first[a + 1]; i++) {
+            const int32_t j = cursor[map->entry_rp[i]]++;
+            const double g = entry_g(map, i, p);
+            ws->rp_entry_ap[j] = a;
+            ws->rp_entry_level_db[j] = g < 0.0 ? 0.0 : g;
+            ws->entry_level_db[i] = (float)g;
+        }
+    }
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        cursor[r] = 0;
+    }
+}
+
 int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
                            const sf_params_t *const p)
 {
     if (ws == NULL || map == NULL || p == NULL || map->n_rp <= 0 || map->n_ap <= 0 || ws->n_rp < map->n_rp ||
         ws->rp_fill_sq_db2 == NULL || ws->rp_miss_loglik == NULL || ws->acc == NULL || ws->n_common == NULL ||
         ws->touched == NULL) {
+        return SF_EINVAL;
+    }
+    const bool any_pre = ws->rp_entry_first != NULL || ws->rp_entry_ap != NULL ||
+                         ws->rp_entry_level_db != NULL || ws->ap_query_w != NULL || ws->entry_level_db != NULL;
+    const bool all_pre = ws->rp_entry_first != NULL && ws->rp_entry_ap != NULL &&
+                         ws->rp_entry_level_db != NULL && ws->ap_query_w != NULL && ws->entry_level_db != NULL;
+    if (any_pre && (!all_pre || ws->n_entries < map->n_entries || ws->n_ap < map->n_ap)) {
         return SF_EINVAL;
     }
     ws->prepared = false;
@@ -92,6 +141,9 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
             ws->rp_fill_sq_db2[r] += v * v;
         }
         ws->rp_miss_loglik[r] += log(1.0 - detection(map, i, p_min)) - log_not_p;
+    }
+    if (all_pre) {
+        prepare_preselect(ws, map, p);
     }
     ws->map_n_ap = map->n_ap;
     ws->map_n_rp = map->n_rp;
@@ -250,12 +302,8 @@ static void touch(sf_fingerprint_workspace_t *const ws, int32_t *const n_touched
     ws->acc[r] += term;
 }
 
-typedef struct {
-    double key; /* lower is better: WkNN d, naive Bayes −L */
-    int32_t rp;
-} ranked_t;
-
-static void insert_best(ranked_t *const best, int32_t *const n_best, const int32_t k, const double key, const int32_t rp)
+void sf_fp_insert_best(sf_fp_ranked_t *const best, int32_t *const n_best, const int32_t k, const double key,
+                       const int32_t rp)
 {
     SF_ASSERT(k >= 1 && k <= SF_FINGERPRINT_K_MAX && *n_best >= 0 && *n_best <= k);
     int32_t pos = *n_best;
@@ -269,10 +317,79 @@ static void insert_best(ranked_t *const best, int32_t *const n_best, const int32
     for (int32_t i = last; i > pos; i--) {
         best[i] = best[i - 1];
     }
-    best[pos] = (ranked_t){key, rp};
+    best[pos] = (sf_fp_ranked_t){key, rp};
     if (*n_best < k) {
         (*n_best)++;
     }
+}
+
+/* Every entry of every used AP: accumulates the per-RP partial sums (touched RPs in ws->touched),
+ * scores the candidates into best[0 .. *n_best), and returns the number touched; *scan_sum is
+ * recomputed (naive Bayes: Σ C_a). Fills the audit's n_touched and n_candidates. */
+static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t *const p,
+                         const sf_radiomap_t *const map, const int16_t floor_hint, const bool any_floor, const int32_t k,
+                         sf_fp_ranked_t *const best, int32_t *const n_best, sf_fingerprint_audit_t *const au,
+                         double *const scan_sum)
+{
+    const bool bayes = p->fingerprint_method == 1;
+    const bool common_only = !bayes && p->fingerprint_missing_mode == 1;
+    const double fill = p->fingerprint_fill_dbm;
+    const double p_min = p->fingerprint_nb_p_min;
+    const double log_p = log(p_min);
+    const double log_not_p = log(1.0 - p_min);
+    const double sigma_floor = p->fingerprint_sigma_floor_db;
+    double sum = 0.0;
+    int32_t n_touched = 0;
+    for (int32_t qi = 0; qi < ws->n_query; qi++) {
+        const int32_t a = ws->query_ap[qi];
+        const double s = ws->query_rssi_dbm[qi];
+        const double u = bayes ? s - fill : represent(s, fill, p->fingerprint_powed_beta);
+        const double c_a = bayes ? log_p + log_normal(s, fill, sigma_floor) - log_not_p : 0.0;
+        sum += bayes ? c_a : u * u;
+        const int32_t end = map->ap_first[a + 1];
+        for (int32_t i = map->ap_first[a]; i < end; i++) {
+            const int32_t r = map->entry_rp[i];
+            if (!any_floor && map->rp_floor[r] != floor_hint) {
+                continue;
+            }
+            double term;
+            if (bayes) {
+                const double mu = (double)map->entry_mean_dbm[i];
+                const double q = detection(map, i, p_min);
+                const double sd = (double)map->entry_std_db[i];
+                term = log(q) + log_normal(s, mu, sd > sigma_floor ? sd : sigma_floor) - log(1.0 - q) - c_a;
+            } else {
+                const double v = entry_g(map, i, p);
+                if (v < 0.0) {
+                    continue; /* censored: the RP "does not hear" it, as a scan could not report it */
+                }
+                term = common_only ? (u - v) * (u - v) : -2.0 * u * v;
+            }
+            touch(ws, &n_touched, r, term);
+        }
+    }
+    au->n_touched = n_touched;
+    for (int32_t t = 0; t < n_touched; t++) {
+        const int32_t r = ws->touched[t];
+        double key;
+        if (bayes) {
+            ws->acc[r] += ws->rp_miss_loglik[r] + sum; /* now L_r */
+            key = -ws->acc[r];
+        } else if (common_only) {
+            if (ws->n_common[r] < p->fingerprint_min_common_aps) {
+                continue;
+            }
+            key = sqrt(ws->acc[r] / (double)ws->n_common[r]);
+        } else {
+            const double d2 = ws->rp_fill_sq_db2[r] + sum + ws->acc[r];
+            key = sqrt(d2 > 0.0 ? d2 : 0.0);
+        }
+        ws->acc[r] = bayes ? ws->acc[r] : key; /* acc now holds the score: L or d */
+        au->n_candidates++;
+        sf_fp_insert_best(best, n_best, k, key, r);
+    }
+    *scan_sum = sum;
+    return n_touched;
 }
 
 int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p, const sf_radiomap_t *const map,
@@ -310,72 +427,30 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
         return SF_ERANGE;
     }
 
-    /* Accumulate over the entries of the used APs only. */
+    /* The k best candidates: by the pre-selection's exact bound where it decides, else by visiting the
+     * entries of every used AP. */
     const bool bayes = p->fingerprint_method == 1;
     const bool common_only = !bayes && p->fingerprint_missing_mode == 1;
-    const double fill = p->fingerprint_fill_dbm;
-    const double p_min = p->fingerprint_nb_p_min;
-    const double log_p = log(p_min);
-    const double log_not_p = log(1.0 - p_min);
-    const double sigma_floor = p->fingerprint_sigma_floor_db;
-    double scan_sum = 0.0; /* WkNN fill: Σ (s − f)²; naive Bayes: Σ C_a */
-    int32_t n_touched = 0;
-    for (int32_t qi = 0; qi < ws->n_query; qi++) {
-        const int32_t a = ws->query_ap[qi];
-        const double s = ws->query_rssi_dbm[qi];
-        const double u = bayes ? s - fill : represent(s, fill, p->fingerprint_powed_beta);
-        const double c_a = bayes ? log_p + log_normal(s, fill, sigma_floor) - log_not_p : 0.0;
-        scan_sum += bayes ? c_a : u * u;
-        const int32_t end = map->ap_first[a + 1];
-        au->n_entries_visited += end - map->ap_first[a];
-        for (int32_t i = map->ap_first[a]; i < end; i++) {
-            const int32_t r = map->entry_rp[i];
-            if (!any_floor && map->rp_floor[r] != floor_hint) {
-                continue;
-            }
-            double term;
-            if (bayes) {
-                const double mu = (double)map->entry_mean_dbm[i];
-                const double q = detection(map, i, p_min);
-                const double sd = (double)map->entry_std_db[i];
-                term = log(q) + log_normal(s, mu, sd > sigma_floor ? sd : sigma_floor) - log(1.0 - q) - c_a;
-            } else {
-                const double mu = entry_level(map, i, p);
-                if (mu < p->fingerprint_min_rssi_dbm) {
-                    continue; /* censored: the RP "does not hear" it, as a scan could not report it */
-                }
-                const double v = represent(mu, fill, p->fingerprint_powed_beta);
-                term = common_only ? (u - v) * (u - v) : -2.0 * u * v;
-            }
-            touch(ws, &n_touched, r, term);
-        }
-    }
-    au->n_touched = n_touched;
-
-    /* Score the candidates and keep the k best. */
+    const bool pre = !bayes && !common_only && ws->rp_entry_first != NULL;
     int32_t k = p->fingerprint_k;
     k = k < 1 ? 1 : (k > SF_FINGERPRINT_K_MAX ? SF_FINGERPRINT_K_MAX : k);
-    ranked_t best[SF_FINGERPRINT_K_MAX];
+    sf_fp_ranked_t best[SF_FINGERPRINT_K_MAX];
     int32_t n_best = 0;
-    for (int32_t t = 0; t < n_touched; t++) {
-        const int32_t r = ws->touched[t];
-        double key;
-        if (bayes) {
-            ws->acc[r] += ws->rp_miss_loglik[r] + scan_sum; /* now L_r */
-            key = -ws->acc[r];
-        } else if (common_only) {
-            if (ws->n_common[r] < p->fingerprint_min_common_aps) {
-                continue;
-            }
-            key = sqrt(ws->acc[r] / (double)ws->n_common[r]);
-        } else {
-            const double d2 = ws->rp_fill_sq_db2[r] + scan_sum + ws->acc[r];
-            key = sqrt(d2 > 0.0 ? d2 : 0.0);
+    double scan_sum = 0.0; /* WkNN fill: Σ (s − f)²; naive Bayes: Σ C_a */
+    bool decided = false;
+    for (int32_t qi = 0; qi < ws->n_query; qi++) {
+        const int32_t a = ws->query_ap[qi];
+        au->n_entries_visited += map->ap_first[a + 1] - map->ap_first[a];
+        if (pre) {
+            const double u = represent(ws->query_rssi_dbm[qi], p->fingerprint_fill_dbm, p->fingerprint_powed_beta);
+            ws->ap_query_w[a] = -2.0 * u; /* exact: a power of two */
+            scan_sum += u * u;
         }
-        ws->acc[r] = bayes ? ws->acc[r] : key; /* acc now holds the score: L or d */
-        au->n_candidates++;
-        insert_best(best, &n_best, k, key, r);
     }
+    if (pre && p->fingerprint_preselect_aps > 0) {
+        decided = sf_fp_preselect(map, ws, p, floor_hint, any_floor, scan_sum, k, best, &n_best, au);
+    }
+    const int32_t n_touched = decided ? 0 : visit_all(ws, p, map, floor_hint, any_floor, k, best, &n_best, au, &scan_sum);
 
     int result = SF_OK;
     if (n_best == 0) {
@@ -468,6 +543,9 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
     /* Leave the scratch as found. */
     for (int32_t t = 0; t < n_touched; t++) {
         ws->n_common[ws->touched[t]] = 0;
+    }
+    for (int32_t qi = 0; pre && qi < ws->n_query; qi++) {
+        ws->ap_query_w[ws->query_ap[qi]] = 0.0;
     }
     return result;
 }

@@ -17,6 +17,21 @@
  * are not candidates. Unless any_floor, entries of RPs on floors other than floor_hint are skipped.
  * Below, R_r is the set of APs the map has at RP r (mean μ, std σ, detection rate q = count/rp_scans).
  *
+ * Pre-selection (WkNN fill mode, when the workspace has its arrays and fingerprint_preselect_aps > 0;
+ * sf_fingerprint_preselect.c). On a large map each heard AP reaches hundreds of RPs, so the full visit
+ * costs E_Q ≈ |Q| × (RPs per AP). Instead, the partial distance over the S = preselect_aps strongest
+ * used APs, LB_r = Σ_{a∈S} (g(s_a) − g(μ_ra))² ≤ d_r² (a lower bound: d² is a sum of such terms), ranks
+ * the RPs they reach, and the preselect_rps of least LB are scored exactly from their own entries
+ * (an RP-major copy), with the full visit's terms in its order, so a scored RP's d is bit-identical.
+ * When the bound proves that no RP left out can rank (audit.preselected 1) the fix is the full
+ * visit's; otherwise (2) it is the k best of those scored — an approximation: a winner of the full
+ * visit whose strongest APs look unlike the scan's is missed, and the strong APs weigh more, which on
+ * synthetic grids made the fixes slightly better, not worse (tests/c/test_fingerprint_preselect.c).
+ * It runs only where it visits fewer entries than the full visit (S's entries + preselect_rps ×
+ * n_entries/n_rp < E_Q): not on a small map, where each AP reaches few RPs (the msindoor and gsd maps
+ * of realbench, whose fixes are therefore unchanged). The estimator's position prior is not used:
+ * a wrong prior would hold the fixes to it, the one failure a fix exists to correct.
+ *
  * WkNN (fingerprint_method 0; Ramadhan 2016, Couceiro 2017). Distance in signal space [dB]:
  *   missing_mode 0 (fill, f = fingerprint_fill_dbm, −100): an AP missing on one side takes the level f,
  *     d_r² = Σ_{a∈Q∩R} (s_a − μ_ra)² + Σ_{a∈Q∖R} (s_a − f)² + Σ_{a∈R∖Q} (μ_ra − f)²
@@ -66,18 +81,23 @@
  * Memory. sizeof(sf_fingerprint_t) = 12 744 B on x86-64, at most 12.5 KiB (checked): the ring of
  * 4 × 255 readings and the audit; 16 320 B of stack (at most 16 KiB, checked in sf_fingerprint.c) while
  * the query is built. The last query (up to 1020 APs, 12 240 B) is scratch in the workspace.
- * Workspace: the query scratch (≈ 12.3 kB, fixed) and caller-owned arrays of n_rp each,
- * SF_FINGERPRINT_WS_BYTES_PER_RP = 32 bytes per RP (two
- * prepared double arrays, one double and two int32 scratch arrays); e.g. 10 000 RPs → 320 kB, allocated
- * by the board layer at site load. The scratch is left as found (n_common all zero) on every return.
+ * Workspace: the query scratch (≈ 12.3 kB, fixed) and caller-owned arrays sized to the map:
+ * SF_FINGERPRINT_WS_BYTES_PER_RP = 36 bytes per RP (two prepared double arrays, one double and two int32
+ * scratch arrays, the RP-major index), SF_FINGERPRINT_WS_BYTES_PER_ENTRY = 16 per map entry (the
+ * pre-selection's RP-major levels and APs, its AP-major float levels) and _PER_AP = 8 per AP (the
+ * query's weights); e.g. 10 000 RPs hearing 50 APs each → 8.4 MB, allocated by the board layer at
+ * site load. The scratch is left as found (n_common and ap_query_w all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
  * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm, _map_level or _powed_beta change). sf_fingerprint_match: O(n_scan·255) to store the
- * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, O(E_Q) for the visited entries
- * (E_Q = total entries of the used APs; one log and one division per entry for naive Bayes), and
- * O(T·k) to select among the T touched RPs — independent of the map size beyond E_Q and T ≤ n_rp.
- * Measured (`stridefix bench perf`, WkNN defaults, synthetic 2 m grids, ~70 instructions per visited
- * entry): 78 k instructions per fix at 100 RPs, 1.48 M at 2 025 RPs (34 APs heard, 20 k entries
- * visited), 2.2 M at 20 164 RPs. The query is sorted by sf_sort (no qsort: it may allocate).
+ * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, then either the full visit,
+ * O(E_Q) for the visited entries (E_Q = total entries of the used APs; one log and one division per
+ * entry for naive Bayes) and O(T·k) to select among the T touched RPs, or the pre-selection,
+ * O(E_S + T_S log C + C·e) (E_S: the S APs' entries, T_S ≤ E_S the RPs they reach, C = preselect_rps,
+ * e: entries per RP) — independent of the map size.
+ * Measured (`stridefix bench perf`, WkNN defaults, synthetic 2 m grids, one AP per 40 m²): full visit
+ * (~70 instructions per visited entry) 78 k instructions per fix at 100 RPs, 1.48 M at 2 025 RPs (34
+ * APs heard, 20 k entries visited), 2.2 M at 20 164 RPs; with the pre-selection 28 k, 136 k and 167 k.
+ * The query is sorted by sf_sort (no qsort: it may allocate).
  * No heap, no I/O, no clock; deterministic (fixed summation order: APs by BSSID, entries by RP).
  *
  * Errors. sf_fingerprint_prepare: SF_EINVAL (NULL, empty map n_rp = 0 or n_ap = 0, workspace smaller than
@@ -100,11 +120,16 @@
 #define SF_FINGERPRINT_QUERY_APS (SF_FINGERPRINT_RING_SCANS * SF_FINGERPRINT_SCAN_APS)
 #define SF_FINGERPRINT_K_MAX 16      /* fingerprint_k ≤ this */
 #define SF_FINGERPRINT_D_MIN_DB 0.01 /* WkNN weight guard: w = 1/max(d, this) */
-#define SF_FINGERPRINT_WS_BYTES_PER_RP (3 * sizeof(double) + 2 * sizeof(int32_t))
+#define SF_FINGERPRINT_WS_BYTES_PER_RP (3 * sizeof(double) + 3 * sizeof(int32_t))
+#define SF_FINGERPRINT_WS_BYTES_PER_ENTRY (sizeof(double) + sizeof(int32_t) + sizeof(float))
+#define SF_FINGERPRINT_WS_BYTES_PER_AP sizeof(double)
+#define SF_FINGERPRINT_PRESELECT_APS_MAX 16  /* fingerprint_preselect_aps ≤ this */
+#define SF_FINGERPRINT_PRESELECT_RPS_MAX 256 /* fingerprint_preselect_rps ≤ this */
 _Static_assert(SF_FINGERPRINT_RING_SCANS >= 3, "SmartLocator averages 3 scans");
 _Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used is int16");
 _Static_assert(SF_FINGERPRINT_K_MAX >= 3, "the papers use k = 3");
-_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 32, "the model above promises 32 bytes per RP");
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 36, "the model above promises 36 bytes per RP");
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 16, "the model above promises 16 bytes per map entry");
 
 /* Why the last match gave no fix. */
 enum { sf_fp_ok = 0, sf_fp_too_few_aps = 1, sf_fp_no_candidate = 2 };
@@ -117,6 +142,14 @@ typedef struct {
     double *acc;              /* [n_rp] scratch: per-RP partial sum */
     int32_t *n_common;        /* [n_rp] scratch: |Q∩R_r|; all 0 between calls */
     int32_t *touched;         /* [n_rp] scratch: RPs with n_common > 0, in order of first touch */
+    /* the pre-selection's arrays (see Candidates above): all set, or all NULL for the full visit */
+    int32_t n_entries;          /* capacity of the per-entry arrays, ≥ map->n_entries */
+    int32_t n_ap;               /* capacity of ap_query_w, ≥ map->n_ap */
+    int32_t *rp_entry_first;    /* [n_rp + 1] prepared: RP r's entries, RP-major, are first[r] … first[r+1]−1 */
+    int32_t *rp_entry_ap;       /* [n_entries] prepared: the AP of each RP-major entry, ascending per RP */
+    double *rp_entry_level_db;  /* [n_entries] prepared: g(μ) RP-major; 0 = censored */
+    float *entry_level_db;      /* [n_entries] prepared, AP-major: g(μ) (to float, for the bound); −1 = censored */
+    double *ap_query_w;         /* [n_ap] scratch: −2·g(s) of a used AP, 0 for the others */
     /* set by sf_fingerprint_prepare */
     bool prepared;
     int32_t map_n_ap, map_n_rp, map_n_entries; /* the map it was prepared for */
@@ -143,7 +176,8 @@ typedef struct {
     int32_t n_used;             /* of them, in the map: |Q| */
     int32_t n_entries_visited;  /* map entries visited (Σ entries of the used APs) */
     int32_t n_touched;          /* RPs sharing at least one used AP (on the allowed floor) */
-    int32_t n_candidates;       /* of them, eligible */
+    int32_t n_candidates;       /* of them, eligible and scored (pre-selection: scored exactly) */
+    int8_t preselected;         /* pre-selection: 0 not used, 1 proven exact, 2 best of the ranked (n_touched: RPs its APs reach) */
     int32_t k_used;             /* min(k, n_candidates) */
     int32_t winner_rp[SF_FINGERPRINT_K_MAX];    /* best first */
     double winner_score[SF_FINGERPRINT_K_MAX];  /* WkNN: d [dB]; naive Bayes: L [log-likelihood] */

@@ -3,7 +3,8 @@
  * array above a size threshold: the "no heap, also not through libc" rule of STYLE.md).
  *
  * Not stable: callers give a total order (sf_fingerprint's readings compare by BSSID, then scan age,
- * a unique pair). Elements are swapped byte by byte, so any element size works without a buffer.
+ * a unique pair). Elements are swapped eight bytes at a time, then byte by byte, so any element size works without
+ * a buffer.
  *
  * Cost: at most 2·n·log2(n) comparisons and n·log2(n) swaps of `size` bytes; no recursion, O(1) stack
  * (a few words), no heap. Cannot fail: n ≤ 1 or size 0 leaves the array as is. */

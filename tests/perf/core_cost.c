@@ -11,12 +11,15 @@
  *                               grows with the map: one AP per 40 m² (200 APs at 2 000 RPs), levels
  *                               −40 − 30·log10(d) dBm (+ 4 dB noise in the scans), an entry where the
  *                               mean is above −85 dBm, a scan hearing every AP above −80 dBm (~31).
+ *                               With the pre-selection's workspace arrays, or with "full" after SCANS
+ *                               without them (every entry of every AP heard visited).
  *   core_cost samples SECONDS   the sensors walk's IMU and MAG samples as text, for a peer filter.
  *   core_cost sizes             sizeof of the core's state structs.
  *
  * Prints one JSON object (counts and what was built); exit 0, 2 on bad usage. The harness may use the
  * heap (the map is the caller's memory by design); the core calls never do (ctest core_symbols). */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +33,7 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS | sizes\n");
+    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS [full] | sizes\n");
     return 2;
 }
 
@@ -119,7 +122,7 @@ static double level_dbm(const double d_m)
     return -40.0 - 30.0 * log10(fmax(d_m, 1.0));
 }
 
-static int run_wifi(const int32_t n_rp_want, const int32_t n_scans)
+static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool preselect)
 {
     const int32_t side = (int32_t)ceil(sqrt((double)n_rp_want));
     const int32_t n_rp = side * side;
@@ -183,6 +186,15 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans)
     ws.acc = malloc(sizeof(double) * (size_t)n_rp);
     ws.n_common = calloc((size_t)n_rp, sizeof(int32_t));
     ws.touched = malloc(sizeof(int32_t) * (size_t)n_rp);
+    if (preselect) {
+        ws.n_entries = n_entries;
+        ws.n_ap = n_ap;
+        ws.rp_entry_first = malloc(sizeof(int32_t) * (size_t)(n_rp + 1));
+        ws.rp_entry_ap = malloc(sizeof(int32_t) * (size_t)n_entries);
+        ws.rp_entry_level_db = malloc(sizeof(double) * (size_t)n_entries);
+        ws.ap_query_w = malloc(sizeof(double) * (size_t)n_ap);
+        ws.entry_level_db = malloc(sizeof(float) * (size_t)n_entries);
+    }
     const int rc = sf_fingerprint_prepare(&ws, &map, &p);
     if (rc != 0) {
         fprintf(stderr, "core_cost: sf_fingerprint_prepare: %d\n", rc);
@@ -192,7 +204,7 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans)
     sf_fingerprint_init(&fp);
     int64_t *sb = malloc(sizeof *sb * (size_t)n_ap);
     float *sr = malloc(sizeof *sr * (size_t)n_ap);
-    long heard = 0, fixes = 0;
+    long heard = 0, fixes = 0, preselected = 0, scored = 0;
     double err_sum_m = 0.0;
     for (int32_t q = 0; q < n_scans; q++) {
         const double qx = 4.0 + (size_m - 8.0) * rng_uniform01(&r);
@@ -212,12 +224,16 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans)
         sf_fix_t fix;
         if (sf_fingerprint_match(&fp, &p, &map, &ws, &scan, 0, true, &fix) == 0) {
             fixes++;
+            preselected += fp.audit.preselected != 0;
+            scored += fp.audit.n_candidates;
             err_sum_m += hypot(fix.x_m - qx, fix.y_m - qy);
         }
     }
     printf("{\"mode\": \"wifi\", \"n_rp\": %d, \"n_ap\": %d, \"n_entries\": %d, \"scans\": %d, \"mean_heard\": %.1f, "
-           "\"fixes\": %ld, \"mean_error_m\": %.2f, \"size_m\": %.0f}\n",
-           n_rp, n_ap, n_entries, n_scans, (double)heard / (double)n_scans, fixes, fixes ? err_sum_m / (double)fixes : -1.0, size_m);
+           "\"fixes\": %ld, \"mean_error_m\": %.17g, \"size_m\": %.0f, \"preselect\": %s, \"preselected\": %ld, "
+           "\"mean_scored\": %.1f}\n",
+           n_rp, n_ap, n_entries, n_scans, (double)heard / (double)n_scans, fixes, fixes ? err_sum_m / (double)fixes : -1.0,
+           size_m, preselect ? "true" : "false", preselected, fixes ? (double)scored / (double)fixes : 0.0);
     return 0;
 }
 
@@ -236,9 +252,9 @@ int main(const int argc, char **const argv)
         const double s = atof(argv[2]);
         return s > 0.0 ? run_sensors(s) : usage();
     }
-    if (argc == 4 && strcmp(argv[1], "wifi") == 0) {
+    if ((argc == 4 || (argc == 5 && strcmp(argv[4], "full") == 0)) && strcmp(argv[1], "wifi") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
-        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans) : usage();
+        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans, argc == 4) : usage();
     }
     if (argc == 3 && strcmp(argv[1], "samples") == 0) {
         const double s = atof(argv[2]);

@@ -34,6 +34,18 @@ def test_wifi_maps_grow_with_constant_density_and_fixes_land_near_the_scan(harne
         assert m["fixes"] == 20 and 0.0 <= m["mean_error_m"] < 8.0
 
 
+def test_wifi_preselection_scores_few_rps_and_keeps_the_accuracy(harness):
+    """GIVEN the 2 025-RP map, the same 20 scans with stridefixd's workspace and with the full visit THEN
+    the pre-selection decides every fix, scores at most preselect_rps (32) RPs of the ~1 500 the full
+    visit scores, and its mean error is no worse than the full visit's by more than 0.3 m."""
+    pre = perf._harness_json(harness, "wifi", "2000", "20")
+    full = perf._harness_json(harness, "wifi", "2000", "20", "full")
+    assert pre["preselect"] is True and full["preselect"] is False
+    assert full["preselected"] == 0 and full["mean_scored"] > 1000
+    assert pre["preselected"] == pre["fixes"] and pre["mean_scored"] <= 32
+    assert pre["mean_error_m"] <= full["mean_error_m"] + 0.3
+
+
 def test_callgrind_counts_the_matcher_per_fix(harness, tmp_path):
     """GIVEN 5 fixes on the 100-RP map under callgrind THEN the matcher's instructions are counted, and
     doubling the fixes roughly doubles them (per-call cost, not the harness's set-up)."""

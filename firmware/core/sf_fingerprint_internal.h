@@ -1,0 +1,28 @@
+/* sf_fingerprint_internal.h — what sf_fingerprint.c and its pre-selection (sf_fingerprint_preselect.c)
+ * share: the ranked list of the k best RPs. Not part of the core's API. */
+#ifndef SF_FINGERPRINT_INTERNAL_H
+#define SF_FINGERPRINT_INTERNAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "sf_fingerprint.h"
+
+typedef struct {
+    double key; /* lower is better: WkNN d, naive Bayes −L */
+    int32_t rp;
+} sf_fp_ranked_t;
+
+/* Inserts (key, rp) into best[0 .. *n_best), kept sorted by key then RP index, at most k long. */
+void sf_fp_insert_best(sf_fp_ranked_t *best, int32_t *n_best, int32_t k, double key, int32_t rp);
+
+/* WkNN fill mode with the pre-selection's arrays and fingerprint_preselect_aps > 0: the k best of the
+ * pre-selected candidates (sf_fingerprint_preselect.c). ws->ap_query_w holds the query; scan_sum =
+ * Σ g(s)². True when there were at least k: best[0 .. *n_best) and the audit's n_touched,
+ * n_candidates and preselected are set. False: *n_best = 0 (the caller visits every entry). The
+ * scratch is left as found either way. */
+bool sf_fp_preselect(const sf_radiomap_t *map, sf_fingerprint_workspace_t *ws, const sf_params_t *p, int16_t floor_hint,
+                     bool any_floor, double scan_sum, int32_t k, sf_fp_ranked_t *best, int32_t *n_best,
+                     sf_fingerprint_audit_t *au);
+
+#endif
