@@ -17,6 +17,10 @@ static void start_at_config(sf_estimator_t *const e, const sf_params_t *const p)
     }
 }
 
+/* The walls of a cloud attached without a grid: none (constant data, not state: sf_wall_grid_empty's
+ * grid, zero everywhere). */
+static const sf_wall_grid_t k_no_walls = {0};
+
 void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
 {
     *e = (sf_estimator_t){0};
@@ -46,8 +50,7 @@ int sf_estimator_attach_particles(sf_estimator_t *const e, const sf_params_t *co
     if (rc != SF_OK) {
         return rc;
     }
-    sf_wall_grid_empty(&e->no_walls);
-    sf_particle_set_map(&e->particles, walls != NULL ? walls : &e->no_walls, e->site != NULL ? &e->site->ports : NULL);
+    sf_particle_set_map(&e->particles, walls != NULL ? walls : &k_no_walls, e->site != NULL ? &e->site->ports : NULL);
     e->has_particles = true;
     sf_fusion_set_cloud(&e->fusion[sf_scheme_particle], p, &e->particles);
     return SF_OK;

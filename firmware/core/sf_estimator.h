@@ -50,13 +50,14 @@
  * nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 25 328 B on x86-64 (i686 not rechecked), at most 25 KiB (checked): the
- * controller is 1 480 B of it (sf_controller.h); the
- * fingerprint's scan ring is half of it (sf_fingerprint_t, 12 744 B; the matcher's query scratch is in the
- * caller's workspace, sf_fingerprint.h), the eight schemes 4 224 B
- * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
- * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
- * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`): ≈ 3 200 instructions per
+ * Memory: sizeof(sf_estimator_t) = 15 224 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
+ * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
+ * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
+ * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's
+ * workspace, sf_fingerprint.h), the step detector 2 416 B, the controller 1 480 B (sf_controller.h);
+ * the particle cloud's arrays (32 kB at 1 000 particles) and the wall index are the caller's
+ * (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) is here (a cloud without walls points at a
+ * constant empty grid). Cost (callgrind, x86-64 -O2, `stridefix bench perf`): ≈ 3 200 instructions per
  * sf_estimator_imu without the particle scheme (the attitude filter ≈ 1 100 of them, atan2/sincos the
  * largest libm share), ≈ 2 700 per sf_estimator_mag (the sf_magcal solve), ≈ 1 500 per
  * sf_estimator_baro (sf_floor's pow); a Wi-Fi fix is sf_fingerprint.h's, a particle step sf_particle.h's. */
@@ -121,7 +122,6 @@ typedef struct {
     sf_fusion_t fusion[sf_scheme_count]; /* every scheme runs on the same inputs */
     sf_particle_t particles; /* the particle scheme's cloud; its arrays are the caller's (attach_particles) */
     bool has_particles;
-    sf_wall_grid_t no_walls;  /* the walls of a cloud attached without a grid: none */
     /* online stride calibration: the anchor is the last accepted Kalman fix */
     bool calib_anchor_valid;
     double calib_fix_x_m, calib_fix_y_m;   /* the anchor fix */
@@ -132,7 +132,7 @@ typedef struct {
     sf_controller_t controller;
     uint32_t context_off; /* source inputs the controller's policy kept off (REASON_CONTEXT_OFF) */
 } sf_estimator_t;
-_Static_assert(sizeof(sf_estimator_t) <= 25 * 1024, "sf_estimator.h promises at most 25 KiB");
+_Static_assert(sizeof(sf_estimator_t) <= 16 * 1024, "sf_estimator.h promises at most 16 KiB");
 
 void sf_estimator_init(sf_estimator_t *est, const sf_params_t *p);
 

@@ -117,7 +117,9 @@
 
 #define SF_FINGERPRINT_RING_SCANS 4  /* scans kept for averaging: fingerprint_average_scans ≤ this */
 #define SF_FINGERPRINT_SCAN_APS 255  /* readings kept per scan (the strongest); = the CAN scan's limit */
-#define SF_FINGERPRINT_QUERY_APS (SF_FINGERPRINT_RING_SCANS * SF_FINGERPRINT_SCAN_APS)
+#define SF_FINGERPRINT_POOL_READINGS (2 * SF_FINGERPRINT_SCAN_APS) /* the ring's readings: two full scans */
+#define SF_FINGERPRINT_QUERY_APS SF_FINGERPRINT_POOL_READINGS
+#define SF_FINGERPRINT_MAX_MAP_APS 65535 /* a stored reading names its map AP in 16 bits */
 #define SF_FINGERPRINT_K_MAX 16      /* fingerprint_k ≤ this */
 #define SF_FINGERPRINT_D_MIN_DB 0.01 /* WkNN weight guard: w = 1/max(d, this) */
 #define SF_FINGERPRINT_WS_BYTES_PER_RP (3 * sizeof(double) + 3 * sizeof(int32_t))
@@ -126,7 +128,7 @@
 #define SF_FINGERPRINT_PRESELECT_APS_MAX 16  /* fingerprint_preselect_aps ≤ this */
 #define SF_FINGERPRINT_PRESELECT_RPS_MAX 256 /* fingerprint_preselect_rps ≤ this */
 _Static_assert(SF_FINGERPRINT_RING_SCANS >= 3, "SmartLocator averages 3 scans");
-_Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used is int16");
+_Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used and the slots' first and n are int16");
 _Static_assert(SF_FINGERPRINT_K_MAX >= 3, "the papers use k = 3");
 _Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 36, "the model above promises 36 bytes per RP");
 _Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 16, "the model above promises 16 bytes per map entry");
@@ -185,24 +187,29 @@ typedef struct {
     double spread_m;            /* accuracy before the floor and the AP scaling */
 } sf_fingerprint_audit_t;
 
-/* One stored scan (filtered, deduplicated, at most SF_FINGERPRINT_SCAN_APS readings). */
+/* One stored scan: its readings (filtered, deduplicated, map APs only, at most SF_FINGERPRINT_SCAN_APS)
+ * are n consecutive readings of the pool from first on, wrapping. */
 typedef struct {
     int64_t t_us;
-    int32_t n;
-    int64_t bssid[SF_FINGERPRINT_SCAN_APS];
-    float rssi_dbm[SF_FINGERPRINT_SCAN_APS];
+    int16_t first;     /* pool index of its first reading */
+    int16_t n;         /* readings kept */
+    int16_t n_unknown; /* readings of APs not in the map (counted, not kept) */
 } sf_fingerprint_scan_slot_t;
 
 typedef struct {
     sf_fingerprint_scan_slot_t ring[SF_FINGERPRINT_RING_SCANS];
+    uint16_t pool_ap[SF_FINGERPRINT_POOL_READINGS];     /* map AP index */
+    float pool_rssi_dbm[SF_FINGERPRINT_POOL_READINGS];
+    const sf_radiomap_t *map; /* the map the pool's AP indices name (another empties the ring) */
     int32_t newest; /* ring index of the newest scan */
     int32_t count;  /* scans in the ring */
     sf_fingerprint_audit_t audit;
     /* counters, never decrease */
     uint32_t scans, fixes, rejected_too_few_aps, rejected_no_candidate;
     uint32_t readings_bad, readings_weak, readings_truncated, readings_unknown, backwards;
+    uint32_t pool_evictions; /* older scans dropped to make room in the pool */
 } sf_fingerprint_t;
-_Static_assert(sizeof(sf_fingerprint_t) <= 12 * 1024 + 512, "sf_fingerprint.h promises at most 12.5 KiB");
+_Static_assert(sizeof(sf_fingerprint_t) <= 4 * 1024 + 512, "sf_fingerprint.h promises at most 4.5 KiB");
 
 /* Empty ring, zero counters. */
 void sf_fingerprint_init(sf_fingerprint_t *fp);

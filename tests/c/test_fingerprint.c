@@ -419,8 +419,9 @@ static void test_averaging(void **state)
     assert_near(m.ws.query_rssi_dbm[0], -42.5, 0.0);
 }
 
-/* A repeated BSSID keeps its strongest reading; more than SF_FINGERPRINT_SCAN_APS readings keep the strongest. */
-static void test_duplicates_and_truncation(void **state)
+/* A repeated BSSID keeps its strongest reading; readings of APs the map lacks are counted, not kept, so
+ * however many there are they never crowd out the map's APs. */
+static void test_duplicates_and_unknown(void **state)
 {
     (void)state;
     const sf_radiomap_t map = tiny_map(k_floor0);
@@ -433,7 +434,7 @@ static void test_duplicates_and_truncation(void **state)
     enum { n_unknown = SF_FINGERPRINT_SCAN_APS + 13, n_all = n_unknown + 3 };
     static int64_t b[n_all];
     static float r[n_all];
-    for (int i = 0; i < n_unknown; i++) { /* unknown APs at −80: 16 of them must go */
+    for (int i = 0; i < n_unknown; i++) { /* unknown APs at −80, more than a scan keeps */
         b[i] = 0x1000 + i;
         r[i] = -80.0f;
     }
@@ -442,8 +443,10 @@ static void test_duplicates_and_truncation(void **state)
     b[n_unknown + 2] = 0x300, r[n_unknown + 2] = -60.0f;
     sf_fix_t fix = {0};
     assert_int_equal(match3(&fp, &p, &map, &m, 1, n_all, b, r, &fix), SF_OK);
-    assert_int_equal(fp.readings_truncated, 16);
-    assert_int_equal(fp.audit.n_heard, SF_FINGERPRINT_SCAN_APS);
+    assert_int_equal(fp.readings_truncated, 0);
+    assert_int_equal(fp.readings_unknown, n_unknown);
+    assert_int_equal(fp.audit.n_unknown, n_unknown);
+    assert_int_equal(fp.audit.n_heard, n_all);
     assert_int_equal(fp.audit.n_used, 3);
     assert_near(fix.x_m, 0.6294865025, 1e-9);
     const int64_t bd[4] = {0x100, 0x200, 0x100, 0x300};
@@ -451,6 +454,67 @@ static void test_duplicates_and_truncation(void **state)
     assert_int_equal(match3(&fp, &p, &map, &m, 2, 4, bd, rd, &fix), SF_OK);
     assert_near(m.ws.query_rssi_dbm[0], -45.0, 0.0);
     assert_near(fix.y_m, 1.5248295278, 1e-9);
+}
+
+/* A map of 300 APs, all heard at both of its RPs (r0 strong, r1 weak). */
+#define WIDE_AP 300
+typedef struct {
+    int64_t bssid[WIDE_AP];
+    int32_t first[WIDE_AP + 1], rp[2 * WIDE_AP], count[2 * WIDE_AP];
+    float mean[2 * WIDE_AP], std[2 * WIDE_AP];
+} wide_map_t;
+
+static sf_radiomap_t wide_map(wide_map_t *const w)
+{
+    static const float x[2] = {0, 10}, y[2] = {0, 0};
+    static const int16_t fl[2] = {0, 0};
+    static const int32_t scans[2] = {10, 10};
+    for (int a = 0; a < WIDE_AP; a++) {
+        w->bssid[a] = 0x10000 + a;
+        w->first[a] = 2 * a;
+        for (int r = 0; r < 2; r++) {
+            w->rp[2 * a + r] = r;
+            w->mean[2 * a + r] = r == 0 ? -50.0f - (float)(a % 30) : -80.0f;
+            w->std[2 * a + r] = 4.0f;
+            w->count[2 * a + r] = 10;
+        }
+    }
+    w->first[WIDE_AP] = 2 * WIDE_AP;
+    return (sf_radiomap_t){WIDE_AP, w->bssid, w->first, 2, x, y, fl, scans, 2 * WIDE_AP, w->rp, w->mean, w->std,
+                           w->count};
+}
+
+/* More than SF_FINGERPRINT_SCAN_APS readings of map APs keep the strongest; scans averaged share a pool of
+ * SF_FINGERPRINT_POOL_READINGS readings, the oldest scan giving way when a new one does not fit. */
+static void test_truncation_and_pool(void **state)
+{
+    (void)state;
+    static wide_map_t w;
+    const sf_radiomap_t map = wide_map(&w);
+    sf_params_t p = params(0, 0);
+    p.fingerprint_average_scans = 3;
+    ws_mem_t m;
+    ws_setup(&m, 2);
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    static sf_fingerprint_t fp;
+    sf_fingerprint_init(&fp);
+    static float r[WIDE_AP];
+    for (int a = 0; a < WIDE_AP; a++) {
+        r[a] = a < 45 ? -85.0f : -55.0f; /* the first 45 are the weakest: they go */
+    }
+    sf_fix_t fix = {0};
+    assert_int_equal(match3(&fp, &p, &map, &m, 1000000, WIDE_AP, w.bssid, r, &fix), SF_OK);
+    assert_int_equal(fp.readings_truncated, WIDE_AP - SF_FINGERPRINT_SCAN_APS);
+    assert_int_equal(fp.audit.n_used, SF_FINGERPRINT_SCAN_APS);
+    assert_int_equal(m.ws.query_ap[0], 45);
+    assert_true(fix.x_m < 5.0); /* nearer r0, whose levels the scan is like */
+    /* 200 readings a scan: two fit the pool (510), a third pushes the oldest out */
+    for (int s = 0; s < 3; s++) {
+        assert_int_equal(match3(&fp, &p, &map, &m, 2000000 + 1000000LL * s, 200, w.bssid, r + 100, &fix), SF_OK);
+    }
+    assert_int_equal(fp.audit.n_scans_averaged, 2);
+    assert_true(fp.pool_evictions >= 1);
+    assert_int_equal(fp.audit.n_used, 200);
 }
 
 /* map_level 1: the level of an entry is the mean over all 10 scans of its RP, misses at −100:
@@ -851,7 +915,8 @@ int main(void)
         cmocka_unit_test(test_min_rssi_and_too_few),
         cmocka_unit_test(test_misuse),
         cmocka_unit_test(test_averaging),
-        cmocka_unit_test(test_duplicates_and_truncation),
+        cmocka_unit_test(test_duplicates_and_unknown),
+        cmocka_unit_test(test_truncation_and_pool),
         cmocka_unit_test(test_map_level_and_censoring),
         cmocka_unit_test(test_powed_representation),
         cmocka_unit_test(test_floor_restriction),
