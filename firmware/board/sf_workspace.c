@@ -7,7 +7,7 @@
 #include "sf_error.h"
 
 _Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 36, "sf_workspace.h promises 36 bytes per reference point");
-_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 16, "sf_workspace.h promises 16 bytes per map entry");
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 20, "sf_workspace.h promises 20 bytes per map entry");
 
 int sf_workspace_alloc(const sf_radiomap_t *const map, sf_fingerprint_workspace_t *const ws, void **const memory)
 {
@@ -28,13 +28,13 @@ int sf_workspace_alloc(const sf_radiomap_t *const map, sf_fingerprint_workspace_
     ws->rp_miss_loglik = d += n;
     ws->acc = d += n;
     ws->rp_entry_level_db = d += n;
+    ws->entry_level_db = d += e;
     ws->ap_query_w = d += e;
     int32_t *i = (int32_t *)(void *)(d + a);
     ws->n_common = i;
     ws->touched = i += n;
     ws->rp_entry_first = i += n; /* n + 1 */
     ws->rp_entry_ap = i += n + 1;
-    ws->entry_level_db = (float *)(void *)(i + e);
     *memory = m;
     return SF_OK;
 }

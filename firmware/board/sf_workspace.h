@@ -1,8 +1,8 @@
 /* sf_workspace.h — the fingerprint matcher's workspace for a loaded site (sf_fingerprint.h): one heap
- * block of SF_FINGERPRINT_WS_BYTES_PER_RP (36) bytes per reference point, _PER_ENTRY (16) per map entry
+ * block of SF_FINGERPRINT_WS_BYTES_PER_RP (36) bytes per reference point, _PER_ENTRY (20) per map entry
  * and _PER_AP (8) per AP, laid out as the workspace's arrays, the pre-selection's included. Allocated
  * once at start-up (the board layer's only allocation besides the site file, the input and the log
- * queue); e.g. 10 000 RPs with 50 APs each → 8.4 MB. */
+ * queue); e.g. 10 000 RPs with 50 APs each → 10.4 MB. */
 #ifndef SF_WORKSPACE_H
 #define SF_WORKSPACE_H
 

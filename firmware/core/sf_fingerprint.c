@@ -72,7 +72,7 @@ static double entry_g(const sf_radiomap_t *const map, const int32_t i, const sf_
                : -1.0;
 }
 
-/* The pre-selection's arrays: every entry's g AP-major (float) and RP-major (a counting sort by RP that
+/* The pre-selection's arrays: every entry's g AP-major and RP-major (a counting sort by RP that
  * keeps the APs ascending within an RP, as the AP-major visit meets them), and an empty query. */
 static void prepare_preselect(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
                               const sf_params_t *const p)
@@ -96,7 +96,7 @@ static void prepare_preselect(sf_fingerprint_workspace_t *const ws, const sf_rad
             const double g = entry_g(map, i, p);
             ws->rp_entry_ap[j] = a;
             ws->rp_entry_level_db[j] = g < 0.0 ? 0.0 : g;
-            ws->entry_level_db[i] = (float)g;
+            ws->entry_level_db[i] = g;
         }
     }
     for (int32_t r = 0; r < map->n_rp; r++) {
@@ -395,7 +395,7 @@ static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t
                 const double sd = (double)map->entry_std_db[i];
                 term = log(q) + log_normal(s, mu, sd > sigma_floor ? sd : sigma_floor) - log(1.0 - q) - c_a;
             } else {
-                const double v = entry_g(map, i, p);
+                const double v = ws->entry_level_db != NULL ? ws->entry_level_db[i] : entry_g(map, i, p);
                 if (v < 0.0) {
                     continue; /* censored: the RP "does not hear" it, as a scan could not report it */
                 }

@@ -83,9 +83,9 @@
  * the query is built. The last query (up to 1020 APs, 12 240 B) is scratch in the workspace.
  * Workspace: the query scratch (≈ 12.3 kB, fixed) and caller-owned arrays sized to the map:
  * SF_FINGERPRINT_WS_BYTES_PER_RP = 36 bytes per RP (two prepared double arrays, one double and two int32
- * scratch arrays, the RP-major index), SF_FINGERPRINT_WS_BYTES_PER_ENTRY = 16 per map entry (the
- * pre-selection's RP-major levels and APs, its AP-major float levels) and _PER_AP = 8 per AP (the
- * query's weights); e.g. 10 000 RPs hearing 50 APs each → 8.4 MB, allocated by the board layer at
+ * scratch arrays, the RP-major index), SF_FINGERPRINT_WS_BYTES_PER_ENTRY = 20 per map entry (the
+ * levels g, AP-major for the full visit and the bound, RP-major with their APs for exact scores) and _PER_AP = 8 per AP (the
+ * query's weights); e.g. 10 000 RPs hearing 50 APs each → 10.4 MB, allocated by the board layer at
  * site load. The scratch is left as found (n_common and ap_query_w all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
  * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm, _map_level or _powed_beta change). sf_fingerprint_match: O(n_scan·255) to store the
@@ -123,7 +123,7 @@
 #define SF_FINGERPRINT_K_MAX 16      /* fingerprint_k ≤ this */
 #define SF_FINGERPRINT_D_MIN_DB 0.01 /* WkNN weight guard: w = 1/max(d, this) */
 #define SF_FINGERPRINT_WS_BYTES_PER_RP (3 * sizeof(double) + 3 * sizeof(int32_t))
-#define SF_FINGERPRINT_WS_BYTES_PER_ENTRY (sizeof(double) + sizeof(int32_t) + sizeof(float))
+#define SF_FINGERPRINT_WS_BYTES_PER_ENTRY (2 * sizeof(double) + sizeof(int32_t))
 #define SF_FINGERPRINT_WS_BYTES_PER_AP sizeof(double)
 #define SF_FINGERPRINT_PRESELECT_APS_MAX 16  /* fingerprint_preselect_aps ≤ this */
 #define SF_FINGERPRINT_PRESELECT_RPS_MAX 256 /* fingerprint_preselect_rps ≤ this */
@@ -131,7 +131,7 @@ _Static_assert(SF_FINGERPRINT_RING_SCANS >= 3, "SmartLocator averages 3 scans");
 _Static_assert(SF_FINGERPRINT_QUERY_APS <= INT16_MAX, "n_ap_used and the slots' first and n are int16");
 _Static_assert(SF_FINGERPRINT_K_MAX >= 3, "the papers use k = 3");
 _Static_assert(SF_FINGERPRINT_WS_BYTES_PER_RP == 36, "the model above promises 36 bytes per RP");
-_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 16, "the model above promises 16 bytes per map entry");
+_Static_assert(SF_FINGERPRINT_WS_BYTES_PER_ENTRY == 20, "the model above promises 20 bytes per map entry");
 
 /* Why the last match gave no fix. */
 enum { sf_fp_ok = 0, sf_fp_too_few_aps = 1, sf_fp_no_candidate = 2 };
@@ -150,7 +150,7 @@ typedef struct {
     int32_t *rp_entry_first;    /* [n_rp + 1] prepared: RP r's entries, RP-major, are first[r] … first[r+1]−1 */
     int32_t *rp_entry_ap;       /* [n_entries] prepared: the AP of each RP-major entry, ascending per RP */
     double *rp_entry_level_db;  /* [n_entries] prepared: g(μ) RP-major; 0 = censored */
-    float *entry_level_db;      /* [n_entries] prepared, AP-major: g(μ) (to float, for the bound); −1 = censored */
+    double *entry_level_db;     /* [n_entries] prepared, AP-major: g(μ) as the full visit uses it; −1 = censored */
     double *ap_query_w;         /* [n_ap] scratch: −2·g(s) of a used AP, 0 for the others */
     /* set by sf_fingerprint_prepare */
     bool prepared;

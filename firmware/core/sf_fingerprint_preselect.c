@@ -20,7 +20,7 @@
 #include "sf_assert.h"
 #include "sf_fingerprint_internal.h"
 
-/* LB is summed from float levels (relative error ~6e-8 per term); this margin is far above that and
+/* LB is summed in another order than d (rounding ~1e-16 per term); this margin is far above that and
  * far below the gaps between RPs, so "proven" is proven. */
 #define PROOF_REL 1e-5
 #define PROOF_ABS_DB2 1e-3
@@ -156,7 +156,7 @@ bool sf_fp_preselect(const sf_radiomap_t *const map, sf_fingerprint_workspace_t 
         const int32_t end = map->ap_first[s_ap[si] + 1];
         for (int32_t i = map->ap_first[s_ap[si]]; i < end; i++) {
             const int32_t r = map->entry_rp[i];
-            const double v = (double)ws->entry_level_db[i];
+            const double v = ws->entry_level_db[i];
             if (v < 0.0 || (!any_floor && map->rp_floor[r] != floor_hint)) {
                 continue; /* censored at r (r does not hear it), or another floor */
             }

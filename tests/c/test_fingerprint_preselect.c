@@ -42,7 +42,7 @@ typedef struct {
     int32_t n_common[N_RP], touched[N_RP];
     double rp_entry_g[CAP_ENTRIES], ap_w[N_AP];
     int32_t rp_first[N_RP + 1], rp_ap[CAP_ENTRIES];
-    float entry_g[CAP_ENTRIES];
+    double entry_g[CAP_ENTRIES];
     sf_fingerprint_workspace_t ws;
 } ws_mem_t;
 

@@ -11,8 +11,8 @@
  *                               grows with the map: one AP per 40 m² (200 APs at 2 000 RPs), levels
  *                               −40 − 30·log10(d) dBm (+ 4 dB noise in the scans), an entry where the
  *                               mean is above −85 dBm, a scan hearing every AP above −80 dBm (~31).
- *                               With the pre-selection's workspace arrays, or with "full" after SCANS
- *                               without them (every entry of every AP heard visited).
+ *                               With stridefixd's workspace and defaults, or with "full" after SCANS
+ *                               fingerprint.preselect_aps = 0 (every entry of every AP heard visited).
  *   core_cost samples SECONDS   the sensors walk's IMU and MAG samples as text, for a peer filter.
  *   core_cost sizes             sizeof of the core's state structs.
  *
@@ -186,15 +186,14 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
     ws.acc = malloc(sizeof(double) * (size_t)n_rp);
     ws.n_common = calloc((size_t)n_rp, sizeof(int32_t));
     ws.touched = malloc(sizeof(int32_t) * (size_t)n_rp);
-    if (preselect) {
-        ws.n_entries = n_entries;
-        ws.n_ap = n_ap;
-        ws.rp_entry_first = malloc(sizeof(int32_t) * (size_t)(n_rp + 1));
-        ws.rp_entry_ap = malloc(sizeof(int32_t) * (size_t)n_entries);
-        ws.rp_entry_level_db = malloc(sizeof(double) * (size_t)n_entries);
-        ws.ap_query_w = malloc(sizeof(double) * (size_t)n_ap);
-        ws.entry_level_db = malloc(sizeof(float) * (size_t)n_entries);
-    }
+    p.fingerprint_preselect_aps = preselect ? p.fingerprint_preselect_aps : 0;
+    ws.n_entries = n_entries;
+    ws.n_ap = n_ap;
+    ws.rp_entry_first = malloc(sizeof(int32_t) * (size_t)(n_rp + 1));
+    ws.rp_entry_ap = malloc(sizeof(int32_t) * (size_t)n_entries);
+    ws.rp_entry_level_db = malloc(sizeof(double) * (size_t)n_entries);
+    ws.ap_query_w = malloc(sizeof(double) * (size_t)n_ap);
+    ws.entry_level_db = malloc(sizeof(double) * (size_t)n_entries);
     const int rc = sf_fingerprint_prepare(&ws, &map, &p);
     if (rc != 0) {
         fprintf(stderr, "core_cost: sf_fingerprint_prepare: %d\n", rc);
