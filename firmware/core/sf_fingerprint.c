@@ -376,7 +376,30 @@ static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t
     const double sigma_floor = p->fingerprint_sigma_floor_db;
     double sum = 0.0;
     int32_t n_touched = 0;
-    for (int32_t qi = 0; qi < ws->n_query; qi++) {
+    const bool fill_fast = !bayes && !common_only && ws->entry_level_db != NULL;
+    for (int32_t qi = 0; fill_fast && qi < ws->n_query; qi++) {
+        /* WkNN fill mode with the prepared levels: the loop below, its mode tests hoisted and the
+         * term -2·u·v as (-2u)·v, which is how C evaluates it there too (bit-identical) */
+        const int32_t a = ws->query_ap[qi];
+        const double u = represent(ws->query_rssi_dbm[qi], fill, p->fingerprint_powed_beta);
+        const double w = -2.0 * u;
+        sum += u * u;
+        const int32_t end = map->ap_first[a + 1];
+        for (int32_t i = map->ap_first[a]; i < end; i++) {
+            const int32_t r = map->entry_rp[i];
+            const double v = ws->entry_level_db[i];
+            if (v < 0.0 || (!any_floor && map->rp_floor[r] != floor_hint)) {
+                continue;
+            }
+            if (ws->n_common[r] == 0) {
+                ws->touched[n_touched++] = r;
+                ws->acc[r] = 0.0;
+            }
+            ws->n_common[r]++;
+            ws->acc[r] += w * v;
+        }
+    }
+    for (int32_t qi = 0; !fill_fast && qi < ws->n_query; qi++) {
         const int32_t a = ws->query_ap[qi];
         const double s = ws->query_rssi_dbm[qi];
         const double u = bayes ? s - fill : represent(s, fill, p->fingerprint_powed_beta);
@@ -422,7 +445,9 @@ static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t
         }
         ws->acc[r] = bayes ? ws->acc[r] : key; /* acc now holds the score: L or d */
         au->n_candidates++;
-        sf_fp_insert_best(best, n_best, k, key, r);
+        if (*n_best < k || key <= best[k - 1].key) { /* most lose to the k-th best: skip the call */
+            sf_fp_insert_best(best, n_best, k, key, r);
+        }
     }
     *scan_sum = sum;
     return n_touched;
