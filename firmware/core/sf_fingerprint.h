@@ -27,9 +27,10 @@
  * visit's; otherwise (2) it is the k best of those scored — an approximation: a winner of the full
  * visit whose strongest APs look unlike the scan's is missed, and the strong APs weigh more, which on
  * synthetic grids made the fixes slightly better, not worse (tests/c/test_fingerprint_preselect.c).
- * It runs only where it visits fewer entries than the full visit (S's entries + preselect_rps ×
- * n_entries/n_rp < E_Q): not on a small map, where each AP reaches few RPs (the msindoor and gsd maps
- * of realbench, whose fixes are therefore unchanged). The estimator's position prior is not used:
+ * It runs only where it at least halves the entries visited (2 × (S's entries + preselect_rps ×
+ * n_entries/n_rp) ≤ E_Q): not on the msindoor and gsd maps of realbench (up to ~800 RPs hearing ~140
+ * APs each), whose fixes are therefore unchanged — forced there, it cost 0.24 m of Wi-Fi fix error on
+ * site1/F2, so on large walk-built maps of that kind it is a speed-for-accuracy trade to check. The estimator's position prior is not used:
  * a wrong prior would hold the fixes to it, the one failure a fix exists to correct.
  *
  * WkNN (fingerprint_method 0; Ramadhan 2016, Couceiro 2017). Distance in signal space [dB]:
