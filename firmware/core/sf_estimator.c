@@ -184,7 +184,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
         e->started = true;
     } else if (s->t_us > e->t_us) {
         const double dt_s = (double)(s->t_us - e->t_us) * 1e-6;
-        e->gravity_mps2 += (1.0 - exp(-dt_s / p->estimator_gravity_tau_s)) * (f_nav[2] - e->gravity_mps2);
+        e->gravity_mps2 += (1.0 - sf_exp_memo(&e->gravity_decay, -dt_s / p->estimator_gravity_tau_s)) * (f_nav[2] - e->gravity_mps2);
     }
     e->t_us = s->t_us;
     const double a_v = f_nav[2] - e->gravity_mps2;

@@ -97,6 +97,7 @@ typedef struct {
     bool started;
     int64_t t_us;        /* newest input time */
     double gravity_mps2; /* ĝ */
+    sf_memo_t gravity_decay; /* e^(−dt/τ) of the last IMU interval: one exp per rate change */
     double accel_v_mps2; /* latest a_v */
     double x_m;
     double y_m;

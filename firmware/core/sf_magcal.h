@@ -70,6 +70,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_math.h"
 #include "sf_params.h"
 
 /* What happened to one sample (control). */
@@ -117,6 +118,7 @@ typedef struct {
     double yty; /* Σ y², for the fit residual */
     bool started;
     int64_t last_t_us;
+    sf_memo_t forget; /* λ of the last interval (the MAG rate's): one exp per rate change */
 
     /* output */
     bool valid;           /* a solution has been taken */

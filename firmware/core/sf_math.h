@@ -4,6 +4,7 @@
 #define SF_MATH_H
 
 #include <math.h>
+#include <stdbool.h>
 
 /* v limited to [lo, hi] (lo ≤ hi; NaN passes through). */
 static inline double sf_clamp(const double v, const double lo, const double hi)
@@ -34,6 +35,35 @@ static inline double sf_lp_gain(sf_lp_gain_t *const g, const double dt_s, const 
         g->tau_s = tau_s;
     }
     return g->k;
+}
+
+/* exp(x) and expm1(x) remembered for the last x: a decay factor e^(−dt/τ) of a stream at a fixed rate
+ * has one argument, so libm runs once per rate change, and the value is bit for bit the call's (the
+ * argument is the key, so the caller's expression for it is unchanged). Zero-initialised = empty. */
+typedef struct {
+    double x;
+    double y;
+    bool valid;
+} sf_memo_t;
+
+static inline double sf_exp_memo(sf_memo_t *const m, const double x)
+{
+    if (!m->valid || x != m->x) {
+        m->y = exp(x);
+        m->x = x;
+        m->valid = true;
+    }
+    return m->y;
+}
+
+static inline double sf_expm1_memo(sf_memo_t *const m, const double x)
+{
+    if (!m->valid || x != m->x) {
+        m->y = expm1(x);
+        m->x = x;
+        m->valid = true;
+    }
+    return m->y;
 }
 
 #endif

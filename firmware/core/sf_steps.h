@@ -77,6 +77,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_math.h"
 #include "sf_params.h"
 
 #define SF_STEPS_RATE_HZ 50
@@ -134,6 +135,8 @@ typedef struct {
     uint32_t backwards; /* samples at or before the previous time, ignored */
     uint32_t dropped;   /* events lost because the queue was full (should stay 0) */
     uint32_t bad;       /* non-finite a_v, ignored */
+    /* the two low-pass gains' expm1 for the last interval: once per rate change, not twice a sample */
+    sf_memo_t gain_pt, gain_tp;
 } sf_steps_t;
 _Static_assert(sizeof(sf_steps_t) <= 2560, "sf_steps.h promises at most 2.5 KiB");
 
