@@ -74,7 +74,9 @@ static void qexp(const double r[3], double q[4])
     q[3] = s * r[2];
 }
 
-static void rotate(const double q[4], const bool transpose, const double v[3], double out[3])
+/* v_nav = R(q) v (transpose: v_body = R(q)ᵀ v). Inline, so each call site compiles its own direction
+ * instead of testing transpose once per element (≈ 40 instructions a call). */
+static inline void rotate(const double q[4], const bool transpose, const double v[3], double out[3])
 {
     const double w = q[0], x = q[1], y = q[2], z = q[3];
     const double r[3][3] = {
@@ -83,9 +85,14 @@ static void rotate(const double q[4], const bool transpose, const double v[3], d
         {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
     };
     double o[3];
-    for (int i = 0; i < 3; i++) {
-        o[i] = transpose ? r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2]
-                         : r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2];
+    if (transpose) {
+        for (int i = 0; i < 3; i++) {
+            o[i] = r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2];
+        }
+    } else {
+        for (int i = 0; i < 3; i++) {
+            o[i] = r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2];
+        }
     }
     out[0] = o[0];
     out[1] = o[1];
