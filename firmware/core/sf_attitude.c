@@ -99,6 +99,26 @@ static inline void rotate(const double q[4], const bool transpose, const double 
     out[2] = o[2];
 }
 
+/* Rᵀ(q)·(v₀, v₁, 0): a nav vector with no vertical part (a tilt error) in body axes, the six of
+ * rotate's nine matrix elements it needs. Not bit for bit rotate's (that added 0·v₂ terms): the
+ * zero's sign of an element that is 0 may differ, nothing else. */
+static void horizontal_nav_to_body(const double q[4], const double v[2], double out[3])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    out[0] = (1 - 2 * (y * y + z * z)) * v[0] + 2 * (x * y + w * z) * v[1];
+    out[1] = 2 * (x * y - w * z) * v[0] + (1 - 2 * (x * x + z * z)) * v[1];
+    out[2] = 2 * (x * z + w * y) * v[0] + 2 * (y * z - w * x) * v[1];
+}
+
+/* Rᵀ(q)·(0, 0, e): e times nav up in body axes, the third row of R (three elements, not nine). */
+static void up_to_body(const double q[4], const double e, double out[3])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    out[0] = 2 * (x * z - w * y) * e;
+    out[1] = 2 * (y * z + w * x) * e;
+    out[2] = (1 - 2 * (x * x + y * y)) * e;
+}
+
 /* q ← exp(r_nav) ⊗ q: rotate the body by r_nav expressed in the nav frame. */
 static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
 {
@@ -238,15 +258,15 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
                 att->accel_gated++;
             } else {
                 /* after a gap the interval says nothing about the gyro: clamp it, no integral */
-                const double dt_f = fmin(dt_s, FUSE_DT_MAX_S);
+                const double dt_f = sf_clamp(dt_s, 0.0, FUSE_DT_MAX_S);
                 double r_nav[3];
                 tilt_error_nav(att, accel_mps2, r_nav);
                 double k;
                 if (mahony) {
-                    k = fmin(p->attitude_mahony_kp * dt_f, 1.0);
+                    k = sf_clamp(p->attitude_mahony_kp * dt_f, 0.0, 1.0);
                     if (!gap && norm3(r_nav) < INTEGRAL_MAX_ERR_RAD) {
                         double e_body[3];
-                        rotate(att->q, true, r_nav, e_body);
+                        horizontal_nav_to_body(att->q, r_nav, e_body);
                         for (int i = 0; i < 3; i++) {
                             att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_f;
                         }
@@ -380,11 +400,10 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
         gain = 1.0;
         att->yaw_absolute = true;
     } else if (p->attitude_mode == sf_attitude_mahony) {
-        gain = fmin(p->attitude_mahony_kp_mag * dt_s, 1.0);
+        gain = sf_clamp(p->attitude_mahony_kp_mag * dt_s, 0.0, 1.0);
         if (fabs(audit->yaw_innov_rad) < INTEGRAL_MAX_ERR_RAD) {
-            const double e_nav[3] = {0.0, 0.0, audit->yaw_innov_rad};
             double e_body[3];
-            rotate(att->q, true, e_nav, e_body);
+            up_to_body(att->q, audit->yaw_innov_rad, e_body);
             for (int i = 0; i < 3; i++) {
                 att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_s;
             }
