@@ -369,7 +369,9 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     }
     const double dip = asin(sf_clamp(-m_nav[2] / f, -1.0, 1.0));
     audit->dip_rad = dip;
-    audit->yaw_innov_rad = sf_wrap_pi(0.5 * PI - atan2(m_nav[1], m_nav[0]));
+    /* the angle from the horizontal field to north (nav +y), clockwise positive: π/2 − atan2(m_y, m_x)
+     * wrapped, which is atan2(m_x, m_y) in one call (≤ 1 ulp, not an atan2, a sincos and another atan2) */
+    audit->yaw_innov_rad = atan2(m_nav[0], m_nav[1]);
 
     /* control: acquisition. The expected field and dip depend on the site (48 µT / 60° in central
      * Europe, 45 µT / 45° in southern China, less indoors near steel): during the first

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "sf_attitude.h"
+#include "sf_math.h"
 #include "sf_params.h"
 #include "sf_test_rng.h"
 
@@ -464,6 +465,28 @@ static void test_deterministic(void **state)
     }
 }
 
+/* GIVEN angles over ±8π (and the edges ±π, ±3π), WHEN wrapped by sf_wrap_pi (whole turns taken off),
+ * THEN each is in (−π, π] and within 3e-15 rad of atan2(sin a, cos a), the wrap it replaced (modulo
+ * the one turn by which the two may place −π/π). */
+static void test_wrap_pi_matches_atan2_wrap(void **state)
+{
+    (void)state;
+    double worst = 0.0;
+    for (int k = -200000; k <= 200000; k++) {
+        const double a = 8.0 * 3.14159265358979323846 * (double)k / 200000.0;
+        const double w = sf_wrap_pi(a);
+        assert_true(w > -3.14159265358979323846 && w <= 3.14159265358979323846);
+        double d = fabs(w - atan2(sin(a), cos(a)));
+        d = fmin(d, fabs(d - 2.0 * 3.14159265358979323846));
+        worst = fmax(worst, d);
+    }
+    printf("wrap_pi: largest |difference| from atan2(sin, cos) %.2e rad\n", worst);
+    assert_true(worst < 3e-15);
+    assert_true(sf_wrap_pi(-3.14159265358979323846) == 3.14159265358979323846);
+    assert_true(isnan(sf_wrap_pi((double)NAN)));
+    assert_true(isnan(sf_wrap_pi((double)INFINITY)));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -474,6 +497,7 @@ int main(void)
         cmocka_unit_test(test_uneven_sampling),
         cmocka_unit_test(test_mag_before_imu_and_initial_yaw),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_wrap_pi_matches_atan2_wrap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
