@@ -250,7 +250,10 @@ void sf_magcal_update(sf_magcal_t *const cal, const sf_params_t *const p, const 
         return;
     }
     sf_magcal_audit_t *const audit = &cal->last;
-    *audit = (sf_magcal_audit_t){.t_us = t_us, .solve = sf_magcal_not_solved};
+    *audit = (sf_magcal_audit_t){.t_us = t_us,
+                                 .spread_ut = {cal->last_spread_ut[0], cal->last_spread_ut[1], cal->last_spread_ut[2]},
+                                 .observed = cal->last_observed,
+                                 .solve = sf_magcal_not_solved};
     if (!finite3(field_ut)) {
         audit->field_ut = (double)NAN;
         audit->corrected_ut = (double)NAN;
@@ -300,9 +303,17 @@ void sf_magcal_update(sf_magcal_t *const cal, const sf_params_t *const p, const 
     cal->by_sample[sf_magcal_used]++;
     audit->sample = sf_magcal_used;
 
-    double b[3];
+    double b[3] = {0.0, 0.0, 0.0};
     double radius_ut = 0.0;
-    const sf_magcal_solve_verdict_t v = solve(cal, p, audit, b, &radius_ut);
+    sf_magcal_solve_verdict_t v = sf_magcal_deferred;
+    if (++cal->used_since_solve >= SF_MAGCAL_SOLVE_EVERY) {
+        cal->used_since_solve = 0;
+        v = solve(cal, p, audit, b, &radius_ut);
+        for (int k = 0; k < 3; k++) {
+            cal->last_spread_ut[k] = audit->spread_ut[k];
+        }
+        cal->last_observed = audit->observed;
+    }
     audit->solve = v;
     cal->by_solve[v]++;
     if (v == sf_magcal_solved) {
