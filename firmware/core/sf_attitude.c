@@ -459,6 +459,21 @@ double sf_attitude_yaw_rad(const sf_attitude_t *const att)
     return atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
 }
 
+void sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)
+{
+    const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
+    const double a = 1 - 2 * (y * y + z * z), b = 2 * (x * y + w * z);
+    const double h = sqrt(a * a + b * b);
+    if (h > 0.0) {
+        *cos_yaw = a / h;
+        *sin_yaw = b / h;
+        return;
+    }
+    const double yaw = atan2(b, a);
+    *cos_yaw = cos(yaw);
+    *sin_yaw = sin(yaw);
+}
+
 double sf_attitude_tilt_rad(const sf_attitude_t *const att)
 {
     const double x = att->q[1], y = att->q[2];

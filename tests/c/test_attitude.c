@@ -465,6 +465,33 @@ static void test_deterministic(void **state)
     }
 }
 
+/* GIVEN 10 000 seeded random attitudes, WHEN the yaw's cosine and sine come from the quaternion
+ * (sf_attitude_yaw_dir, no sincos), THEN they are cos and sin of sf_attitude_yaw_rad within 1e-15. */
+static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
+{
+    (void)state;
+    rng_t rng = {.s = 0x5EED0016ULL};
+    double worst = 0.0;
+    for (int k = 0; k < 10000; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        double n = 0.0;
+        for (int i = 0; i < 4; i++) {
+            att.q[i] = rng_pm1(&rng);
+            n += att.q[i] * att.q[i];
+        }
+        for (int i = 0; i < 4; i++) {
+            att.q[i] /= sqrt(n);
+        }
+        double c, s;
+        sf_attitude_yaw_dir(&att, &c, &s);
+        const double yaw = sf_attitude_yaw_rad(&att);
+        worst = fmax(worst, fmax(fabs(c - cos(yaw)), fabs(s - sin(yaw))));
+    }
+    printf("yaw_dir: largest |difference| from cos/sin of the yaw %.2e\n", worst);
+    assert_true(worst < 1e-15);
+}
+
 /* GIVEN angles over ±8π (and the edges ±π, ±3π), WHEN wrapped by sf_wrap_pi (whole turns taken off),
  * THEN each is in (−π, π] and within 3e-15 rad of atan2(sin a, cos a), the wrap it replaced (modulo
  * the one turn by which the two may place −π/π). */
@@ -497,6 +524,7 @@ int main(void)
         cmocka_unit_test(test_uneven_sampling),
         cmocka_unit_test(test_mag_before_imu_and_initial_yaw),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_yaw_dir_is_cos_sin_of_yaw),
         cmocka_unit_test(test_wrap_pi_matches_atan2_wrap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
