@@ -144,6 +144,26 @@ static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
     }
 }
 
+/* atan2(y, x) given h = √(x² + y²), by the half angle: atan2(y, x) = 2·atan(t), t = y/(h + x) = tan of
+ * half the angle. The errors the filter corrects each sample (the tilt seen by the accelerometer, the
+ * yaw seen by the magnetometer) are mostly a few degrees: for |t| ≤ ATAN_SERIES_MAX (angles ≤ 11.4°)
+ * atan's series to t¹³ leaves out < t¹⁵/15 = 6.7e-17, so the angle is within a few ulp of atan2's
+ * (≈ 25 instructions, not ≈ 130); larger angles, and x ≤ −h (no half angle), are atan2's. */
+#define ATAN_SERIES_MAX 0.1
+static double angle_of(const double y, const double x, const double h)
+{
+    const double d = h + x;
+    if (d > 0.0) {
+        const double t = y / d;
+        if (fabs(t) <= ATAN_SERIES_MAX) {
+            const double t2 = t * t;
+            return 2.0 * t *
+                   (1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 / 13))))));
+        }
+    }
+    return atan2(y, x);
+}
+
 /* The rotation (nav frame, axis × angle) that takes the measured up direction onto nav z.
  * Horizontal axis, so it never changes yaw about the vertical. */
 static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mps2[3], double r_nav[3])
@@ -153,7 +173,7 @@ static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mp
     const double n = norm3(u);
     const double c[3] = {u[1] / n, -u[0] / n, 0.0}; /* (u/|u|) × ẑ */
     const double s = sqrt(c[0] * c[0] + c[1] * c[1]);
-    const double angle = atan2(s, u[2] / n);
+    const double angle = angle_of(sqrt(u[0] * u[0] + u[1] * u[1]), u[2], n); /* atan2(s, u_z/n) */
     if (s < 1e-15) {
         r_nav[0] = r_nav[1] = r_nav[2] = 0.0; /* aligned (or exactly upside down: no axis; next sample) */
         return;
@@ -371,7 +391,7 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     audit->dip_rad = dip;
     /* the angle from the horizontal field to north (nav +y), clockwise positive: π/2 − atan2(m_y, m_x)
      * wrapped, which is atan2(m_x, m_y) in one call (≤ 1 ulp, not an atan2, a sincos and another atan2) */
-    audit->yaw_innov_rad = atan2(m_nav[0], m_nav[1]);
+    audit->yaw_innov_rad = angle_of(m_nav[0], m_nav[1], h);
 
     /* control: acquisition. The expected field and dip depend on the site (48 µT / 60° in central
      * Europe, 45 µT / 45° in southern China, less indoors near steel): during the first
