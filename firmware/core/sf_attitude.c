@@ -86,29 +86,24 @@ static void qexp(const double r[3], double q[4])
     q[3] = s * r[2];
 }
 
-/* v_nav = R(q) v (transpose: v_body = R(q)ᵀ v). Inline, so each call site compiles its own direction
- * instead of testing transpose once per element (≈ 40 instructions a call). */
+/* v_nav = R(q) v (transpose: v_body = R(q)ᵀ v, the conjugate's rotation), as q ⊗ v ⊗ q* written out
+ * for a unit q: t = 2 q_v × v, v' = v + w t + q_v × t (≈ 30 flops, against ≈ 50 for building the
+ * matrix and multiplying). Equal to the matrix form up to rounding: q is normalised after every
+ * update (|q| = 1 within 2e-16), so the two differ by a few ulp of |v| (≈ 1e-14 m/s² on gravity,
+ * against an accelerometer's ≈ 1e-3 m/s² noise). out may alias v. */
 static inline void rotate(const double q[4], const bool transpose, const double v[3], double out[3])
 {
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    const double r[3][3] = {
-        {1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)},
-        {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)},
-        {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)},
-    };
-    double o[3];
-    if (transpose) {
-        for (int i = 0; i < 3; i++) {
-            o[i] = r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2];
-        }
-    } else {
-        for (int i = 0; i < 3; i++) {
-            o[i] = r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2];
-        }
-    }
-    out[0] = o[0];
-    out[1] = o[1];
-    out[2] = o[2];
+    const double w = q[0];
+    const double x = transpose ? -q[1] : q[1], y = transpose ? -q[2] : q[2], z = transpose ? -q[3] : q[3];
+    const double t0 = 2.0 * (y * v[2] - z * v[1]);
+    const double t1 = 2.0 * (z * v[0] - x * v[2]);
+    const double t2 = 2.0 * (x * v[1] - y * v[0]);
+    const double o0 = v[0] + w * t0 + (y * t2 - z * t1);
+    const double o1 = v[1] + w * t1 + (z * t0 - x * t2);
+    const double o2 = v[2] + w * t2 + (x * t1 - y * t0);
+    out[0] = o0;
+    out[1] = o1;
+    out[2] = o2;
 }
 
 /* Rᵀ(q)·(v₀, v₁, 0): a nav vector with no vertical part (a tilt error) in body axes, the six of
