@@ -50,16 +50,19 @@
  * nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 25 328 B on x86-64 (i686 not rechecked), at most 25 KiB (checked): the
+ * Memory: sizeof(sf_estimator_t) = 25 536 B on x86-64 (i686 not rechecked), at most 25 KiB (checked): the
  * controller is 1 480 B of it (sf_controller.h); the
  * fingerprint's scan ring is half of it (sf_fingerprint_t, 12 744 B; the matcher's query scratch is in the
  * caller's workspace, sf_fingerprint.h), the eight schemes 4 224 B
  * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
  * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
- * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`): ≈ 3 200 instructions per
- * sf_estimator_imu without the particle scheme (the attitude filter ≈ 1 100 of them, atan2/sincos the
- * largest libm share), ≈ 2 700 per sf_estimator_mag (the sf_magcal solve), ≈ 1 500 per
- * sf_estimator_baro (sf_floor's pow); a Wi-Fi fix is sf_fingerprint.h's, a particle step sf_particle.h's. */
+ * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 2 100
+ * instructions per sf_estimator_imu without the particle scheme (the attitude filter ≈ 730 of them,
+ * the two sample gates ≈ 220, the steps ≈ 180, the yaw's atan2 ≈ 160: now libm's largest share),
+ * ≈ 1 230 per sf_estimator_mag (the attitude's magnetometer fusion ≈ 640, sf_magcal ≈ 400), ≈ 650 per
+ * sf_estimator_baro (sf_floor ≈ 400, a third of it the pow): ≈ 2 840 per IMU sample at 100/50/20 Hz,
+ * all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is sf_fingerprint.h's, a particle step
+ * sf_particle.h's. */
 #ifndef SF_ESTIMATOR_H
 #define SF_ESTIMATOR_H
 
