@@ -514,6 +514,45 @@ static void test_wrap_pi_matches_atan2_wrap(void **state)
     assert_true(isnan(sf_wrap_pi((double)INFINITY)));
 }
 
+/* GIVEN 100 000 seeded random attitudes and the axes' edge cases, WHEN sf_attitude_yaw_rad computes the
+ * yaw without libm's atan2, THEN it is within 2e-15 rad of atan2 of the same projection, in (−π, π],
+ * with atan2's answers on the axes (±0, ±π/2, π for −x). */
+static void test_yaw_matches_atan2(void **state)
+{
+    (void)state;
+    rng_t rng = {.s = 0x5EED0116ULL};
+    double worst = 0.0;
+    for (int k = 0; k < 100000; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        double n = 0.0;
+        for (int i = 0; i < 4; i++) {
+            att.q[i] = rng_pm1(&rng);
+            n += att.q[i] * att.q[i];
+        }
+        for (int i = 0; i < 4; i++) {
+            att.q[i] /= sqrt(n);
+        }
+        const double w = att.q[0], x = att.q[1], y = att.q[2], z = att.q[3];
+        const double ref = atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
+        const double yaw = sf_attitude_yaw_rad(&att);
+        assert_true(yaw >= -3.14159265358979323846 && yaw <= 3.14159265358979323846);
+        worst = fmax(worst, fabs(yaw - ref));
+    }
+    printf("yaw: largest |difference| from atan2 %.2e rad\n", worst);
+    assert_true(worst < 2e-15);
+    /* yaw ψ about up: q = (cos ψ/2, 0, 0, sin ψ/2); ψ = 0, ±π/2, π */
+    const double psi[4] = {0.0, 0.5 * 3.14159265358979323846, -0.5 * 3.14159265358979323846, 3.14159265358979323846};
+    for (int k = 0; k < 4; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        att.q[0] = cos(0.5 * psi[k]);
+        att.q[3] = sin(0.5 * psi[k]);
+        const double w = att.q[0], z = att.q[3];
+        assert_true(sf_attitude_yaw_rad(&att) == atan2(2 * (w * z), 1 - 2 * (z * z)));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -526,6 +565,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_yaw_dir_is_cos_sin_of_yaw),
         cmocka_unit_test(test_wrap_pi_matches_atan2_wrap),
+        cmocka_unit_test(test_yaw_matches_atan2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
