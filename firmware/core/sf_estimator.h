@@ -56,11 +56,11 @@
  * caller's workspace, sf_fingerprint.h), the eight schemes 4 224 B
  * (each carries the ekf's 408 B filter); the particle cloud's arrays (32 kB at 1 000 particles) and the
  * wall index are the caller's (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) and an empty grid
- * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 2 100
+ * (≤ 1 KiB) are here. Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 2 000
  * instructions per sf_estimator_imu without the particle scheme (the attitude filter ≈ 730 of them,
- * the two sample gates ≈ 220, the steps ≈ 180, the yaw's atan2 ≈ 160: now libm's largest share),
- * ≈ 1 230 per sf_estimator_mag (the attitude's magnetometer fusion ≈ 640, sf_magcal ≈ 400), ≈ 650 per
- * sf_estimator_baro (sf_floor ≈ 400, a third of it the pow): ≈ 2 840 per IMU sample at 100/50/20 Hz,
+ * the activity ≈ 260, the two sample gates ≈ 200, the steps ≈ 180, the yaw ≈ 100), ≈ 1 220 per
+ * sf_estimator_mag (the attitude's magnetometer fusion ≈ 640, sf_magcal ≈ 400), ≈ 630 per
+ * sf_estimator_baro (sf_floor ≈ 400, a third of it the pow): ≈ 2 750 per IMU sample at 100/50/20 Hz,
  * all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is sf_fingerprint.h's, a particle step
  * sf_particle.h's. */
 #ifndef SF_ESTIMATOR_H
