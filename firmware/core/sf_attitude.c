@@ -72,7 +72,8 @@ static void qexp(const double r[3], double q[4])
     if (angle2 < QEXP_SERIES_MAX_RAD * QEXP_SERIES_MAX_RAD) {
         const double x = 0.25 * angle2;
         q[0] = 1.0 - x / 2.0 * (1.0 - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0)));          /* cos(θ/2) */
-        const double s = 0.5 * (1.0 - x / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0)))); /* sin(θ/2)/θ */
+        /* sin(θ/2)/θ */
+        const double s = 0.5 * (1.0 - x / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0))));
         q[1] = s * r[0];
         q[2] = s * r[1];
         q[3] = s * r[2];
@@ -139,26 +140,6 @@ static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
     }
 }
 
-/* atan2(y, x) given h = √(x² + y²), by the half angle: atan2(y, x) = 2·atan(t), t = y/(h + x) = tan of
- * half the angle. The errors the filter corrects each sample (the tilt seen by the accelerometer, the
- * yaw seen by the magnetometer) are mostly a few degrees: for |t| ≤ ATAN_SERIES_MAX (angles ≤ 11.4°)
- * atan's series to t¹³ leaves out < t¹⁵/15 = 6.7e-17, so the angle is within a few ulp of atan2's
- * (≈ 25 instructions, not ≈ 130); larger angles, and x ≤ −h (no half angle), are atan2's. */
-#define ATAN_SERIES_MAX 0.1
-static double angle_of(const double y, const double x, const double h)
-{
-    const double d = h + x;
-    if (d > 0.0) {
-        const double t = y / d;
-        if (fabs(t) <= ATAN_SERIES_MAX) {
-            const double t2 = t * t;
-            return 2.0 * t *
-                   (1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 / 13))))));
-        }
-    }
-    return atan2(y, x);
-}
-
 /* The rotation (nav frame, axis × angle) that takes the measured up direction onto nav z.
  * Horizontal axis, so it never changes yaw about the vertical. */
 static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mps2[3], double r_nav[3])
@@ -168,7 +149,7 @@ static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mp
     const double n = norm3(u);
     const double c[3] = {u[1] / n, -u[0] / n, 0.0}; /* (u/|u|) × ẑ */
     const double s = sqrt(c[0] * c[0] + c[1] * c[1]);
-    const double angle = angle_of(sqrt(u[0] * u[0] + u[1] * u[1]), u[2], n); /* atan2(s, u_z/n) */
+    const double angle = sf_atan2_half(sqrt(u[0] * u[0] + u[1] * u[1]), u[2], n); /* atan2(s, u_z/n) */
     if (s < 1e-15) {
         r_nav[0] = r_nav[1] = r_nav[2] = 0.0; /* aligned (or exactly upside down: no axis; next sample) */
         return;
@@ -386,7 +367,7 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     audit->dip_rad = dip;
     /* the angle from the horizontal field to north (nav +y), clockwise positive: π/2 − atan2(m_y, m_x)
      * wrapped, which is atan2(m_x, m_y) in one call (≤ 1 ulp, not an atan2, a sincos and another atan2) */
-    audit->yaw_innov_rad = angle_of(m_nav[0], m_nav[1], h);
+    audit->yaw_innov_rad = sf_atan2_half(m_nav[0], m_nav[1], h);
 
     /* control: acquisition. The expected field and dip depend on the site (48 µT / 60° in central
      * Europe, 45 µT / 45° in southern China, less indoors near steel): during the first
@@ -468,41 +449,10 @@ void sf_attitude_nav_to_body(const sf_attitude_t *const att, const double v_nav[
     rotate(att->q, true, v_nav, v_body);
 }
 
-/* atan2(y, x) on (−π, π] without libm's atan2 (≈ 130 instructions): a quarter-turn swap (exact) brings
- * the angle within ±π/4, two half-angle steps t ← t/(1 + √(1 + t²)) bring tan of a quarter of it within
- * tan(π/16) = 0.199, and atan's series to t²¹ leaves out < t²³/23 = 3.2e-18 (×4 in the angle). The
- * roundings of the steps keep it within 2e-15 rad of atan2 (test_yaw_matches_atan2), where the gyro's
- * noise alone moves the yaw by ≈ 1e-5 rad per 100 Hz sample. Zero, infinite and NaN arguments go to
- * atan2, so its signed-zero and ±π conventions hold. */
-static double yaw_atan2(const double y, const double x)
-{
-    const double ax = fabs(x), ay = fabs(y);
-    if (!(ax + ay > 0.0) || !isfinite(ax + ay)) {
-        return atan2(y, x);
-    }
-    double u, v, base; /* (u, v): (x, y) turned by −base, u > 0, |v| ≤ u */
-    if (ay <= x) {
-        u = x, v = y, base = 0.0;
-    } else if (ax <= y) {
-        u = y, v = -x, base = 0.5 * PI;
-    } else if (ax <= -y) {
-        u = -y, v = x, base = -0.5 * PI;
-    } else {
-        u = -x, v = -y, base = signbit(y) ? -PI : PI;
-    }
-    const double t1 = v / (sqrt(u * u + v * v) + u);  /* tan(φ/2), |t1| ≤ tan(π/8) */
-    const double t = t1 / (1.0 + sqrt(1.0 + t1 * t1)); /* tan(φ/4), |t| ≤ tan(π/16) */
-    const double t2 = t * t;
-    const double p = /* atan(t)/t = 1 − t²/3 + t⁴/5 − … + t²⁰/21 */
-        1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 * (1.0 / 13 -
-        t2 * (1.0 / 15 - t2 * (1.0 / 17 - t2 * (1.0 / 19 - t2 / 21)))))))));
-    return base + 4.0 * t * p;
-}
-
 double sf_attitude_yaw_rad(const sf_attitude_t *const att)
 {
     const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
-    return yaw_atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
+    return sf_atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
 }
 
 void sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)

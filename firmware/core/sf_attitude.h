@@ -61,8 +61,8 @@
  * sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float) takes 331 (issue 16 asks
  * ≤ 1.5×, ≈ 500).
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
- * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at qexp, angle_of and
- * yaw_atan2 in sf_attitude.c); libm keeps a few sqrt per call and the dip's asin. Memory
+ * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at qexp in sf_attitude.c,
+ * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory
  * sizeof(sf_attitude_t) = 344 B on x86-64 (316 B on i686; < 400 B, checked). No heap, no I/O, no clock, no
  * hidden state: the same inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are
  * a contract violation (SF_ASSERT). */

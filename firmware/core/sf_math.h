@@ -41,6 +41,58 @@ static inline double sf_wrap_pi(const double a)
     return atan2(sin(a), cos(a));
 }
 
+/* atan2(y, x) given h = √(x² + y²), by the half angle: atan2(y, x) = 2·atan(t), t = y/(h + x) = tan of
+ * half the angle. The errors an attitude filter corrects each sample (the tilt an accelerometer sees,
+ * the yaw a magnetometer sees: sf_attitude) are mostly a few degrees: for |t| ≤ SF_ATAN_SERIES_MAX
+ * (angles ≤ 11.4°) atan's series to t¹³ leaves out < t¹⁵/15 = 6.7e-17, so the angle is within a few ulp of atan2's
+ * (≈ 25 instructions, not ≈ 130); larger angles, and x ≤ −h (no half angle), are atan2's. */
+#define SF_ATAN_SERIES_MAX 0.1
+static inline double sf_atan2_half(const double y, const double x, const double h)
+{
+    const double d = h + x;
+    if (d > 0.0) {
+        const double t = y / d;
+        if (fabs(t) <= SF_ATAN_SERIES_MAX) {
+            const double t2 = t * t;
+            const double p = /* atan(t)/t = 1 − t²/3 + … − t¹²/13 */
+                1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 / 13)))));
+            return 2.0 * t * p;
+        }
+    }
+    return atan2(y, x);
+}
+
+/* atan2(y, x) on (−π, π] without libm's atan2 (≈ 130 instructions): a quarter-turn swap (exact) brings
+ * the angle within ±π/4, two half-angle steps t ← t/(1 + √(1 + t²)) bring tan of a quarter of it within
+ * tan(π/16) = 0.199, and atan's series to t²¹ leaves out < t²³/23 = 3.2e-18 (×4 in the angle). The
+ * roundings of the steps keep it within 2e-15 rad of atan2 (test_yaw_matches_atan2, test_attitude.c),
+ * where the gyro's noise alone moves a yaw by ≈ 1e-5 rad per 100 Hz sample. Zero, infinite and NaN
+ * arguments go to atan2, so its signed-zero and ±π conventions hold. */
+static inline double sf_atan2(const double y, const double x)
+{
+    const double ax = fabs(x), ay = fabs(y);
+    if (!(ax + ay > 0.0) || !isfinite(ax + ay)) {
+        return atan2(y, x);
+    }
+    double u, v, base; /* (u, v): (x, y) turned by −base, u > 0, |v| ≤ u */
+    if (ay <= x) {
+        u = x, v = y, base = 0.0;
+    } else if (ax <= y) {
+        u = y, v = -x, base = 0.5 * SF_PI;
+    } else if (ax <= -y) {
+        u = -y, v = x, base = -0.5 * SF_PI;
+    } else {
+        u = -x, v = -y, base = signbit(y) ? -SF_PI : SF_PI;
+    }
+    const double t1 = v / (sqrt(u * u + v * v) + u);  /* tan(φ/2), |t1| ≤ tan(π/8) */
+    const double t = t1 / (1.0 + sqrt(1.0 + t1 * t1)); /* tan(φ/4), |t| ≤ tan(π/16) */
+    const double t2 = t * t;
+    const double p = /* atan(t)/t = 1 − t²/3 + t⁴/5 − … + t²⁰/21 */
+        1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 * (1.0 / 13 -
+        t2 * (1.0 / 15 - t2 * (1.0 / 17 - t2 * (1.0 / 19 - t2 / 21)))))))));
+    return base + 4.0 * t * p;
+}
+
 /* The exact first-order low-pass gain k = −expm1(−dt/τ) = 1 − e^(−dt/τ), remembered for the last
  * (dt, τ): a stream sampled at a fixed rate has one dt, so libm's expm1 runs once, not on every sample
  * (≈ 80 instructions each), and k is bit for bit what the call would give. Zero-initialised = empty. */
