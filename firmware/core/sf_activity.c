@@ -24,11 +24,12 @@ static int32_t steps_in_window(const sf_activity_t *const a, const sf_params_t *
 {
     const int64_t from_us = t_us - (int64_t)p->activity_step_window_ms * 1000;
     int32_t n = 0;
+    int32_t i = a->step_head; /* newest first, back round the ring (no modulo per step) */
     for (int32_t k = 0; k < a->step_count; k++) {
-        const int32_t i = (a->step_head + SF_ACTIVITY_STEPS - k) % SF_ACTIVITY_STEPS;
         if (a->step_t_us[i] > from_us) {
             n++;
         }
+        i = i > 0 ? i - 1 : SF_ACTIVITY_STEPS - 1;
     }
     return n;
 }
@@ -44,14 +45,16 @@ static void classify(sf_activity_t *const a, const sf_params_t *const p)
         a->activity = sf_activity_unknown;
         return;
     }
+    const double v = a->vspeed_mps;
+    if (fabs(v) > 2.0 * p->activity_elevator_vspeed_mps) {
+        a->activity = sf_activity_elevator; /* faster than anyone climbs stairs: whatever the steps say */
+        return;                             /* (so the step window is not even counted) */
+    }
     const int64_t t_us = a->last_t_us;
     const bool stepping = steps_in_window(a, p, t_us) >= p->activity_min_steps;
     const bool recent_step =
         a->step_count > 0 && t_us - a->step_t_us[a->step_head] <= (int64_t)p->activity_still_time_ms * 1000;
-    const double v = a->vspeed_mps;
-    if (fabs(v) > 2.0 * p->activity_elevator_vspeed_mps) {
-        a->activity = sf_activity_elevator; /* faster than anyone climbs stairs: whatever the steps say */
-    } else if (stepping && v > p->activity_stairs_vspeed_mps) {
+    if (stepping && v > p->activity_stairs_vspeed_mps) {
         a->activity = sf_activity_stairs_up;
     } else if (stepping && v < -p->activity_stairs_vspeed_mps) {
         a->activity = sf_activity_stairs_down;

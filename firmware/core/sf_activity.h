@@ -62,7 +62,8 @@
  * detector saw. A refused step does not count for the rules above; the estimator must not move the
  * position for it. While the class is still, the estimator also holds the position (zero-velocity).
  *
- * Cost: O(SF_ACTIVITY_STEPS) per call, one exp() per a_v or gyro sample, one 3×3 eigenvalue (an acos,
+ * Cost: O(SF_ACTIVITY_STEPS) per call, the variance gain's expm1 only when the interval changes
+ * (sf_lp_gain), one 3×3 eigenvalue (an acos,
  * two cos) per detection. Memory: sizeof(sf_activity_t) = 320 B on x86-64, at most 320 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
 #ifndef SF_ACTIVITY_H
 #define SF_ACTIVITY_H

@@ -187,7 +187,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
         e->started = true;
     } else if (s->t_us > e->t_us) {
         const double dt_s = (double)(s->t_us - e->t_us) * 1e-6;
-        e->gravity_mps2 += (1.0 - exp(-dt_s / p->estimator_gravity_tau_s)) * (f_nav[2] - e->gravity_mps2);
+        e->gravity_mps2 += (1.0 - sf_exp_memo(&e->gravity_decay, -dt_s / p->estimator_gravity_tau_s)) * (f_nav[2] - e->gravity_mps2);
     }
     e->t_us = s->t_us;
     const double a_v = f_nav[2] - e->gravity_mps2;
@@ -195,7 +195,9 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 
     /* one atan2 per sample: the heading filter and the walking direction read the same yaw */
     const double yaw = sf_attitude_yaw_rad(&e->attitude);
-    sf_heading_update(&e->heading, p, s->t_us, f_nav, yaw);
+    double cos_yaw, sin_yaw;
+    sf_attitude_yaw_dir(&e->attitude, &cos_yaw, &sin_yaw);
+    sf_heading_update_dir(&e->heading, p, s->t_us, f_nav, cos_yaw, sin_yaw);
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
     sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
     e->heading_rad = walk_heading(e, p, yaw);

@@ -6,17 +6,13 @@
 
 #include "sf_assert.h"
 #include "sf_error.h"
+#include "sf_math.h"
 
 double sf_floor_pressure_to_height_m(const double pressure_pa)
 {
     return 44330.77 * (1.0 - pow(pressure_pa / 101325.0, 0.190263));
 }
 
-/* Exact first-order low-pass gain for step dt and time constant tau. */
-static double lp_gain(const double dt_s, const double tau_s)
-{
-    return -expm1(-dt_s / tau_s);
-}
 
 static int16_t to_floor16(const int32_t v)
 {
@@ -63,13 +59,32 @@ static int16_t nearest_floor(const sf_floor_t *const f, const double h_m)
         const double k = floor((h_m - f->height_m[n - 1]) / end_storey_m(f, true) + 0.5);
         return to_floor16((int32_t)f->lowest_floor + n - 1 + (int32_t)fmin(k, (double)SF_FLOOR_CAPACITY));
     }
-    int32_t best = 0;
-    for (int32_t i = 1; i < n; i++) {
-        if (fabs(h_m - f->height_m[i]) < fabs(h_m - f->height_m[best])) {
-            best = i;
+    if (isnan(h_m)) {
+        return f->lowest_floor; /* NaN: no distance is smaller than another, the first floor */
+    }
+    /* The table is strictly increasing (sf_floor_set_heights checks it; the default's storey is
+     * ≥ 1 m), so |h − H_i| falls, then rises with i, and rounding keeps that order (fl is
+     * monotone). Bisect for lo = the last floor at or below h (H_0 ≤ h ≤ H_{n−1} here), then take
+     * what a scan from floor 0 keeping the first strictly nearest would: lo + 1 when strictly nearer,
+     * else the first floor at lo's distance (lo itself unless heights round to one distance).
+     * O(log n) instead of O(n): 64 floors cost ~800 instructions per sample scanned. */
+    int32_t lo = 0, hi = n - 1;
+    while (hi - lo > 1) {
+        const int32_t mid = lo + (hi - lo) / 2;
+        if (f->height_m[mid] <= h_m) {
+            lo = mid;
+        } else {
+            hi = mid;
         }
     }
-    return (int16_t)(f->lowest_floor + best);
+    const double d_lo = fabs(h_m - f->height_m[lo]);
+    if (lo + 1 < n && fabs(h_m - f->height_m[lo + 1]) < d_lo) {
+        return (int16_t)(f->lowest_floor + lo + 1);
+    }
+    while (lo > 0 && fabs(h_m - f->height_m[lo - 1]) == d_lo) {
+        lo--;
+    }
+    return (int16_t)(f->lowest_floor + lo);
 }
 
 /* Moves the altimeter so the filtered height equals the current floor's height. */
@@ -182,7 +197,7 @@ static void control(sf_floor_t *const f, const sf_params_t *const p, const int64
     if (f->reref_due && settled && !f->change_pending && near_own_floor(f, p, f->height_m_f)) {
         rereference(f);
     } else if (!f->reref_due && !f->change_pending && settled) {
-        move_altimeter(f, lp_gain(dt_s, p->floor_drift_tau_s) * (floor_height(f, f->floor) - f->height_m_f));
+        move_altimeter(f, sf_lp_gain(&f->gain_drift, dt_s, p->floor_drift_tau_s) * (floor_height(f, f->floor) - f->height_m_f));
     } else if (!settled && f->was_settled && !f->reref_due && f->stood_valid &&
                fabs(f->stood_height_m - floor_height(f, f->floor)) <= weather_lag_m(p)) {
         /* leaving the floor: the body stood on it until the climb began, so the climb counts from there
@@ -238,9 +253,9 @@ void sf_floor_update(sf_floor_t *const f, const sf_params_t *const p, const int6
         return;
     }
     const double h_prev = f->height_m_f;
-    f->height_m_f += lp_gain(dt_s, p->floor_height_tau_s) * (h - f->height_m_f);
+    f->height_m_f += sf_lp_gain(&f->gain_height, dt_s, p->floor_height_tau_s) * (h - f->height_m_f);
     const double rate_mps = (f->height_m_f - h_prev) / dt_s;
-    f->vspeed_mps += lp_gain(dt_s, p->floor_vspeed_tau_s) * (rate_mps - f->vspeed_mps);
+    f->vspeed_mps += sf_lp_gain(&f->gain_vspeed, dt_s, p->floor_vspeed_tau_s) * (rate_mps - f->vspeed_mps);
     control(f, p, t_us, dt_s);
 }
 

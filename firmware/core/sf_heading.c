@@ -29,9 +29,15 @@ void sf_heading_init(sf_heading_t *const h, const sf_params_t *const p)
 void sf_heading_update(sf_heading_t *const h, const sf_params_t *const p, const int64_t t_us,
                        const double accel_nav_mps2[3], const double device_yaw_rad)
 {
+    sf_heading_update_dir(h, p, t_us, accel_nav_mps2, cos(device_yaw_rad), sin(device_yaw_rad));
+}
+
+void sf_heading_update_dir(sf_heading_t *const h, const sf_params_t *const p, const int64_t t_us,
+                           const double accel_nav_mps2[3], const double c, const double s)
+{
     SF_ASSERT(h != NULL && p != NULL && accel_nav_mps2 != NULL);
     if (!isfinite(accel_nav_mps2[0]) || !isfinite(accel_nav_mps2[1]) || !isfinite(accel_nav_mps2[2]) ||
-        !isfinite(device_yaw_rad)) {
+        !isfinite(c) || !isfinite(s)) {
         h->invalid++;
         return;
     }
@@ -65,7 +71,6 @@ void sf_heading_update(sf_heading_t *const h, const sf_params_t *const p, const 
     h->v_up_mps = (h->v_up_mps + a_up * dt_s) * (tau_v / (tau_v + dt_s));
 
     /* horizontal, turned by −yaw into the device-yaw frame */
-    const double c = cos(device_yaw_rad), s = sin(device_yaw_rad);
     const double x = c * accel_nav_mps2[0] + s * accel_nav_mps2[1];
     const double y = -s * accel_nav_mps2[0] + c * accel_nav_mps2[1];
     const double z = h->v_up_mps;

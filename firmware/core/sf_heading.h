@@ -39,7 +39,8 @@
  * discarded). A sample interval ≤ 0 is skipped; one longer than 0.5 s restarts the vertical filters
  * and the open window (counted in gaps).
  *
- * Cost: O(1) per sample (~40 flops, one sin/cos pair), O(1) per step (one atan2, one sqrt); memory
+ * Cost: O(1) per sample (~40 flops; sf_heading_update adds a sin/cos pair, sf_heading_update_dir
+ * none: ≈ 100 instructions), O(1) per step (one atan2, one sqrt); memory
  * sizeof(sf_heading_t) = 312 B on x86-64 (296 B on i686; < 400 B, checked). No heap, I/O, clock or hidden
  * state: bit-identical outputs for the same inputs. Functions cannot fail (void); NULL arguments break the
  * contract (SF_ASSERT). */
@@ -97,6 +98,11 @@ void sf_heading_init(sf_heading_t *h, const sf_params_t *p);
 /* One IMU sample: specific force rotated into nav (m/s², see the header) and the device yaw (rad). */
 void sf_heading_update(sf_heading_t *h, const sf_params_t *p, int64_t t_us, const double accel_nav_mps2[3],
                        double device_yaw_rad);
+
+/* The same with the yaw given as its cosine and sine (sf_attitude_yaw_dir), which is all the window
+ * needs: the caller that has the attitude saves the sincos. */
+void sf_heading_update_dir(sf_heading_t *h, const sf_params_t *p, int64_t t_us, const double accel_nav_mps2[3],
+                           double cos_yaw, double sin_yaw);
 
 /* A step was detected at t_us: closes the step window, updates the offset estimate. */
 void sf_heading_on_step(sf_heading_t *h, const sf_params_t *p, int64_t t_us);

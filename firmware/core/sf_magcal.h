@@ -46,6 +46,16 @@
  * inconsistent candidate is only not taken: the memory holds good data. Direction-only disturbances at
  * unchanged strength are not detected here (the attitude's dip test catches some of them downstream).
  *
+ * Solve schedule (control). Every used sample enters the normal equations, but the solve (the
+ * eigen-decomposition and the elimination, most of a used sample's cost) runs on every
+ * SF_MAGCAL_SOLVE_EVERY-th used sample only: 10 Hz at the board's 50 Hz; the ones between are
+ * `deferred`, and every audit carries the last solve's spread and observed. The offset in use is then
+ * the solve over a memory at most four samples (80 ms at 50 Hz) short of the current one, and those
+ * carry a weight ≤ 4δt/magcal_tau_s of it (1.3e-4 at the default 600 s, 8e-3 at the 10 s minimum):
+ * the fit is the one a solve on every sample would give up to 80 ms later, a lag of 1e-4 of its own
+ * time constant. The first solution and a bootstrap restart come at most four used samples later,
+ * against the half turn of samples they need.
+ *
  * Time: δt < 0 (time going backwards) skips the sample (by_sample[sf_magcal_time]); the first sample and δt = 0
  * forget nothing. magcal_enable = 0 makes sf_magcal_update return at once: no counters, b stays 0 and
  * sf_magcal_apply is the identity.
@@ -59,9 +69,12 @@
  * watch by_sample[sf_magcal_gated]); a board that never sees half a turn free of disturbance never
  * becomes valid.
  *
- * Cost per used sample: one exp, a 3×3 Jacobi eigen-decomposition (≤ 16 sweeps, ~5 in practice) and a 4×4
- * Gaussian elimination, a few kflop; a gated sample costs the exp and two sqrt. Memory sizeof(sf_magcal_t) =
- * 408 B on x86-64 (392 B on i686; < 512 B, checked). No heap, no I/O, no clock, no hidden state: the same
+ * Cost per used sample: the normal equations' update and, on every SF_MAGCAL_SOLVE_EVERY-th, a 3×3
+ * Jacobi eigen-decomposition (≤ 16 sweeps, ~5 in practice) and a 4×4 Gaussian elimination, a few
+ * kflop; the forgetting factor's exp only when the interval changes (sf_exp_memo); a gated sample
+ * costs two sqrt: ≈ 400 instructions per sf_magcal_update in `stridefix bench perf`'s sensors walk
+ * (callgrind, x86-64 -O2). Memory sizeof(sf_magcal_t) = 472 B on x86-64 (i686 not rechecked; < 512 B,
+ * checked). No heap, no I/O, no clock, no hidden state: the same
  * inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are a contract violation
  * (SF_ASSERT). Counters never decrease. */
 #ifndef SF_MAGCAL_H
@@ -70,7 +83,11 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_math.h"
 #include "sf_params.h"
+
+/* A solve on every this-many-th used sample: see "Solve schedule" above. */
+#define SF_MAGCAL_SOLVE_EVERY 5
 
 /* What happened to one sample (control). */
 typedef enum {
@@ -90,7 +107,8 @@ typedef enum {
     sf_magcal_singular = 4,      /* normal equations singular (pivot underflow) */
     sf_magcal_out_of_bound = 5,  /* |b| > magcal_max_offset_ut, or R² ≤ 0 / non-finite */
     sf_magcal_inconsistent = 6,  /* fit residual RMS > magcal_max_rms_ut: a disturbance is in memory */
-    sf_magcal_solve_verdict_count = 7
+    sf_magcal_deferred = 7,      /* used, the solve left to the next SF_MAGCAL_SOLVE_EVERY-th used sample */
+    sf_magcal_solve_verdict_count = 8
 } sf_magcal_solve_verdict_t;
 
 /* Audit record of the last sample (the FIX habit). */
@@ -100,8 +118,8 @@ typedef struct {
     double corrected_ut;   /* |m − b| with b before this sample */
     double ref_ut;         /* reference radius of the gate */
     double tol_ut;         /* gate half-width */
-    double spread_ut[3];   /* RMS spread along the eigen-directions of C, descending (after this sample) */
-    int32_t observed;      /* directions with spread ≥ magcal_min_spread_ut */
+    double spread_ut[3];   /* RMS spread along the eigen-directions of C, descending (the last solve's) */
+    int32_t observed;      /* directions with spread ≥ magcal_min_spread_ut (the last solve's) */
     double candidate_offset_ut[3]; /* solution of this solve (taken or not); 0 when not solved */
     double candidate_radius_ut;    /* √(k + |b|²) of that solution; 0 when not computed */
     double candidate_rms_ut;       /* RMS of |m − b| − R over the memory for that solution */
@@ -117,6 +135,10 @@ typedef struct {
     double yty; /* Σ y², for the fit residual */
     bool started;
     int64_t last_t_us;
+    sf_memo_t forget; /* λ of the last interval (the MAG rate's): one exp per rate change */
+    int32_t used_since_solve;    /* used samples since the last solve, < SF_MAGCAL_SOLVE_EVERY */
+    double last_spread_ut[3];    /* the last solve's spread and observed, kept in every audit */
+    int32_t last_observed;
 
     /* output */
     bool valid;           /* a solution has been taken */

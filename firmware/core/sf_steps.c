@@ -7,10 +7,11 @@
 
 #define PI 3.14159265358979323846
 
-/* Exact first-order low-pass gain for a step dt: k = 1 − exp(−dt/τ), τ = 1/(2π f_c). */
-static double lp_gain(const double dt_s, const double cutoff_hz)
+/* Exact first-order low-pass gain for a step dt: k = 1 − exp(−dt/τ), τ = 1/(2π f_c); expm1 remembered
+ * for the last argument in memo. */
+static double lp_gain(sf_memo_t *const memo, const double dt_s, const double cutoff_hz)
 {
-    return -expm1(-dt_s * 2.0 * PI * cutoff_hz);
+    return -sf_expm1_memo(memo, -dt_s * 2.0 * PI * cutoff_hz);
 }
 
 void sf_steps_init(sf_steps_t *const s, const sf_params_t *const p)
@@ -184,8 +185,8 @@ bool sf_steps_update(sf_steps_t *const s, const sf_params_t *const p, const int6
     } else {
         const int64_t t0_us = s->last_t_us;
         const double dt_s = (double)(t_us - t0_us) * 1e-6;
-        const double kpt = lp_gain(dt_s, p->steps_pt_lowpass_hz);
-        const double ktp = lp_gain(dt_s, p->steps_tp_lowpass_hz);
+        const double kpt = lp_gain(&s->gain_pt, dt_s, p->steps_pt_lowpass_hz);
+        const double ktp = lp_gain(&s->gain_tp, dt_s, p->steps_tp_lowpass_hz);
         const double pt0 = s->pt2_mps2, tp0 = s->tp2_mps2;
         s->pt1_mps2 += kpt * (accel_v_mps2 - s->pt1_mps2);
         s->pt2_mps2 += kpt * (s->pt1_mps2 - s->pt2_mps2);

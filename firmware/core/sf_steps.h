@@ -67,9 +67,10 @@
  * than steps_max_gap_ms is counted in `gaps` and restarts filters, grid and detector (the previous
  * step's time is kept, so the period rule above still applies).
  *
- * Cost: O(1) per grid point and per sample, a few dozen flops plus two exp() per sample; the grid loop
- * runs at most steps_max_gap_ms / 20 ms times in one call. Memory: sizeof(sf_steps_t) = 2 416 B on
- * x86-64 (2 400 B on i686; at most 2.5 KiB, checked), the amax/amin ring most of it.
+ * Cost: O(1) per grid point and per sample, a few dozen flops (≈ 180 instructions per sample in
+ * `stridefix bench perf`); the two low-pass gains' expm1 run only when the interval changes
+ * (sf_expm1_memo); the grid loop runs at most steps_max_gap_ms / 20 ms times in one call. Memory:
+ * sizeof(sf_steps_t) = 2 464 B on x86-64 (i686 not rechecked; at most 2.5 KiB, checked), the amax/amin ring most of it.
  * No heap, no I/O, no clock. Deterministic: the same inputs give bit-identical events. */
 #ifndef SF_STEPS_H
 #define SF_STEPS_H
@@ -77,6 +78,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_math.h"
 #include "sf_params.h"
 
 #define SF_STEPS_RATE_HZ 50
@@ -134,6 +136,8 @@ typedef struct {
     uint32_t backwards; /* samples at or before the previous time, ignored */
     uint32_t dropped;   /* events lost because the queue was full (should stay 0) */
     uint32_t bad;       /* non-finite a_v, ignored */
+    /* the two low-pass gains' expm1 for the last interval: once per rate change, not twice a sample */
+    sf_memo_t gain_pt, gain_tp;
 } sf_steps_t;
 _Static_assert(sizeof(sf_steps_t) <= 2560, "sf_steps.h promises at most 2.5 KiB");
 

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "sf_attitude.h"
+#include "sf_math.h"
 #include "sf_params.h"
 #include "sf_test_rng.h"
 
@@ -464,6 +465,94 @@ static void test_deterministic(void **state)
     }
 }
 
+/* GIVEN 10 000 seeded random attitudes, WHEN the yaw's cosine and sine come from the quaternion
+ * (sf_attitude_yaw_dir, no sincos), THEN they are cos and sin of sf_attitude_yaw_rad within 1e-15. */
+static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
+{
+    (void)state;
+    rng_t rng = {.s = 0x5EED0016ULL};
+    double worst = 0.0;
+    for (int k = 0; k < 10000; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        double n = 0.0;
+        for (int i = 0; i < 4; i++) {
+            att.q[i] = rng_pm1(&rng);
+            n += att.q[i] * att.q[i];
+        }
+        for (int i = 0; i < 4; i++) {
+            att.q[i] /= sqrt(n);
+        }
+        double c, s;
+        sf_attitude_yaw_dir(&att, &c, &s);
+        const double yaw = sf_attitude_yaw_rad(&att);
+        worst = fmax(worst, fmax(fabs(c - cos(yaw)), fabs(s - sin(yaw))));
+    }
+    printf("yaw_dir: largest |difference| from cos/sin of the yaw %.2e\n", worst);
+    assert_true(worst < 1e-15);
+}
+
+/* GIVEN angles over ±8π (and the edges ±π, ±3π), WHEN wrapped by sf_wrap_pi (whole turns taken off),
+ * THEN each is in (−π, π] and within 3e-15 rad of atan2(sin a, cos a), the wrap it replaced (modulo
+ * the one turn by which the two may place −π/π). */
+static void test_wrap_pi_matches_atan2_wrap(void **state)
+{
+    (void)state;
+    double worst = 0.0;
+    for (int k = -200000; k <= 200000; k++) {
+        const double a = 8.0 * 3.14159265358979323846 * (double)k / 200000.0;
+        const double w = sf_wrap_pi(a);
+        assert_true(w > -3.14159265358979323846 && w <= 3.14159265358979323846);
+        double d = fabs(w - atan2(sin(a), cos(a)));
+        d = fmin(d, fabs(d - 2.0 * 3.14159265358979323846));
+        worst = fmax(worst, d);
+    }
+    printf("wrap_pi: largest |difference| from atan2(sin, cos) %.2e rad\n", worst);
+    assert_true(worst < 3e-15);
+    assert_true(sf_wrap_pi(-3.14159265358979323846) == 3.14159265358979323846);
+    assert_true(isnan(sf_wrap_pi((double)NAN)));
+    assert_true(isnan(sf_wrap_pi((double)INFINITY)));
+}
+
+/* GIVEN 100 000 seeded random attitudes and the axes' edge cases, WHEN sf_attitude_yaw_rad computes the
+ * yaw without libm's atan2, THEN it is within 2e-15 rad of atan2 of the same projection, in (−π, π],
+ * with atan2's answers on the axes (±0, ±π/2, π for −x). */
+static void test_yaw_matches_atan2(void **state)
+{
+    (void)state;
+    rng_t rng = {.s = 0x5EED0116ULL};
+    double worst = 0.0;
+    for (int k = 0; k < 100000; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        double n = 0.0;
+        for (int i = 0; i < 4; i++) {
+            att.q[i] = rng_pm1(&rng);
+            n += att.q[i] * att.q[i];
+        }
+        for (int i = 0; i < 4; i++) {
+            att.q[i] /= sqrt(n);
+        }
+        const double w = att.q[0], x = att.q[1], y = att.q[2], z = att.q[3];
+        const double ref = atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
+        const double yaw = sf_attitude_yaw_rad(&att);
+        assert_true(yaw >= -3.14159265358979323846 && yaw <= 3.14159265358979323846);
+        worst = fmax(worst, fabs(yaw - ref));
+    }
+    printf("yaw: largest |difference| from atan2 %.2e rad\n", worst);
+    assert_true(worst < 2e-15);
+    /* yaw ψ about up: q = (cos ψ/2, 0, 0, sin ψ/2); ψ = 0, ±π/2, π */
+    const double psi[4] = {0.0, 0.5 * 3.14159265358979323846, -0.5 * 3.14159265358979323846, 3.14159265358979323846};
+    for (int k = 0; k < 4; k++) {
+        sf_attitude_t att;
+        sf_attitude_init(&att);
+        att.q[0] = cos(0.5 * psi[k]);
+        att.q[3] = sin(0.5 * psi[k]);
+        const double w = att.q[0], z = att.q[3];
+        assert_true(sf_attitude_yaw_rad(&att) == atan2(2 * (w * z), 1 - 2 * (z * z)));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -474,6 +563,9 @@ int main(void)
         cmocka_unit_test(test_uneven_sampling),
         cmocka_unit_test(test_mag_before_imu_and_initial_yaw),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_yaw_dir_is_cos_sin_of_yaw),
+        cmocka_unit_test(test_wrap_pi_matches_atan2_wrap),
+        cmocka_unit_test(test_yaw_matches_atan2),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
