@@ -153,6 +153,11 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     ws->min_rssi_dbm = p->fingerprint_min_rssi_dbm;
     ws->map_level = p->fingerprint_map_level;
     ws->powed_beta = p->fingerprint_powed_beta;
+    double scans = 0.0;
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        scans += (double)map->rp_scans[r];
+    }
+    ws->rp_scans_mean = scans / (double)map->n_rp;
     ws->prepared = true;
     return SF_OK;
 }

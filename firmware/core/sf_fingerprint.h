@@ -27,10 +27,13 @@
  * visit's; otherwise (2) it is the k best of those scored — an approximation: a winner of the full
  * visit whose strongest APs look unlike the scan's is missed, and the strong APs weigh more, which on
  * synthetic grids made the fixes slightly better, not worse (tests/c/test_fingerprint_preselect.c).
- * It runs only where it at least halves the entries visited (2 × (S's entries + preselect_rps ×
- * n_entries/n_rp) ≤ E_Q): not on the msindoor and gsd maps of realbench (up to ~800 RPs hearing ~140
- * APs each), whose fixes are therefore unchanged — forced there, it cost 0.24 m of Wi-Fi fix error on
- * site1/F2, so on large walk-built maps of that kind it is a speed-for-accuracy trade to check. The estimator's position prior is not used:
+ * It runs only on a map of at least fingerprint_preselect_min_scans scans per RP (3: a surveyed map,
+ * where an AP missing at an RP was not heard there; an AP heard 70 % of the time is missed by 1 scan
+ * in 30 % and by 3 in 2.7 %), and only where it at least halves the entries visited (2 × (S's entries +
+ * preselect_rps × n_entries/n_rp) ≤ E_Q). Not, therefore, on the walk-built maps of realbench (msindoor
+ * 1.5, gsd 1.9 scans per RP), whose fixes are unchanged: forced there, the RPs the strongest APs reach
+ * missed the full visit's winners often enough to cost 0.22 m of Wi-Fi-only mean error on site1/F2
+ * (and gain 0.32 m on site2/F3). The estimator's position prior is not used:
  * a wrong prior would hold the fixes to it, the one failure a fix exists to correct.
  *
  * WkNN (fingerprint_method 0; Ramadhan 2016, Couceiro 2017). Distance in signal space [dB]:
@@ -159,6 +162,7 @@ typedef struct {
     double fill_dbm, nb_p_min, min_rssi_dbm;    /* the parameters it was prepared with */
     int32_t map_level;
     double powed_beta;
+    double rp_scans_mean; /* the map's scans per RP (the pre-selection's gate) */
     /* scratch of sf_fingerprint_match, rebuilt by every call (so not the estimator's state): the last
      * query, its used APs (map indices ascending) and their mean levels */
     int32_t n_query;

@@ -13,8 +13,8 @@
  * out can be among the k best, and the answer is the full visit's (audit.preselected = 1, proven). Otherwise the k best of the scored ones are taken
  * (audit.preselected = 2): a winner of the full visit whose strongest APs look unlike the scan's is
  * then missed — the approximation the cost budget buys. Fewer than k reached: undecided (the caller
- * visits everything), as it does when the pre-selection would not halve the entries visited (a small
- * map: each AP reaches few RPs, each RP hears many APs). */
+ * visits everything), as it does on a walk-built map (fewer than fingerprint_preselect_min_scans scans
+ * per RP) and where the pre-selection would not halve the entries visited. */
 #include <math.h>
 
 #include "sf_assert.h"
@@ -128,6 +128,9 @@ bool sf_fp_preselect(const sf_radiomap_t *const map, sf_fingerprint_workspace_t 
 {
     SF_ASSERT(k >= 1 && k <= SF_FINGERPRINT_K_MAX && map->n_rp > 0);
     *n_best = 0;
+    if (ws->rp_scans_mean < (double)p->fingerprint_preselect_min_scans) {
+        return false; /* a walk-built map: an AP missing at an RP may just not have been scanned there */
+    }
     int32_t s_ap[SF_FINGERPRINT_PRESELECT_APS_MAX];
     double s_u[SF_FINGERPRINT_PRESELECT_APS_MAX];
     const int32_t n_want = p->fingerprint_preselect_aps < SF_FINGERPRINT_PRESELECT_APS_MAX
@@ -140,9 +143,7 @@ bool sf_fp_preselect(const sf_radiomap_t *const map, sf_fingerprint_workspace_t 
     n_rank_max = n_rank_max < k ? k : n_rank_max;
     /* Only where it at least halves the work, an approximation being worth no less: the entries it
      * visits (S's, and the kept RPs' own, about n_entries / n_rp each) against the full visit's
-     * (every used AP's). On msindoor's walk-built maps (800 RPs of ~140 APs each) it does not: forced
-     * there, its strongest APs missed the full visit's winners often enough to cost 0.24 m of Wi-Fi
-     * fix error (realbench site1/F2). */
+     * (every used AP's). */
     int64_t work = (int64_t)n_rank_max * map->n_entries / map->n_rp;
     for (int32_t si = 0; si < n_s; si++) {
         work += map->ap_first[s_ap[si] + 1] - map->ap_first[s_ap[si]];

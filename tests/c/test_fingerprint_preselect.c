@@ -1,8 +1,8 @@
 /* test_fingerprint_preselect.c — the WkNN candidate pre-selection (sf_fingerprint_preselect.c) against
  * the full visit on a 40 × 40 grid of two floors: on a noisy walk no less accurate than the full
  * visit (within 5 cm), far fewer RPs scored; the floor hint and censoring respected; a proven fix
- * always the full visit's; the full visit where it does not apply or costs less (a small map); a
- * capped ranking; misuse of the arrays. */
+ * always the full visit's; the full visit where it does not apply, on a walk-built map, or where it
+ * costs less (a small map); a capped ranking; misuse of the arrays. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -252,6 +252,25 @@ static void test_full_visit_when_not_applicable(void **state)
     }
 }
 
+/* A walk-built map (2 scans per RP, under preselect_min_scans 3): the full visit, every fix. */
+static void test_walk_built_map_full_visit(void **state)
+{
+    (void)state;
+    for (int r = 0; r < N_RP; r++) {
+        g_grid.scans[r] = 2;
+    }
+    for (int32_t i = 0; i < g_grid.map.n_entries; i++) {
+        g_grid.count[i] = g_grid.count[i] > 2 ? 2 : g_grid.count[i];
+    }
+    sf_params_t p;
+    sf_params_default(&p);
+    const walk_stats_t st = walk(&p, 4.0, false);
+    make_grid(&g_grid); /* as the other tests have it */
+    assert_true(st.fixes >= 290);
+    assert_int_equal(st.preselected, 0);
+    assert_int_equal(st.identical, st.fixes);
+}
+
 /* Ranking only k RPs (preselect_rps 1 → k) with one AP: mostly unproven (preselected 2), and then the
  * full visit's winners may be missed; a proven one is the full visit's fix. */
 static void test_capped_ranking(void **state)
@@ -337,6 +356,7 @@ int main(void)
         cmocka_unit_test(test_full_visit_when_not_applicable),
         cmocka_unit_test(test_capped_ranking),
         cmocka_unit_test(test_small_map_full_visit),
+        cmocka_unit_test(test_walk_built_map_full_visit),
         cmocka_unit_test(test_prepare_checks_arrays),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
