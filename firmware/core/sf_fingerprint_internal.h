@@ -1,5 +1,5 @@
-/* sf_fingerprint_internal.h — what sf_fingerprint.c and its pre-selection (sf_fingerprint_preselect.c)
- * share: the ranked list of the k best RPs. Not part of the core's API. */
+/* sf_fingerprint_internal.h — what sf_fingerprint.c, its query (sf_fingerprint_query.c) and its
+ * pre-selection (sf_fingerprint_preselect.c) share. Not part of the core's API. */
 #ifndef SF_FINGERPRINT_INTERNAL_H
 #define SF_FINGERPRINT_INTERNAL_H
 
@@ -12,6 +12,13 @@ typedef struct {
     double key; /* lower is better: WkNN d, naive Bayes −L */
     int32_t rp;
 } sf_fp_ranked_t;
+
+/* Stores the scan in fp's ring (sf_fingerprint_query.c); returns the number of weak readings dropped. */
+int32_t sf_fp_store_scan(sf_fingerprint_t *fp, const sf_params_t *p, const sf_radiomap_t *map,
+                         const sf_wifi_scan_t *scan);
+
+/* Builds ws->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
+void sf_fp_build_query(sf_fingerprint_t *fp, sf_fingerprint_workspace_t *ws, const sf_params_t *p);
 
 /* Inserts (key, rp) into best[0 .. *n_best), kept sorted by key then RP index, at most k long. */
 void sf_fp_insert_best(sf_fp_ranked_t *best, int32_t *n_best, int32_t k, double key, int32_t rp);
