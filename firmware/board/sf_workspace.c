@@ -34,7 +34,7 @@ int sf_workspace_alloc(const sf_radiomap_t *const map, sf_fingerprint_workspace_
     ws->n_common = i;
     ws->touched = i += n;
     ws->rp_entry_first = i += n; /* n + 1 */
-    ws->rp_entry_ap = i += n + 1;
+    ws->rp_entry_ap = i + n + 1;
     *memory = m;
     return SF_OK;
 }
