@@ -169,7 +169,7 @@
     X(fingerprint, powed_beta,     double,  1.0,     1.0,     5.0,     "",      "WkNN representation: 1 = dBm above fill_dbm; > 1 = 'powed' |fill|((v - fill)/|fill|)^beta (Torres-Sospedra 2015: e)") \
     X(fingerprint, preselect_aps,  int32_t, 4,       0,       16,      "APs",   "WkNN fill mode on a large map: the partial distance over this many strongest used APs (the nearest few carry the position) ranks the RPs they reach, and only the best-ranked are scored in full; 0 = score every RP sharing an AP") \
     X(fingerprint, preselect_rps,  int32_t, 32,      1,       256,     "RPs",   "pre-selection: this many best-ranked RPs scored in full (about 10 k; 32 cells of 2 m cover a 6 m radius)") \
-    X(fingerprint, preselect_min_scans, int32_t, 3,  1,       1000,    "scans", "pre-selection only on maps of at least this many scans per RP on average (a surveyed map: an AP heard 70% of the time is missing from 3 scans in 2.7% of RPs, from 1 in 30%)") \
+    X(fingerprint, preselect_min_scans, int32_t, 3,  1,       1000,    "scans", "pre-selection only on maps of at least this many scans per RP (surveyed: an AP heard 70% of the time is missing at 2.7% of RPs after 3 scans, 30% after 1)") \
     X(fingerprint, min_common_aps, int32_t, 2,       1,       64,      "APs",   "WkNN mode 1: fewest APs shared with the scan for an RP to be a candidate") \
     X(fingerprint, min_rssi_dbm,   double,  -90.0,   -150.0,  0.0,     "dBm",   "scan readings weaker than this are ignored") \
     X(fingerprint, min_aps,        int32_t, 3,       1,       64,      "APs",   "fewest usable APs (at least min_rssi_dbm and in the map) for a fix") \
