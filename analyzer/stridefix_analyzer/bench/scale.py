@@ -13,8 +13,8 @@ Each run is its own ``stridefix`` process (so a Dask run's wall time includes it
 
 Wall times, speed-ups over serial and the machine's load average (a shared machine's runs vary: the
 load says how much) go into ``scale.json``, rewritten after every run (a run that is stopped keeps the
-ones before it). Not in ``make bench``: about 25 minutes on 2 cores for site1/F2 (102 walks), 10 for
-site2/F3 (37 walks).
+ones before it). Not in ``make bench``: site2/F3 (37 walks, the default) took 7 minutes on 2 cores
+(81 s of it warming the cache); site1/F2 (102 walks) takes about 25.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from typing import Any
 from stridefix_analyzer.realbench.summary import untimed
 from stridefix_analyzer.stages import run_stage, stridefix_exe
 
-DEFAULT_FLOOR = Path("..") / "shared" / "data" / "msindoor" / "site1" / "F2"
+DEFAULT_FLOOR = Path("..") / "shared" / "data" / "msindoor" / "site2" / "F3"
 #: name → --scheduler options
 RUNS = {
     "serial": ["--scheduler", "serial"],
@@ -76,13 +76,13 @@ def run_scale(
     for name, opts in runs.items():
         load = os.getloadavg()[0]
         wall_s = _timed([*base, *opts], f"realbench {name}")
-        doc = json.loads(results.read_text())
-        first = first or untimed(doc)
+        res = json.loads(results.read_text())
+        first = first or untimed(res)
         realbench[name] = {
             "wall_s": wall_s,
-            "run_s": doc["run_s"],
-            "scheduler": doc["params"]["scheduler"],
-            "identical": untimed(doc) == first,
+            "run_s": res["run_s"],
+            "scheduler": res["params"]["scheduler"],
+            "identical": untimed(res) == first,
             "load_1min_before": load,
         }
         _write(out, doc, t0)
