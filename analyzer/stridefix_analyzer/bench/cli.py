@@ -27,6 +27,7 @@ from stridefix_analyzer.bench import (
     perf,
     realdata,
     reliability,
+    scale,
     sil_pdr,
     soak,
     sources,
@@ -153,6 +154,14 @@ def _run_crowd_scale(args: argparse.Namespace, firmware: Firmware, seeds: list[i
     return crowd_scale.missed_targets(doc)
 
 
+def _run_scale(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
+    del seeds  # real walks, no seed
+    doc = scale.run_scale(firmware.path, out, Path(args.floor))
+    print(scale.format_table(doc))
+    print(f"wrote {out / 'scale.json'} ({doc['run_s']:.0f} s)")
+    return scale.missed_targets(doc)
+
+
 Runner = Callable[[argparse.Namespace, Firmware, list[int], Path], list[str]]
 #: sub-bench name → (runner, default seeds)
 BENCHES: dict[str, tuple[Runner, str]] = {
@@ -167,6 +176,7 @@ BENCHES: dict[str, tuple[Runner, str]] = {
     "particle-cost": (_run_particle_cost, "1"),
     "perf": (_run_perf, "1"),
     "crowd-scale": (_run_crowd_scale, "1"),
+    "scale": (_run_scale, "1"),
 }
 #: benches that run no firmware (no --stridefixd needed)
 NO_FIRMWARE = {"crowd-scale"}
@@ -207,7 +217,8 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "sample and per Wi-Fi fix against map size under callgrind, state sizes, no heap, replay speed and peak "
         "RSS against issue 16's budgets; crowd-scale: the crowd fit and graph solve on a "
         "synthetic fleet (100 000 scans / 500 walks) serially and on Dask 1 and 2 workers (target fit + solve "
-        "<= 300 s)",
+        "<= 300 s); scale: realbench and radiomap build on one msindoor floor (--floor) serially, on 2 "
+        "processes and on Dask 1 and 2 workers, wall times and identical results (~25 min, not in make bench)",
     )
     p.add_argument(
         "--paces",
@@ -296,6 +307,12 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         default="chunk:1",
         metavar="floor|all|chunk:K",
         help="crowd-scale: walks per solve task (default chunk:1, one walk per task)",
+    )
+    p.add_argument(
+        "--floor",
+        default=str(scale.DEFAULT_FLOOR),
+        metavar="DIR",
+        help=f"scale: the msindoor floor folder (default {scale.DEFAULT_FLOOR})",
     )
     p.add_argument(
         "--no-calibration",

@@ -30,8 +30,8 @@ import numpy as np
 
 from stridefix_analyzer.crowd.fit import fit_walks
 from stridefix_analyzer.crowd.fleet import FleetSpec, make_fleet
-from stridefix_analyzer.crowd.parallel import dask_client
 from stridefix_analyzer.crowd.scale_solve import solve_walks_grouped
+from stridefix_analyzer.parallel import dask_client
 from stridefix_analyzer.scoring.targets import missed_lines, table_lines
 
 TARGET_S = 300.0

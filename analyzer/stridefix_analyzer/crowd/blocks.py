@@ -7,7 +7,7 @@ i0, then j0 — the order of the serial loop). Every sum is therefore accumulate
 whoever ran the tasks: the serial run, a local Dask cluster and any scheduler give bit-identical bins,
 and at float64 the same bins as the serial loop always gave (``0 + x`` is exact). Any binned fit can
 use it: the task's per-pair work is ``bin_block``'s (:func:`.model._block` for the dissimilarity, the
-true distance from the positions), the runner is :func:`.parallel.run_tasks`.
+true distance from the positions), the runner is :func:`stridefix_analyzer.parallel.run_tasks`.
 
 Scale (issue 15): the full pair set of 100 000 scans is ~10⁹–5·10⁹ pairs; blocks are computed in
 ``dtype`` (float32 halves the memory traffic of the matrix products; RSS are whole dBm, so V, V² and
@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from stridefix_analyzer.crowd import model as cm
-from stridefix_analyzer.crowd.parallel import run_tasks
+from stridefix_analyzer.parallel import run_tasks
 
 
 @dataclasses.dataclass(frozen=True)
@@ -177,7 +177,7 @@ def bin_pairs_tasks(
     client: Any = None,
 ) -> tuple[cm.PairBins, dict[str, Any]]:
     """Every (or a sampled ``pair_fraction`` of the) scan pairs of the same group into PairBins, the
-    block pairs run by :func:`.parallel.run_tasks`; returns (bins, info: tasks, pairs, sampling)."""
+    block pairs run by :func:`stridefix_analyzer.parallel.run_tasks`; returns (bins, info: tasks, pairs, sampling)."""
     settings = settings or BinSettings()
     sampled = pair_fraction < 1
     groups = prepare_groups(R, xy_m, group, dtype, permute_seed=seed if sampled else None)

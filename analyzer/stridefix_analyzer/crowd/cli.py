@@ -41,6 +41,7 @@ from stridefix_analyzer.crowd.solve import RANGES, SOLVERS
 from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.logread import LogReadError
+from stridefix_analyzer.parallel import add_scheduler_argument
 
 # action -> its command (experiment returns its own exit status)
 ACTIONS: dict[str, Callable[[argparse.Namespace], Any]] = {
@@ -154,14 +155,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="pairs sharing fewer APs are excluded (default 1, the thesis); the model "
         "file records it and solve uses it",
     )
+    add_scheduler_argument(f, "serial")  # the pair blocks; the bins are bit-identical on every scheduler
     f.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="local|tcp://HOST:PORT",
-        help="run the pair blocks on Dask: 'local' = a LocalCluster of --workers processes, or a "
-        "scheduler address (default: serial; the bins are bit-identical either way)",
+        "--workers", type=int, default=2, help="--scheduler processes or local: worker processes (default 2)"
     )
-    f.add_argument("--workers", type=int, default=2, help="--scheduler local: worker processes (default 2)")
     f.add_argument(
         "--pair-fraction",
         type=float,

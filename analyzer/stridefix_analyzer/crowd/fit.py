@@ -20,8 +20,8 @@ import numpy as np
 
 from stridefix_analyzer.crowd import blocks as cbk
 from stridefix_analyzer.crowd import model as cm
-from stridefix_analyzer.crowd.parallel import SchedulerError, check_scheduler
 from stridefix_analyzer.crowd.walks import DEFAULT_BAND, CrowdInputError, Walk, load_walks, pool_scans
+from stridefix_analyzer.parallel import SchedulerError, check_scheduler
 
 PRECISIONS = ("float64", "float32")
 

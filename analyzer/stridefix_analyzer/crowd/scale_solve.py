@@ -5,7 +5,7 @@ tie only the points of one walk; anchors are unary), so its minimiser is the uni
 of any partition of the walks into groups. ``solve_walks_grouped`` partitions the walks (``per="floor"``:
 the walks of a floor, what Wi-Fi rows would join, so the same split stays valid with them; ``"chunk:K"``:
 K consecutive walks; ``"all"``: one problem) and solves each group with
-:func:`.graph_run.solve_walks_graph` as a task of :func:`.parallel.run_tasks`. Each group's problem is
+:func:`.graph_run.solve_walks_graph` as a task of :func:`stridefix_analyzer.parallel.run_tasks`. Each group's problem is
 solved by Ceres when ``stridefix_native.solve_graph`` is importable, else by the scipy twin (sparse
 analytic Jacobian, LSMR); the info names which ran.
 
@@ -22,8 +22,8 @@ import numpy as np
 
 from stridefix_analyzer.crowd.graph import GraphSettings
 from stridefix_analyzer.crowd.graph_run import solve_walks_graph
-from stridefix_analyzer.crowd.parallel import run_tasks
 from stridefix_analyzer.crowd.walks import DEFAULT_BAND, CrowdInputError, Walk
+from stridefix_analyzer.parallel import run_tasks
 
 
 def walk_groups(walks: list[Walk], per: str = "floor") -> list[list[int]]:

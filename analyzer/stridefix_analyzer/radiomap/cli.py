@@ -1,7 +1,7 @@
 """``stridefix radiomap build|show``: the command line of the radio-map builder.
 
-``build`` reads the logs (:mod:`.recordings`), builds the site (:func:`~.build.build_site`) and
-writes it; ``show`` checks a site file and prints its summary (and a PNG, :mod:`.show`).
+``build`` reads the logs (:mod:`.recordings`; one task per argument on ``--scheduler``, see
+:mod:`stridefix_analyzer.parallel`), builds the site (:func:`~.build.build_site`) and writes it; ``show`` checks a site file and prints its summary (and a PNG, :mod:`.show`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,13 @@ from stridefix import site_t
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
+from stridefix_analyzer.parallel import (
+    SchedulerError,
+    WorkerFiles,
+    add_scheduler_argument,
+    is_remote,
+    task_runner,
+)
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
 from stridefix_analyzer.radiomap.build import MODES, build_site
 from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
@@ -23,7 +30,7 @@ from stridefix_analyzer.radiomap.contexts import ContextMapError, build_context_
 from stridefix_analyzer.radiomap.floorplan import FloorPlanError
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
 from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
-from stridefix_analyzer.radiomap.recordings import RadioMapInputError, load_recordings
+from stridefix_analyzer.radiomap.recordings import RadioMapInputError, arg_files, load_recordings
 from stridefix_analyzer.radiomap.show import format_summary, plot_site
 
 
@@ -184,6 +191,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="A",
         help="rooms of the plan smaller than this are no walls (default 0: every room)",
     )
+    add_scheduler_argument(b, "serial")
+    b.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        metavar="N",
+        help="processes of --scheduler processes or local (default 2)",
+    )
     s = sub.add_parser(
         "show",
         help="summary (and PNG) of a site file",
@@ -236,7 +251,12 @@ def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
         if args.origin_deg is None:
             raise RadioMapInputError("--beacon-table needs --origin-deg LAT,LON (the frame's origin)")
         table = read_beacon_table(args.beacon_table, tuple(args.origin_deg))
-    recordings = load_recordings(args.logs)
+    logs, scheduler = list(args.logs), getattr(args, "scheduler", None)
+    if is_remote(scheduler):  # a remote worker's working folder is not ours
+        logs = [",".join(os.path.abspath(f) for f in arg_files(a)) for a in logs]
+    files = WorkerFiles(read=[f for a in logs for f in arg_files(a)])
+    with task_runner(scheduler, getattr(args, "workers", 2), files) as runner:
+        recordings = load_recordings(logs, runner)
     name = args.name or os.path.splitext(os.path.basename(args.out))[0]
     site, summary = build_site(
         recordings,
@@ -291,6 +311,7 @@ def run(args: argparse.Namespace) -> int:
         BuildingError,
         FloorPlanError,
         ContextMapError,
+        SchedulerError,
     ) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)

@@ -5,16 +5,20 @@ beacon_id, rssi_dbm), which the beacon learning (:mod:`.beacons`) uses.
 Logs are grouped into *recordings* that share a clock: an argument ``a.lcmlog,b.lcmlog`` is one
 recording of those files; a plain argument holding both WIFI and TRUTH is a recording by itself; the
 remaining plain arguments (e.g. the simulator's firmware log and its truth log) are merged into one
-recording.
+recording. Each argument is read as one task (:mod:`stridefix_analyzer.parallel`: serially, or on
+local processes or Dask workers for a fleet of walks); the recordings come back in argument order, so
+the site is the same whoever read them.
 """
 
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 
 from stridefix_analyzer.io.logread import LogData, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.parallel import TaskRunner
 
 
 class RadioMapInputError(Exception):
@@ -104,19 +108,33 @@ def _merge(files: list[str], datas: list[LogData]) -> Recording:
     return Recording(files, wifi, Table(cols), truth, read_ble(files))
 
 
-def load_recordings(args: list[str]) -> list[Recording]:
-    """Group log arguments into recordings (see the module docstring) and read them.
+def arg_files(arg: Any) -> list[str]:
+    """The log files of one argument (``a,b`` is two files of one recording)."""
+    return [f for f in str(arg).split(",") if f]
+
+
+def read_arg(arg: Any) -> Recording | tuple[str, LogData]:
+    """One argument read (a task): its recording, or (file, its data) for a plain argument that is
+    not a recording by itself (merged with the other such files afterwards)."""
+    files = arg_files(arg)
+    datas = [_read_one(f) for f in files]
+    if len(files) > 1 or (datas[0].table("WIFI") and datas[0].table("TRUTH")):
+        return _merge(files, datas)
+    return files[0], datas[0]
+
+
+def load_recordings(args: list[str], tasks: TaskRunner | None = None) -> list[Recording]:
+    """Group log arguments into recordings (see the module docstring) and read them, one task per
+    argument on ``tasks`` (None: in this process).
 
     Raises LogReadError (a file unreadable) or RadioMapInputError (a recording lacks WIFI/TRUTH).
     """
     recordings, rest = [], []
-    for arg in args:
-        files = [f for f in str(arg).split(",") if f]
-        datas = [_read_one(f) for f in files]
-        if len(files) > 1 or (datas[0].table("WIFI") and datas[0].table("TRUTH")):
-            recordings.append(_merge(files, datas))
+    for r in (tasks or TaskRunner(None, 1)).map(read_arg, args):
+        if isinstance(r, Recording):
+            recordings.append(r)
         else:
-            rest.append((files[0], datas[0]))
+            rest.append(r)
     if rest:
         recordings.append(_merge([f for f, _ in rest], [d for _, d in rest]))
     return recordings

@@ -22,6 +22,7 @@ from stridefix_analyzer.datasets.protocol import seconds_arg
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
+from stridefix_analyzer.parallel import SchedulerError, add_scheduler_argument
 from stridefix_analyzer.realbench import tuning
 from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT
 from stridefix_analyzer.realbench.fusion import DEFAULT_CELL_SIZE_M, FusionConfig, run_fusion
@@ -104,11 +105,14 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     d.add_argument(
         "--jobs",
         "-j",
+        "--workers",
+        dest="jobs",
         type=int,
         default=None,
         metavar="N",
-        help="walks prepared in parallel (default: CPU count)",
+        help="walks prepared in parallel: processes of --scheduler processes or local (default: CPU count)",
     )
+    add_scheduler_argument(d, "processes")
     d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
     d.set_defaults(_bench=_run_pdr_distance_cli)
     return p
@@ -129,8 +133,13 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
             args.jobs,
             args.reimport,
             progress,
+            scheduler=args.scheduler,
         )
-    except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
+    except (
+        RealbenchError,
+        LogReadError,
+        SchedulerError,
+    ) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     print(format_table(doc))
@@ -180,7 +189,7 @@ def add_fusion_parser(sub: Any) -> None:
         metavar="N",
         help="only the first N walks of each group (sorted by name)",
     )
-    d.add_argument("--jobs", "-j", type=int, default=2, metavar="N", help="parallel workers")
+    _add_workers(d)
     d.add_argument(
         "--true-start", action="store_true", help="also run every walk truth-initialised (labelled as such)"
     )
@@ -242,6 +251,21 @@ def add_fusion_parser(sub: Any) -> None:
     d.set_defaults(_bench=_run_fusion_cli)
 
 
+def _add_workers(d: argparse.ArgumentParser) -> None:
+    """``--jobs``/``--workers`` and ``--scheduler`` of the fold benchmarks."""
+    d.add_argument(
+        "--jobs",
+        "-j",
+        "--workers",
+        dest="jobs",
+        type=int,
+        default=2,
+        metavar="N",
+        help="worker processes of --scheduler processes or local (a scheduler address has its own)",
+    )
+    add_scheduler_argument(d, "processes")
+
+
 def _run_fusion_cli(args: argparse.Namespace) -> int:
     try:
         cfg = FusionConfig(
@@ -251,6 +275,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             stridefixd=args.stridefixd,
             limit=args.limit,
             jobs=args.jobs,
+            scheduler=args.scheduler,
             reimport=args.reimport,
             true_start=args.true_start,
             max_wifi_age_s=args.max_wifi_age_s,
@@ -269,7 +294,11 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             ),
         )
         doc = run_fusion(cfg)
-    except (RealbenchError, LogReadError) as exc:  # LogReadError: e.g. a stale stridefixd build
+    except (
+        RealbenchError,
+        LogReadError,
+        SchedulerError,
+    ) as exc:  # LogReadError: e.g. a stale stridefixd build
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     print(format_tables(doc, tuning.axes(args.param_sets)))
@@ -312,7 +341,7 @@ def add_crowd_map_parser(sub: Any) -> None:
     d.add_argument(
         "--limit", type=int, default=None, metavar="N", help="only the first N walks of each group"
     )
-    d.add_argument("--jobs", "-j", type=int, default=2, metavar="N", help="parallel workers")
+    _add_workers(d)
     d.add_argument("--cell-size-m", type=float, default=DEFAULT_CELL_SIZE_M, help="radio-map grid cell [m]")
     d.add_argument("--min-count", type=int, default=DEFAULT_MIN_COUNT, help="radio map: min scans per entry")
     d.add_argument(
@@ -345,6 +374,7 @@ def _run_crowd_map_cli(args: argparse.Namespace) -> int:
             stridefixd=args.stridefixd,
             limit=args.limit,
             jobs=args.jobs,
+            scheduler=args.scheduler,
             reimport=args.reimport,
             cell_size_m=args.cell_size_m,
             min_count=args.min_count,
@@ -356,7 +386,7 @@ def _run_crowd_map_cli(args: argparse.Namespace) -> int:
         doc = run_crowd_map(
             CrowdMapConfig(cfg, anchors=args.anchors, solver=args.solver, max_sigma_m=args.max_sigma_m)
         )
-    except (RealbenchError, LogReadError, CrowdInputError) as exc:
+    except (RealbenchError, LogReadError, CrowdInputError, SchedulerError) as exc:
         print(f"stridefix realbench: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     print(format_tables(doc))

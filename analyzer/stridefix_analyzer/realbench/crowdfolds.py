@@ -21,7 +21,6 @@ share one solve per walk: a median over 101 of 102 walks takes few distinct valu
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import math
 import time
@@ -29,6 +28,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any, TextIO
 
 from stridefix_analyzer.crowd.graph import FleetPriors, agreed_variant
+from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench.progress import Progress
 
@@ -119,42 +119,40 @@ def solve_folds(
     jobs: Mapping[int, CrowdJob],
     folds: Mapping[int, Sequence[int]],
     variants: Sequence[str],
-    n_workers: int,
+    tasks: TaskRunner,
     stream: TextIO,
 ) -> tuple[dict[int, Choice], dict[Choice, dict[int, dict[str, Any]]]]:
     """``jobs``: walk index → its job; ``folds``: test walk index → its training walk indices.
     Returns each fold's choice and, per distinct choice, every walk's :func:`crowd_walk` result
-    (walks of a fold's training set that failed: ``error`` set)."""
-    sims: dict[int, dict[str, Any]] = {}
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, n_workers)) as pool:
-        prog = Progress("crowd anchors", len(jobs), stream)
-        futs = {pool.submit(walk_similarities, job): i for i, job in jobs.items()}
-        for fut in concurrent.futures.as_completed(futs):
-            s = sims[futs[fut]] = fut.result()
-            told = sum(v is not None for v in s["sims"].values())
-            prog.step(f"{s['walk']}: {s['error'] or f'{told} of {len(variants)} variants tell'}")
-        choice = {
-            t: choose([sims[i] for i in train if not sims[i]["error"]], variants)
-            for t, train in folds.items()
-        }
-        distinct = list(dict.fromkeys(choice.values()))
-        ok = [i for i in jobs if not sims[i]["error"]]
-        solved: dict[Choice, dict[int, dict[str, Any]]] = {c: {} for c in distinct}
-        for i in jobs:
-            if sims[i]["error"]:
-                for c in distinct:
-                    solved[c][i] = {"walk": jobs[i].walk, "error": sims[i]["error"]}
-        prog = Progress(f"crowd solve ({len(distinct)} fold choices)", len(distinct) * len(ok), stream)
-        futs2 = {
-            pool.submit(crowd_walk, dataclasses.replace(jobs[i], variant=c[0], priors=c[1])): (c, i)
-            for c in distinct
-            for i in ok
-        }
-        for fut in concurrent.futures.as_completed(futs2):
-            c, i = futs2[fut]
-            r = solved[c][i] = fut.result()
-            mean_m = (r.get("positions") or {}).get("graph", {}).get("mean_m", math.nan)
-            prog.step(f"{r['walk']}: {r['error'] or f'{c[0]}, graph mean {mean_m:.1f} m'}")
+    (walks of a fold's training set that failed: ``error`` set); every task on ``tasks``."""
+    prog = Progress("crowd anchors", len(jobs), stream)
+
+    def told(_: int, s: dict[str, Any]) -> None:
+        n = sum(v is not None for v in s["sims"].values())
+        prog.step(f"{s['walk']}: {s['error'] or f'{n} of {len(variants)} variants tell'}")
+
+    ids = list(jobs)
+    sims = dict(zip(ids, tasks.map(walk_similarities, [jobs[i] for i in ids], on_result=told)))
+    choice = {
+        t: choose([sims[i] for i in train if not sims[i]["error"]], variants) for t, train in folds.items()
+    }
+    distinct = list(dict.fromkeys(choice.values()))
+    ok = [i for i in jobs if not sims[i]["error"]]
+    solved: dict[Choice, dict[int, dict[str, Any]]] = {c: {} for c in distinct}
+    for i in jobs:
+        if sims[i]["error"]:
+            for c in distinct:
+                solved[c][i] = {"walk": jobs[i].walk, "error": sims[i]["error"]}
+    prog = Progress(f"crowd solve ({len(distinct)} fold choices)", len(distinct) * len(ok), stream)
+    keys = [(c, i) for c in distinct for i in ok]
+
+    def solved_one(k: int, r: dict[str, Any]) -> None:
+        mean_m = (r.get("positions") or {}).get("graph", {}).get("mean_m", math.nan)
+        prog.step(f"{r['walk']}: {r['error'] or f'{keys[k][0][0]}, graph mean {mean_m:.1f} m'}")
+
+    walks = [dataclasses.replace(jobs[i], variant=c[0], priors=c[1]) for c, i in keys]
+    for (c, i), r in zip(keys, tasks.map(crowd_walk, walks, on_result=solved_one)):
+        solved[c][i] = r
     return choice, solved
 
 

@@ -25,7 +25,6 @@ work folders (``<walk>`` for the truth map, ``<walk>/crowd-map`` for the crowd m
 from __future__ import annotations
 
 import collections
-import concurrent.futures
 import dataclasses
 import json
 import math
@@ -35,6 +34,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any, TextIO
 
+from stridefix_analyzer.datasets.protocol import WalkGroup
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench.crowdfolds import Choice, CrowdJob, choice_doc, fold_stats, solve_folds
@@ -68,7 +68,13 @@ def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
     """Run the benchmark (module docstring); write ``cc.fusion.out_json``; return the document."""
     t_start = time.perf_counter()
     cfg = dataclasses.replace(cc.fusion, true_start=False, report=False)
-    run, groups = start_run(dataclasses.replace(cfg, quiet=True))  # fusion's own progress: silent
+    with start_run(dataclasses.replace(cfg, quiet=True)) as (run, groups):  # fusion's progress: silent
+        return _run_crowd_map(cc, cfg, run, groups, t_start)
+
+
+def _run_crowd_map(
+    cc: CrowdMapConfig, cfg: FusionConfig, run: Run, groups: list[WalkGroup], t_start: float
+) -> dict[str, Any]:
     stream = open(os.devnull, "w") if cfg.quiet else sys.stderr
     print(
         f"realbench: crowd-map: preparing {sum(len(g.walks) for g in groups)} walks", file=stream, flush=True
@@ -97,7 +103,7 @@ def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
         ids = [j.index for j in jobs]
         folds |= {j.index: [i for i in ids if i != j.index and i in crowd_jobs] for j in jobs}
     variants = list(next(a for a in run.axes if a.name == "heading").candidates)
-    choice, solved = solve_folds(crowd_jobs, folds, variants, run.cfg.jobs, stream)  # the crowd positions
+    choice, solved = solve_folds(crowd_jobs, folds, variants, run.tasks, stream)  # the crowd positions
     t_crowd = time.perf_counter()
     pairs = []
     for _, jobs in planned:
@@ -132,6 +138,7 @@ def run_crowd_map(cc: CrowdMapConfig) -> dict[str, Any]:
             "firmware_sets": list(run.cfg.param_sets),
             "limit": cfg.limit,
             "jobs": cfg.jobs,
+            "scheduler": run.tasks.describe(),
         },
         "stridefixd": {"path": str(run.firmware.path), "version": run.firmware.version()},
         "groups": groups_doc,
@@ -155,22 +162,21 @@ def run_pairs(
     run: Run, pairs: list[tuple[FoldJob, FoldJob]], stream: TextIO
 ) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
     """Both replays of every fold, in parallel (walk → truth-map result, crowd-map result)."""
-    results: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {}
     prog = Progress("fold", len(pairs), stream)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, run.cfg.jobs)) as pool:
-        futs2 = {pool.submit(_pair, p): p[0].walk for p in pairs}
-        for fut in concurrent.futures.as_completed(futs2):
-            tr, cr = results[futs2[fut]] = fut.result()
-            note = (
-                tr["error"]
-                or cr["error"]
-                or " vs ".join(
-                    f"{m} {r['fixes'].get('wifi_only', {}).get('mean', math.nan):.1f} m"
-                    for m, r in (("truth", tr), ("crowd", cr))
-                )
+
+    def done(k: int, both: tuple[dict[str, Any], dict[str, Any]]) -> None:
+        tr, cr = both
+        note = (
+            tr["error"]
+            or cr["error"]
+            or " vs ".join(
+                f"{m} {r['fixes'].get('wifi_only', {}).get('mean', math.nan):.1f} m"
+                for m, r in (("truth", tr), ("crowd", cr))
             )
-            prog.step(f"{futs2[fut]}: wifi_only {note}")
-    return results
+        )
+        prog.step(f"{pairs[k][0].walk}: wifi_only {note}")
+
+    return {p[0].walk: r for p, r in zip(pairs, run.tasks.map(_pair, pairs, on_result=done))}
 
 
 def _scores(r: Mapping[str, Any]) -> dict[str, dict[str, Any]]:

@@ -40,6 +40,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.progress import Progress
 
@@ -203,7 +204,7 @@ def measure(
     work_dir: Path,
     base_sets: Sequence[str],
     block_sets: Mapping[int, Sequence[str]],
-    jobs: int,
+    tasks: TaskRunner,
     stream: TextIO,
     n_blocks: int = rs.DEFAULT_BLOCKS,
 ) -> tuple[list[dict[str, Any] | None], list[float], dict[str, Any]]:
@@ -219,7 +220,7 @@ def measure(
         work_dir=work_dir,
         base_sets=list(base_sets),
         candidates={"measured": []},
-        jobs=jobs,
+        tasks=tasks,
         n_blocks=n_blocks,
         progress=prog.step,
         replay=rs.replay_task,

@@ -18,18 +18,24 @@ of the group only (DESIGN.md, evaluation protocol):
 Outputs (:mod:`.summary`): ``results.json``, the HTML report next to it (:mod:`.report`), and the
 per-walk work files under ``OUT/realbench_work/<group>/<walk>`` (site file, stridefixd log,
 metrics.json, analysis.npz).
+
+Phases 1 and 3 and the inner cross-validation of phase 2 are independent tasks (a walk, a fold, a
+replay) on ``--scheduler`` (:mod:`stridefix_analyzer.parallel`: serial, local processes, a Dask
+LocalCluster or a Dask scheduler's workers), one runner for the whole run; their results are merged in
+task order, so every scheduler gives the same results.json (apart from ``run_s`` and ``params.jobs``/
+``params.scheduler``).
 """
 
 from __future__ import annotations
 
-import concurrent.futures
+import contextlib
 import dataclasses
 import json
 import math
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -38,6 +44,7 @@ import numpy as np
 from stridefix_analyzer.datasets.protocol import Dataset, WalkGroup
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.parallel import TaskRunner, WorkerFiles, is_remote, task_runner
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import priors, tuning
 from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M, fold_floors
@@ -69,7 +76,9 @@ class FusionConfig:
     out_json: Path
     stridefixd: str | Path | None = None  # None: $STRIDEFIXD or the CMake build's
     limit: int | None = None
-    jobs: int = 2
+    jobs: int = 2  # worker processes of the scheduler "processes" or "local"
+    #: where the tasks run (:func:`stridefix_analyzer.parallel.check_scheduler`)
+    scheduler: str | None = "processes"
     reimport: bool = False
     true_start: bool = False
     max_wifi_age_s: float | None = None  # None: the data set's default
@@ -105,6 +114,7 @@ class Run:
     max_wifi_age_s: float
     out_dir: Path
     stream: TextIO
+    tasks: TaskRunner  # where the walks, replays and folds run
 
 
 def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
@@ -113,7 +123,11 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     Returns the JSON document (non-finite numbers still NaN). Raises :class:`.walks.RealbenchError`.
     """
     t_start = time.perf_counter()
-    run, groups = start_run(cfg)
+    with start_run(cfg) as (run, groups):
+        return _run_fusion(run, groups, t_start)
+
+
+def _run_fusion(run: Run, groups: list[WalkGroup], t_start: float) -> dict[str, Any]:
     cfg, fw, stream = run.cfg, run.firmware, run.stream
     walks, parts = prepare_walks(run, groups)  # phase 1
     t_prep = time.perf_counter() - t_start
@@ -147,9 +161,20 @@ def run_fusion(cfg: FusionConfig) -> dict[str, Any]:
     return doc
 
 
-def start_run(cfg: FusionConfig) -> tuple[Run, list[WalkGroup]]:
-    """The data set, the checked firmware, the tuning axes, the output folder and the progress stream
-    of a run, and its walk groups (shared with ``realbench crowd-map``). Raises RealbenchError."""
+@contextlib.contextmanager
+def start_run(cfg: FusionConfig) -> Iterator[tuple[Run, list[WalkGroup]]]:
+    """The data set, the checked firmware, the tuning axes, the output folder, the progress stream
+    and the task runner of a run (closed after), and its walk groups (shared with ``realbench
+    crowd-map``). Raises RealbenchError, or SchedulerError when the scheduler or its workers cannot run it."""
+    if is_remote(cfg.scheduler):
+        # a remote worker's working folder is not ours: every path the tasks see is absolute
+        cfg = dataclasses.replace(
+            cfg,
+            dirs=[Path(d).resolve() for d in cfg.dirs],
+            out_json=cfg.out_json.resolve(),
+            stridefixd=Path(cfg.stridefixd or Firmware().path).resolve(),
+            cache_dir=Path(cfg.cache_dir).resolve() if cfg.cache_dir else None,
+        )
     ds = dataset(cfg.fmt)
     # the data set's own overrides first, the user's --set after them (the later one wins)
     cfg = dataclasses.replace(cfg, param_sets=(*ds.firmware_sets, *cfg.param_sets))
@@ -162,7 +187,12 @@ def start_run(cfg: FusionConfig) -> tuple[Run, list[WalkGroup]]:
     rows = tuning.axes(cfg.param_sets)
     if not cfg.content.controller:
         rows = tuple(a for a in rows if a.name != "lsd")
-    return Run(cfg, ds, fw, rows, age, out_dir, stream), groups
+    cache = Path(cfg.cache_dir) if cfg.cache_dir else out_dir / "cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    # what the tasks read and write by path: a Dask worker must see the same (checked before the first)
+    files = WorkerFiles(read=[*cfg.dirs], write=[out_dir, cache], same=[fw.path])
+    with task_runner(cfg.scheduler, cfg.jobs, files) as runner:
+        yield Run(cfg, ds, fw, rows, age, out_dir, stream, runner), groups
 
 
 def prepare_walks(run: Run, groups: list[WalkGroup]) -> tuple[list[dict[str, Any]], list[Part]]:
@@ -190,14 +220,13 @@ def prepare_walks(run: Run, groups: list[WalkGroup]) -> tuple[list[dict[str, Any
                     heading_candidates=heading,
                 )
             )
-    walks: list[dict[str, Any]] = [{}] * len(jobs)
-    prog = Progress("prepare", len(jobs), run.stream)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, cfg.jobs)) as pool:
-        futs = {pool.submit(prepare, job): i for i, job in enumerate(jobs)}
-        for fut in concurrent.futures.as_completed(futs):
-            walks[futs[fut]] = w = fut.result()
-            steps = w["error"] or f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints"
-            prog.step(f"{w['walk']}: {steps}")
+    prog = Progress(f"prepare ({run.tasks.describe()})", len(jobs), run.stream)
+
+    def done(_: int, w: dict[str, Any]) -> None:
+        steps = w["error"] or f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints"
+        prog.step(f"{w['walk']}: {steps}")
+
+    walks: list[dict[str, Any]] = run.tasks.map(prepare, jobs, on_result=done)
     parts = []
     for g in groups:
         ids = [i for i, (o, _) in enumerate(owner) if o is g]
@@ -232,7 +261,7 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
     heading = next(a for a in run.axes if a.name == "heading").candidates
     sites = SelectionSites(total, sub, seg, used, rotation, heading, run.cfg.min_count)
     group = tuning.Group(
-        sub, rotation, sites, run.firmware, part.work / "select", run.cfg.param_sets, run.cfg.jobs, run.stream
+        sub, rotation, sites, run.firmware, part.work / "select", run.cfg.param_sets, run.tasks, run.stream
     )
     choices = tuning.choose(run.axes, group)
     for c in choices.values():
@@ -299,18 +328,15 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
 
 
 def run_folds(run: Run, jobs: list[FoldJob]) -> list[dict[str, Any]]:
-    """Phase 3: every fold, in parallel; results in the order of ``jobs``."""
-    results = []
+    """Phase 3: every fold, on the run's scheduler; results in the order of ``jobs``."""
     prog = Progress("fold", len(jobs), run.stream)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=max(1, run.cfg.jobs)) as pool:
-        for fut in concurrent.futures.as_completed([pool.submit(run_fold, j) for j in jobs]):
-            r = fut.result()
-            results.append(r)
-            k = r.get("fixes", {}).get("kalman", {}).get("mean")
-            note = r["error"] or (f"kalman mean {k:.1f} m" if k is not None else "scored")
-            prog.step(f"{r['walk']}: {note}")
-    order = {j.walk: n for n, j in enumerate(jobs)}
-    return sorted(results, key=lambda r: order[r["walk"]])
+
+    def done(_: int, r: dict[str, Any]) -> None:
+        k = r.get("fixes", {}).get("kalman", {}).get("mean")
+        note = r["error"] or (f"kalman mean {k:.1f} m" if k is not None else "scored")
+        prog.step(f"{r['walk']}: {note}")
+
+    return run.tasks.map(run_fold, jobs, on_result=done)
 
 
 def _params(run: Run) -> dict[str, Any]:
@@ -322,6 +348,7 @@ def _params(run: Run) -> dict[str, Any]:
         "max_wifi_age_s": run.max_wifi_age_s,
         "limit": cfg.limit,
         "jobs": cfg.jobs,
+        "scheduler": run.tasks.describe(),
         "robust_mean_m": ROBUST_MEAN_M,
         "ipin_floor_penalty_m": IPIN_FLOOR_PENALTY_M,
         "rotation": {

@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike
 from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
+from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.progress import Progress
 
@@ -83,7 +84,7 @@ def choose_lsd(
     work_dir: Path,
     base_sets: Sequence[str],
     block_sets: Mapping[int, Sequence[str]],
-    jobs: int,
+    tasks: TaskRunner,
     stream: Any,
     n_blocks: int = rs.DEFAULT_BLOCKS,
 ) -> tuple[list[str], dict[str, Any]]:
@@ -101,7 +102,7 @@ def choose_lsd(
         work_dir=work_dir,
         base_sets=list(base_sets),
         candidates={"all schemes": []},
-        jobs=jobs,
+        tasks=tasks,
         n_blocks=n_blocks,
         progress=prog.step,
         replay=replay_all_schemes,

@@ -20,7 +20,6 @@ errors include the surveyor's path shape; K absorbs the floor-wide average of th
 
 from __future__ import annotations
 
-import concurrent.futures
 import json
 import math
 import os
@@ -37,6 +36,7 @@ from stridefix_analyzer.datasets.protocol import DatasetReadError
 from stridefix_analyzer.firmware import Firmware, FirmwareError
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
+from stridefix_analyzer.parallel import WorkerFiles, is_remote, task_runner
 from stridefix_analyzer.realbench.pdr_plot import plot_pdr_distance
 from stridefix_analyzer.realbench.strides import (
     DEFAULT_MIN_SEGMENT_M,
@@ -169,35 +169,44 @@ def run_pdr_distance(
     reimport: bool = False,
     progress: Callable[[str], None] | None = None,
     plot: bool = True,
+    scheduler: str | None = "processes",
 ) -> dict[str, Any]:
     """Run the PDR distance benchmark on one floor; write JSON (+ PNG) into ``out_dir``.
 
-    ``stridefixd`` None: :func:`stridefix_analyzer.firmware.default_path`. Returns the JSON document
+    ``stridefixd`` None: :func:`stridefix_analyzer.firmware.default_path`. The walks are prepared on
+    ``scheduler`` with ``jobs`` workers (:mod:`stridefix_analyzer.parallel`). Returns the JSON document
     (a dict; non-finite numbers still as NaN).
 
     Raises
     ------
     RealbenchError
         No traces, or no executable ``stridefixd``.
+    SchedulerError
+        The scheduler cannot be reached, or a Dask worker lacks the data or the build.
     """
     t_start = time.perf_counter()
+    if is_remote(scheduler):  # a remote worker's working folder is not ours
+        floor_dir = Path(floor_dir).resolve()
+        stridefixd = Path(stridefixd or Firmware().path).resolve()
     (group,) = find_groups(dataset(DATASET), [floor_dir], limit)
     label, traces = group.label, group.walks
     fw = firmware(stridefixd or Firmware().path)
     out = Path(out_dir or os.path.join(DEFAULT_OUT, label.replace("/", "-")))
+    out = out.resolve() if is_remote(scheduler) else out
     out.mkdir(parents=True, exist_ok=True)
     say = progress or (lambda msg: None)
     n_jobs = max(1, jobs or os.cpu_count() or 1)
-    walks: list[dict[str, Any]] = [{}] * len(traces)
-    with concurrent.futures.ProcessPoolExecutor(max_workers=n_jobs) as pool:
-        futures = {
-            pool.submit(prepare_walk, t, out, fw, max_wifi_age_s, reimport): i for i, t in enumerate(traces)
-        }
-        for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
-            i = futures[fut]
-            walks[i] = w = fut.result()
-            state = w["error"] or (f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints")
-            say(f"walk {done}/{len(traces)} {w['walk']}: {state}")
+    done = [0]
+
+    def prepared(_: int, w: dict[str, Any]) -> None:
+        done[0] += 1
+        state = w["error"] or (f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints")
+        say(f"walk {done[0]}/{len(traces)} {w['walk']}: {state}")
+
+    files = WorkerFiles(read=[floor_dir], write=[out], same=[fw.path])
+    with task_runner(scheduler, n_jobs, files) as runner:
+        shared = (out, fw, max_wifi_age_s, reimport)
+        walks = runner.map(_prepare_task, traces, shared=shared, on_result=prepared)
 
     seg, fits = score_segments(build_segments(walks, min_segment_m), len(walks))
     doc = summarize(label, floor_dir, walks, seg, fits, min_segment_m, max_wifi_age_s, limit)
@@ -210,6 +219,11 @@ def run_pdr_distance(
     if plot:
         (out / PNG_FILE).write_bytes(plot_pdr_distance(seg, label, TARGET_MEDIAN_ABS_ERROR_PCT))
     return doc
+
+
+def _prepare_task(trace: Path, shared: tuple[Path, Firmware, float, bool]) -> dict[str, Any]:
+    """:func:`prepare_walk` of one trace, as a task (the other arguments are the run's)."""
+    return prepare_walk(trace, *shared)
 
 
 def summarize(

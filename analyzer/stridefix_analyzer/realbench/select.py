@@ -26,20 +26,17 @@ are rows of :mod:`.tuning` (:data:`~.tuning.AXES`); this module only measures th
 
 from __future__ import annotations
 
-import concurrent.futures
 import math
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
-
-T = TypeVar("T")
-R = TypeVar("R")
+from stridefix_analyzer.parallel import TaskRunner
 
 #: what each stage replays (--fusion) and scores
 STAGES = {"matcher": "wifi_only", "adaptive": "adaptive", "fixmodel": "wifi_only"}
@@ -121,17 +118,18 @@ def block_replays(
     work_dir: Path,
     base_sets: list[str],
     candidates: dict[str, list[str]],
-    jobs: int,
+    tasks: TaskRunner | None,
     n_blocks: int,
     progress: Callable[[], None] | None,
     replay: Callable[[dict[str, Any]], dict[str, Any]],
     stage: str,
     block_sets: Mapping[int, Sequence[str]] | None,
-) -> tuple[list[int], Iterator[dict[str, Any]]]:
+) -> tuple[list[int], list[dict[str, Any]]]:
     """The block of every walk, and the replays of every (a, b ≠ a) block pair for every candidate
-    (walks of block b on the map without blocks a and b), as they finish (see the module text)."""
+    (walks of block b on the map without blocks a and b) in that order, run on ``tasks`` (None: in
+    this process; the sites are written here, before any replay; see the module text)."""
     block = [i % n_blocks for i in range(len(sub))]
-    tasks = []
+    replays = []
     for a in range(n_blocks):
         for b in range(n_blocks):
             if a == b:
@@ -145,7 +143,7 @@ def block_replays(
             for i in (i for i in range(len(sub)) if block[i] == b):
                 for name in candidates:
                     sets = [*base_sets, *site_sets, *(block_sets or {}).get(a, []), *candidates[name]]
-                    tasks.append(
+                    replays.append(
                         {
                             "a": a,
                             "name": name,
@@ -163,18 +161,10 @@ def block_replays(
                         }
                     )
 
-    def run() -> Iterator[dict[str, Any]]:
-        with (
-            concurrent.futures.ProcessPoolExecutor(max_workers=max(1, jobs))
-            if jobs > 1
-            else _InProcess() as pool
-        ):
-            for r in pool.map(replay, tasks, chunksize=4):
-                yield r
-                if progress:
-                    progress()
-
-    return block, run()
+    runner = tasks or TaskRunner(None, 1)
+    done = (lambda i, r: progress()) if progress else None
+    # chunks of 4: a replay takes ~30 ms, a submission's round trip is not free
+    return block, runner.map(replay, replays, on_result=done, chunksize=4)
 
 
 def select(
@@ -185,7 +175,7 @@ def select(
     work_dir: str | Path,
     base_sets: list[str],
     candidates: dict[str, list[str]],
-    jobs: int = 2,
+    tasks: TaskRunner | None = None,
     n_blocks: int = DEFAULT_BLOCKS,
     progress: Callable[[], None] | None = None,
     replay: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
@@ -198,7 +188,8 @@ def select(
     the group's total minus ``stats_removed`` (the summed ``stats`` of the excluded walks), learned
     from the walks ``others`` (map rotation included), and returns the stridefixd settings learned
     from them too (heading variant, stride K) for the replays with that site. ``replay(task) -> task + {"errors", "failure"}`` runs one walk (default:
-    stridefixd; in this process when ``jobs`` ≤ 1). ``stage`` says what is replayed and scored
+    stridefixd; on ``tasks``, :class:`~stridefix_analyzer.parallel.TaskRunner`, None: in this process, each
+    task a pickled copy as a worker gets it). ``stage`` says what is replayed and scored
     (:data:`STAGES`: Wi-Fi fix errors, or the adaptive POSE at the waypoints); ``block_sets[a]`` are
     settings already chosen for block a (its matcher). Returns (the candidate per walk, a report).
     """
@@ -216,7 +207,7 @@ def select(
         work_dir=work_dir,
         base_sets=base_sets,
         candidates=candidates,
-        jobs=jobs,
+        tasks=tasks,
         n_blocks=n_blocks,
         progress=progress,
         replay=replay or replay_task,
@@ -259,20 +250,6 @@ def choose_per_block(
         choice[a] = min(finite, key=lambda n: finite[n]) if finite else default
         blocks[str(a)] = {"candidates": means, "chosen": choice[a]}
     return choice, blocks
-
-
-class _InProcess:
-    """The part of an executor :func:`select` uses, without processes (jobs ≤ 1, tests)."""
-
-    def __enter__(self) -> _InProcess:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-    @staticmethod
-    def map(fn: Callable[[T], R], items: Iterable[T], chunksize: int = 1) -> Iterator[R]:
-        return map(fn, items)
 
 
 def n_tasks(n_walks: int, n_candidates: int, n_blocks: int = DEFAULT_BLOCKS) -> int:

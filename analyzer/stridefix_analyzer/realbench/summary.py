@@ -150,6 +150,26 @@ def strip_samples(doc: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: the wall-clock timers of a results.json (the run's phases, a fold's site content, its floor-plan
+#: survey) and how the run was scheduled (``params.jobs``, ``params.scheduler``): not results
+TIMERS = ("run_s", "content_content_s", "survey_s")
+HOW_RUN = ("jobs", "scheduler")
+
+
+def untimed(doc: Any) -> Any:
+    """``doc`` (a results.json document) without :data:`TIMERS` and ``params``' :data:`HOW_RUN`: what
+    must be identical on every scheduler."""
+    if isinstance(doc, Mapping):
+        return {
+            k: ({p: untimed(q) for p, q in v.items() if p not in HOW_RUN} if k == "params" else untimed(v))
+            for k, v in doc.items()
+            if k not in TIMERS
+        }
+    if isinstance(doc, list):
+        return [untimed(v) for v in doc]
+    return doc
+
+
 def pdr_true_start(group: Mapping[str, Any]) -> dict[str, Any] | None:
     """pdr_only's row of a group's truth-initialised run; None when it was not run (no --true-start)."""
     return group.get("summary_true_start", {}).get("schemes", {}).get(schemes.PDR_ONLY)

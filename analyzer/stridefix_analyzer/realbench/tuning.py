@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any, Protocol, TextIO
 
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import fixmodel, lsd
 from stridefix_analyzer.realbench import select as rs
 from stridefix_analyzer.realbench.heading import (
@@ -72,7 +73,7 @@ class Group:
     firmware: Firmware
     work_dir: Path
     base_sets: Sequence[str]
-    jobs: int
+    tasks: TaskRunner  # where the replays run
     stream: TextIO
 
 
@@ -131,7 +132,7 @@ class InnerCV:
             work_dir=group.work_dir,
             base_sets=list(group.base_sets),
             candidates={k: list(v) for k, v in axis.candidates.items()},
-            jobs=group.jobs,
+            tasks=group.tasks,
             progress=prog.step,
             stage=self.stage,
             block_sets={a: list(s) for a, s in block_sets.items()},
@@ -160,7 +161,7 @@ class Measured:
             group.work_dir / axis.name,
             group.base_sets,
             block_sets,
-            group.jobs,
+            group.tasks,
             group.stream,
         )
         extra = [
@@ -190,7 +191,7 @@ class SchemeByError:
             work_dir=group.work_dir / axis.name,
             base_sets=group.base_sets,
             block_sets=block_sets,
-            jobs=group.jobs,
+            tasks=group.tasks,
             stream=group.stream,
         )
         fields: list[dict[str, Any] | None] = [{lsd.SITE_KEY: s} for s in per_walk]

@@ -165,6 +165,7 @@ LAYERS = (
     "schemes",
     "firmware",
     "stages",
+    "parallel",
     "io",
     "datasets",
     "radiomap",

@@ -105,7 +105,6 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
         work_dir=tmp_path,
         base_sets=["k=v"],
         candidates=tuning.MATCHER_VARIANTS,
-        jobs=1,
         replay=replay,
     )
     assert choice == ["2 scans, dBm" if i % 4 == 1 else "1 scan, dBm" for i in range(10)]
