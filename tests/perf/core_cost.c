@@ -13,16 +13,25 @@
  *                               mean is above −85 dBm, a scan hearing every AP above −80 dBm (~31).
  *                               With stridefixd's workspace and defaults, or with "full" after SCANS
  *                               fingerprint.preselect_aps = 0 (every entry of every AP heard visited).
+ *   core_cost wifidump N_RP SCANS PATH [full]
+ *                               the wifi mode's map and scans, and each scan's fix, written to PATH as
+ *                               text for a peer matcher (bench/perf_peers.py): "rp I X Y" per RP,
+ *                               "e RP AP MEAN_DBM" per entry, "q X Y OK FX FY N AP RSSI ..." per scan
+ *                               (truth, fix, the readings by AP index).
+ *   The wifi modes' JSON has match_s: the wall time inside sf_fingerprint_match (CLOCK_MONOTONIC).
  *   core_cost samples SECONDS   the sensors walk's IMU and MAG samples as text, for a peer filter.
  *   core_cost sizes             sizeof of the core's state structs.
  *
  * Prints one JSON object (counts and what was built); exit 0, 2 on bad usage. The harness may use the
  * heap (the map is the caller's memory by design); the core calls never do (ctest core_symbols). */
+/* clock_gettime (POSIX) under -std=c11: the harness times the matcher calls */
+#define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "sf_estimator.h"
 #include "sf_fingerprint.h"
@@ -33,7 +42,8 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS [full] | sizes\n");
+    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS [full] | wifidump N_RP SCANS PATH [full] | "
+                    "sizes\n");
     return 2;
 }
 
@@ -122,7 +132,15 @@ static double level_dbm(const double d_m)
     return -40.0 - 30.0 * log10(fmax(d_m, 1.0));
 }
 
-static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool preselect)
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* dump: NULL, or where the map, the scans and the fixes go as text (wifidump) */
+static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool preselect, FILE *const dump)
 {
     const int32_t side = (int32_t)ceil(sqrt((double)n_rp_want));
     const int32_t n_rp = side * side;
@@ -176,6 +194,16 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
         }
     }
     ap_first[n_ap] = n_entries;
+    if (dump != NULL) {
+        for (int32_t i = 0; i < n_rp; i++) {
+            fprintf(dump, "rp %d %.9g %.9g\n", i, rx[i], ry[i]);
+        }
+        for (int32_t a = 0; a < n_ap; a++) {
+            for (int32_t e = ap_first[a]; e < ap_first[a + 1]; e++) {
+                fprintf(dump, "e %d %d %.9g\n", erp[e], a, emean[e]);
+            }
+        }
+    }
     const sf_radiomap_t map = {n_ap, bssid, ap_first, n_rp, rx, ry, rf, rscans, n_entries, erp, emean, estd, ecount};
     static sf_params_t p;
     sf_params_default(&p);
@@ -204,7 +232,7 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
     int64_t *sb = malloc(sizeof *sb * (size_t)n_ap);
     float *sr = malloc(sizeof *sr * (size_t)n_ap);
     long heard = 0, fixes = 0, preselected = 0, scored = 0;
-    double err_sum_m = 0.0;
+    double err_sum_m = 0.0, match_s = 0.0;
     for (int32_t q = 0; q < n_scans; q++) {
         const double qx = 4.0 + (size_m - 8.0) * rng_uniform01(&r);
         const double qy = 4.0 + (size_m - 8.0) * rng_uniform01(&r);
@@ -221,7 +249,17 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
         /* scans 30 s apart: each fix stands alone (no averaging with the previous scan) */
         const sf_wifi_scan_t scan = {(int64_t)(q + 1) * 30000000LL, n, sb, sr};
         sf_fix_t fix;
-        if (sf_fingerprint_match(&fp, &p, &map, &ws, &scan, 0, true, &fix) == 0) {
+        const double t0_s = now_s();
+        const int ok = sf_fingerprint_match(&fp, &p, &map, &ws, &scan, 0, true, &fix) == 0;
+        match_s += now_s() - t0_s;
+        if (dump != NULL) {
+            fprintf(dump, "q %.9g %.9g %d %.9g %.9g %d", qx, qy, ok, ok ? fix.x_m : 0.0, ok ? fix.y_m : 0.0, n);
+            for (int32_t j = 0; j < n; j++) {
+                fprintf(dump, " %d %.0f", (int)(sb[j] - bssid[0]), sr[j]);
+            }
+            fputc('\n', dump);
+        }
+        if (ok) {
             fixes++;
             preselected += fp.audit.preselected != 0;
             scored += fp.audit.n_candidates;
@@ -230,9 +268,9 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
     }
     printf("{\"mode\": \"wifi\", \"n_rp\": %d, \"n_ap\": %d, \"n_entries\": %d, \"scans\": %d, \"mean_heard\": %.1f, "
            "\"fixes\": %ld, \"mean_error_m\": %.17g, \"size_m\": %.0f, \"preselect\": %s, \"preselected\": %ld, "
-           "\"mean_scored\": %.1f}\n",
+           "\"mean_scored\": %.1f, \"match_s\": %.9g}\n",
            n_rp, n_ap, n_entries, n_scans, (double)heard / (double)n_scans, fixes, fixes ? err_sum_m / (double)fixes : -1.0,
-           size_m, preselect ? "true" : "false", preselected, fixes ? (double)scored / (double)fixes : 0.0);
+           size_m, preselect ? "true" : "false", preselected, fixes ? (double)scored / (double)fixes : 0.0, match_s);
     return 0;
 }
 
@@ -253,7 +291,20 @@ int main(const int argc, char **const argv)
     }
     if ((argc == 4 || (argc == 5 && strcmp(argv[4], "full") == 0)) && strcmp(argv[1], "wifi") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
-        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans, argc == 4) : usage();
+        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans, argc == 4, NULL) : usage();
+    }
+    if ((argc == 5 || (argc == 6 && strcmp(argv[5], "full") == 0)) && strcmp(argv[1], "wifidump") == 0) {
+        const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
+        if (n_rp <= 0 || n_scans <= 0) {
+            return usage();
+        }
+        FILE *const dump = fopen(argv[4], "w");
+        if (dump == NULL) {
+            fprintf(stderr, "core_cost: cannot write %s\n", argv[4]);
+            return 1;
+        }
+        const int rc = run_wifi(n_rp, n_scans, argc == 5, dump);
+        return fclose(dump) == 0 ? rc : 1;
     }
     if (argc == 3 && strcmp(argv[1], "samples") == 0) {
         const double s = atof(argv[2]);

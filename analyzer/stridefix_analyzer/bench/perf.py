@@ -24,8 +24,11 @@ Each figure says how it was measured:
 The attitude peer is x-io Fusion (PyPI ``imufusion``, the C library compiled into its wheel): the same
 samples (``sf_core_cost samples``) through ``FusionAhrsUpdate`` (gyro + accelerometer + magnetometer on
 every IMU sample), counted by callgrind inside that function only; ours is ``sf_attitude_update_imu`` +
-``sf_attitude_update_mag`` per IMU sample (MAG at 50 Hz). The ``ahrs`` package's Madgwick and
-scikit-learn's KNN are not in this run yet. Writes ``perf.json``.
+``sf_attitude_update_mag`` per IMU sample (MAG at 50 Hz). The Python peers (:mod:`.perf_peers`,
+``python_peers`` in the JSON, informative, no budget): the ``ahrs`` package's Madgwick and imufusion's
+Python API on the same samples, wall time per sample and their yaw agreement; scikit-learn's
+``KNeighborsRegressor`` against ``sf_fingerprint_match`` on the harness's synthetic map, mean error and
+queries/s. Writes ``perf.json``.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import callgrind
+from stridefix_analyzer.bench import callgrind, perf_peers
 from stridefix_analyzer.bench.soak import vm_hwm_kb
 from stridefix_analyzer.firmware import REPO, Firmware
 from stridefix_analyzer.stages import StageError, stridefix_exe
@@ -268,6 +271,15 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
     sensors = measure_sensors(harness, out)
     print("bench perf: x-io Fusion on the same samples under callgrind", file=sys.stderr, flush=True)
     peer = measure_attitude_peer(harness, out)
+    print(
+        "bench perf: Python peers (ahrs Madgwick, scikit-learn KNN) by wall clock",
+        file=sys.stderr,
+        flush=True,
+    )
+    python_peers = {
+        "attitude": perf_peers.measure_madgwick_peer(out / "perf.samples.txt"),
+        "wifi": perf_peers.measure_knn_peer(harness, out),
+    }
     wifi = measure_wifi(harness, out)
     sizes = _harness_json(harness, "sizes")
     heap = check_no_heap(firmware.path)
@@ -292,13 +304,14 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "harness": str(harness),
         "sensors": sensors,
         "attitude_peer": peer,
+        "python_peers": python_peers,
         "wifi": wifi,
         "sizes": sizes,
         "core_no_heap": heap,
         "replay": replay,
         "budgets": budgets,
         "not_measured": [
-            "the ahrs package's Madgwick and scikit-learn's KNN as peers",
+            "scikit-learn's KNN on a real msindoor floor (its peer row is the harness's synthetic map)",
             "realbench <= 60 s per msindoor floor (see realbench results' run_s)",
         ],
     }
@@ -323,6 +336,8 @@ def format_table(doc: dict[str, Any]) -> str:
             f"{w['ir_per_fix']:>11,.0f}{w['mean_error_m']:>7.2f}{w['ir_per_fix_full_visit']:>12,.0f}"
             f"{w['mean_error_m_full_visit']:>7.2f}"
         )
+    if "python_peers" in doc:
+        lines += perf_peers.format_rows(doc["python_peers"]["attitude"], doc["python_peers"]["wifi"])
     r = doc["replay"]
     lines.append(
         f"  replay: {r['walk_s']:.0f} s walk in {r['wall_s']:.2f} s wall ({r['x_realtime']:,.0f}x real time), "
