@@ -4,10 +4,14 @@
  * in a room and walks STEPS steps (a walker bouncing off the walls, PDR heading 5° off with noise) with
  * a Wi-Fi-like fix (σ 3 m) every 4th step, through the scheme's own calls (sf_fusion_step_on_floor,
  * sf_fusion_fix). callgrind counts the instructions inside those calls (--toggle-collect); the bench
- * divides by the number of calls. Prints the plan's figures; exit 0. Usage: sf_particle_cost [STEPS] */
+ * divides by the number of calls. With "ekf" after STEPS the ekf scheme walks the same steps and fixes
+ * instead (`stridefix bench perf`'s per-update figures). Prints the plan's figures; exit 0, 2 on bad
+ * usage. Usage: sf_particle_cost [STEPS [particle|ekf]] */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "sf_fusion.h"
 #include "sf_particle.h"
@@ -59,6 +63,12 @@ static bool crosses(const sf_wall_grid_t *const g, const double ax, const double
 int main(int argc, char **argv)
 {
     const int steps = argc > 1 ? atoi(argv[1]) : 400;
+    /* the scheme walked: the particle cloud (default) or the ekf on the same steps and fixes */
+    const bool ekf = argc > 2 && strcmp(argv[2], "ekf") == 0;
+    if (steps <= 0 || (argc > 2 && !ekf && strcmp(argv[2], "particle") != 0)) {
+        fprintf(stderr, "usage: particle_cost [STEPS [particle|ekf]]\n");
+        return 2;
+    }
     sf_rng_t r;
     sf_rng_seed(&r, 42u, 1u);
     building(&r);
@@ -77,8 +87,10 @@ int main(int argc, char **argv)
     }
     sf_particle_set_map(&c, &g, NULL);
     sf_fusion_t f;
-    sf_fusion_init(&f, sf_scheme_particle);
-    sf_fusion_set_cloud(&f, &p, &c);
+    sf_fusion_init(&f, ekf ? sf_scheme_ekf : sf_scheme_particle);
+    if (!ekf) {
+        sf_fusion_set_cloud(&f, &p, &c);
+    }
     double x = 52.5, y = 52.5, h = 0.3;
     (void)sf_fusion_init_at(&f, &p, 0, x, y, 0, 0.5, 0);
     int fixes = 0;
@@ -105,9 +117,9 @@ int main(int argc, char **argv)
     }
     sf_pose_t pose = {0};
     (void)sf_fusion_pose(&f, &p, (int64_t)steps * 500000 + 1, 0, &pose);
-    printf("{\"walls\": %d, \"grid_bytes\": %zu, \"cell_m\": %.3f, \"particles\": %d, \"steps\": %d, \"fixes\": %d, "
+    printf("{\"scheme\": \"%s\", \"walls\": %d, \"grid_bytes\": %zu, \"cell_m\": %.3f, \"particles\": %d, \"steps\": %d, \"fixes\": %d, "
            "\"deaths\": %u, \"resamples\": %u, \"all_blocked\": %u, \"recoveries\": %u, \"final_error_m\": %.3f}\n",
-           n, bytes, g.floors[0].cell_m, c.n, steps, fixes, c.deaths, c.resamples, c.all_blocked, f.recoveries,
+           ekf ? "ekf" : "particle", n, bytes, g.floors[0].cell_m, ekf ? 0 : c.n, steps, fixes, c.deaths, c.resamples, c.all_blocked, f.recoveries,
            hypot(pose.x_m - x, pose.y_m - y));
     free(mem);
     return 0;

@@ -12,6 +12,9 @@ Each figure says how it was measured:
   that grows with the map (one AP per 40 m², ~31–42 heard per scan; the harness's docstring), with the
   workspace stridefixd gives it (the candidate pre-selection, ``sf_fingerprint.h``) and, on the same
   scans, the full visit of every used AP's entries, each with its mean error;
+* **the ekf and particle schemes**: particle-cost's harness (``tests/perf/particle_cost.c``: 5 000
+  walls, 1 000 particles, 400 PDR steps, a Wi-Fi-like fix every 4th) walks each scheme; callgrind counts
+  inside ``sf_fusion_step_on_floor`` and ``sf_fusion_fix_on_floor``, per call;
 * **state sizes**: ``sizeof`` printed by the harness (the radio map and the particle arrays are the
   caller's memory, not in them);
 * **no heap in the core**: the ctest ``core_symbols`` check (``firmware/cmake/check_core_symbols.cmake``)
@@ -41,7 +44,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import callgrind, perf_peers
+from stridefix_analyzer.bench import callgrind, particle_cost, perf_peers
 from stridefix_analyzer.bench.soak import vm_hwm_kb
 from stridefix_analyzer.firmware import REPO, Firmware
 from stridefix_analyzer.stages import StageError, stridefix_exe
@@ -181,6 +184,30 @@ def measure_wifi(harness: Path, out: Path) -> list[dict[str, Any]]:
     return rows
 
 
+def measure_schemes(stridefixd: Path, out: Path) -> dict[str, Any]:
+    """The ekf's and the particle scheme's instructions per PDR step and per Wi-Fi fix: particle-cost's
+    harness (5 000 walls, 1 000 particles, a fix every 4th step) walks each scheme, callgrind counts
+    inside sf_fusion_step_on_floor and sf_fusion_fix_on_floor."""
+    harness = particle_cost.harness_path(stridefixd)
+    steps, fixes = particle_cost.STEPS, particle_cost.FIXES
+    rows: dict[str, Any] = {}
+    for scheme in ("ekf", "particle"):
+        args = (str(harness), str(steps), scheme)
+        step_ir = callgrind.instructions(
+            args, ["sf_fusion_step_on_floor"], out / f"perf.{scheme}.step.cg", "perf"
+        )
+        fix_ir = callgrind.instructions(
+            args, ["sf_fusion_fix_on_floor"], out / f"perf.{scheme}.fix.cg", "perf"
+        )
+        rows[scheme] = {
+            "steps": steps,
+            "fixes": fixes,
+            "ir_per_step": step_ir / steps,
+            "ir_per_fix": fix_ir / fixes,
+        }
+    return rows
+
+
 def check_no_heap(stridefixd: Path) -> dict[str, Any]:
     lib = stridefixd.resolve().parent / "libsf_core.a"
     script = REPO / "firmware" / "cmake" / "check_core_symbols.cmake"
@@ -281,6 +308,8 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "wifi": perf_peers.measure_knn_peer(harness, out),
     }
     wifi = measure_wifi(harness, out)
+    print("bench perf: the ekf and particle schemes under callgrind", file=sys.stderr, flush=True)
+    schemes = measure_schemes(firmware.path, out)
     sizes = _harness_json(harness, "sizes")
     heap = check_no_heap(firmware.path)
     print(f"bench perf: replaying a {REPLAY_SECONDS} s simulated walk", file=sys.stderr, flush=True)
@@ -306,6 +335,7 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "attitude_peer": peer,
         "python_peers": python_peers,
         "wifi": wifi,
+        "schemes": schemes,
         "sizes": sizes,
         "core_no_heap": heap,
         "replay": replay,
@@ -338,6 +368,11 @@ def format_table(doc: dict[str, Any]) -> str:
         )
     if "python_peers" in doc:
         lines += perf_peers.format_rows(doc["python_peers"]["attitude"], doc["python_peers"]["wifi"])
+    for name, sc in doc["schemes"].items():
+        lines.append(
+            f"  {name} scheme (5,000 walls, fix every 4th step): {sc['ir_per_step']:,.0f} instructions per step, "
+            f"{sc['ir_per_fix']:,.0f} per Wi-Fi fix"
+        )
     r = doc["replay"]
     lines.append(
         f"  replay: {r['walk_s']:.0f} s walk in {r['wall_s']:.2f} s wall ({r['x_realtime']:,.0f}x real time), "

@@ -108,3 +108,16 @@ def test_budgets_are_judged_from_the_figures():
         in perf.missed_targets(doc)
     )
     assert len(perf.missed_targets(doc)) == 5
+
+
+def test_scheme_costs_per_step_and_fix(stridefixd, tmp_path):
+    """GIVEN particle-cost's walk through the ekf and the particle scheme under callgrind THEN each has a
+    per-step and per-fix count, and the cloud of 1 000 particles costs far more per step than the ekf's
+    3-state filter."""
+    if not perf.particle_cost.harness_path(stridefixd).is_file():
+        pytest.skip("sf_particle_cost not built")
+    rows = perf.measure_schemes(stridefixd, tmp_path)
+    assert set(rows) == {"ekf", "particle"}
+    for r in rows.values():
+        assert r["ir_per_step"] > 0 and r["ir_per_fix"] > 0
+    assert rows["particle"]["ir_per_step"] > 50 * rows["ekf"]["ir_per_step"]
