@@ -197,8 +197,10 @@ void sf_fp_insert_best(sf_fp_ranked_t *const best, int32_t *const n_best, const 
 }
 
 /* Every entry of every used AP: accumulates the per-RP partial sums (touched RPs in ws->touched),
- * scores the candidates into best[0 .. *n_best), and returns the number touched; *scan_sum is
- * recomputed (naive Bayes: Σ C_a). Fills the audit's n_touched and n_candidates. */
+ * scores the candidates into best[0 .. *n_best), and returns the number touched. With the prepared
+ * arrays in WkNN fill mode it takes the query's weights (ap_query_w) and *scan_sum from the caller;
+ * otherwise it computes *scan_sum (WkNN: Σ g(s)², naive Bayes: Σ C_a). Fills the audit's n_touched and
+ * n_candidates. */
 static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t *const p,
                          const sf_radiomap_t *const map, const int16_t floor_hint, const bool any_floor, const int32_t k,
                          sf_fp_ranked_t *const best, int32_t *const n_best, sf_fingerprint_audit_t *const au,
@@ -214,13 +216,15 @@ static int32_t visit_all(sf_fingerprint_workspace_t *const ws, const sf_params_t
     double sum = 0.0;
     int32_t n_touched = 0;
     const bool fill_fast = !bayes && !common_only && ws->entry_level_db != NULL;
+    if (fill_fast) {
+        sum = *scan_sum; /* the caller's Σ g(s)², summed in this order when it set ap_query_w */
+    }
     for (int32_t qi = 0; fill_fast && qi < ws->n_query; qi++) {
         /* WkNN fill mode with the prepared levels: the loop below, its mode tests hoisted and the
-         * term -2·u·v as (-2u)·v, which is how C evaluates it there too (bit-identical) */
+         * term -2·u·v as (-2u)·v, which is how C evaluates it there too (bit-identical); -2u is the
+         * query's weight the caller set */
         const int32_t a = ws->query_ap[qi];
-        const double u = represent(ws->query_rssi_dbm[qi], fill, p->fingerprint_powed_beta);
-        const double w = -2.0 * u;
-        sum += u * u;
+        const double w = ws->ap_query_w[a];
         const int32_t end = map->ap_first[a + 1];
         for (int32_t i = map->ap_first[a]; i < end; i++) {
             const int32_t r = map->entry_rp[i];
@@ -325,11 +329,11 @@ int sf_fingerprint_match(sf_fingerprint_t *const fp, const sf_params_t *const p,
         return SF_ERANGE;
     }
 
-    /* The k best candidates: by the pre-selection's exact bound where it decides, else by visiting the
-     * entries of every used AP. */
+    /* The k best candidates: by the pre-selection (sf_fingerprint_preselect.c) where it runs, else by
+     * visiting the entries of every used AP. */
     const bool bayes = p->fingerprint_method == 1;
     const bool common_only = !bayes && p->fingerprint_missing_mode == 1;
-    const bool pre = !bayes && !common_only && ws->rp_entry_first != NULL;
+    const bool pre = !bayes && !common_only && ws->entry_level_db != NULL; /* the arrays come together */
     int32_t k = p->fingerprint_k;
     k = k < 1 ? 1 : (k > SF_FINGERPRINT_K_MAX ? SF_FINGERPRINT_K_MAX : k);
     sf_fp_ranked_t best[SF_FINGERPRINT_K_MAX];

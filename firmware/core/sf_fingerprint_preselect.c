@@ -10,9 +10,10 @@
  * reach; the fingerprint_preselect_rps of least LB are scored exactly, each from its own entries (the
  * workspace's RP-major copy: the same terms in the same order as the full visit of sf_fingerprint.c,
  * so the same d bit for bit). When the largest LB kept and U_S both exceed the k-th best d, no RP left
- * out can be among the k best, and the answer is the full visit's (audit.preselected = 1, proven). Otherwise the k best of the scored ones are taken
- * (audit.preselected = 2): a winner of the full visit whose strongest APs look unlike the scan's is
- * then missed — the approximation the cost budget buys. Fewer than k reached: undecided (the caller
+ * out can be among the k best, and the answer is the full visit's (audit.preselected = 1, proven).
+ * Otherwise the k best of the scored ones are taken (audit.preselected = 2): a winner of the full
+ * visit whose strongest APs look unlike the scan's is then missed — the approximation the cost budget
+ * buys. Fewer than k reached: undecided (the caller
  * visits everything), as it does on a walk-built map (fewer than fingerprint_preselect_min_scans scans
  * per RP) and where the pre-selection would not halve the entries visited. */
 #include <math.h>
