@@ -465,6 +465,22 @@ static void test_deterministic(void **state)
     }
 }
 
+/* A seeded random attitude: a uniform point of [−1, 1]⁴ normalised to a unit quaternion. */
+static sf_attitude_t random_attitude(rng_t *const rng)
+{
+    sf_attitude_t att;
+    sf_attitude_init(&att);
+    double n = 0.0;
+    for (int i = 0; i < 4; i++) {
+        att.q[i] = rng_pm1(rng);
+        n += att.q[i] * att.q[i];
+    }
+    for (int i = 0; i < 4; i++) {
+        att.q[i] /= sqrt(n);
+    }
+    return att;
+}
+
 /* GIVEN 10 000 seeded random attitudes, WHEN the yaw's cosine and sine come from the quaternion
  * (sf_attitude_yaw_dir, no sincos), THEN they are cos and sin of sf_attitude_yaw_rad within 1e-15. */
 static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
@@ -473,16 +489,7 @@ static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
     rng_t rng = {.s = 0x5EED0016ULL};
     double worst = 0.0;
     for (int k = 0; k < 10000; k++) {
-        sf_attitude_t att;
-        sf_attitude_init(&att);
-        double n = 0.0;
-        for (int i = 0; i < 4; i++) {
-            att.q[i] = rng_pm1(&rng);
-            n += att.q[i] * att.q[i];
-        }
-        for (int i = 0; i < 4; i++) {
-            att.q[i] /= sqrt(n);
-        }
+        const sf_attitude_t att = random_attitude(&rng);
         double c, s;
         sf_attitude_yaw_dir(&att, &c, &s);
         const double yaw = sf_attitude_yaw_rad(&att);
@@ -523,16 +530,7 @@ static void test_yaw_matches_atan2(void **state)
     rng_t rng = {.s = 0x5EED0116ULL};
     double worst = 0.0;
     for (int k = 0; k < 100000; k++) {
-        sf_attitude_t att;
-        sf_attitude_init(&att);
-        double n = 0.0;
-        for (int i = 0; i < 4; i++) {
-            att.q[i] = rng_pm1(&rng);
-            n += att.q[i] * att.q[i];
-        }
-        for (int i = 0; i < 4; i++) {
-            att.q[i] /= sqrt(n);
-        }
+        const sf_attitude_t att = random_attitude(&rng);
         const double w = att.q[0], x = att.q[1], y = att.q[2], z = att.q[3];
         const double ref = atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
         const double yaw = sf_attitude_yaw_rad(&att);

@@ -102,17 +102,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="S",
         help=f"importer: drop cached Wi-Fi entries older than S (default {DEFAULT_MAX_WIFI_AGE_S:g})",
     )
-    d.add_argument(
-        "--jobs",
-        "-j",
-        "--workers",
-        dest="jobs",
-        type=int,
+    _add_workers(
+        d,
         default=None,
-        metavar="N",
-        help="walks prepared in parallel: processes of --scheduler processes or local (default: CPU count)",
+        help_text="walks prepared in parallel: processes of --scheduler processes or local (default: CPU count)",
     )
-    add_scheduler_argument(d, "processes")
     d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
     d.set_defaults(_bench=_run_pdr_distance_cli)
     return p
@@ -251,17 +245,14 @@ def add_fusion_parser(sub: Any) -> None:
     d.set_defaults(_bench=_run_fusion_cli)
 
 
-def _add_workers(d: argparse.ArgumentParser) -> None:
-    """``--jobs``/``--workers`` and ``--scheduler`` of the fold benchmarks."""
+def _add_workers(
+    d: argparse.ArgumentParser,
+    default: int | None = 2,
+    help_text: str = "worker processes of --scheduler processes or local (a scheduler address has its own)",
+) -> None:
+    """``--jobs``/``--workers`` and ``--scheduler`` (default: local processes) of the realbench commands."""
     d.add_argument(
-        "--jobs",
-        "-j",
-        "--workers",
-        dest="jobs",
-        type=int,
-        default=2,
-        metavar="N",
-        help="worker processes of --scheduler processes or local (a scheduler address has its own)",
+        "--jobs", "-j", "--workers", dest="jobs", type=int, default=default, metavar="N", help=help_text
     )
     add_scheduler_argument(d, "processes")
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from stridefix import config_t, health_t, pose_t, step_t, truth_t
 from stridefix_analyzer import cli
+from stridefix_analyzer.bench import perf
 
 
 def make_truth(t_us, x_m, y_m, floor=0, step_count=-1, heading_rad=float("nan")):
@@ -124,3 +125,12 @@ def walk_logs(write_log, straight_walk):
     ]
     sim = [("TRUTH", make_truth(ti, xi, yi, step_count=k)) for k, (ti, xi, yi) in enumerate(zip(t, x, y))]
     return write_log("fw.lcmlog", fw), write_log("sim.lcmlog", sim)
+
+
+@pytest.fixture(scope="module")
+def harness(stridefixd):
+    """``sf_core_cost``, bench perf's harness, of the build under test (test_bench_perf*.py)."""
+    path = perf.harness_path(stridefixd)
+    if not path.is_file():
+        pytest.fail(f"{path} not built: run `make build`")
+    return path

@@ -9,14 +9,6 @@ from stridefix_analyzer.bench import perf
 from stridefix_analyzer.firmware import Firmware
 
 
-@pytest.fixture(scope="module")
-def harness(stridefixd):
-    path = perf.harness_path(stridefixd)
-    if not path.is_file():
-        pytest.fail(f"{path} not built: run `make build`")
-    return path
-
-
 def test_sensor_walk_runs_the_pdr_at_the_board_rates(harness):
     """GIVEN 30 s at 100/50/20 Hz with a 1.8 Hz gait THEN every sample reached the core and the PDR
     counted the gait's steps (the cost is of a working estimator, not of an idle one)."""

@@ -7,15 +7,7 @@ from __future__ import annotations
 import subprocess
 
 import pytest
-from stridefix_analyzer.bench import perf, perf_peers
-
-
-@pytest.fixture(scope="module")
-def harness(stridefixd):
-    path = perf.harness_path(stridefixd)
-    if not path.is_file():
-        pytest.fail(f"{path} not built: run `make build`")
-    return path
+from stridefix_analyzer.bench import perf_peers
 
 
 def test_madgwick_and_fusion_run_per_sample_and_agree_on_the_yaw(harness, tmp_path):
