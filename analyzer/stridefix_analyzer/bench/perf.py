@@ -342,7 +342,7 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "budgets": budgets,
         "not_measured": [
             "scikit-learn's KNN on a real msindoor floor (its peer row is the harness's synthetic map)",
-            "realbench <= 60 s per msindoor floor (see realbench results' run_s)",
+            "realbench <= 60 s per msindoor floor: a row of bench real-targets (the fusion results' run_s.total)",
         ],
     }
     (out / "perf.json").write_text(json.dumps(doc, indent=1))

@@ -98,3 +98,25 @@ def test_crowd_map_bound_is_relative_to_the_truth_map(tmp_path):
     assert any("[crowd map] wifi_only mean <= 1.15 x truth map: 4.7 (bound 4.6)" in m for m in missed)
     rows, missed = realdata.check(realdata.load_groups([fusion]))
     assert "realbench site1/F2 [crowd map] wifi_only mean <= 1.15 x truth map: not run" in missed
+
+
+def test_wall_time_is_the_fusion_files_total_per_floor(tmp_path):
+    """Issue 16: realbench <= 60 s per msindoor floor, read from the fusion file's run_s.total (a
+    crowd-map file of the same group does not replace it); a file without it is not run."""
+    doc = _doc("site1/F2", 3.2, 1.0)
+    doc["run_s"] = {"prepare": 5.0, "folds": 40.0, "total": 47.5}
+    fusion = tmp_path / "fusion.json"
+    fusion.write_text(json.dumps(doc))
+    crowd = tmp_path / "crowd.json"
+    crowd.write_text(
+        json.dumps({"benchmark": "crowd-map", "run_s": {"total": 500.0}, "groups": [{"label": "site1/F2"}]})
+    )
+    rows, missed = realdata.check(realdata.load_groups([fusion, crowd]))
+    by = {r["target"]: r for r in rows}
+    row = by["site1/F2 realbench fusion wall time [s] <= 60"]
+    assert row["value"] == 47.5 and row["met"]
+    assert "realbench site2/F3 realbench fusion wall time [s] <= 60: not run" in missed
+    doc["run_s"]["total"] = 229.0
+    fusion.write_text(json.dumps(doc))
+    rows, missed = realdata.check(realdata.load_groups([crowd, fusion]))
+    assert "realbench site1/F2 realbench fusion wall time [s] <= 60: 229 (bound 60)" in missed
