@@ -121,8 +121,8 @@ def _run_soak(args: argparse.Namespace, firmware: Firmware, seeds: list[int], ou
 
 
 def _run_perf(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:
-    del args, seeds  # fixed walks of the harness and one simulated walk
-    doc = perf.run_perf(firmware, out)
+    del seeds  # fixed walks of the harness and one simulated walk; args.floor: the real-map peer
+    doc = perf.run_perf(firmware, out, Path(args.floor))
     print(perf.format_table(doc))
     print(f"wrote {out / 'perf.json'}")
     return perf.missed_targets(doc)
@@ -312,7 +312,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         "--floor",
         default=str(scale.DEFAULT_FLOOR),
         metavar="DIR",
-        help=f"scale: the msindoor floor folder (default {scale.DEFAULT_FLOOR})",
+        help=f"scale, perf (its scikit-learn peer on a real map): the msindoor floor folder (default {scale.DEFAULT_FLOOR})",
     )
     p.add_argument(
         "--no-calibration",

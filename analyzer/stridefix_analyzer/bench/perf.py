@@ -44,7 +44,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer.bench import callgrind, particle_cost, perf_peers
+from stridefix_analyzer.bench import callgrind, particle_cost, perf_knn_real, perf_peers
 from stridefix_analyzer.bench.soak import vm_hwm_kb
 from stridefix_analyzer.firmware import REPO, Firmware
 from stridefix_analyzer.stages import StageError, stridefix_exe
@@ -288,8 +288,9 @@ def judge(values: dict[str, Any]) -> list[dict[str, Any]]:
     return budgets
 
 
-def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
-    """Every measurement (module docstring); writes ``OUT/perf.json``."""
+def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[str, Any]:
+    """Every measurement (module docstring); writes ``OUT/perf.json``. ``floor``: the msindoor floor
+    folder of the scikit-learn peer on a real map (:mod:`.perf_knn_real`; None or missing: not measured)."""
     harness = harness_path(firmware.path)
     if not harness.is_file():
         raise StageError(f"perf: {harness} not found (build it: make build)")
@@ -307,6 +308,14 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "attitude": perf_peers.measure_madgwick_peer(out / "perf.samples.txt"),
         "wifi": perf_peers.measure_knn_peer(harness, out),
     }
+    not_measured = []
+    if floor is not None and floor.is_dir():
+        print(f"bench perf: scikit-learn KNN on the radio map of {floor}", file=sys.stderr, flush=True)
+        python_peers["wifi_real"] = perf_knn_real.measure_knn_peer_real(
+            perf_knn_real.site_match_path(firmware.path), floor, out
+        )
+    else:
+        not_measured.append(f"scikit-learn's KNN on a real msindoor floor ({floor} not found)")
     wifi = measure_wifi(harness, out)
     print("bench perf: the ekf and particle schemes under callgrind", file=sys.stderr, flush=True)
     schemes = measure_schemes(firmware.path, out)
@@ -341,7 +350,7 @@ def run_perf(firmware: Firmware, out: Path) -> dict[str, Any]:
         "replay": replay,
         "budgets": budgets,
         "not_measured": [
-            "scikit-learn's KNN on a real msindoor floor (its peer row is the harness's synthetic map)",
+            *not_measured,
             "realbench <= 60 s per msindoor floor: a row of bench real-targets (the fusion results' run_s.total)",
         ],
     }
@@ -367,7 +376,12 @@ def format_table(doc: dict[str, Any]) -> str:
             f"{w['mean_error_m_full_visit']:>7.2f}"
         )
     if "python_peers" in doc:
-        lines += perf_peers.format_rows(doc["python_peers"]["attitude"], doc["python_peers"]["wifi"])
+        peers = doc["python_peers"]
+        lines += perf_peers.format_rows(peers["attitude"], peers["wifi"])
+        if "wifi_real" in peers:
+            lines.append(
+                perf_peers.format_knn_row(peers["wifi_real"], f"msindoor {peers['wifi_real']['floor']}")
+            )
     for name, sc in doc["schemes"].items():
         lines.append(
             f"  {name} scheme (5,000 walls, fix every 4th step): {sc['ir_per_step']:,.0f} instructions per step, "
