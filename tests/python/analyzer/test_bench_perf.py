@@ -66,6 +66,9 @@ def test_replay_reads_its_own_rss_not_the_forked_python(stridefixd, tmp_path, mo
     r = perf.measure_replay(Firmware(stridefixd), tmp_path)
     assert r["walk_s"] == pytest.approx(30.0, abs=1.0)
     assert r["x_realtime"] > 10.0 and r["log_bytes"] > 0
+    # the daemon's own CPU time (wait4): positive, and at most its wall time on this machine's 2 cores
+    assert 0.0 < r["cpu_s"] <= 2.0 * r["wall_s"] + 0.05
+    assert r["x_realtime_cpu"] == pytest.approx(r["walk_s"] / r["cpu_s"])
     assert 0 < r["peak_rss_kB"] < 64 * 1024  # the daemon is a few MB; the Python parent is > 100 MB
     assert r["analyze_s"] > 0
 
