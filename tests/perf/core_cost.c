@@ -13,6 +13,9 @@
  *                               mean is above −85 dBm, a scan hearing every AP above −80 dBm (~31).
  *                               With stridefixd's workspace and defaults, or with "full" after SCANS
  *                               fingerprint.preselect_aps = 0 (every entry of every AP heard visited).
+ *   core_cost wifiheard N_RP SCANS HEARD_DBM
+ *                               the wifi mode (pre-selection) with scans that hear every AP above
+ *                               HEARD_DBM instead of −80 dBm: the fix's cost against the APs heard.
  *   core_cost wifidump N_RP SCANS PATH [full]
  *                               the wifi mode's map and scans, and each scan's fix, written to PATH as
  *                               text for a peer matcher (bench/perf_peers.py): "rp I X Y" per RP,
@@ -43,7 +46,7 @@
 static int usage(void)
 {
     fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS [full] | wifidump N_RP SCANS PATH [full] | "
-                    "sizes\n");
+                    "wifiheard N_RP SCANS HEARD_DBM | sizes\n");
     return 2;
 }
 
@@ -127,6 +130,9 @@ static int run_samples(const double seconds)
     return 0;
 }
 
+/* a scan hears every AP above this level [dBm] (~31 APs at 2 000 RPs); wifiheard sets it */
+#define WIFI_HEARD_DBM (-80.0)
+
 static double level_dbm(const double d_m)
 {
     return -40.0 - 30.0 * log10(fmax(d_m, 1.0));
@@ -140,7 +146,8 @@ static double now_s(void)
 }
 
 /* dump: NULL, or where the map, the scans and the fixes go as text (wifidump) */
-static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool preselect, FILE *const dump)
+static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool preselect, const double heard_dbm,
+                    FILE *const dump)
 {
     const int32_t side = (int32_t)ceil(sqrt((double)n_rp_want));
     const int32_t n_rp = side * side;
@@ -239,7 +246,7 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
         int32_t n = 0;
         for (int32_t a = 0; a < n_ap; a++) {
             const double lv = level_dbm(hypot(qx - ax[a], qy - ay[a])) + 4.0 * rng_gauss(&r);
-            if (lv > -80.0) {
+            if (lv > heard_dbm) {
                 sb[n] = bssid[a];
                 sr[n] = (float)round(lv);
                 n++;
@@ -268,9 +275,9 @@ static int run_wifi(const int32_t n_rp_want, const int32_t n_scans, const bool p
     }
     printf("{\"mode\": \"wifi\", \"n_rp\": %d, \"n_ap\": %d, \"n_entries\": %d, \"scans\": %d, \"mean_heard\": %.1f, "
            "\"fixes\": %ld, \"mean_error_m\": %.17g, \"size_m\": %.0f, \"preselect\": %s, \"preselected\": %ld, "
-           "\"mean_scored\": %.1f, \"match_s\": %.9g}\n",
+           "\"mean_scored\": %.1f, \"heard_dbm\": %.1f, \"match_s\": %.9g}\n",
            n_rp, n_ap, n_entries, n_scans, (double)heard / (double)n_scans, fixes, fixes ? err_sum_m / (double)fixes : -1.0,
-           size_m, preselect ? "true" : "false", preselected, fixes ? (double)scored / (double)fixes : 0.0, match_s);
+           size_m, preselect ? "true" : "false", preselected, fixes ? (double)scored / (double)fixes : 0.0, heard_dbm, match_s);
     return 0;
 }
 
@@ -291,7 +298,12 @@ int main(const int argc, char **const argv)
     }
     if ((argc == 4 || (argc == 5 && strcmp(argv[4], "full") == 0)) && strcmp(argv[1], "wifi") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
-        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans, argc == 4, NULL) : usage();
+        return n_rp > 0 && n_scans > 0 ? run_wifi(n_rp, n_scans, argc == 4, WIFI_HEARD_DBM, NULL) : usage();
+    }
+    if (argc == 5 && strcmp(argv[1], "wifiheard") == 0) {
+        const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
+        const double heard_dbm = atof(argv[4]);
+        return n_rp > 0 && n_scans > 0 && heard_dbm < -40.0 ? run_wifi(n_rp, n_scans, true, heard_dbm, NULL) : usage();
     }
     if ((argc == 5 || (argc == 6 && strcmp(argv[5], "full") == 0)) && strcmp(argv[1], "wifidump") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);
@@ -303,7 +315,7 @@ int main(const int argc, char **const argv)
             fprintf(stderr, "core_cost: cannot write %s\n", argv[4]);
             return 1;
         }
-        const int rc = run_wifi(n_rp, n_scans, argc == 5, dump);
+        const int rc = run_wifi(n_rp, n_scans, argc == 5, WIFI_HEARD_DBM, dump);
         return fclose(dump) == 0 ? rc : 1;
     }
     if (argc == 3 && strcmp(argv[1], "samples") == 0) {

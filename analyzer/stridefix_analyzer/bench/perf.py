@@ -11,7 +11,8 @@ Each figure says how it was measured:
   (``sf_fingerprint_match``) on synthetic maps of 100, 2 000 and 20 000 reference points of a building
   that grows with the map (one AP per 40 m², ~31–42 heard per scan; the harness's docstring), with the
   workspace stridefixd gives it (the candidate pre-selection, ``sf_fingerprint.h``) and, on the same
-  scans, the full visit of every used AP's entries, each with its mean error;
+  scans, the full visit of every used AP's entries, each with its mean error; and against the APs
+  heard: the ~2 000-RP map with scans hearing every AP above −70, −80, −85 or −88 dBm (~8–89 heard);
 * **the ekf and particle schemes**: particle-cost's harness (``tests/perf/particle_cost.c``: 5 000
   walls, 1 000 particles, 400 PDR steps, a Wi-Fi-like fix every 4th) walks each scheme; callgrind counts
   inside ``sf_fusion_step_on_floor`` and ``sf_fusion_fix_on_floor``, per call;
@@ -56,6 +57,8 @@ from stridefix_analyzer.stages import StageError, stridefix_exe
 SENSOR_SECONDS = 120
 WIFI_SIZES = (100, 2000, 20000)
 WIFI_SCANS = 50
+#: the scans' sensitivity [dBm] for the fix's cost against the APs heard, at ~2 000 RPs (-80: the map-size rows)
+WIFI_HEARD_DBM = (-70.0, -80.0, -85.0, -88.0)
 REPLAY_SECONDS = 3600
 
 #: issue 16's budgets: (key, figure, comparison, bound)
@@ -185,6 +188,20 @@ def measure_wifi(harness: Path, out: Path) -> list[dict[str, Any]]:
             f"(full visit {ir_full / full['scans']:,.0f})",
             file=sys.stderr,
         )
+    return rows
+
+
+def measure_wifi_heard(harness: Path, out: Path) -> list[dict[str, Any]]:
+    """Per scan sensitivity (:data:`WIFI_HEARD_DBM`) on the ~2 000-RP map: instructions per fix against
+    the APs a scan hears (``sf_core_cost wifiheard``, stridefixd's workspace and defaults)."""
+    rows = []
+    for heard_dbm in WIFI_HEARD_DBM:
+        args = ("wifiheard", "2000", str(WIFI_SCANS), f"{heard_dbm:g}")
+        built = _harness_json(harness, *args)
+        ir = _callgrind(
+            harness, ("sf_fingerprint_match",), args, out / f"perf.wifiheard{-heard_dbm:g}.callgrind"
+        )
+        rows.append(built | {"ir_per_fix": ir / built["scans"]})
     return rows
 
 
@@ -335,6 +352,7 @@ def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[s
     else:
         not_measured.append(f"scikit-learn's KNN on a real msindoor floor ({floor} not found)")
     wifi = measure_wifi(harness, out)
+    wifi_heard = measure_wifi_heard(harness, out)
     print("bench perf: the ekf and particle schemes under callgrind", file=sys.stderr, flush=True)
     schemes = measure_schemes(firmware.path, out)
     sizes = _harness_json(harness, "sizes")
@@ -362,6 +380,7 @@ def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[s
         "attitude_peer": peer,
         "python_peers": python_peers,
         "wifi": wifi,
+        "wifi_heard": wifi_heard,
         "schemes": schemes,
         "sizes": sizes,
         "core_no_heap": heap,
@@ -393,6 +412,12 @@ def format_table(doc: dict[str, Any]) -> str:
             f"{w['ir_per_fix']:>11,.0f}{w['mean_error_m']:>7.2f}{w['ir_per_fix_full_visit']:>12,.0f}"
             f"{w['mean_error_m_full_visit']:>7.2f}"
         )
+    lines += [
+        f"  {'synthetic, APs heard':<22}{w['n_rp']:>7}{w['n_ap']:>6}{w['n_entries']:>10}{w['mean_heard']:>7.1f}"
+        f"{w['ir_per_fix']:>11,.0f}{w['mean_error_m']:>7.2f}  (scans hear APs above {w['heard_dbm']:g} dBm; "
+        f"{'pre-selection' if w['preselected'] else 'full visit: the pre-selection would not halve the visit'})"
+        for w in doc.get("wifi_heard", [])
+    ]
     if "python_peers" in doc:
         peers = doc["python_peers"]
         lines += perf_peers.format_rows(peers["attitude"], peers["wifi"])

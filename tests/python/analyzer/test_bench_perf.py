@@ -38,6 +38,20 @@ def test_wifi_preselection_scores_few_rps_and_keeps_the_accuracy(harness):
     assert pre["mean_error_m"] <= full["mean_error_m"] + 0.3
 
 
+def test_wifi_heard_sweeps_the_aps_a_scan_hears_on_the_same_map(harness):
+    """GIVEN the 2 025-RP map and scans of rising sensitivity THEN the map stays the same, the scans hear
+    more APs (the -80 dBm rows are the map-size rows' scans), and the -80 and -85 dBm scans are pre-selected."""
+    rows = [perf._harness_json(harness, "wifiheard", "2000", "10", f"{h:g}") for h in (-70, -80, -85)]
+    assert {(r["n_rp"], r["n_entries"]) for r in rows} == {(2025, rows[0]["n_entries"])}
+    heard = [r["mean_heard"] for r in rows]
+    assert heard == sorted(heard) and heard[0] < 15 < heard[1] < 45 < heard[2]
+    base = perf._harness_json(harness, "wifi", "2000", "10")
+    assert rows[1]["mean_heard"] == base["mean_heard"] and rows[1]["mean_error_m"] == base["mean_error_m"]
+    assert rows[1]["preselected"] == rows[1]["fixes"] and rows[2]["preselected"] == rows[2]["fixes"]
+    with pytest.raises(perf.StageError):
+        perf._harness_json(harness, "wifiheard", "2000", "10", "-20")  # a scan cannot hear above the APs
+
+
 def test_callgrind_counts_the_matcher_per_fix(harness, tmp_path):
     """GIVEN 5 fixes on the 100-RP map under callgrind THEN the matcher's instructions are counted, and
     doubling the fixes roughly doubles them (per-call cost, not the harness's set-up)."""
