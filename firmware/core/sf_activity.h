@@ -66,7 +66,7 @@
  * or the oldest counted one leaving the window: the count is remembered until then), the variance
  * gain's expm1 only when the interval changes (sf_lp_gain), one 3×3 eigenvalue (an acos, two cos)
  * per detection; ≈ 50 instructions per classification in `stridefix bench perf`'s sensors walk
- * (callgrind, x86-64 -O2; ≈ 120 counting the window on every call). Memory: sizeof(sf_activity_t) =
+ * (callgrind, x86-64 -O3; ≈ 120 at -O2 counting the window on every call). Memory: sizeof(sf_activity_t) =
  * 344 B on x86-64, at most 344 B (_Static_assert below). No heap, no I/O, no clock. Cannot fail. */
 #ifndef SF_ACTIVITY_H
 #define SF_ACTIVITY_H

@@ -57,12 +57,13 @@
  * workspace, sf_fingerprint.h), the step detector 2 464 B, the controller 1 480 B (sf_controller.h);
  * the particle cloud's arrays (32 kB at 1 000 particles) and the wall index are the caller's
  * (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) is here (a cloud without walls points at a
- * constant empty grid). Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 1 790
- * instructions per sf_estimator_imu without the particle scheme (the attitude filter ≈ 700 of them,
- * the activity ≈ 180, the steps ≈ 180, the two sample gates ≈ 130, the yaw ≈ 90), ≈ 1 100 per
- * sf_estimator_mag (the attitude's magnetometer fusion ≈ 620, sf_magcal ≈ 350), ≈ 540 per
- * sf_estimator_baro (sf_floor ≈ 400, a third of it the pow): ≈ 2 440 per IMU sample at 100/50/20 Hz,
- * all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is sf_fingerprint.h's, a particle step
+ * constant empty grid). Cost (callgrind, x86-64, `stridefix bench perf`'s sensors walk; the sensor
+ * modules at -O3, firmware/CMakeLists.txt): ≈ 1 510 instructions per sf_estimator_imu without the
+ * particle scheme (the attitude filter ≈ 430 of them, the steps ≈ 180, the activity ≈ 170, the two
+ * sample gates ≈ 130, the yaw ≈ 90), ≈ 980 per sf_estimator_mag (the attitude's magnetometer fusion
+ * ≈ 545, sf_magcal ≈ 315), ≈ 520 per sf_estimator_baro (sf_floor ≈ 380, a third of it the pow):
+ * ≈ 2 100 per IMU sample at 100/50/20 Hz, all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is
+ * sf_fingerprint.h's, a particle step
  * sf_particle.h's. */
 #ifndef SF_ESTIMATOR_H
 #define SF_ESTIMATOR_H

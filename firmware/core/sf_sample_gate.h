@@ -10,7 +10,8 @@
  * accepted and becomes the reference, so a rejection never latches.
  * The limits are physics and sensor specifications (sf_params.h, section `gate`), not tuned.
  * Cost: O(axes) per sample: sf_sample_gate_stream ≈ 65 instructions per 3-axis sample in `stridefix
- * bench perf`'s sensors walk (callgrind, x86-64 -O2; sf_sample_limits + sf_sample_gate_check ≈ 120); no heap. Memory: sizeof(sf_sample_gate_t) = 72 B. */
+ * bench perf`'s sensors walk (callgrind, x86-64 -O3; sf_sample_limits + sf_sample_gate_check ≈ 120
+ * at -O2); no heap. Memory: sizeof(sf_sample_gate_t) = 72 B. */
 #ifndef SF_SAMPLE_GATE_H
 #define SF_SAMPLE_GATE_H
 
