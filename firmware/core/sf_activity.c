@@ -11,6 +11,7 @@ void sf_activity_init(sf_activity_t *const a, const sf_params_t *const p)
     *a = (sf_activity_t){0};
     a->activity = sf_activity_unknown;
     a->last_detection_t_us = INT64_MIN / 2; /* no detection yet: the first one starts a bout */
+    a->window_n = -1;
 }
 
 double sf_activity_variance_m2ps4(const sf_activity_t *const a)
@@ -34,6 +35,35 @@ static int32_t steps_in_window(const sf_activity_t *const a, const sf_params_t *
     return n;
 }
 
+/* steps_in_window, remembered: a step counted at t stays counted until step_t + window, an uncounted
+ * one never comes back as t grows, so the count holds from the time it was taken to the earliest of
+ * those ends (or until credit() adds a step). The same number as steps_in_window, without the loop
+ * over the ring on every sample. */
+static int32_t steps_in_window_memo(sf_activity_t *const a, const sf_params_t *const p, const int64_t t_us)
+{
+    if (a->window_n >= 0 && t_us >= a->window_t_us && t_us < a->window_until_us &&
+        a->window_ms == p->activity_step_window_ms) {
+        return a->window_n;
+    }
+    const int64_t w_us = (int64_t)p->activity_step_window_ms * 1000;
+    int64_t until_us = INT64_MAX;
+    int32_t n = 0;
+    int32_t i = a->step_head; /* the ring's entries, as steps_in_window walks them */
+    for (int32_t k = 0; k < a->step_count; k++) {
+        const int64_t s_us = a->step_t_us[i];
+        if (s_us > t_us - w_us) {
+            n++;
+            until_us = s_us + w_us < until_us ? s_us + w_us : until_us;
+        }
+        i = i > 0 ? i - 1 : SF_ACTIVITY_STEPS - 1;
+    }
+    a->window_n = n;
+    a->window_ms = p->activity_step_window_ms;
+    a->window_t_us = t_us;
+    a->window_until_us = until_us;
+    return n;
+}
+
 double sf_activity_step_rate_hz(const sf_activity_t *const a, const sf_params_t *const p)
 {
     return (double)steps_in_window(a, p, a->last_t_us) / ((double)p->activity_step_window_ms * 1e-3);
@@ -51,7 +81,7 @@ static void classify(sf_activity_t *const a, const sf_params_t *const p)
         return;                             /* (so the step window is not even counted) */
     }
     const int64_t t_us = a->last_t_us;
-    const bool stepping = steps_in_window(a, p, t_us) >= p->activity_min_steps;
+    const bool stepping = steps_in_window_memo(a, p, t_us) >= p->activity_min_steps;
     const bool recent_step =
         a->step_count > 0 && t_us - a->step_t_us[a->step_head] <= (int64_t)p->activity_still_time_ms * 1000;
     if (stepping && v > p->activity_stairs_vspeed_mps) {
@@ -114,6 +144,7 @@ static void credit(sf_activity_t *const a, const int64_t t_us)
         a->step_count++;
     }
     a->accepted_steps++;
+    a->window_n = -1; /* the window's count changed */
 }
 
 /* Ends the bout being held: its detections were no walk. */

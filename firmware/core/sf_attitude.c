@@ -5,6 +5,7 @@
 
 #include "sf_assert.h"
 #include "sf_math.h"
+#include "sf_quat.h"
 
 #define PI 3.14159265358979323846
 #define G_MPS2 9.80665
@@ -14,127 +15,31 @@
 #define FUSE_DT_MAX_S 0.1    /* clamp of the interval used by the accelerometer corrections */
 #define INTEGRAL_MAX_ERR_RAD (10.0 * PI / 180.0) /* anti-windup: larger errors do not feed the bias */
 
-/* ---- small vector and quaternion helpers (q = w, x, y, z) ---- */
-
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static double norm3(const double a[3])
-{
-    return sqrt(dot3(a, a));
-}
-
-static bool finite3(const double a[3])
-{
-    return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
-}
-
-static void qmul(const double a[4], const double b[4], double out[4])
-{
-    const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
-    const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
-    const double y = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
-    const double z = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
-    out[0] = w;
-    out[1] = x;
-    out[2] = y;
-    out[3] = z;
-}
-
-static void qnormalise(double q[4])
-{
-    const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    for (int i = 0; i < 4; i++) {
-        q[i] /= n;
-    }
-    if (q[0] < 0.0) { /* one of the two signs, so outputs are unique */
-        for (int i = 0; i < 4; i++) {
-            q[i] = -q[i];
-        }
-    }
-}
-
-/* exp of a rotation vector r (axis × angle θ, rad): the quaternion (cos(θ/2), r·sin(θ/2)/θ).
- *
- * Every call here turns by one sample's worth: the gyro's ω·δt (0.05 rad at 5 rad/s and 100 Hz) or a
- * fraction of a tilt or yaw error. Below QEXP_SERIES_MAX_RAD both factors are their Taylor series in
- * x = (θ/2)² to x⁴ (no sqrt, no sincos: ≈ 30 instructions instead of ≈ 200). The first term left out,
- * x⁵/10!, is < 2.6e-16 at θ = 0.25 rad (x = 1/64), so each component is within a few ulp of libm's,
- * an angle error below 1e-15 rad per call: a MEMS gyro's white noise alone (0.005 °/s/√Hz) turns the
- * attitude by ≈ 1e-5 rad per 100 Hz sample, ten orders more. Larger angles (a 25 rad/s spin, an init)
- * keep sin/cos. */
-#define QEXP_SERIES_MAX_RAD 0.25
-static void qexp(const double r[3], double q[4])
-{
-    const double angle2 = dot3(r, r);
-    if (angle2 < QEXP_SERIES_MAX_RAD * QEXP_SERIES_MAX_RAD) {
-        const double x = 0.25 * angle2;
-        q[0] = 1.0 - x / 2.0 * (1.0 - x / 12.0 * (1.0 - x / 30.0 * (1.0 - x / 56.0)));          /* cos(θ/2) */
-        /* sin(θ/2)/θ */
-        const double s = 0.5 * (1.0 - x / 6.0 * (1.0 - x / 20.0 * (1.0 - x / 42.0 * (1.0 - x / 72.0))));
-        q[1] = s * r[0];
-        q[2] = s * r[1];
-        q[3] = s * r[2];
-        return;
-    }
-    const double angle = sqrt(angle2);
-    const double s = sin(0.5 * angle) / angle;
-    q[0] = cos(0.5 * angle);
-    q[1] = s * r[0];
-    q[2] = s * r[1];
-    q[3] = s * r[2];
-}
-
-/* v_nav = R(q) v (transpose: v_body = R(q)ᵀ v, the conjugate's rotation), as q ⊗ v ⊗ q* written out
- * for a unit q: t = 2 q_v × v, v' = v + w t + q_v × t (≈ 30 flops, against ≈ 50 for building the
- * matrix and multiplying). Equal to the matrix form up to rounding: q is normalised after every
- * update (|q| = 1 within 2e-16), so the two differ by a few ulp of |v| (≈ 1e-14 m/s² on gravity,
- * against an accelerometer's ≈ 1e-3 m/s² noise). out may alias v. */
-static inline void rotate(const double q[4], const bool transpose, const double v[3], double out[3])
-{
-    const double w = q[0];
-    const double x = transpose ? -q[1] : q[1], y = transpose ? -q[2] : q[2], z = transpose ? -q[3] : q[3];
-    const double t0 = 2.0 * (y * v[2] - z * v[1]);
-    const double t1 = 2.0 * (z * v[0] - x * v[2]);
-    const double t2 = 2.0 * (x * v[1] - y * v[0]);
-    const double o0 = v[0] + w * t0 + (y * t2 - z * t1);
-    const double o1 = v[1] + w * t1 + (z * t0 - x * t2);
-    const double o2 = v[2] + w * t2 + (x * t1 - y * t0);
-    out[0] = o0;
-    out[1] = o1;
-    out[2] = o2;
-}
-
-/* Rᵀ(q)·(v₀, v₁, 0): a nav vector with no vertical part (a tilt error) in body axes, the six of
- * rotate's nine matrix elements it needs. Not bit for bit rotate's (that added 0·v₂ terms): the
- * zero's sign of an element that is 0 may differ, nothing else. */
-static void horizontal_nav_to_body(const double q[4], const double v[2], double out[3])
-{
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    out[0] = (1 - 2 * (y * y + z * z)) * v[0] + 2 * (x * y + w * z) * v[1];
-    out[1] = 2 * (x * y - w * z) * v[0] + (1 - 2 * (x * x + z * z)) * v[1];
-    out[2] = 2 * (x * z + w * y) * v[0] + 2 * (y * z - w * x) * v[1];
-}
-
-/* Rᵀ(q)·(0, 0, e): e times nav up in body axes, the third row of R (three elements, not nine). */
-static void up_to_body(const double q[4], const double e, double out[3])
-{
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    out[0] = 2 * (x * z - w * y) * e;
-    out[1] = 2 * (y * z + w * x) * e;
-    out[2] = (1 - 2 * (x * x + y * y)) * e;
-}
-
 /* q ← exp(r_nav) ⊗ q: rotate the body by r_nav expressed in the nav frame. */
 static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
 {
     double dq[4];
-    qexp(r_nav, dq);
+    sf_qexp(r_nav, dq);
     double out[4];
-    qmul(dq, att->q, out);
-    qnormalise(out);
+    sf_qmul(dq, att->q, out);
+    sf_qnormalise(out);
+    for (int i = 0; i < 4; i++) {
+        att->q[i] = out[i];
+    }
+}
+
+/* q ← exp(ẑ·angle) ⊗ q: rotate_in_nav for a turn about nav up (the magnetometer's yaw correction),
+ * the product with (cos, 0, 0, sin) of half the angle written out: 8 products instead of 16, the same
+ * numbers but for the sign of a zero term. */
+static void rotate_about_up(sf_attitude_t *const att, const double angle_rad)
+{
+    const double r[3] = {0.0, 0.0, angle_rad};
+    double dq[4];
+    sf_qexp(r, dq);
+    const double c = dq[0], s = dq[3];
+    const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
+    double out[4] = {c * w - s * z, c * x - s * y, c * y + s * x, c * z + s * w};
+    sf_qnormalise(out);
     for (int i = 0; i < 4; i++) {
         att->q[i] = out[i];
     }
@@ -145,8 +50,8 @@ static void rotate_in_nav(sf_attitude_t *const att, const double r_nav[3])
 static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mps2[3], double r_nav[3])
 {
     double u[3];
-    rotate(att->q, false, accel_mps2, u);
-    const double n = norm3(u);
+    sf_qrotate(att->q, false, accel_mps2, u);
+    const double n = sf_norm3(u);
     const double c[3] = {u[1] / n, -u[0] / n, 0.0}; /* (u/|u|) × ẑ */
     const double s = sqrt(c[0] * c[0] + c[1] * c[1]);
     const double angle = sf_atan2_half(sqrt(u[0] * u[0] + u[1] * u[1]), u[2], n); /* atan2(s, u_z/n) */
@@ -157,6 +62,36 @@ static void tilt_error_nav(const sf_attitude_t *const att, const double accel_mp
     r_nav[0] = c[0] / s * angle;
     r_nav[1] = c[1] / s * angle;
     r_nav[2] = 0.0;
+}
+
+/* The tilt error in body axes (axis × angle): the rotation, applied on the right (q ⊗ exp(e)), that
+ * takes the measured up a/|a| onto the estimated up v = Rᵀ(q)·ẑ. It is Rᵀ of tilt_error_nav's
+ * rotation (rotations keep cross products: Rᵀ(u × ẑ) = a × v), without rotating a into nav: e = (a × v)
+ * · θ/|a × v|, θ = 2·atan(t), t = |a × v|/(|a| + a·v) = tan(θ/2). For |t| ≤ SF_ATAN_SERIES_MAX (θ ≤
+ * 11.4°) θ/|a × v| = 2·P(t²)/(|a| + a·v), P = atan(t)/t by its series (sf_math.h's, to t¹²): no sqrt
+ * and no atan2; larger errors take atan2. a_norm = |a| > 0. */
+static void tilt_error_body(const double q[4], const double a[3], const double a_norm, double e[3])
+{
+    double v[3];
+    sf_up_to_body(q, 1.0, v);
+    const double c[3] = {a[1] * v[2] - a[2] * v[1], a[2] * v[0] - a[0] * v[2], a[0] * v[1] - a[1] * v[0]};
+    const double s2 = sf_dot3(c, c);
+    const double d = a_norm + sf_dot3(a, v);
+    double f; /* θ / |a × v| */
+    if (d > 0.0 && s2 <= SF_ATAN_SERIES_MAX * SF_ATAN_SERIES_MAX * d * d) {
+        const double t2 = s2 / (d * d);
+        f = 2.0 * sf_atan_series(t2) / d;
+    } else {
+        const double sn = sqrt(s2);
+        if (sn < 1e-15 * a_norm) {
+            e[0] = e[1] = e[2] = 0.0; /* aligned, or exactly upside down (no axis; next sample) */
+            return;
+        }
+        f = atan2(sn, sf_dot3(a, v)) / sn;
+    }
+    e[0] = c[0] * f;
+    e[1] = c[1] * f;
+    e[2] = c[2] * f;
 }
 
 /* Roll/pitch from one accelerometer sample, yaw 0 (body x towards east, or as close as tilt allows). */
@@ -196,11 +131,11 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
                             const double accel_mps2[3], const double gyro_radps[3])
 {
     SF_ASSERT(att != NULL && p != NULL && accel_mps2 != NULL && gyro_radps != NULL);
-    if (!finite3(accel_mps2) || !finite3(gyro_radps)) {
+    if (!sf_finite3(accel_mps2) || !sf_finite3(gyro_radps)) {
         att->imu_invalid++;
         return;
     }
-    const double a_norm = norm3(accel_mps2);
+    const double a_norm = sf_norm3(accel_mps2);
     const bool accel_usable = a_norm > MIN_ACCEL_MPS2;
 
     if (!att->imu_started) {
@@ -228,7 +163,7 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
         /* rest detector (control): both conditions held for rest_time_s */
         const double w_c[3] = {gyro_radps[0] - att->gyro_bias_radps[0], gyro_radps[1] - att->gyro_bias_radps[1],
                                gyro_radps[2] - att->gyro_bias_radps[2]};
-        const bool still = !gap && norm3(w_c) < p->attitude_rest_gyro_radps &&
+        const bool still = !gap && sf_norm3(w_c) < p->attitude_rest_gyro_radps &&
                            fabs(a_norm - G_MPS2) < p->attitude_rest_accel_mps2;
         if (!still) {
             att->rest_candidate = false;
@@ -245,19 +180,14 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
             }
         } else {
             const bool mahony = p->attitude_mode == sf_attitude_mahony;
-            /* fusion: gyro propagation (trapezoid over the interval) */
+            /* fusion: one body-frame rotation per sample, q ← q ⊗ exp(r), r = the gyro's turn over the
+             * interval (trapezoid, bias removed; none after a gap) + k · the tilt error e (body axes,
+             * from the attitude before this sample, as Mahony's ω − b̂ + Kp·e): one exp, one product,
+             * one normalisation (the header's propagation and gravity paragraphs) */
+            double r[3] = {0.0, 0.0, 0.0};
             if (!gap) {
-                double r_body[3];
                 for (int i = 0; i < 3; i++) {
-                    r_body[i] = (0.5 * (att->last_gyro_radps[i] + gyro_radps[i]) - att->gyro_bias_radps[i]) * dt_s;
-                }
-                double dq[4];
-                qexp(r_body, dq);
-                double out[4];
-                qmul(att->q, dq, out);
-                qnormalise(out);
-                for (int i = 0; i < 4; i++) {
-                    att->q[i] = out[i];
+                    r[i] = (0.5 * (att->last_gyro_radps[i] + gyro_radps[i]) - att->gyro_bias_radps[i]) * dt_s;
                 }
             }
             /* fusion: gravity */
@@ -267,14 +197,12 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
             } else {
                 /* after a gap the interval says nothing about the gyro: clamp it, no integral */
                 const double dt_f = sf_clamp(dt_s, 0.0, FUSE_DT_MAX_S);
-                double r_nav[3];
-                tilt_error_nav(att, accel_mps2, r_nav);
+                double e_body[3];
+                tilt_error_body(att->q, accel_mps2, a_norm, e_body);
                 double k;
                 if (mahony) {
                     k = sf_clamp(p->attitude_mahony_kp * dt_f, 0.0, 1.0);
-                    if (!gap && norm3(r_nav) < INTEGRAL_MAX_ERR_RAD) {
-                        double e_body[3];
-                        horizontal_nav_to_body(att->q, r_nav, e_body);
+                    if (!gap && sf_dot3(e_body, e_body) < INTEGRAL_MAX_ERR_RAD * INTEGRAL_MAX_ERR_RAD) {
                         for (int i = 0; i < 3; i++) {
                             att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_f;
                         }
@@ -282,8 +210,16 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
                 } else {
                     k = 1.0 - p->attitude_tau_s / (p->attitude_tau_s + dt_f); /* 1 − α */
                 }
-                const double r_k[3] = {k * r_nav[0], k * r_nav[1], 0.0};
-                rotate_in_nav(att, r_k);
+                for (int i = 0; i < 3; i++) {
+                    r[i] += k * e_body[i];
+                }
+            }
+            double dq[4], out[4];
+            sf_qexp(r, dq);
+            sf_qmul(att->q, dq, out);
+            sf_qnormalise(out);
+            for (int i = 0; i < 4; i++) {
+                att->q[i] = out[i];
             }
             /* fusion: fast bias at rest (Mahony only; the thesis filter has no bias state) */
             if (mahony && att->at_rest) {
@@ -318,7 +254,7 @@ void sf_attitude_update_mag(sf_attitude_t *const att, const sf_params_t *const p
                             const double field_ut[3])
 {
     SF_ASSERT(att != NULL && p != NULL && field_ut != NULL);
-    if (!att->tilt_initialised && finite3(field_ut)) {
+    if (!att->tilt_initialised && sf_finite3(field_ut)) {
         if (att->mag_pending) {
             reject(att, sf_mag_no_tilt); /* the held sample is replaced by a newer one */
         }
@@ -327,7 +263,7 @@ void sf_attitude_update_mag(sf_attitude_t *const att, const sf_params_t *const p
         for (int i = 0; i < 3; i++) {
             att->mag_pending_ut[i] = field_ut[i];
         }
-        att->last_mag = (sf_attitude_mag_audit_t){.t_us = t_us, .field_ut = norm3(field_ut), .dip_rad = (double)NAN,
+        att->last_mag = (sf_attitude_mag_audit_t){.t_us = t_us, .field_ut = sf_norm3(field_ut), .dip_rad = (double)NAN,
                                                   .verdict = sf_mag_no_tilt};
         return;
     }
@@ -352,11 +288,11 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     sf_attitude_mag_audit_t *const audit = &att->last_mag;
     *audit = (sf_attitude_mag_audit_t){.t_us = t_us, .dip_rad = (double)NAN, .ref_field_ut = att->mag_ref_field_ut,
                                        .ref_dip_rad = att->mag_ref_dip_rad};
-    const double f = finite3(field_ut) ? norm3(field_ut) : (double)NAN;
+    const double f = sf_finite3(field_ut) ? sf_norm3(field_ut) : (double)NAN;
     audit->field_ut = f;
     double m_nav[3] = {0.0, 0.0, 0.0};
     if (isfinite(f) && f > 0.0) {
-        rotate(att->q, false, field_ut, m_nav);
+        sf_qrotate(att->q, false, field_ut, m_nav);
     }
     const double h = sqrt(m_nav[0] * m_nav[0] + m_nav[1] * m_nav[1]);
     if (!isfinite(f) || f <= 0.0 || h < MIN_HORIZONTAL * f) {
@@ -413,7 +349,7 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
         gain = sf_clamp(p->attitude_mahony_kp_mag * dt_s, 0.0, 1.0);
         if (fabs(audit->yaw_innov_rad) < INTEGRAL_MAX_ERR_RAD) {
             double e_body[3];
-            up_to_body(att->q, audit->yaw_innov_rad, e_body);
+            sf_up_to_body(att->q, audit->yaw_innov_rad, e_body);
             for (int i = 0; i < 3; i++) {
                 att->gyro_bias_radps[i] -= p->attitude_mahony_ki * e_body[i] * dt_s;
             }
@@ -422,8 +358,7 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
     } else {
         gain = 1.0 - p->attitude_tau_s / (p->attitude_tau_s + dt_s); /* 1 − α */
     }
-    const double r_nav[3] = {0.0, 0.0, gain * audit->yaw_innov_rad};
-    rotate_in_nav(att, r_nav);
+    rotate_about_up(att, gain * audit->yaw_innov_rad);
     audit->gain = gain;
     audit->verdict = sf_mag_accepted;
     att->mag_accepted++;
@@ -441,12 +376,12 @@ static void judge_mag(sf_attitude_t *const att, const sf_params_t *const p, cons
 
 void sf_attitude_body_to_nav(const sf_attitude_t *const att, const double v_body[3], double v_nav[3])
 {
-    rotate(att->q, false, v_body, v_nav);
+    sf_qrotate(att->q, false, v_body, v_nav);
 }
 
 void sf_attitude_nav_to_body(const sf_attitude_t *const att, const double v_nav[3], double v_body[3])
 {
-    rotate(att->q, true, v_nav, v_body);
+    sf_qrotate(att->q, true, v_nav, v_body);
 }
 
 double sf_attitude_yaw_rad(const sf_attitude_t *const att)

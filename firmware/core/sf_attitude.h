@@ -11,7 +11,12 @@
  *
  * Propagation (both modes). The gyro rate, minus the bias estimate, is averaged over the interval
  * (trapezoid of the previous and the current sample) and integrated exactly as a rotation over δt from
- * the sample times: q ← q ⊗ exp(½ ω̄ δt). Any rate 20–200 Hz with jitter works; an interval ≤ 0 or
+ * the sample times: q ← q ⊗ exp(ω̄ δt) (exp of a rotation vector). The accelerometer's correction
+ * below joins the same step: one exp, one quaternion product and one normalisation per sample,
+ * q ← q ⊗ exp(ω̄ δt + k·e_b), e_b the tilt error in body axes measured with the attitude before the
+ * sample (as Mahony's ω − b̂ + Kp·e; to first order the separate gyro step, then correction in nav,
+ * that this filter did before: the two differ by a commutator of the step and the correction,
+ * ≈ ½·|ω δt|·k·|e|, and by the one-sample-older attitude the error is measured with). Any rate 20–200 Hz with jitter works; an interval ≤ 0 or
  * longer than attitude_max_gap_ms is not integrated (counted in imu_time_errors / imu_gaps), the
  * accelerometer still corrects tilt. The accelerometer corrections below use δt clamped to 0.1 s, and
  * the Mahony integral skips the sample after a gap, so a gap never turns into one large step.
@@ -56,12 +61,12 @@
  * slow local difference is learned but a disturbance can never walk the reference away.
  * Time for the mag blend is the interval since the previous mag sample, clamped to [0, 0.2] s.
  *
- * Counters never decrease. Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 730
- * instructions per sf_attitude_update_imu and ≈ 640 per sf_attitude_update_mag, ≈ 1 050 per IMU
- * sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float) takes 331 (issue 16 asks
- * ≤ 1.5×, ≈ 500).
+ * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 430
+ * instructions per sf_attitude_update_imu and ≈ 545 per sf_attitude_update_mag (the dip's asin ≈ 75),
+ * ≈ 700 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float) takes 331
+ * (issue 16 asks ≤ 1.5×, ≈ 500).
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
- * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at qexp in sf_attitude.c,
+ * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at sf_qexp in sf_quat.h,
  * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory
  * sizeof(sf_attitude_t) = 344 B on x86-64 (316 B on i686; < 400 B, checked). No heap, no I/O, no clock, no
  * hidden state: the same inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are

@@ -160,10 +160,9 @@ static void move(sf_estimator_t *const e, const sf_params_t *const p, const sf_s
 
 /* Whether a sample passes its stream's gate (sf_sample_gate.h); a refused one is counted by verdict. */
 static bool admit(sf_estimator_t *const e, const sf_params_t *const p, const sf_gate_stream_t stream,
-                  const int64_t t_us, const double *const value, const int n_axes)
+                  const int64_t t_us, const double *const value)
 {
-    const sf_sample_limits_t limits = sf_sample_limits(p, stream);
-    const sf_gate_verdict_t v = sf_sample_gate_check(&e->gates[stream], &limits, t_us, value, n_axes);
+    const sf_gate_verdict_t v = sf_sample_gate_stream(&e->gates[stream], p, stream, t_us, value);
     if (v != sf_gate_accepted) {
         e->samples_refused[v]++;
         return false;
@@ -174,8 +173,8 @@ static bool admit(sf_estimator_t *const e, const sf_params_t *const p, const sf_
 int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
-    if (!admit(e, p, sf_gate_accel, s->t_us, s->accel_mps2, 3) ||
-        !admit(e, p, sf_gate_gyro, s->t_us, s->gyro_radps, 3)) {
+    if (!admit(e, p, sf_gate_accel, s->t_us, s->accel_mps2) ||
+        !admit(e, p, sf_gate_gyro, s->t_us, s->gyro_radps)) {
         return 0;
     }
     sf_gap_bridge_on_imu(&e->gap, p, e->started ? e->t_us : 0, s->t_us);
@@ -230,7 +229,7 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
 void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                       const double field_ut[3])
 {
-    if (!admit(e, p, sf_gate_mag, t_us, field_ut, 3)) {
+    if (!admit(e, p, sf_gate_mag, t_us, field_ut)) {
         return;
     }
     sf_magcal_update(&e->magcal, p, t_us, field_ut);
@@ -242,7 +241,7 @@ void sf_estimator_mag(sf_estimator_t *const e, const sf_params_t *const p, const
 void sf_estimator_baro(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
                        const double pressure_pa)
 {
-    if (!admit(e, p, sf_gate_baro, t_us, &pressure_pa, 1)) {
+    if (!admit(e, p, sf_gate_baro, t_us, &pressure_pa)) {
         return;
     }
     sf_floor_update(&e->floor, p, t_us, pressure_pa);

@@ -53,7 +53,7 @@
  * Errors: sf_floor_set_heights returns SF_OK or SF_EINVAL (NULL, n_floors outside
  * [1, SF_FLOOR_CAPACITY], a height not finite or not strictly above the one below, or a table that
  * would leave int16 floor numbers). Everything else cannot fail.
- * Cost (callgrind, x86-64 -O2, `stridefix bench perf`'s sensors walk): ≈ 400 instructions per
+ * Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 380 instructions per
  * sf_floor_update, a third of them the pow(); the low-pass gains are remembered per (dt, τ)
  * (sf_lp_gain: an expm1 only when the rate changes) and the nearest floor is a bisection,
  * O(log n_floors) (the 64-floor scan was ≈ 800). Memory: sizeof(sf_floor_t) = 712 B on x86-64

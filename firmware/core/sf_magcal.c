@@ -272,33 +272,46 @@ void sf_magcal_update(sf_magcal_t *const cal, const sf_params_t *const p, const 
         reject(cal, sf_magcal_time);
         return;
     }
-    if (cal->started) {
-        const double lambda = sf_exp_memo(&cal->forget, -(double)(t_us - cal->last_t_us) * 1e-6 / p->magcal_tau_s);
-        for (int i = 0; i < 4; i++) {
-            for (int j = 0; j < 4; j++) {
-                cal->ata[i][j] *= lambda;
-            }
-            cal->aty[i] *= lambda;
-        }
-        cal->yty *= lambda;
-    }
+    const double lambda =
+        cal->started ? sf_exp_memo(&cal->forget, -(double)(t_us - cal->last_t_us) * 1e-6 / p->magcal_tau_s) : 1.0;
+    const bool forget = cal->started;
     cal->started = true;
     cal->last_t_us = t_us;
     if (!(fabs(audit->corrected_ut - audit->ref_ut) <= audit->tol_ut)) {
+        if (forget) {
+            for (int i = 0; i < 4; i++) {
+                for (int j = 0; j < 4; j++) {
+                    cal->ata[i][j] *= lambda;
+                }
+                cal->aty[i] *= lambda;
+            }
+            cal->yty *= lambda;
+        }
         reject(cal, sf_magcal_gated);
         return;
     }
 
-    /* fusion: accumulate the row a = (2m, 1), y = |m|² */
+    /* fusion: forget, then accumulate the row a = (2m, 1), y = |m|², in one pass over the ten distinct
+     * elements of the symmetric AᵀA (each element is (x·λ) + aᵢaⱼ as in two passes, and aᵢaⱼ = aⱼaᵢ
+     * exactly, so the matrix stays symmetric bit for bit; aᵢ·1 is aᵢ). Without forgetting λ = 1 and
+     * x·1 = x: the same numbers as the accumulation alone. */
     const double a[4] = {2.0 * field_ut[0], 2.0 * field_ut[1], 2.0 * field_ut[2], 1.0};
     const double y = audit->field_ut * audit->field_ut;
+    /* written out: gcc -O2 keeps the triangular loops, whose counters cost as much as the sums */
+    cal->ata[0][0] = cal->ata[0][0] * lambda + a[0] * a[0];
+    cal->ata[0][1] = cal->ata[1][0] = cal->ata[0][1] * lambda + a[0] * a[1];
+    cal->ata[0][2] = cal->ata[2][0] = cal->ata[0][2] * lambda + a[0] * a[2];
+    cal->ata[0][3] = cal->ata[3][0] = cal->ata[0][3] * lambda + a[0];
+    cal->ata[1][1] = cal->ata[1][1] * lambda + a[1] * a[1];
+    cal->ata[1][2] = cal->ata[2][1] = cal->ata[1][2] * lambda + a[1] * a[2];
+    cal->ata[1][3] = cal->ata[3][1] = cal->ata[1][3] * lambda + a[1];
+    cal->ata[2][2] = cal->ata[2][2] * lambda + a[2] * a[2];
+    cal->ata[2][3] = cal->ata[3][2] = cal->ata[2][3] * lambda + a[2];
+    cal->ata[3][3] = cal->ata[3][3] * lambda + 1.0;
     for (int i = 0; i < 4; i++) {
-        for (int j = 0; j < 4; j++) {
-            cal->ata[i][j] += a[i] * a[j];
-        }
-        cal->aty[i] += a[i] * y;
+        cal->aty[i] = cal->aty[i] * lambda + a[i] * y;
     }
-    cal->yty += y * y;
+    cal->yty = cal->yty * lambda + y * y;
     cal->samples_used++;
     cal->by_sample[sf_magcal_used]++;
     audit->sample = sf_magcal_used;

@@ -72,8 +72,9 @@
  * Cost per used sample: the normal equations' update and, on every SF_MAGCAL_SOLVE_EVERY-th, a 3×3
  * Jacobi eigen-decomposition (≤ 16 sweeps, ~5 in practice) and a 4×4 Gaussian elimination, a few
  * kflop; the forgetting factor's exp only when the interval changes (sf_exp_memo); a gated sample
- * costs two sqrt: ≈ 400 instructions per sf_magcal_update in `stridefix bench perf`'s sensors walk
- * (callgrind, x86-64 -O2). Memory sizeof(sf_magcal_t) = 472 B on x86-64 (i686 not rechecked; < 512 B,
+ * costs two sqrt; forgetting and accumulation are one pass over AᵀA's ten distinct elements: ≈ 315
+ * instructions per sf_magcal_update in `stridefix bench perf`'s sensors walk
+ * (callgrind, x86-64 -O3). Memory sizeof(sf_magcal_t) = 472 B on x86-64 (i686 not rechecked; < 512 B,
  * checked). No heap, no I/O, no clock, no hidden state: the same
  * inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are a contract violation
  * (SF_ASSERT). Counters never decrease. */

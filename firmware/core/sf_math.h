@@ -47,16 +47,18 @@ static inline double sf_wrap_pi(const double a)
  * (angles ≤ 11.4°) atan's series to t¹³ leaves out < t¹⁵/15 = 6.7e-17, so the angle is within a few ulp of atan2's
  * (≈ 25 instructions, not ≈ 130); larger angles, and x ≤ −h (no half angle), are atan2's. */
 #define SF_ATAN_SERIES_MAX 0.1
+/* atan(t)/t = 1 − t²/3 + … − t¹²/13 for t² = t2 ≤ SF_ATAN_SERIES_MAX² (the bound above). */
+static inline double sf_atan_series(const double t2)
+{
+    return 1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 / 13)))));
+}
 static inline double sf_atan2_half(const double y, const double x, const double h)
 {
     const double d = h + x;
     if (d > 0.0) {
         const double t = y / d;
         if (fabs(t) <= SF_ATAN_SERIES_MAX) {
-            const double t2 = t * t;
-            const double p = /* atan(t)/t = 1 − t²/3 + … − t¹²/13 */
-                1.0 - t2 * (1.0 / 3 - t2 * (1.0 / 5 - t2 * (1.0 / 7 - t2 * (1.0 / 9 - t2 * (1.0 / 11 - t2 / 13)))));
-            return 2.0 * t * p;
+            return 2.0 * t * sf_atan_series(t * t);
         }
     }
     return atan2(y, x);
