@@ -78,6 +78,11 @@ const char *sf_input_name(const sf_input_t *in);
  * stdin and logs, whose replay may wait rather than drop. */
 bool sf_input_is_live(const sf_input_t *in);
 
+/* True for an input read from a regular file (a candump file, an LCM log), whose reads never wait:
+ * the log may be written by the reading thread (sf_lcm_out.h caller_writes). False for SocketCAN,
+ * stdin, a pipe or a FIFO. */
+bool sf_input_is_regular_file(const sf_input_t *in);
+
 /* True for a spec that names a live source (socketcan:IFACE), before anything is opened. */
 bool sf_input_spec_is_live(const char *spec);
 
