@@ -14,7 +14,8 @@
 #include "sf_can_frame.h"
 
 /* Parses one line (a trailing newline is allowed). SF_OK, SF_ESYNTAX or SF_EINVAL (NULL). Cost: one
- * pass with a table lookup per character, ~300 instructions for a line of 8 data bytes. */
+ * pass with a table lookup per character: ~430 instructions for a replay line (10-digit seconds, 8 data
+ * bytes), 627 before the table. */
 int sf_candump_parse(const char *line, sf_can_frame_t *frame);
 
 /* As sf_candump_parse on the len characters of line that its NUL follows; a NUL inside them is
