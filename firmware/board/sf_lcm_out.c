@@ -133,7 +133,10 @@ static void *writer_main(void *arg)
             break;
         }
         const bool limited = out->rotate_asked;
-        const uint64_t max = limited ? out->rotate_after - out->n_taken : UINT64_MAX;
+        uint64_t max = limited ? out->rotate_after - out->n_taken : UINT64_MAX;
+        if (out->cfg.fsync_interval_ms == 0 && max > 1) {
+            max = 1; /* a sync after every event, as fsync_interval_ms = 0 promises */
+        }
         write_batch(out, max); /* returns with the lock held */
         const bool rotate = limited && out->n_taken >= out->rotate_after;
         out->rotate_asked &= !rotate;
@@ -340,7 +343,8 @@ int sf_lcm_out_commit(sf_lcm_out_t *const out, const bool filled)
     out->n_queued += filled ? 1u : 0u;
     if (out->threaded) {
         pthread_cond_signal(&out->not_empty);
-    } else if (sf_log_ring_queued_bytes(&out->ring) >= SF_LCM_OUT_CALLER_BATCH_BYTES) {
+    } else if (sf_log_ring_queued_bytes(&out->ring) >= SF_LCM_OUT_CALLER_BATCH_BYTES ||
+               out->cfg.fsync_interval_ms == 0) { /* 0: a sync after every event */
         flush_in_caller(out, false);
     }
     ring_unlock(out);

@@ -21,8 +21,8 @@
  * Durability: with the writer thread, every event is in the kernel as soon as the writer has it (no
  * user-space buffer beyond the queue, so SIGKILL loses only what is still queued, microseconds'
  * worth); with caller_writes, SIGKILL loses at most the batch being gathered (the input file is still
- * there to replay). The writer fdatasyncs at least every fsync_interval_ms (0: after every write, a
- * batch of events), so power loss loses at most that much.
+ * there to replay). The writer fdatasyncs at least every fsync_interval_ms (0: after every event,
+ * each then written on its own), so power loss loses at most that much.
  *
  * Rotation: by size (a file is closed before an event would take it past rotate_bytes), by age
  * (rotate_s since the file was opened) and on request (sf_lcm_out_rotate, or a change of the counter
