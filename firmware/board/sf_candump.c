@@ -11,7 +11,7 @@
  * the parser was a sixth of the daemon's instructions (627 per line). */
 enum { NOT_HEX = 16, BLANK = 17, LINE_END = 18, NUL_END = 19 };
 
-#define HEX_ROW(c) ((c) >= '0' && (c) <= '9' ? (c) - '0' : (c) >= 'a' && (c) <= 'f' ? (c) - 'a' + 10 \
+#define HEX_ROW(c) (uint8_t)((c) >= '0' && (c) <= '9' ? (c) - '0' : (c) >= 'a' && (c) <= 'f' ? (c) - 'a' + 10 \
                     : (c) >= 'A' && (c) <= 'F' ? (c) - 'A' + 10 : (c) == ' ' || (c) == '\t' ? BLANK \
                     : (c) == '\r' || (c) == '\n' ? LINE_END : (c) == '\0' ? NUL_END : NOT_HEX)
 #define ROW4(c) HEX_ROW(c), HEX_ROW((c) + 1), HEX_ROW((c) + 2), HEX_ROW((c) + 3)
