@@ -337,6 +337,9 @@ static int open_output(daemon_t *const d, char *const err, const size_t err_size
                                .queue_capacity = LOG_QUEUE_MESSAGES,
                                /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
                                .block_when_full = !sf_input_is_live(d->in),
+                               /* DEVIATION: STYLE's "queue -> writer thread": a regular file's reads never
+                                * wait, and the hand-off cost a replay more than it saved (sf_lcm_out.h). */
+                               .caller_writes = sf_input_is_regular_file(d->in),
                                .force = d->opt.force,
                                .fsync_interval_ms = d->params.output_fsync_interval_ms,
                                .rotate_bytes = (uint64_t)d->params.output_log_rotate_mb * 1000000u,

@@ -3,6 +3,7 @@
 #include "sf_can_input.h"
 
 #include <errno.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/time.h>
 #include <unistd.h>
@@ -136,37 +137,121 @@ static int next_socketcan(sf_can_input_t *const in, sf_can_frame_t *const frame)
 #endif
 }
 
+/* More input after the bytes not yet consumed (moved to the front first): 1 bytes read, 0 the end,
+ * SF_EINTR or SF_EIO. A descriptor is read with read(2), which returns what a pipe has now (a
+ * live-paced stdin is never waited on for a whole chunk); a stream without one (a memory stream)
+ * with fread. */
+static int fill(sf_can_input_t *const in)
+{
+    if (in->chunk_pos > 0) {
+        memmove(in->chunk, in->chunk + in->chunk_pos, in->chunk_len - in->chunk_pos);
+        in->chunk_len -= in->chunk_pos;
+        in->chunk_pos = 0;
+    }
+    const size_t room = SF_CAN_INPUT_CHUNK_BYTES - in->chunk_len;
+    const int fd = fileno(in->file);
+    ssize_t n;
+    if (fd >= 0) {
+        n = read(fd, in->chunk + in->chunk_len, room);
+    } else {
+        n = (ssize_t)fread(in->chunk + in->chunk_len, 1, room, in->file);
+        n = n == 0 && ferror(in->file) ? -1 : n;
+    }
+    if (n < 0) {
+        return errno == EINTR ? SF_EINTR : SF_EIO; /* a signal: the caller decides whether to stop */
+    }
+    in->chunk_len += (size_t)n;
+    return n > 0 ? 1 : 0;
+}
+
+/* The longest line taken whole (without its newline): what fgets into line[512] took, 510
+ * characters and the newline; a longer one is skipped as bad syntax. */
+#define LINE_MAX_CHARS (sizeof(((sf_can_input_t *)0)->line) - 2)
+
+/* The rest of an overlong line, up to and with its newline: 1 done, or as fill. */
+static int skip_rest(sf_can_input_t *const in)
+{
+    for (;;) {
+        const char *const start = in->chunk + in->chunk_pos;
+        const char *const nl = memchr(start, '\n', in->chunk_len - in->chunk_pos);
+        if (nl != NULL) {
+            in->chunk_pos += (size_t)(nl - start) + 1;
+            in->skipping = false;
+            return 1;
+        }
+        in->chunk_pos = in->chunk_len;
+        const int rc = in->eof ? 0 : fill(in);
+        if (rc <= 0) {
+            in->eof |= rc == 0;
+            in->skipping = rc != 0; /* interrupted: go on skipping at the next call */
+            return rc == 0 ? 1 : rc;
+        }
+    }
+}
+
+/* The next line from the chunk buffer (a line per call, no copy until it is whole): the candump
+ * replay read a million lines an hour through fgets + strlen at ~170 instructions a line, here one
+ * memchr. Lines as fgets read them: blank ones skipped, trailing CR/LF dropped, an overlong one bad
+ * syntax; a NUL inside a line makes it bad syntax (regression: with fgets, strlen stopped at the NUL,
+ * the line looked cut short and the line after it was swallowed as its rest). */
+static int next_line(sf_can_input_t *const in, sf_can_frame_t *const frame)
+{
+    if (in->chunk == NULL) {
+        in->chunk = malloc(SF_CAN_INPUT_CHUNK_BYTES + 1); /* + 1: the NUL after a last line without newline */
+        if (in->chunk == NULL) {
+            errno = ENOMEM;
+            return SF_EIO;
+        }
+    }
+    for (;;) {
+        if (in->skipping) {
+            const int rc = skip_rest(in);
+            if (rc != 1) {
+                return rc;
+            }
+        }
+        char *const start = in->chunk + in->chunk_pos;
+        const size_t avail = in->chunk_len - in->chunk_pos;
+        char *nl = memchr(start, '\n', avail);
+        if (nl == NULL && avail <= LINE_MAX_CHARS && !in->eof) {
+            const int rc = fill(in);
+            in->eof |= rc == 0;
+            if (rc < 0) {
+                return rc;
+            }
+            continue;
+        }
+        if (nl == NULL && avail == 0) {
+            return 0; /* the end, and it stays the end */
+        }
+        size_t len = nl != NULL ? (size_t)(nl - start) : avail;
+        in->line_no++;
+        if (len > LINE_MAX_CHARS) { /* longer than any candump line: skipped, its start kept for the message */
+            memcpy(in->line, start, sizeof in->line - 1);
+            in->line[sizeof in->line - 1] = '\0';
+            in->chunk_pos += nl != NULL ? len + 1 : avail;
+            in->skipping = nl == NULL;
+            return SF_ESYNTAX;
+        }
+        in->chunk_pos += nl != NULL ? len + 1 : len;
+        while (len > 0 && start[len - 1] == '\r') {
+            len--;
+        }
+        memcpy(in->line, start, len);
+        in->line[len] = '\0';
+        if (len == 0) {
+            continue; /* blank lines are not frames */
+        }
+        return sf_candump_parse_line(in->line, len, frame) == SF_OK ? 1 : SF_ESYNTAX;
+    }
+}
+
 int sf_can_input_next(sf_can_input_t *const in, sf_can_frame_t *const frame)
 {
     if (in->kind == sf_can_input_socketcan) {
         return next_socketcan(in, frame);
     }
-    for (;;) {
-        if (fgets(in->line, sizeof in->line, in->file) == NULL) {
-            if (ferror(in->file) && errno == EINTR) {
-                clearerr(in->file);
-                return SF_EINTR; /* a signal: the caller decides whether to stop */
-            }
-            return ferror(in->file) ? SF_EIO : 0;
-        }
-        in->line_no++;
-        size_t len = strlen(in->line);
-        const int whole = len > 0 && in->line[len - 1] == '\n';
-        if (!whole && !feof(in->file)) {
-            /* Longer than any candump line: skip the rest of it and report it as bad syntax. */
-            int c;
-            while ((c = fgetc(in->file)) != EOF && c != '\n') {
-            }
-            return SF_ESYNTAX;
-        }
-        while (len > 0 && (in->line[len - 1] == '\n' || in->line[len - 1] == '\r')) {
-            in->line[--len] = '\0';
-        }
-        if (len == 0) {
-            continue; /* blank lines are not frames */
-        }
-        return sf_candump_parse(in->line, frame) == SF_OK ? 1 : SF_ESYNTAX;
-    }
+    return next_line(in, frame);
 }
 
 void sf_can_input_close(sf_can_input_t *const in)
@@ -175,6 +260,8 @@ void sf_can_input_close(sf_can_input_t *const in)
         fclose(in->file);
     }
     in->file = NULL;
+    free(in->chunk);
+    in->chunk = NULL;
     /* Only a socket this input opened: a zeroed, never-opened input has fd 0, which is stdin (the
      * --replay bug that closed a CAN input it never opened). */
     if (in->kind == sf_can_input_socketcan && in->fd >= 0) {

@@ -7,11 +7,17 @@
 #ifndef SF_CAN_INPUT_H
 #define SF_CAN_INPUT_H
 
+#include <stdbool.h>
+#include <stddef.h>
 #include <stdio.h>
 
 #include "sf_can_frame.h"
 
 #define SF_CAN_INPUT_SOCKETCAN_PREFIX "socketcan:"
+
+/* A file or stdin is read this much at a time (one read(2), or fread on a stream without a
+ * descriptor), and split into lines in place. */
+#define SF_CAN_INPUT_CHUNK_BYTES (64u * 1024u)
 
 typedef enum { sf_can_input_file, sf_can_input_socketcan } sf_can_input_kind_t;
 
@@ -22,6 +28,10 @@ typedef struct {
     int fd;         /* socketcan kind */
     long line_no;   /* file kind: number of the line last read (1-based) */
     char line[512]; /* file kind: the line last read, newline stripped, for messages */
+    char *chunk;    /* file kind: SF_CAN_INPUT_CHUNK_BYTES read ahead (malloc'd at the first read) */
+    size_t chunk_len, chunk_pos; /* bytes in chunk, and consumed */
+    bool eof;       /* the end was read */
+    bool skipping;  /* inside the rest of an overlong line */
 } sf_can_input_t;
 
 /* Opens a spec: "-" (stdin), "socketcan:IFACE", or a file path. SF_OK, SF_ENOENT (no such file or

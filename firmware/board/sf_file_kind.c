@@ -40,3 +40,9 @@ int sf_file_check(const char *const path, const char *const what, const bool all
     }
     return SF_OK;
 }
+
+bool sf_file_is_regular(const int fd)
+{
+    struct stat st;
+    return fd >= 0 && fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+}

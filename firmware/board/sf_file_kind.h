@@ -16,4 +16,9 @@
  * ("config", "site file", ...) in the message. */
 int sf_file_check(const char *path, const char *what, bool allow_fifo, char *err_text, size_t err_size);
 
+/* True when fd is open on a regular file, whose reads never wait for a writer (the log may then be
+ * written by the reading thread, sf_lcm_out.h caller_writes); false for a pipe, a FIFO, a terminal,
+ * a socket, or fd < 0. Cost: one fstat(). */
+bool sf_file_is_regular(int fd);
+
 #endif

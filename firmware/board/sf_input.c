@@ -1,4 +1,5 @@
 /* sf_input.c — CAN (candump, stdin, SocketCAN) and raw-sensor LCM replay as one input (see sf_input.h). */
+#define _POSIX_C_SOURCE 200809L /* fileno */
 #include "sf_input.h"
 
 #include <inttypes.h>
@@ -8,6 +9,7 @@
 
 #include "sf_can_input.h"
 #include "sf_error.h"
+#include "sf_file_kind.h"
 #include "sf_lcm_input.h"
 
 struct sf_input {
@@ -194,6 +196,14 @@ const char *sf_input_name(const sf_input_t *const in)
 bool sf_input_is_live(const sf_input_t *const in)
 {
     return in->lcm == NULL && in->can.kind == sf_can_input_socketcan;
+}
+
+bool sf_input_is_regular_file(const sf_input_t *const in)
+{
+    if (in->lcm != NULL) {
+        return sf_lcm_input_is_regular(in->lcm);
+    }
+    return in->can.kind == sf_can_input_file && in->can.file != NULL && sf_file_is_regular(fileno(in->can.file));
 }
 
 bool sf_input_spec_is_live(const char *const spec)

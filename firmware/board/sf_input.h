@@ -10,9 +10,10 @@
  * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable, or a
  * directory or device: sf_file_kind.h; a FIFO is read like stdin),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
- * sf_input_next: see below. Memory: one heap block per open input (6656 B on x86-64, asserted
+ * sf_input_next: see below. Memory: one heap block per open input (6688 B on x86-64, asserted
  * ≤ 7 KiB: the decoder with its Wi-Fi scan and BLE window in progress, the candump line buffer), allocated by
- * sf_input_open, freed by sf_input_close; sf_input_item_t is ≈ 4 KiB (the caller's). */
+ * sf_input_open, and for a candump file or stdin the reader's 64 KiB chunk (SF_CAN_INPUT_CHUNK_BYTES,
+ * at the first read), freed by sf_input_close; sf_input_item_t is ≈ 4 KiB (the caller's). */
 #ifndef SF_INPUT_H
 #define SF_INPUT_H
 
@@ -77,6 +78,11 @@ const char *sf_input_name(const sf_input_t *in);
 /* True for a live source (SocketCAN), where the logger must never wait on the disk; false for files,
  * stdin and logs, whose replay may wait rather than drop. */
 bool sf_input_is_live(const sf_input_t *in);
+
+/* True for an input read from a regular file (a candump file, an LCM log), whose reads never wait:
+ * the log may be written by the reading thread (sf_lcm_out.h caller_writes). False for SocketCAN,
+ * stdin, a pipe or a FIFO. */
+bool sf_input_is_regular_file(const sf_input_t *in);
 
 /* True for a spec that names a live source (socketcan:IFACE), before anything is opened. */
 bool sf_input_spec_is_live(const char *spec);

@@ -1,6 +1,7 @@
 /* sf_lcm_input.c — raw-sensor LCM log → sf_rx_event_t (see sf_lcm_input.h); the events come from the
  * strict reader of sf_eventlog.c, the per-channel decode is the kind table of sf_rx_lcm.c, the same
  * one the daemon logs inputs with. */
+#define _POSIX_C_SOURCE 200809L /* fileno */
 #include "sf_lcm_input.h"
 
 #include <errno.h>
@@ -50,6 +51,11 @@ int sf_lcm_input_open(sf_lcm_input_t **const result, const char *const path, cha
         return e == ENOENT ? SF_ENOENT : SF_EIO;
     }
     return sf_lcm_input_open_stream(result, f, path, err, err_size);
+}
+
+bool sf_lcm_input_is_regular(const sf_lcm_input_t *const in)
+{
+    return sf_file_is_regular(fileno(in->f));
 }
 
 /* A bad event: counted, its message kept; the code the caller sees. */

@@ -12,6 +12,7 @@
 #ifndef SF_LCM_INPUT_H
 #define SF_LCM_INPUT_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -36,6 +37,9 @@ int sf_lcm_input_open(sf_lcm_input_t **in, const char *path, char *err_text, siz
 /* The same on a stream already open (a memory stream in the fuzz harness); the input owns f and
  * closes it (also on failure). name is used in messages. */
 int sf_lcm_input_open_stream(sf_lcm_input_t **in, FILE *f, const char *name, char *err_text, size_t err_size);
+
+/* True when the log is read from a regular file (sf_file_is_regular). */
+bool sf_lcm_input_is_regular(const sf_lcm_input_t *in);
 
 /* Next sensor event: 1 filled (*log_t_us = the event's log timestamp); 0 end of log; SF_ESYNTAX an
  * event that failed to decode, was too large or was cut short by the end of the log (skipped,

@@ -1,259 +1,105 @@
-/* sf_lcm_out.c — bounded queue + writer thread in front of the log file (sf_log_file.h) and live
- * LCM (see sf_lcm_out.h). The writer thread owns the file: rotation, syncs and failure episodes
- * all happen there; the caller's thread only copies into the queue. */
+/* sf_lcm_out.c — bounded queue + writer in front of the log file (sf_log_file.h) and live LCM (see
+ * sf_lcm_out.h). The queue is a byte ring of events already in the file's format (sf_log_ring.h):
+ * the caller encodes into it, the writer hands whole runs of it to one write. The writer — the
+ * writer thread, or with caller_writes the caller's thread at each batch — owns the file: rotation,
+ * syncs and failure episodes all happen there. */
 #define _GNU_SOURCE
 #include "sf_lcm_out.h"
 
 #include <errno.h>
 #include <pthread.h>
 #include <signal.h>
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/statvfs.h>
 #include <time.h>
 
 #include <lcm/lcm.h>
 
 #include "sf_error.h"
 #include "sf_log_file.h"
+#include "sf_log_ring.h"
+#include "sf_log_writer.h"
 
 #define IDLE_WAKE_US 100000 /* the idle writer looks at syncs and rotation this often */
-#define MAX_NAME_ATTEMPTS 1000
-
-typedef struct {
-    char *channel;
-    void *data;
-    size_t size;
-    int64_t timestamp_us;
-    bool is_header;
-} item_t;
 
 struct sf_lcm_out {
     sf_lcm_out_config_t cfg;
-    char first_path[SF_LOG_FILE_PATH_MAX];
     lcm_t *lcm;
-    /* the writer thread's (the caller's before the thread starts and after it ends) */
-    sf_log_file_t file;
-    unsigned file_index; /* the current file, or the last one while none is open */
-    int64_t file_opened_us;
-    int64_t last_sync_us;
-    bool unsynced;
-    unsigned rotations_seen;
-    item_t header; /* copy of the latest header event; channel NULL if none */
-    bool failing;  /* inside a write-failure episode */
-    int fail_errno; /* why the episode began */
-    /* shared, under lock */
+    sf_log_writer_t w; /* the file's side: the writer thread's, or the caller's (caller_writes) */
+    bool threaded;     /* a log written by the writer thread (not caller_writes) */
+    /* shared, under lock when threaded */
     pthread_t writer;
     bool writer_started;
     pthread_mutex_t lock;
     pthread_cond_t not_empty;
     pthread_cond_t not_full;
-    item_t *ring;
-    size_t capacity;
-    size_t head; /* next to write */
-    size_t count;
+    sf_log_ring_t ring;
+    bool has_log;
     bool closing;
-    uint64_t n_queued;   /* items ever queued */
-    uint64_t n_taken;    /* items ever taken by the writer */
-    bool rotate_asked;   /* by sf_lcm_out_rotate: after the item n_queued counted then */
+    uint64_t n_queued;   /* events ever queued */
+    uint64_t n_taken;    /* events ever taken by the writer */
+    bool rotate_asked;   /* by sf_lcm_out_rotate: after the event n_queued counted then */
     uint64_t rotate_after;
-    bool write_failed;
-    sf_lcm_out_counters_t counters;
+    /* the caller's: the reservation in progress (sf_lcm_out_reserve .. _commit) */
+    const char *res_channel;
+    uint8_t *res_data;
+    size_t res_size;
+    bool res_in_ring; /* else in scratch: no log, or dropped from a full queue but still published */
+    uint8_t *scratch;
+    size_t scratch_cap;
 };
 
-static int64_t monotonic_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
-
-static uint64_t event_bytes(const char *const channel, const size_t size)
-{
-    return SF_LOG_FILE_EVENT_OVERHEAD + (uint64_t)strlen(channel) + (uint64_t)size;
-}
-
-static void report(const sf_lcm_out_t *const out, const char *const fmt, ...)
-{
-    if (out->cfg.report == NULL) {
-        return;
-    }
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(out->cfg.report, "stridefixd: ");
-    vfprintf(out->cfg.report, fmt, ap);
-    fprintf(out->cfg.report, "\n");
-    va_end(ap);
-}
-
-static void count(sf_lcm_out_t *const out, const bool written, const uint64_t bytes)
+static void lock(sf_lcm_out_t *const out)
 {
     pthread_mutex_lock(&out->lock);
-    if (written) {
-        out->counters.events++;
-        out->counters.bytes += bytes;
-    } else {
-        out->counters.drops++;
-        out->counters.drop_bytes += bytes;
-        out->write_failed = true;
-    }
+}
+
+static void unlock(sf_lcm_out_t *const out)
+{
     pthread_mutex_unlock(&out->lock);
 }
 
-/* Tells the start and the end of a failure episode, once each. */
-static void episode(sf_lcm_out_t *const out, const bool ok, const int err_no)
+/* The ring's lock: only a writer thread shares it (with caller_writes one thread owns everything). */
+static void ring_lock(sf_lcm_out_t *const out)
 {
-    if (!ok && !out->failing) {
-        out->failing = true;
-        out->fail_errno = err_no;
-        report(out, "%s: writing the log failed: %s; events are dropped and counted until writes succeed again",
-               out->file.fd >= 0 ? out->file.part_path : out->first_path, strerror(err_no));
-    } else if (ok && out->failing) {
-        out->failing = false;
-        sf_lcm_out_counters_t c;
-        sf_lcm_out_counters(out, &c);
-        report(out, "%s: logging resumed (%llu events, %llu bytes dropped so far)", out->file.part_path,
-               (unsigned long long)c.drops, (unsigned long long)c.drop_bytes);
+    if (out->threaded) {
+        lock(out);
     }
 }
 
-static void close_file(sf_lcm_out_t *const out)
+static void ring_unlock(sf_lcm_out_t *const out)
 {
-    char err[2 * SF_LOG_FILE_PATH_MAX + 128];
-    if (sf_log_file_close(&out->file, err, sizeof err) != SF_OK) {
-        report(out, "%s", err);
-        pthread_mutex_lock(&out->lock);
-        out->write_failed = true;
-        pthread_mutex_unlock(&out->lock);
+    if (out->threaded) {
+        unlock(out);
     }
-    out->unsynced = false;
 }
 
-/* Opens the next rotated file (skipping names that exist) and writes the header copy into it,
- * stamped timestamp_us. On failure no file is open and errno tells why. */
-static int open_next(sf_lcm_out_t *const out, const int64_t timestamp_us)
+/* Takes up to max_events (the ring's lock held), writes them (without it) and frees their room. */
+static void write_batch(sf_lcm_out_t *const out, const uint64_t max_events)
 {
-    char path[SF_LOG_FILE_PATH_MAX];
-    char err[SF_LOG_FILE_PATH_MAX + 128];
-    int rc = SF_EIO;
-    unsigned index = out->file_index;
-    for (int attempt = 0; attempt < MAX_NAME_ATTEMPTS; attempt++) {
-        index++;
-        if (sf_log_file_rotated_name(path, sizeof path, out->first_path, index) != SF_OK) {
-            errno = ENAMETOOLONG;
-            return SF_EIO;
-        }
-        rc = sf_log_file_open(&out->file, path, out->cfg.force, err, sizeof err);
-        if (rc == SF_OK || errno != EEXIST) {
-            break;
-        }
+    sf_log_ring_run_t runs[2];
+    uint64_t n;
+    const int n_runs = sf_log_ring_take(&out->ring, max_events, runs, &n);
+    out->n_taken += n;
+    if (out->threaded) {
+        pthread_cond_signal(&out->not_full); /* a message slot is free */
+        unlock(out);
     }
-    if (rc != SF_OK) {
-        return rc;
+    for (int i = 0; i < n_runs; i++) {
+        sf_log_writer_events(&out->w, runs[i].p, runs[i].len);
     }
-    if (out->header.channel != NULL) {
-        const int hrc = sf_log_file_write(&out->file, out->header.channel, timestamp_us, out->header.data,
-                                          out->header.size);
-        if (hrc != SF_OK) { /* a file without its header would not read alone: none at all */
-            const int e = errno;
-            sf_log_file_discard(&out->file);
-            errno = e;
-            return hrc;
-        }
+    ring_lock(out);
+    sf_log_ring_release(&out->ring);
+    if (out->threaded) {
+        pthread_cond_signal(&out->not_full); /* and the bytes */
     }
-    out->file_index = index;
-    out->file_opened_us = monotonic_us();
-    out->unsynced = true;
-    pthread_mutex_lock(&out->lock);
-    out->counters.files++;
-    if (out->header.channel != NULL) {
-        out->counters.events++;
-        out->counters.header_copies++;
-        out->counters.bytes += event_bytes(out->header.channel, out->header.size);
-    }
-    pthread_mutex_unlock(&out->lock);
-    return SF_OK;
 }
 
-/* Keeps a copy of a header event for the files to come (the item keeps its own buffers). */
-static void keep_header(sf_lcm_out_t *const out, const item_t *const it)
+/* caller_writes: everything queued written now, then the housekeeping a writer thread would do. */
+static void flush_in_caller(sf_lcm_out_t *const out, const bool rotate)
 {
-    char *const channel = strdup(it->channel);
-    void *const data = malloc(it->size > 0 ? it->size : 1);
-    if (channel == NULL || data == NULL) {
-        free(channel);
-        free(data);
-        return; /* the old header (if any) stays */
-    }
-    memcpy(data, it->data, it->size);
-    free(out->header.channel);
-    free(out->header.data);
-    out->header.channel = channel;
-    out->header.data = data;
-    out->header.size = it->size;
-    out->header.timestamp_us = it->timestamp_us;
-    out->header.is_header = true;
-}
-
-/* A full disk is not free again because one small event fits its last page (tmpfs: 346 B did, inside
- * one episode): during an ENOSPC/EDQUOT episode writes resume only with 64 KiB free (or unknown). */
-static bool room_again(const sf_lcm_out_t *const out)
-{
-    struct statvfs st;
-    if (!out->failing || (out->fail_errno != ENOSPC && out->fail_errno != EDQUOT) || out->file.fd < 0 ||
-        fstatvfs(out->file.fd, &st) != 0) {
-        return true;
-    }
-    return (uint64_t)st.f_bavail * (uint64_t)st.f_frsize >= 64u * 1024u;
-}
-
-static void write_item(sf_lcm_out_t *const out, const item_t *const it)
-{
-    if (it->is_header) {
-        keep_header(out, it);
-    }
-    const uint64_t bytes = event_bytes(it->channel, it->size);
-    if (out->file.fd >= 0 && out->cfg.rotate_bytes > 0 && out->file.offset > 0 &&
-        out->file.offset + bytes > out->cfg.rotate_bytes) {
-        close_file(out);
-    }
-    if (!room_again(out)) {
-        count(out, false, bytes); /* still full: dropped, counted, the episode goes on */
-        return;
-    }
-    int rc = out->file.fd >= 0 ? SF_OK : open_next(out, it->timestamp_us);
-    if (rc == SF_OK) {
-        rc = sf_log_file_write(&out->file, it->channel, it->timestamp_us, it->data, it->size);
-    }
-    const int e = errno;
-    count(out, rc == SF_OK, bytes);
-    episode(out, rc == SF_OK, e);
-    out->unsynced |= rc == SF_OK;
-}
-
-/* Between events: a rotation that was asked for or is due, else a sync that is due. */
-static void housekeeping(sf_lcm_out_t *const out, bool rotate)
-{
-    const int64_t now = monotonic_us();
-    if (out->cfg.rotate_requests != NULL) {
-        const unsigned seen = atomic_load(out->cfg.rotate_requests);
-        rotate |= seen != out->rotations_seen;
-        out->rotations_seen = seen;
-    }
-    if (out->file.fd < 0) {
-        return;
-    }
-    if (rotate || (out->cfg.rotate_s > 0 && now - out->file_opened_us >= (int64_t)out->cfg.rotate_s * 1000000)) {
-        close_file(out);
-        return;
-    }
-    if (out->unsynced && now - out->last_sync_us >= (int64_t)out->cfg.fsync_interval_ms * 1000) {
-        const bool ok = sf_log_file_sync(&out->file) == SF_OK;
-        episode(out, ok, errno);
-        out->last_sync_us = now;
-        out->unsynced = false;
-    }
+    write_batch(out, UINT64_MAX);
+    sf_log_writer_housekeeping(&out->w, rotate);
 }
 
 static void wait_a_while(sf_lcm_out_t *const out)
@@ -266,42 +112,39 @@ static void wait_a_while(sf_lcm_out_t *const out)
     (void)pthread_cond_timedwait(&out->not_empty, &out->lock, &until);
 }
 
+/* Each wake-up takes every queued event (up to a rotation asked for after some of them) and writes
+ * them in one go: in the kernel as soon as the writer has them, one system call per run. */
 static void *writer_main(void *arg)
 {
     sf_lcm_out_t *const out = arg;
-    out->last_sync_us = monotonic_us();
-    pthread_mutex_lock(&out->lock);
+    lock(out);
     for (;;) {
-        while (out->count == 0 && !out->closing) {
-            const bool rotate = out->rotate_asked; /* the queue is empty: every item before it is written */
+        while (out->ring.queued == 0 && !out->closing) {
+            const bool rotate = out->rotate_asked; /* the queue is empty: every event before it is written */
             out->rotate_asked = false;
-            pthread_mutex_unlock(&out->lock);
-            housekeeping(out, rotate);
-            pthread_mutex_lock(&out->lock);
-            if (out->count == 0 && !out->closing && !out->rotate_asked) {
+            unlock(out);
+            sf_log_writer_housekeeping(&out->w, rotate);
+            lock(out);
+            if (out->ring.queued == 0 && !out->closing && !out->rotate_asked) {
                 wait_a_while(out);
             }
         }
-        if (out->count == 0 && out->closing) {
+        if (out->ring.queued == 0 && out->closing) {
             break;
         }
-        const item_t it = out->ring[out->head];
-        out->head = (out->head + 1) % out->capacity;
-        out->count--;
-        out->n_taken++;
-        const bool rotate = out->rotate_asked && out->n_taken >= out->rotate_after;
+        const bool limited = out->rotate_asked;
+        uint64_t max = limited ? out->rotate_after - out->n_taken : UINT64_MAX;
+        if (out->cfg.fsync_interval_ms == 0 && max > 1) {
+            max = 1; /* a sync after every event, as fsync_interval_ms = 0 promises */
+        }
+        write_batch(out, max); /* returns with the lock held */
+        const bool rotate = limited && out->n_taken >= out->rotate_after;
         out->rotate_asked &= !rotate;
-        pthread_cond_signal(&out->not_full);
-        pthread_mutex_unlock(&out->lock);
-
-        write_item(out, &it);
-        free(it.channel);
-        free(it.data);
-        housekeeping(out, rotate);
-
-        pthread_mutex_lock(&out->lock);
+        unlock(out);
+        sf_log_writer_housekeeping(&out->w, rotate);
+        lock(out);
     }
-    pthread_mutex_unlock(&out->lock);
+    unlock(out);
     return NULL;
 }
 
@@ -329,6 +172,40 @@ static int init_sync(sf_lcm_out_t *const out)
     return rc == 0 ? SF_OK : SF_EIO;
 }
 
+/* The ring: room for the queue's messages at ~128 B each, and never less than 1 MiB (so that the
+ * largest message, ≤ a quarter of it, always fits). */
+static size_t ring_bytes(const size_t queue_capacity)
+{
+    const size_t min = (size_t)1 << 20;
+    return queue_capacity < min / 128 ? min : queue_capacity * 128;
+}
+
+/* The first file, the queue and (without caller_writes) the writer thread. */
+static int open_log(sf_lcm_out_t *const out, char *const err, const size_t err_size)
+{
+    const int rc = sf_log_writer_open(&out->w, err, err_size);
+    if (rc != SF_OK) {
+        return rc;
+    }
+    out->has_log = true;
+    if (sf_log_ring_init(&out->ring, ring_bytes(out->cfg.queue_capacity)) != SF_OK) {
+        snprintf(err, err_size, "out of memory for the log queue");
+        sf_log_file_discard(&out->w.file);
+        return SF_EIO;
+    }
+    if (out->cfg.caller_writes) {
+        return SF_OK;
+    }
+    if (start_writer(out) != SF_OK) {
+        snprintf(err, err_size, "cannot start the log writer thread");
+        sf_log_file_discard(&out->w.file);
+        return SF_EIO;
+    }
+    out->writer_started = true;
+    out->threaded = true;
+    return SF_OK;
+}
+
 int sf_lcm_out_open_config(sf_lcm_out_t **const result, const sf_lcm_out_config_t *const cfg, char *const err,
                            const size_t err_size)
 {
@@ -342,11 +219,7 @@ int sf_lcm_out_open_config(sf_lcm_out_t **const result, const sf_lcm_out_config_
         return SF_EIO;
     }
     out->cfg = *cfg;
-    out->capacity = cfg->queue_capacity;
-    out->file.fd = -1;
-    if (cfg->rotate_requests != NULL) {
-        out->rotations_seen = atomic_load(cfg->rotate_requests);
-    }
+    sf_log_writer_init(&out->w, &out->cfg);
     if (init_sync(out) != SF_OK) {
         free(out);
         snprintf(err, err_size, "cannot set up the log writer's condition variable");
@@ -361,29 +234,13 @@ int sf_lcm_out_open_config(sf_lcm_out_t **const result, const sf_lcm_out_config_
         }
     }
     if (cfg->log_path != NULL) {
-        snprintf(out->first_path, sizeof out->first_path, "%s", cfg->log_path);
-        out->ring = calloc(cfg->queue_capacity, sizeof *out->ring);
-        if (out->ring == NULL) {
-            snprintf(err, err_size, "out of memory for the log queue");
-            sf_lcm_out_close(out, NULL);
-            return SF_EIO;
-        }
-        const int rc = sf_log_file_open(&out->file, cfg->log_path, cfg->force, err, err_size);
+        const int rc = open_log(out, err, err_size);
         if (rc != SF_OK) {
             const int e = errno;
             sf_lcm_out_close(out, NULL);
             errno = e;
             return rc;
         }
-        out->counters.files = 1;
-        out->file_opened_us = monotonic_us();
-        if (start_writer(out) != SF_OK) {
-            snprintf(err, err_size, "cannot start the log writer thread");
-            sf_log_file_discard(&out->file);
-            sf_lcm_out_close(out, NULL);
-            return SF_EIO;
-        }
-        out->writer_started = true;
     }
     *result = out;
     return SF_OK;
@@ -401,72 +258,146 @@ int sf_lcm_out_open(sf_lcm_out_t **const result, const char *const log_path, con
     return sf_lcm_out_open_config(result, &cfg, err, err_size);
 }
 
-static int enqueue(sf_lcm_out_t *const out, const char *const channel, const int64_t timestamp_us,
-                   const void *const data, const size_t size, const bool is_header)
+/* The reservation's place outside the ring (no log, or a message the queue dropped that live LCM
+ * still gets): NULL when out of memory. */
+static uint8_t *scratch(sf_lcm_out_t *const out, const size_t size)
+{
+    if (size > out->scratch_cap || out->scratch == NULL) {
+        const size_t cap = size > 4096 ? size : 4096;
+        uint8_t *const bigger = realloc(out->scratch, cap);
+        if (bigger == NULL) {
+            return NULL;
+        }
+        out->scratch = bigger;
+        out->scratch_cap = cap;
+    }
+    out->res_in_ring = false;
+    return out->scratch;
+}
+
+/* Room in the ring for one event, waiting (block_when_full), writing the queue out (caller_writes)
+ * or dropping it (counted) when there is none: the data's place, or NULL. */
+static uint8_t *reserve_in_ring(sf_lcm_out_t *const out, const char *const channel, const size_t channel_len,
+                                const int64_t timestamp_us, const size_t size, const uint32_t flags)
+{
+    const uint64_t bytes = SF_LOG_FILE_EVENT_OVERHEAD + (uint64_t)channel_len + size;
+    uint8_t *p = NULL;
+    ring_lock(out);
+    if (bytes <= out->ring.size / 4) { /* larger never fits for sure: dropped */
+        for (;;) {
+            p = out->ring.queued < out->cfg.queue_capacity
+                    ? sf_log_ring_reserve(&out->ring, channel, channel_len, timestamp_us, size, flags)
+                    : NULL;
+            if (p != NULL || (out->threaded && !out->cfg.block_when_full)) {
+                break;
+            }
+            if (out->threaded) {
+                pthread_cond_wait(&out->not_full, &out->lock);
+            } else {
+                flush_in_caller(out, false); /* then the ring is empty */
+            }
+        }
+    }
+    ring_unlock(out);
+    if (p == NULL) {
+        sf_log_writer_dropped(&out->w, bytes);
+    }
+    out->res_in_ring = p != NULL;
+    return p;
+}
+
+void *sf_lcm_out_reserve(sf_lcm_out_t *const out, const char *const channel, const int64_t timestamp_us,
+                         const size_t size, const bool is_header)
+{
+    if (out == NULL || channel == NULL || size > INT32_MAX) {
+        return NULL;
+    }
+    out->res_channel = channel;
+    out->res_size = size;
+    out->res_data = NULL;
+    if (out->has_log) {
+        out->res_data = reserve_in_ring(out, channel, strlen(channel), timestamp_us, size,
+                                        is_header ? SF_LOG_RING_HEADER : 0u);
+    }
+    if (out->res_data == NULL && (!out->has_log || out->lcm != NULL)) {
+        out->res_data = scratch(out, size > 0 ? size : 1);
+    }
+    return out->res_data;
+}
+
+int sf_lcm_out_commit(sf_lcm_out_t *const out, const bool filled)
+{
+    if (out == NULL || out->res_data == NULL) {
+        return SF_EINVAL;
+    }
+    const uint8_t *const data = out->res_data;
+    out->res_data = NULL;
+    if (out->lcm != NULL && filled && lcm_publish(out->lcm, out->res_channel, data, (unsigned)out->res_size) != 0) {
+        sf_log_writer_publish_failed(&out->w);
+    }
+    if (!out->res_in_ring) {
+        return !filled ? SF_EINVAL : out->has_log ? SF_EFULL : SF_OK;
+    }
+    ring_lock(out);
+    sf_log_ring_commit(&out->ring, filled);
+    out->n_queued += filled ? 1u : 0u;
+    if (out->threaded) {
+        pthread_cond_signal(&out->not_empty);
+    } else if (sf_log_ring_queued_bytes(&out->ring) >= SF_LCM_OUT_CALLER_BATCH_BYTES ||
+               out->cfg.fsync_interval_ms == 0) { /* 0: a sync after every event */
+        flush_in_caller(out, false);
+    }
+    ring_unlock(out);
+    return filled ? SF_OK : SF_EINVAL;
+}
+
+static int write_copy(sf_lcm_out_t *const out, const char *const channel, const int64_t timestamp_us,
+                      const void *const data, const size_t size, const bool is_header)
 {
     if (out == NULL || channel == NULL || (data == NULL && size > 0)) {
         return SF_EINVAL;
     }
-    if (out->lcm != NULL && lcm_publish(out->lcm, channel, data, (unsigned)size) != 0) {
-        pthread_mutex_lock(&out->lock);
-        out->counters.publish_errors++;
-        pthread_mutex_unlock(&out->lock);
+    void *const p = sf_lcm_out_reserve(out, channel, timestamp_us, size, is_header);
+    if (p == NULL) {
+        return out->has_log ? SF_EFULL : SF_OK; /* no room (counted), or nowhere to go at all */
     }
-    if (out->ring == NULL) {
-        return SF_OK;
+    if (size > 0) {
+        memcpy(p, data, size);
     }
-    /* Copy outside the lock so the writer is held up as little as possible. */
-    item_t it = {strdup(channel), malloc(size > 0 ? size : 1), size, timestamp_us, is_header};
-    pthread_mutex_lock(&out->lock);
-    while (it.channel != NULL && it.data != NULL && out->cfg.block_when_full && out->count == out->capacity) {
-        pthread_cond_wait(&out->not_full, &out->lock);
-    }
-    if (it.channel == NULL || it.data == NULL || out->count == out->capacity) {
-        out->counters.drops++;
-        out->counters.drop_bytes += event_bytes(channel, size);
-        pthread_mutex_unlock(&out->lock);
-        free(it.channel);
-        free(it.data);
-        return SF_EFULL;
-    }
-    memcpy(it.data, data, size);
-    out->ring[(out->head + out->count) % out->capacity] = it;
-    out->count++;
-    out->n_queued++;
-    pthread_cond_signal(&out->not_empty);
-    pthread_mutex_unlock(&out->lock);
-    return SF_OK;
+    return sf_lcm_out_commit(out, true);
 }
 
 int sf_lcm_out_write(sf_lcm_out_t *const out, const char *const channel, const int64_t timestamp_us,
                      const void *const data, const size_t size)
 {
-    return enqueue(out, channel, timestamp_us, data, size, false);
+    return write_copy(out, channel, timestamp_us, data, size, false);
 }
 
 int sf_lcm_out_write_header(sf_lcm_out_t *const out, const char *const channel, const int64_t timestamp_us,
                             const void *const data, const size_t size)
 {
-    return enqueue(out, channel, timestamp_us, data, size, true);
+    return write_copy(out, channel, timestamp_us, data, size, true);
 }
 
 void sf_lcm_out_rotate(sf_lcm_out_t *const out)
 {
-    if (out == NULL || out->ring == NULL) {
+    if (out == NULL || !out->has_log) {
         return;
     }
-    pthread_mutex_lock(&out->lock);
+    if (!out->threaded) {
+        flush_in_caller(out, true); /* every event before the request written, then the file closed */
+        return;
+    }
+    lock(out);
     out->rotate_asked = true;
     out->rotate_after = out->n_queued;
     pthread_cond_signal(&out->not_empty);
-    pthread_mutex_unlock(&out->lock);
+    unlock(out);
 }
 
 void sf_lcm_out_counters(sf_lcm_out_t *const out, sf_lcm_out_counters_t *const counters)
 {
-    pthread_mutex_lock(&out->lock);
-    *counters = out->counters;
-    pthread_mutex_unlock(&out->lock);
+    sf_log_writer_counters(&out->w, counters);
 }
 
 int sf_lcm_out_close(sf_lcm_out_t *const out, sf_lcm_out_counters_t *const final)
@@ -475,23 +406,24 @@ int sf_lcm_out_close(sf_lcm_out_t *const out, sf_lcm_out_counters_t *const final
         return SF_OK;
     }
     if (out->writer_started) {
-        pthread_mutex_lock(&out->lock);
+        lock(out);
         out->closing = true;
         pthread_cond_signal(&out->not_empty);
-        pthread_mutex_unlock(&out->lock);
+        unlock(out);
         pthread_join(out->writer, NULL);
-        close_file(out); /* the writer is gone: the file is ours */
+        out->threaded = false; /* the writer is gone: the file is ours */
+    } else if (out->has_log) {
+        write_batch(out, UINT64_MAX);
     }
-    const int rc = out->write_failed ? SF_EIO : SF_OK;
     if (final != NULL) {
-        *final = out->counters;
+        sf_log_writer_counters(&out->w, final);
     }
+    const int rc = sf_log_writer_close(&out->w);
     if (out->lcm != NULL) {
         lcm_destroy(out->lcm);
     }
-    free(out->header.channel);
-    free(out->header.data);
-    free(out->ring);
+    free(out->scratch);
+    sf_log_ring_free(&out->ring);
     pthread_cond_destroy(&out->not_empty);
     pthread_cond_destroy(&out->not_full);
     pthread_mutex_destroy(&out->lock);

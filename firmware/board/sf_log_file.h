@@ -10,9 +10,11 @@
  *
  * Events are written in the LCM log format (28-byte header: sync word 0xEDA1DA01, event number,
  * timestamp [µs], channel length, data length, all big-endian; then the channel and the data),
- * numbered from 0 in each file as liblcm's writer numbers them, one pwritev() per event with no
- * user-space buffer: an event is in the kernel when sf_log_file_write returns (so SIGKILL loses
- * nothing written), on disk after sf_log_file_sync. A write that fails (disk full) is undone by
+ * numbered from 0 in each file as liblcm's writer numbers them, one pwritev() per call with no
+ * user-space buffer: one event (sf_log_file_write), or a run of events the caller already laid out
+ * in the format (sf_log_file_append: a batch costs one system call, not one per event). An event is
+ * in the kernel when the call returns (so SIGKILL loses nothing written), on disk after
+ * sf_log_file_sync. A write that fails (disk full) is undone by
  * truncating the file back to its last whole event, so the file holds exactly the events that
  * were reported written and later events follow them cleanly. liblcm offers no entry point that
  * takes a descriptor (lcm_eventlog_create opens with fopen, which can neither O_EXCL nor
@@ -50,6 +52,19 @@ int sf_log_file_open(sf_log_file_t *f, const char *path, bool force, char *err, 
 
 /* Appends one event, or leaves the file as it was and returns SF_EIO (errno says why). */
 int sf_log_file_write(sf_log_file_t *f, const char *channel, int64_t timestamp_us, const void *data, size_t size);
+
+/* Appends n_events whole events laid out in the file format (sf_log_file_put_header, then the channel
+ * and the data), bytes in all: their event-number fields are overwritten with this file's numbering
+ * (the caller may keep anything there until then), then one write; or the file is left as it was and
+ * SF_EIO (errno says why). SF_EINVAL if the events do not add up to bytes. */
+int sf_log_file_append(sf_log_file_t *f, uint8_t *events, size_t bytes, uint64_t n_events);
+
+/* The 28-byte event header (the format in sf_eventlog.h) into head. */
+void sf_log_file_put_header(unsigned char *head, int64_t number, int64_t timestamp_us, size_t channel_len,
+                            size_t size);
+
+/* The bytes of the whole event whose header is at head (header, channel and data). */
+size_t sf_log_file_event_bytes(const unsigned char *head);
 
 /* fdatasync: everything written so far survives power loss. */
 int sf_log_file_sync(sf_log_file_t *f);

@@ -272,5 +272,5 @@ void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const in
                               .key = key_ptrs,
                               .value = value_ptrs};
     /* the header: every rotated log file starts with a copy, so each reads alone */
-    SF_LCM_WRITE_WITH(sf_lcm_out_write_header, out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
+    SF_LCM_WRITE_AS(true, out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
 }

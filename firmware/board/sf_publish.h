@@ -6,9 +6,10 @@
  * Each call converts a core struct into its generated stridefix type and queues it on the log with the
  * caller's log timestamp (the host receive time of the frame being handled, so replaying the same
  * input gives the same log). Cannot fail: a full queue is counted by sf_lcm_out. Cost: one encode
- * into a stack buffer; CONFIG, once per run, builds its key/value text on the stack: 112 B per key,
- * ≈ 20 KiB for the 185 keys of today (the particle scheme's 15 among them), asserted ≤ 28 KiB (room for
- * the other issue-13 sources' keys; plus its encoded copy, about a third). */
+ * straight into the log queue (sf_lcm_out_reserve); CONFIG, once per run, builds its key/value text
+ * on the stack: 112 B per key, ≈ 20 KiB for the 185 keys of today (the particle scheme's 15 among
+ * them), asserted ≤ 28 KiB (room for the other issue-13 sources' keys; its encoding, about a third of
+ * that, goes into the queue). */
 #ifndef SF_PUBLISH_H
 #define SF_PUBLISH_H
 

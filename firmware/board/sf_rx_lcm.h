@@ -4,8 +4,9 @@
  *
  * One row per SF_RX_KINDS entry (sf_rx_event.h) with its channel, decode and encode, generated from
  * that list: a kind without both functions does not compile, so the CAN path, the replay and the log
- * always carry the same kinds. Cost: one generated LCM encode or decode per call; the encode buffer
- * is on the stack (at most 4109 B: a full scan of SF_WIFI_MAX_AP access points). */
+ * always carry the same kinds. Cost: one generated LCM encode or decode per call; the encode goes
+ * straight into the log queue (sf_lcm_out_reserve; at most 4109 B: a full scan of SF_WIFI_MAX_AP
+ * access points). */
 #ifndef SF_RX_LCM_H
 #define SF_RX_LCM_H
 

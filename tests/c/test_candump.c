@@ -1,6 +1,6 @@
 /* test_candump.c — the candump -L parser and formatter (sf_candump.h) and the frame inputs
- * (sf_can_input.h): files, bad lines with their line numbers, missing files, SocketCAN where the
- * kernel has no AF_CAN. */
+ * (sf_can_input.h): files, bad lines with their line numbers, a NUL inside a line, lines across the
+ * reader's chunks from a file and a pipe, missing files, SocketCAN where the kernel has no AF_CAN. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "sf_can_input.h"
@@ -252,14 +253,16 @@ static void test_input_file_good_blank_and_garbage(void **state)
     unlink(path);
 }
 
-static void test_input_overlong_line_is_skipped(void **state)
+/* GIVEN a file of len bytes whose line 1 is bad and line 2 a frame at good_t_us, THEN the input
+ * says so, line by line, and ends. */
+static void bad_line_then_good_line(const char *const text, const size_t len, const int64_t good_t_us)
 {
-    (void)state;
-    char text[2048];
-    memset(text, 'x', 1500);
-    strcpy(text + 1500, "\n(5.000000) can0 100#01\n");
     char path[64];
-    write_temp(path, text);
+    strcpy(path, "/tmp/sf_test_candump_XXXXXX");
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, text, len), (ssize_t)len);
+    close(fd);
     sf_can_input_t in;
     assert_int_equal(sf_can_input_open(&in, path, NULL, 0), SF_OK);
     sf_can_frame_t f;
@@ -267,10 +270,114 @@ static void test_input_overlong_line_is_skipped(void **state)
     assert_int_equal(in.line_no, 1);
     assert_int_equal(sf_can_input_next(&in, &f), 1);
     assert_int_equal(in.line_no, 2);
-    assert_int_equal(f.host_t_us, 5000000);
+    assert_int_equal(f.host_t_us, good_t_us);
     assert_int_equal(sf_can_input_next(&in, &f), 0);
     sf_can_input_close(&in);
     unlink(path);
+}
+
+static void test_input_overlong_line_is_skipped(void **state)
+{
+    (void)state;
+    char text[2048];
+    memset(text, 'x', 1500);
+    strcpy(text + 1500, "\n(5.000000) can0 100#01\n");
+    bad_line_then_good_line(text, strlen(text), 5000000);
+}
+
+/* Regression for "a NUL swallows the next line": with fgets + strlen, a line holding a NUL looked cut
+ * short and its "rest" — the whole next line — was skipped unread. Now only that line is bad. */
+static void test_input_nul_inside_a_line_spoils_that_line_only(void **state)
+{
+    (void)state;
+    const char text[] = "(1.000000) can0 100#00\0junk\n(2.000000) can0 100#01\n";
+    bad_line_then_good_line(text, sizeof text - 1, 2000000);
+}
+
+#define N_CHUNK_LINES 6000
+
+/* Line i of the chunk-boundary test: a frame of i % 9 bytes, every 7th line CRLF, every 11th
+ * followed by a blank line; the text into buf, its length. */
+static size_t numbered_line(const int i, char *const buf, const size_t size)
+{
+    sf_can_frame_t f = {.host_t_us = 1000000LL * i + i, .id = (uint32_t)i & 0x7FFu, .dlc = (uint8_t)(i % 9)};
+    for (int k = 0; k < f.dlc; k++) {
+        f.data[k] = (uint8_t)(i + k);
+    }
+    int n = sf_candump_format(&f, i % 2 ? "can0" : "a-much-longer-interface-name", buf, size);
+    assert_true(n > 0);
+    if (i % 7 == 0) {
+        strcpy(buf + n - 1, "\r\n");
+        n++;
+    }
+    if (i % 11 == 0) {
+        strcpy(buf + n, "\n");
+        n++;
+    }
+    return (size_t)n;
+}
+
+static void read_numbered_lines(sf_can_input_t *const in)
+{
+    long line_no = 0;
+    for (int i = 0; i < N_CHUNK_LINES; i++) {
+        sf_can_frame_t f;
+        assert_int_equal(sf_can_input_next(in, &f), 1);
+        line_no += 1 + (i > 0 && (i - 1) % 11 == 0); /* the blank line after the previous one */
+        assert_int_equal(in->line_no, line_no);
+        assert_int_equal(f.host_t_us, 1000000LL * i + i);
+        assert_int_equal(f.dlc, i % 9);
+        for (int k = 0; k < f.dlc; k++) {
+            assert_int_equal(f.data[k], (uint8_t)(i + k));
+        }
+    }
+    sf_can_frame_t f;
+    assert_int_equal(sf_can_input_next(in, &f), 0);
+}
+
+/* Lines that straddle the reader's 64 KiB chunks, from a file and from a pipe fed a few bytes at a
+ * time (read(2) returns what the pipe holds: partial lines wait for their rest). */
+static void test_input_lines_across_chunks_from_a_file_and_a_pipe(void **state)
+{
+    (void)state;
+    static char text[N_CHUNK_LINES * 80];
+    size_t len = 0;
+    for (int i = 0; i < N_CHUNK_LINES; i++) {
+        len += numbered_line(i, text + len, sizeof text - len);
+    }
+    assert_true(len > 4 * SF_CAN_INPUT_CHUNK_BYTES);
+    char path[64];
+    write_temp(path, text);
+    sf_can_input_t in;
+    assert_int_equal(sf_can_input_open(&in, path, NULL, 0), SF_OK);
+    read_numbered_lines(&in);
+    sf_can_input_close(&in);
+    unlink(path);
+
+    int fds[2];
+    assert_int_equal(pipe(fds), 0);
+    const pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        close(fds[0]);
+        for (size_t at = 0; at < len;) {
+            const size_t piece = 1 + (at * 7919) % 97;
+            const ssize_t n = write(fds[1], text + at, piece < len - at ? piece : len - at);
+            if (n <= 0) {
+                _exit(1);
+            }
+            at += (size_t)n;
+        }
+        _exit(0);
+    }
+    close(fds[1]);
+    sf_can_input_t p = {.kind = sf_can_input_file, .file = fdopen(fds[0], "r"), .fd = -1};
+    assert_non_null(p.file);
+    read_numbered_lines(&p);
+    sf_can_input_close(&p);
+    int status = -1;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    assert_int_equal(status, 0);
 }
 
 static void test_input_missing_file(void **state)
@@ -323,6 +430,8 @@ int main(void)
         cmocka_unit_test(test_format_exact_text_and_small_buffer),
         cmocka_unit_test(test_input_file_good_blank_and_garbage),
         cmocka_unit_test(test_input_overlong_line_is_skipped),
+        cmocka_unit_test(test_input_nul_inside_a_line_spoils_that_line_only),
+        cmocka_unit_test(test_input_lines_across_chunks_from_a_file_and_a_pipe),
         cmocka_unit_test(test_input_missing_file),
         cmocka_unit_test(test_input_empty_spec),
         cmocka_unit_test(test_input_socketcan_nonexistent),

@@ -1,6 +1,7 @@
 /* test_lcm_out.c — sf_lcm_out: what goes in comes out of the event log, in order, byte for byte,
  * read back with liblcm's own reader; the counters agree with the file; a small blocking queue
- * loses nothing; live publishing to memq:// (no network). */
+ * loses nothing; live publishing to memq:// (no network); the same with caller_writes; a batch cut
+ * short by the file size limit keeps exactly the events that fit. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -8,9 +9,11 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -259,6 +262,91 @@ static void test_log_and_memq_together(void **state)
     unlink(path);
 }
 
+/* caller_writes (a file replay): the same log, byte for byte in content, from batches the caller
+ * writes; a queue of 4 messages still loses nothing (the caller writes it out when it is full). */
+static void test_caller_writes_the_same_log(void **state)
+{
+    (void)state;
+    for (size_t capacity = 4; capacity <= 4096; capacity *= 1024) {
+        char path[64];
+        temp_path(path, sizeof path);
+        const sf_lcm_out_config_t cfg = {.log_path = path, .queue_capacity = capacity, .block_when_full = true,
+                                         .caller_writes = true, .fsync_interval_ms = 1000, .report = stderr};
+        sf_lcm_out_t *out = NULL;
+        char err[256] = "";
+        assert_int_equal(sf_lcm_out_open_config(&out, &cfg, err, sizeof err), SF_OK);
+        const int n = write_all(out);
+        sf_lcm_out_counters_t c;
+        assert_int_equal(sf_lcm_out_close(out, &c), SF_OK);
+        assert_int_equal(c.events, (uint64_t)n);
+        assert_int_equal(c.drops, 0);
+        assert_int_equal((long)c.bytes, file_size(path));
+        check_log(path, n);
+        unlink(path);
+    }
+}
+
+/* Injected: the file may not grow past 10,000 bytes (RLIMIT_FSIZE; the write that crosses it is cut
+ * short, the next fails with EFBIG). A batch that does not fit is undone and its events go one by
+ * one, so exactly the events that fit are in the file, numbered, whole, and each other one is
+ * dropped and counted with its bytes; the episode is reported once. With the writer thread and with
+ * caller_writes. */
+static void test_a_batch_that_does_not_fit_keeps_exactly_the_events_that_fit(void **state)
+{
+    (void)state;
+    struct rlimit old;
+    assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+    void (*const old_handler)(int) = signal(SIGXFSZ, SIG_IGN);
+    for (int mode = 0; mode < 2; mode++) {
+        char path[64], report_path[64];
+        temp_path(path, sizeof path);
+        temp_path(report_path, sizeof report_path);
+        FILE *const report = fopen(report_path, "w+");
+        assert_non_null(report);
+        const sf_lcm_out_config_t cfg = {.log_path = path, .queue_capacity = 4096, .block_when_full = true,
+                                         .caller_writes = mode == 1, .fsync_interval_ms = 1000, .report = report};
+        sf_lcm_out_t *out = NULL;
+        char err[256] = "";
+        assert_int_equal(sf_lcm_out_open_config(&out, &cfg, err, sizeof err), SF_OK);
+        const struct rlimit small = {10000, old.rlim_max};
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
+        const char payload[72] = {7}; /* 28 + 1 + 72 = 101 bytes an event */
+        for (int i = 0; i < 500; i++) {
+            assert_int_equal(sf_lcm_out_write(out, "X", i, payload, sizeof payload), SF_OK);
+        }
+        sf_lcm_out_counters_t c;
+        assert_int_equal(sf_lcm_out_close(out, &c), SF_EIO); /* the log is incomplete */
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+        assert_int_equal(c.events, 10000 / 101);
+        assert_int_equal(c.events + c.drops, 500);
+        assert_int_equal(c.drop_bytes, c.drops * 101);
+        assert_int_equal((long)c.bytes, file_size(path));
+        lcm_eventlog_t *const log = lcm_eventlog_create(path, "r");
+        assert_non_null(log);
+        int64_t j = 0;
+        lcm_eventlog_event_t *ev;
+        while ((ev = lcm_eventlog_read_next_event(log)) != NULL) {
+            assert_int_equal(ev->eventnum, j);
+            assert_int_equal(ev->timestamp, j);
+            lcm_eventlog_free_event(ev);
+            j++;
+        }
+        lcm_eventlog_destroy(log);
+        assert_int_equal(j, (int64_t)c.events);
+        char line[512];
+        int told = 0;
+        rewind(report);
+        while (fgets(line, sizeof line, report) != NULL) {
+            told += strstr(line, "writing the log failed") != NULL;
+        }
+        assert_int_equal(told, 1);
+        fclose(report);
+        unlink(report_path);
+        unlink(path);
+    }
+    signal(SIGXFSZ, old_handler);
+}
+
 static void test_open_errors(void **state)
 {
     (void)state;
@@ -285,6 +373,8 @@ int main(void)
         cmocka_unit_test(test_small_dropping_queue_counts_drops),
         cmocka_unit_test(test_live_memq_publishing),
         cmocka_unit_test(test_log_and_memq_together),
+        cmocka_unit_test(test_caller_writes_the_same_log),
+        cmocka_unit_test(test_a_batch_that_does_not_fit_keeps_exactly_the_events_that_fit),
         cmocka_unit_test(test_open_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

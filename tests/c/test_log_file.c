@@ -1,7 +1,8 @@
 /* test_log_file.c — sf_log_file and sf_lcm_out's rotation: the .part is renamed on close and never
  * replaces a file that appeared meanwhile; existing names and symlinks are refused; a failed write
  * (injected: /dev/full) leaves the file as it was; rotated names and default names; size rotation
- * and sf_lcm_out_rotate give files that each start with the header; drops count their bytes. */
+ * and sf_lcm_out_rotate give files that each start with the header, with a writer thread and with
+ * caller_writes; sf_log_file_append numbers a laid-out run; drops count their bytes. */
 #define _GNU_SOURCE
 #include <stdarg.h>
 #include <stddef.h>
@@ -146,6 +147,42 @@ static void test_failed_write_leaves_the_file_as_it_was(void **state)
     close(f.fd);
 }
 
+/* sf_log_file_append: events laid out by the caller (any number in their number field) are
+ * numbered on from the file's count, in one write; a layout that does not add up is refused before
+ * anything is written; on /dev/full the file stays as it was. */
+static void test_append_numbers_the_events_in_one_write(void **state)
+{
+    const fixture_t *const fx = *state;
+    sf_log_file_t f;
+    char err[256];
+    assert_int_equal(sf_log_file_open(&f, fx->path, false, err, sizeof err), SF_OK);
+    assert_int_equal(sf_log_file_write(&f, "X", 1, "abc", 3), SF_OK);
+    uint8_t events[3 * (SF_LOG_FILE_EVENT_OVERHEAD + 2 + 4)];
+    size_t at = 0;
+    for (int i = 0; i < 3; i++) {
+        sf_log_file_put_header(events + at, 777 + i, 2 + i, 2, 4);
+        memcpy(events + at + SF_LOG_FILE_EVENT_OVERHEAD, "YZ" "data", 6);
+        assert_int_equal(sf_log_file_event_bytes(events + at), SF_LOG_FILE_EVENT_OVERHEAD + 6);
+        at += SF_LOG_FILE_EVENT_OVERHEAD + 6;
+    }
+    assert_int_equal(sf_log_file_append(&f, events, sizeof events - 1, 3), SF_EINVAL);
+    assert_int_equal(sf_log_file_append(&f, events, sizeof events, 2), SF_EINVAL);
+    assert_int_equal(f.next_event, 1);
+    assert_int_equal(sf_log_file_append(&f, events, sizeof events, 3), SF_OK);
+    assert_int_equal(f.next_event, 4);
+    assert_int_equal(f.offset, SF_LOG_FILE_EVENT_OVERHEAD + 4 + sizeof events);
+    assert_int_equal(sf_log_file_close(&f, err, sizeof err), SF_OK);
+    char first[8];
+    assert_int_equal(read_back(fx->path, first, sizeof first), 4); /* numbered 0, 1, 2, 3 */
+    sf_log_file_t full = {.fd = open("/dev/full", O_WRONLY)};
+    assert_true(full.fd >= 0);
+    assert_int_equal(sf_log_file_append(&full, events, sizeof events, 3), SF_EIO);
+    assert_int_equal(errno, ENOSPC);
+    assert_int_equal(full.offset, 0);
+    assert_int_equal(full.next_event, 0);
+    close(full.fd);
+}
+
 static void test_names(void **state)
 {
     (void)state;
@@ -170,10 +207,10 @@ static sf_lcm_out_config_t config(const char *const path)
                                  .fsync_interval_ms = 0, .report = stderr};
 }
 
-static void test_size_rotation_and_rotate_request(void **state)
+static void size_rotation(const fixture_t *const fx, const bool caller_writes)
 {
-    const fixture_t *const fx = *state;
     sf_lcm_out_config_t cfg = config(fx->path);
+    cfg.caller_writes = caller_writes;
     const char payload[72] = {0};                               /* 28 + 1 + 72 = 101 bytes an event */
     cfg.rotate_bytes = 1000;                                    /* 9 events and a 101-byte header */
     sf_lcm_out_t *out = NULL;
@@ -203,10 +240,21 @@ static void test_size_rotation_and_rotate_request(void **state)
     assert_int_equal(total, (int)c.events);
 }
 
-static void test_rotate_request_closes_the_file_at_once(void **state)
+static void test_size_rotation_and_rotate_request(void **state)
 {
-    const fixture_t *const fx = *state;
+    size_rotation(*state, false);
+}
+
+/* The same rules when the caller writes the batches (a file replay: sf_lcm_out.h caller_writes). */
+static void test_size_rotation_caller_writes(void **state)
+{
+    size_rotation(*state, true);
+}
+
+static void rotate_request(const fixture_t *const fx, const bool caller_writes)
+{
     sf_lcm_out_config_t cfg = config(fx->path);
+    cfg.caller_writes = caller_writes;
     sf_lcm_out_t *out = NULL;
     char err[256];
     assert_int_equal(sf_lcm_out_open_config(&out, &cfg, err, sizeof err), SF_OK);
@@ -226,6 +274,16 @@ static void test_rotate_request_closes_the_file_at_once(void **state)
     assert_int_equal(read_back(second, first, sizeof first), 2);
     assert_string_equal(first, "H");
     assert_int_equal(c.events, 4);
+}
+
+static void test_rotate_request_closes_the_file_at_once(void **state)
+{
+    rotate_request(*state, false);
+}
+
+static void test_rotate_request_caller_writes(void **state)
+{
+    rotate_request(*state, true);
 }
 
 static void test_queue_drops_count_their_bytes(void **state)
@@ -259,6 +317,9 @@ int main(void)
         cmocka_unit_test(test_names),
         cmocka_unit_test_setup_teardown(test_size_rotation_and_rotate_request, setup, teardown),
         cmocka_unit_test_setup_teardown(test_rotate_request_closes_the_file_at_once, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_size_rotation_caller_writes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_rotate_request_caller_writes, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_append_numbers_the_events_in_one_write, setup, teardown),
         cmocka_unit_test_setup_teardown(test_queue_drops_count_their_bytes, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
