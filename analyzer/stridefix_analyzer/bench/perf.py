@@ -247,7 +247,7 @@ def check_no_heap(stridefixd: Path) -> dict[str, Any]:
 
 
 def measure_replay(firmware: Firmware, out: Path) -> dict[str, Any]:
-    """The simulated walk replayed by stridefixd from its candump file; wall time and peak RSS."""
+    """The simulated walk replayed by stridefixd from its candump file; CPU and wall time, peak RSS."""
     work = out / "perf_replay"
     work.mkdir(parents=True, exist_ok=True)
     sim = [stridefix_exe(), "sim", "--duration-s", str(REPLAY_SECONDS), "--out", str(work)]
