@@ -152,9 +152,11 @@ class Firmware:
         sets: Iterable[str] = (),
         quiet: bool = True,
         extra: Sequence[str] = (),
+        channels: Sequence[str] | None = None,
     ) -> list[str]:
         """The stridefixd command line for one replay: exactly one of ``input`` (candump file or
-        ``lcmlog:FILE``) and ``replay`` (a raw-sensor LCM log)."""
+        ``lcmlog:FILE``) and ``replay`` (a raw-sensor LCM log); ``channels``: write only these
+        (``--channels``; None: every channel)."""
         if (input is None) == (replay is None):
             raise FirmwareError("Firmware.run: give exactly one of input= and replay=")
         cmd = [str(self.path)]
@@ -165,6 +167,8 @@ class Firmware:
             cmd += ["--site", str(site)]
         if fusion is not None:
             cmd += ["--fusion", fusion]
+        if channels is not None:
+            cmd += ["--channels", ",".join(channels)]
         if quiet:
             cmd.append("-q")
         return cmd + set_args(sets) + [str(a) for a in extra]

@@ -68,6 +68,9 @@ typedef struct {
     sf_publish_sources_t sources; /* fixes offered and made, by source */
 } daemon_t;
 
+/* Whether --channels lets channel NAME (SF_CHANNELS) into the outputs. */
+#define WRITES(d, NAME) (((d)->opt.channels >> sf_options_channel_##NAME & 1u) != 0)
+
 /* One bad-input message (file and line where there is one), at most opt.max_messages of them. */
 static void complain(daemon_t *const d, const int code)
 {
@@ -100,7 +103,9 @@ static void write_health(daemon_t *const d)
     sf_input_counters(d->in, &ic);
     sf_estimator_status_t st;
     sf_estimator_status(&d->est, &st);
-    sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->sources, &d->loop);
+    if (WRITES(d, HEALTH)) {
+        sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->sources, &d->loop);
+    }
     d->last_health_t_us = d->board_t_us;
 }
 
@@ -114,13 +119,13 @@ static void write_pose(daemon_t *const d)
     for (int scheme = 0; scheme < n_schemes; scheme++) {
         sf_pose_t p;
         if ((d->params.output_scheme < 0 || scheme == d->params.output_scheme) &&
-            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
+            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p) && WRITES(d, POSE)) {
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
     sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8) */
     const bool controller_out = d->params.output_scheme < 0 || d->params.output_scheme == sf_scheme_controller;
-    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p)) {
+    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p) && WRITES(d, POSE)) {
         sf_publish_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;
@@ -137,7 +142,7 @@ static void publish_fixes(daemon_t *const d, const int method, const int n, cons
     d->sources.offered[method]++;
     d->sources.made[method] += has_fix ? 1u : 0u;
     for (int i = 0; i < n; i++) {
-        if (d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) {
+        if ((d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) && WRITES(d, FIX)) {
             sf_publish_fix(d->out, d->host_t_us, &audits[i]);
         }
     }
@@ -199,7 +204,7 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     memcpy(in.gyro_radps, s->gyro_radps, sizeof in.gyro_radps);
     sf_step_t steps[SF_ESTIMATOR_MAX_STEPS];
     const int n_steps = sf_estimator_imu(&d->est, &d->params, &in, steps);
-    for (int i = 0; i < n_steps; i++) {
+    for (int i = 0; i < n_steps && WRITES(d, STEP); i++) {
         sf_publish_step(d->out, d->host_t_us, &steps[i]);
     }
     sf_estimator_status_t st;
@@ -220,7 +225,9 @@ static void drain_contexts(daemon_t *const d)
     sf_fix_audit_t audits[sf_scheme_count];
     int n;
     while (sf_estimator_next_context(&d->est, &d->params, &ev, &fix, &has_fix, audits, &n)) {
-        sf_publish_context(d->out, d->host_t_us, &ev, &d->site, &d->params);
+        if (WRITES(d, CONTEXT)) {
+            sf_publish_context(d->out, d->host_t_us, &ev, &d->site, &d->params);
+        }
         if (n > 0) {
             publish_fixes(d, sf_fix_port, n, has_fix, audits); /* and the POSE */
         } else {
@@ -233,7 +240,9 @@ static void drain_contexts(daemon_t *const d)
  * kind added to SF_RX_KINDS without a case here stops the build (-Wswitch, -Werror). */
 static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
 {
-    sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
+    if (sf_options_channel_on(&d->opt, sf_rx_lcm_channel(ev->kind))) {
+        sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
+    }
     switch (ev->kind) {
     case sf_rx_imu:
         d->board_t_us = ev->u.imu.t_us;
@@ -269,7 +278,9 @@ static void handle(daemon_t *const d, const sf_input_item_t *const item)
 {
     d->host_t_us = item->log_t_us;
     if (!d->config_written) {
-        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+        if (WRITES(d, CONFIG)) {
+            sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+        }
         d->config_written = true;
     }
     const double t0 = monotonic_us();
@@ -321,7 +332,9 @@ static int run(daemon_t *const d)
     }
     sf_signals_input_done();
     if (!d->config_written) {
-        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+        if (WRITES(d, CONFIG)) {
+            sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+        }
         d->config_written = true;
     }
     write_health(d);
