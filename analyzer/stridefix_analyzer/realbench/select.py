@@ -30,7 +30,11 @@ are rows of :mod:`.tuning` (:data:`~.tuning.AXES`); this module only measures th
   only FIX and POSE written. ``--fusion`` only picks what is published (the estimator runs every
   scheme either way), and a FIX record's fix fields (t_us, x_m, y_m, accuracy_m) are the fix as
   offered, the same in every scheme's audit (``firmware/core/sf_fusion.c``, ``audit_begin``), so
-  the adaptive scheme's FIX rows give the Wi-Fi fix errors that wifi_only's gave.
+  the adaptive scheme's FIX rows give the Wi-Fi fix errors that wifi_only's gave. Those replays
+  also run a one-particle cloud (``particle.count=1``, after every other setting): neither a fix
+  nor the adaptive scheme reads the particle scheme (its cloud is its own state, with its own
+  generator), and the cloud was ~40 % of a replay's instructions. The controller scheme's replays
+  ("all") score every scheme, the particle scheme too, and keep the cloud.
 """
 
 from __future__ import annotations
@@ -54,11 +58,12 @@ STAGES = {"matcher": "wifi_only", "adaptive": "adaptive", "fixmodel": "wifi_only
 DEFAULT_BLOCKS = 4
 #: fewest walks in a group for a choice (fewer: the firmware default)
 MIN_WALKS = 6
-#: how a stage's replays run (its mode): stridefixd --fusion (None: every scheme) and the channels
-#: written; "one" replays serve the matcher, adaptive and fix-model stages alike (module text)
-MODES: dict[str, tuple[str | None, tuple[str, ...]]] = {
-    "one": ("adaptive", ("FIX", "POSE")),
-    "all": (None, ("POSE",)),
+#: how a stage's replays run (its mode): stridefixd --fusion (None: every scheme), the channels
+#: written and settings after the job's own (what the mode does not score, made cheap); "one"
+#: replays serve the matcher, adaptive and fix-model stages alike (module text)
+MODES: dict[str, tuple[str | None, tuple[str, ...], tuple[str, ...]]] = {
+    "one": ("adaptive", ("FIX", "POSE"), ("particle.count=1",)),
+    "all": (None, ("POSE",), ()),
 }
 STAGE_MODE = {"matcher": "one", "adaptive": "one", "fixmodel": "one", "lsd": "all"}
 #: the fusion schemes whose POSE errors an "all" replay keeps (the controller is not one)
@@ -130,13 +135,13 @@ def replay_products(job: dict[str, Any]) -> dict[str, Any]:
     ``fix`` (:func:`fix_residuals_m` rows) and ``pose`` (the adaptive POSE errors at the waypoints,
     :func:`pose_errors_m`), for "all", ``schemes`` (:func:`scheme_pose_errors`); or the end of
     stridefixd's stderr as ``failure``. Only the numbers are kept: the log is removed."""
-    fusion, channels = MODES[job["mode"]]
+    fusion, channels, cheap = MODES[job["mode"]]
     proc = Firmware(job["stridefixd"]).run(
         input=f"lcmlog:{job['import_log']}",
         site=job["site"],
         fusion=fusion,
         log=job["log"],
-        sets=job["sets"],
+        sets=[*job["sets"], *cheap],
         channels=channels,
         check=False,
     )
