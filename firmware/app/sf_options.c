@@ -75,6 +75,8 @@ static void usage(FILE *const f)
             "Messages\n"
             "  -q, --quiet            no per-line bad-input messages (counts still in HEALTH and the summary)\n"
             "      --max-messages N   print at most N bad-input messages (default 20)\n"
+            "      --batch FILE       (alone) one replay per line of FILE, its options TAB-separated, each run as\n"
+            "                         its own; a site file is read once for them all; exit statuses on stdout\n"
             "  -h, --help             this text\n"
             "  -V, --version          version and the DBC it was built from\n"
             "\n"

@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "sf_batch.h"
 #include "sf_error.h"
 #include "sf_estimator.h"
 #include "sf_input.h"
@@ -51,8 +52,7 @@ typedef struct {
     sf_input_item_t item; /* large (a whole scan): here, not on the stack */
     sf_lcm_out_t *out;
     sf_estimator_t est;
-    sf_site_store_t site_store;
-    sf_site_t site;
+    sf_site_t site; /* a view of sf_batch_site's copy */
     sf_fingerprint_workspace_t ws;
     void *ws_memory;
     sf_particle_mem_t particle_mem; /* the particle scheme's cloud and the site's wall index */
@@ -381,7 +381,7 @@ static int open_output(daemon_t *const d, char *const err, const size_t err_size
 static int load_site(daemon_t *const d)
 {
     char err[512];
-    if (sf_site_load(d->opt.site_path, &d->site_store, &d->site, err, sizeof err) != SF_OK) {
+    if (sf_batch_site(d->opt.site_path, &d->site, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return -1;
     }
@@ -470,9 +470,12 @@ static int serve(daemon_t *const d)
     return status;
 }
 
-int main(int argc, char **argv)
+/* One replay: options, serve, close. */
+static int run_once(const int argc, char **const argv)
 {
-    static daemon_t d; /* large (scan buffers): static, not on the stack */
+    static daemon_t d; /* large (scan buffers): static, not on the stack; zeroed for every run */
+    memset(&d, 0, sizeof d);
+    optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state) */
     const int prc = sf_options_parse(argc, argv, SF_VERSION, SF_DBC_SHA256, &d.opt, &d.params);
     if (prc != 0) {
         return prc;
@@ -482,8 +485,15 @@ int main(int argc, char **argv)
         (void)sf_lcm_out_close(d.out, NULL);
     }
     sf_input_close(d.in); /* only what was opened: never stdin on --replay */
-    sf_site_store_free(&d.site_store);
     sf_workspace_free(d.ws_memory);
     sf_particle_mem_free(&d.particle_mem);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    const int status = argc == 3 && strcmp(argv[1], "--batch") == 0 ? sf_batch_run(argv[2], run_once, stdout)
+                                                                     : run_once(argc, argv);
+    sf_batch_site_free();
     return status;
 }

@@ -130,24 +130,21 @@ def scheme_pose_errors(pose: Table | None, wp_t_us: ArrayLike, wp_xy_m: ArrayLik
     return out
 
 
-def replay_products(job: dict[str, Any]) -> dict[str, Any]:
-    """One inner-CV replay in its mode (:data:`MODES`): ``{"failure": None, ...}`` with, for "one",
-    ``fix`` (:func:`fix_residuals_m` rows) and ``pose`` (the adaptive POSE errors at the waypoints,
-    :func:`pose_errors_m`), for "all", ``schemes`` (:func:`scheme_pose_errors`); or the end of
-    stridefixd's stderr as ``failure``. Only the numbers are kept: the log is removed."""
+def _firmware_args(job: Mapping[str, Any]) -> dict[str, Any]:
     fusion, channels, cheap = MODES[job["mode"]]
-    proc = Firmware(job["stridefixd"]).run(
-        input=f"lcmlog:{job['import_log']}",
-        site=job["site"],
-        fusion=fusion,
-        log=job["log"],
-        sets=[*job["sets"], *cheap],
-        channels=channels,
-        check=False,
-    )
-    if proc.returncode != 0:
-        return {"failure": proc.stderr.strip()[-200:]}
-    tables = read_tables(job["log"], channels)
+    return {
+        "input": f"lcmlog:{job['import_log']}",
+        "site": job["site"],
+        "fusion": fusion,
+        "log": job["log"],
+        "sets": [*job["sets"], *cheap],
+        "channels": channels,
+    }
+
+
+def _products(job: Mapping[str, Any]) -> dict[str, Any]:
+    """The numbers of a finished replay's log (removed after)."""
+    tables = read_tables(job["log"], MODES[job["mode"]][1])
     wp = (job["wp_t_us"], job["wp_xy_m"])
     out: dict[str, Any]
     if job["mode"] == "one":
@@ -156,6 +153,34 @@ def replay_products(job: dict[str, Any]) -> dict[str, Any]:
         out = {"schemes": scheme_pose_errors(tables["POSE"], *wp)}
     Path(job["log"]).unlink(missing_ok=True)
     return {"failure": None, **out}
+
+
+def replay_products(job: dict[str, Any]) -> dict[str, Any]:
+    """One inner-CV replay in its mode (:data:`MODES`): ``{"failure": None, ...}`` with, for "one",
+    ``fix`` (:func:`fix_residuals_m` rows) and ``pose`` (the adaptive POSE errors at the waypoints,
+    :func:`pose_errors_m`), for "all", ``schemes`` (:func:`scheme_pose_errors`); or the end of
+    stridefixd's stderr as ``failure``. Only the numbers are kept: the log is removed."""
+    proc = Firmware(job["stridefixd"]).run(**_firmware_args(job), check=False)
+    if proc.returncode != 0:
+        return {"failure": proc.stderr.strip()[-200:]}
+    return _products(job)
+
+
+def replay_batch(jobs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """:func:`replay_products` of every job, in one ``stridefixd --batch`` process (the jobs of a batch
+    share their firmware; consecutive jobs mostly share a site, read once). A job whose replay failed
+    (or a batch that could not run) is replayed alone, for its own stderr."""
+    fw = Firmware(jobs[0]["stridefixd"])
+    statuses = fw.run_batch([_firmware_args(j) for j in jobs], Path(jobs[0]["log"]).with_suffix(".batch"))
+    return [
+        _products(j) if statuses is not None and statuses[k] == 0 else replay_products(j)
+        for k, j in enumerate(jobs)
+    ]
+
+
+#: inner-CV replays per stridefixd process (:func:`replay_batch`; chunks of consecutive jobs, mostly
+#: of one site)
+BATCH = 16
 
 
 #: what each stage measures on its replay's products (:func:`replay_products`)
@@ -173,6 +198,9 @@ class ReplayCache:
     site, --set list, firmware): a replay that another stage already ran is not run again."""
 
     products: dict[tuple[Any, ...], dict[str, Any]] = dataclasses.field(default_factory=dict)
+    #: the summed statistics of the walks a selection map leaves out, by their indices (every stage
+    #: asks for the same block pairs)
+    removed: dict[tuple[int, ...], Any] = dataclasses.field(default_factory=dict)
     ran: int = 0  # replays run
     reused: int = 0  # tasks served from an earlier replay
 
@@ -197,9 +225,16 @@ class ReplayCache:
             k = self.key(j)
             if k not in self.products and k not in todo:
                 todo[k] = j
-        done = (lambda i, r: progress()) if progress else None
-        # chunks of 4: a replay takes ~30 ms, a submission's round trip is not free
-        for k, r in zip(todo, runner.map(replay_products, list(todo.values()), on_result=done, chunksize=4)):
+
+        def done(_: int, batch: list[dict[str, Any]]) -> None:
+            if progress is not None:
+                for _r in batch:
+                    progress()
+
+        jobs_todo = list(todo.values())
+        batches = [jobs_todo[i : i + BATCH] for i in range(0, len(jobs_todo), BATCH)]
+        results = [p for r in runner.map(replay_batch, batches, on_result=done) for p in r]
+        for k, r in zip(todo, results, strict=True):
             self.products[k] = r
         self.ran += len(todo)
         self.reused += len(jobs) - len(todo)
@@ -236,12 +271,15 @@ def block_replays(
     ``replay(task)`` for every task."""
     block = [i % n_blocks for i in range(len(sub))]
     replays = []
+    cache = cache if cache is not None else ReplayCache()
     for a in range(n_blocks):
         for b in range(n_blocks):
             if a == b:
                 continue
-            inside = [i for i in range(len(sub)) if block[i] in (a, b)]
-            removed = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
+            inside = tuple(i for i in range(len(sub)) if block[i] in (a, b))
+            if inside not in cache.removed:
+                cache.removed[inside] = sum((sub[i]["stats"] for i in inside[1:]), sub[inside[0]]["stats"])
+            removed = cache.removed[inside]
             others = [sub[i] for i in range(len(sub)) if block[i] not in (a, b)]
             site_path = (site_dir or work_dir) / f"site_{a}_{b}.sfsite"
             assert build_site is not None  # only None when no choice is made (tests)
@@ -270,7 +308,7 @@ def block_replays(
 
     runner = tasks or TaskRunner(None, 1)
     if replay is None:
-        return block, (cache if cache is not None else ReplayCache()).run(replays, runner, progress)
+        return block, cache.run(replays, runner, progress)
     done = (lambda i, r: progress()) if progress else None
     return block, runner.map(replay, replays, on_result=done, chunksize=4)
 

@@ -425,3 +425,37 @@ def test_inner_cv_replay_mode_scores_as_the_stage_replays_did(realbench_fusion_s
     assert got["failure"] is None
     assert_array_equal(got["fix"], fix)
     assert_array_equal(rs.SCORES["matcher"](got), rs.fix_errors_m(logs["wifi_only"], wp_t, wp_xy))
+
+
+def test_a_batch_replays_as_separate_processes_do(realbench_fusion_small, tmp_path):
+    """`stridefixd --batch FILE` (the inner cross-validation's replays, realbench.select.replay_batch):
+    GIVEN two real walks on one site, with and without a setting, and a replay that cannot run,
+    WHEN run in one batch and each alone, THEN every channel but HEALTH (its loop timing is the
+    host's) is the same, message for message, and the batch reports each exit status."""
+    from stridefix_analyzer.firmware import Firmware
+    from stridefix_analyzer.io.logread import KNOWN_CHANNELS
+
+    r = realbench_fusion_small
+    rows = r["doc"]["groups"][0]["walk_rows"]
+    site = f"{rows[0]['dir']}/site.sfsite"
+    imports = [r["out"] / "cache" / "site1-F2" / f"{row['walk']}.lcmlog" for row in rows[1:3]]
+    runs = [
+        {"input": f"lcmlog:{imp}", "site": site, "sets": [*MSINDOOR_SETS, *extra]}
+        for imp in imports
+        for extra in ([], ["fingerprint.powed_beta=2"])
+    ]
+    fw = Firmware(r["stridefixd"])
+    batch = [{**kw, "log": tmp_path / f"batch{i}.lcmlog"} for i, kw in enumerate(runs)]
+    missing = {"input": f"lcmlog:{tmp_path / 'missing.lcmlog'}", "log": tmp_path / "missing_out.lcmlog"}
+    assert fw.run_batch([*batch, missing], tmp_path / "jobs.batch") == [0, 0, 0, 0, 2]
+    channels = [c for c in KNOWN_CHANNELS if c != "HEALTH"]
+    for i, kw in enumerate(runs):
+        alone = tmp_path / f"alone{i}.lcmlog"
+        fw.run(**kw, log=alone)
+        a, b = (read_logs([p], decode=channels) for p in (batch[i]["log"], alone))
+        assert a.messages == b.messages and a.config == b.config
+        for c in channels:
+            ta, tb = a.table(c), b.table(c)
+            assert (ta is None) == (tb is None), c
+            for k in ta.names if ta is not None else ():
+                assert_array_equal(ta[k], tb[k], err_msg=f"{c}.{k}")

@@ -199,7 +199,7 @@ def test_a_replay_asked_for_twice_runs_once(monkeypatch):
             "pose": np.array([float(n)]),
         }
 
-    monkeypatch.setattr(rs, "replay_products", fake)
+    monkeypatch.setattr(rs, "replay_batch", lambda jobs: [fake(j) for j in jobs])
     runner = rs.TaskRunner(None, 1)
     base = {"mode": "one", "import_log": "x.lcmlog", "site": "s", "stridefixd": "fw", "a": 0, "name": "c"}
     cache = rs.ReplayCache()
