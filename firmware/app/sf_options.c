@@ -260,6 +260,7 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         {"channels", required_argument, NULL, opt_channels},
         {NULL, 0, NULL, 0}};
     *o = (sf_options_t){.log_dir = ".", .max_messages = 20, .channels = UINT32_MAX};
+    optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state): parse is re-entrant */
     bool want_print_config = false;
     bool want_json = false;
     int c;

@@ -21,6 +21,8 @@ enum {
         sf_options_channel_count
 };
 _Static_assert(sf_options_channel_count <= 32, "one bit of sf_options_t.channels per channel");
+/* Whether --channels lets channel NAME (of SF_CHANNELS) into the outputs of options *o. */
+#define SF_OPTIONS_WRITES(o, NAME) ((((o)->channels >> sf_options_channel_##NAME) & 1u) != 0)
 
 /* The exit-status contract, the same for stridefixd and every `stridefix` command (README "Exit
  * status"; the Python side is stridefix_analyzer/exits.py, a test keeps the two equal). */

@@ -68,8 +68,7 @@ typedef struct {
     sf_publish_sources_t sources; /* fixes offered and made, by source */
 } daemon_t;
 
-/* Whether --channels lets channel NAME (SF_CHANNELS) into the outputs. */
-#define WRITES(d, NAME) (((d)->opt.channels >> sf_options_channel_##NAME & 1u) != 0)
+#define WRITES(d, NAME) SF_OPTIONS_WRITES(&(d)->opt, NAME)
 
 /* One bad-input message (file and line where there is one), at most opt.max_messages of them. */
 static void complain(daemon_t *const d, const int code)
@@ -95,6 +94,15 @@ static void refuse_rest(const daemon_t *const d)
         snprintf(text, sizeof text, "%s: %s", sf_input_name(d->in), sf_strerror(SF_ECORRUPT));
     }
     fprintf(stderr, "stridefixd: %s\n", text);
+}
+
+/* CONFIG, once, before the first input item (or at the end of an empty input). */
+static void write_config(daemon_t *const d)
+{
+    if (!d->config_written && WRITES(d, CONFIG)) {
+        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+    }
+    d->config_written = true;
 }
 
 static void write_health(daemon_t *const d)
@@ -277,12 +285,7 @@ static double monotonic_us(void)
 static void handle(daemon_t *const d, const sf_input_item_t *const item)
 {
     d->host_t_us = item->log_t_us;
-    if (!d->config_written) {
-        if (WRITES(d, CONFIG)) {
-            sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
-        }
-        d->config_written = true;
-    }
+    write_config(d);
     const double t0 = monotonic_us();
     if (item->status < 0) {
         complain(d, item->status);
@@ -331,12 +334,7 @@ static int run(daemon_t *const d)
         handle(d, &d->item);
     }
     sf_signals_input_done();
-    if (!d->config_written) {
-        if (WRITES(d, CONFIG)) {
-            sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
-        }
-        d->config_written = true;
-    }
+    write_config(d);
     write_health(d);
     return status;
 }
@@ -475,7 +473,6 @@ static int run_once(const int argc, char **const argv)
 {
     static daemon_t d; /* large (scan buffers): static, not on the stack; zeroed for every run */
     memset(&d, 0, sizeof d);
-    optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state) */
     const int prc = sf_options_parse(argc, argv, SF_VERSION, SF_DBC_SHA256, &d.opt, &d.params);
     if (prc != 0) {
         return prc;
