@@ -152,9 +152,11 @@ class Firmware:
         sets: Iterable[str] = (),
         quiet: bool = True,
         extra: Sequence[str] = (),
+        channels: Sequence[str] | None = None,
     ) -> list[str]:
         """The stridefixd command line for one replay: exactly one of ``input`` (candump file or
-        ``lcmlog:FILE``) and ``replay`` (a raw-sensor LCM log)."""
+        ``lcmlog:FILE``) and ``replay`` (a raw-sensor LCM log); ``channels``: write only these
+        (``--channels``; None: every channel)."""
         if (input is None) == (replay is None):
             raise FirmwareError("Firmware.run: give exactly one of input= and replay=")
         cmd = [str(self.path)]
@@ -165,9 +167,31 @@ class Firmware:
             cmd += ["--site", str(site)]
         if fusion is not None:
             cmd += ["--fusion", fusion]
+        if channels is not None:
+            cmd += ["--channels", ",".join(channels)]
         if quiet:
             cmd.append("-q")
         return cmd + set_args(sets) + [str(a) for a in extra]
+
+    def run_batch(
+        self, runs: Sequence[dict[str, Any]], batch_file: str | os.PathLike[str]
+    ) -> list[int] | None:
+        """Runs several replays (each the arguments of :meth:`command`) in one ``stridefixd --batch``
+        process, the batch file written to ``batch_file`` (removed after): their exit statuses, in
+        order, or None when an argument cannot go into a batch line (a TAB or a line break) or the
+        batch itself failed; a failed replay's messages are in no one place, so run it alone."""
+        self.check_executable()
+        lines = [self.command(**kw)[1:] for kw in runs]
+        if any("\t" in a or "\n" in a or "\r" in a for line in lines for a in line):
+            return None
+        path = Path(batch_file)
+        path.write_text("".join("\t".join(line) + "\n" for line in lines), encoding="utf-8")
+        try:
+            proc = subprocess.run([str(self.path), "--batch", str(path)], capture_output=True, text=True)
+        finally:
+            path.unlink(missing_ok=True)
+        statuses = [int(v) for v in proc.stdout.split()]
+        return statuses if proc.returncode == 0 and len(statuses) == len(lines) else None
 
     def run(
         self, *, check: bool = True, timeout: float | None = None, **kw: Any

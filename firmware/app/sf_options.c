@@ -48,6 +48,9 @@ static void usage(FILE *const f)
             "      --force            replace an existing log file (never through a symlink); without it an\n"
             "                         existing FILE or FILE.part is refused (exit 1)\n"
             "      --no-log           write no log (live publishing only)\n"
+            "      --channels LIST    write only these channels (log and live LCM), comma-separated, e.g.\n"
+            "                         FIX,POSE (a replay scored on them alone: less to write and to read\n"
+            "                         back); the estimator runs the same (default: every channel)\n"
             "  -u, --lcm-url URL      also publish live to this LCM URL (default: none, nothing leaves the\n"
             "                         process), e.g. udpm://239.255.76.67:7667?ttl=0 (ttl=0: this host only)\n"
             "Privilege\n"
@@ -72,6 +75,8 @@ static void usage(FILE *const f)
             "Messages\n"
             "  -q, --quiet            no per-line bad-input messages (counts still in HEALTH and the summary)\n"
             "      --max-messages N   print at most N bad-input messages (default 20)\n"
+            "      --batch FILE       (alone) one replay per line of FILE, its options TAB-separated, each run as\n"
+            "                         its own; a site file is read once for them all; exit statuses on stdout\n"
             "  -h, --help             this text\n"
             "  -V, --version          version and the DBC it was built from\n"
             "\n"
@@ -110,6 +115,55 @@ static int parse_long(const char *const option, const char *const text, const lo
     }
     *value = v;
     return 0;
+}
+
+static const char *const channel_names[sf_options_channel_count] = {
+#define CHANNEL_NAME(name, type) SF_CHANNEL_##name,
+    SF_CHANNELS(CHANNEL_NAME)
+#undef CHANNEL_NAME
+};
+
+static int channel_index(const char *const name, const size_t len)
+{
+    for (int i = 0; i < sf_options_channel_count; i++) {
+        if (strlen(channel_names[i]) == len && strncmp(channel_names[i], name, len) == 0) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+bool sf_options_channel_on(const sf_options_t *const o, const char *const channel)
+{
+    if (channel == NULL) {
+        return true;
+    }
+    const int i = channel_index(channel, strlen(channel));
+    return i < 0 || (o->channels >> i & 1u) != 0;
+}
+
+/* --channels A,B,...: the bits of the named channels; 0, or SF_EXIT_USAGE naming an unknown one. */
+static int parse_channels(const char *const text, uint32_t *const bits)
+{
+    *bits = 0;
+    const char *p = text;
+    for (;;) {
+        const size_t len = strcspn(p, ",");
+        const int i = channel_index(p, len);
+        if (i < 0) {
+            fprintf(stderr, "stridefixd: --channels: unknown channel '%.*s'; expected one of", (int)len, p);
+            for (int k = 0; k < sf_options_channel_count; k++) {
+                fprintf(stderr, " %s", channel_names[k]);
+            }
+            fprintf(stderr, "\n");
+            return SF_EXIT_USAGE;
+        }
+        *bits |= 1u << i;
+        if (p[len] == '\0') {
+            return 0;
+        }
+        p += len + 1;
+    }
 }
 
 /* A path option that fits the daemon's buffers (room_left: what the daemon appends to it). */
@@ -187,7 +241,8 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         opt_replay,
         opt_json,
         opt_force,
-        opt_allow_root
+        opt_allow_root,
+        opt_channels
     };
     static const struct option longs[] = {
         {"input", required_argument, NULL, 'i'},   {"log", required_argument, NULL, 'l'},
@@ -202,8 +257,10 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         {"json", no_argument, NULL, opt_json},
         {"force", no_argument, NULL, opt_force},
         {"allow-root", no_argument, NULL, opt_allow_root},
+        {"channels", required_argument, NULL, opt_channels},
         {NULL, 0, NULL, 0}};
-    *o = (sf_options_t){.log_dir = ".", .max_messages = 20};
+    *o = (sf_options_t){.log_dir = ".", .max_messages = 20, .channels = UINT32_MAX};
+    optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state): parse is re-entrant */
     bool want_print_config = false;
     bool want_json = false;
     int c;
@@ -241,6 +298,11 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         case opt_json: want_json = true; break;
         case opt_force: o->force = true; break;
         case opt_allow_root: o->allow_root = true; break;
+        case opt_channels:
+            if (parse_channels(optarg, &o->channels) != 0) {
+                return SF_EXIT_USAGE;
+            }
+            break;
         case 'q': o->quiet = true; break;
         case opt_max_messages:
             if (parse_long("--max-messages", optarg, 0, LONG_MAX, &o->max_messages) != 0) {

@@ -5,11 +5,24 @@
 #define SF_OPTIONS_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
+#include "sf_channels.h"
 #include "sf_params.h"
 
 #define SF_OPTIONS_MAX_SETS 64
 #define SF_OPTIONS_PATH_MAX 4096 /* a path option's length limit (PATH_MAX): refused, never cut short */
+
+/* One bit per LCM channel of SF_CHANNELS (sf_channels.h, from lcmtypes/channels.csv): --channels. */
+enum {
+#define SF_OPTIONS_CHANNEL_BIT(name, type) sf_options_channel_##name,
+    SF_CHANNELS(SF_OPTIONS_CHANNEL_BIT)
+#undef SF_OPTIONS_CHANNEL_BIT
+        sf_options_channel_count
+};
+_Static_assert(sf_options_channel_count <= 32, "one bit of sf_options_t.channels per channel");
+/* Whether --channels lets channel NAME (of SF_CHANNELS) into the outputs of options *o. */
+#define SF_OPTIONS_WRITES(o, NAME) ((((o)->channels >> sf_options_channel_##NAME) & 1u) != 0)
 
 /* The exit-status contract, the same for stridefixd and every `stridefix` command (README "Exit
  * status"; the Python side is stridefix_analyzer/exits.py, a test keeps the two equal). */
@@ -35,10 +48,14 @@ typedef struct {
     long max_messages;
     bool force;      /* --force: an existing log file may be replaced */
     bool allow_root; /* --allow-root: a live input as root */
+    uint32_t channels; /* --channels: bit sf_options_channel_<NAME> set = that channel is written */
 } sf_options_t;
 
 /* 0 to run, or the exit status (SF_EXIT_USAGE, with a message on stderr). */
 int sf_options_parse(int argc, char **argv, const char *version, const char *dbc_sha256, sf_options_t *o,
                      sf_params_t *params);
+
+/* Whether --channels lets `channel` through (every channel without the option; NULL: true). */
+bool sf_options_channel_on(const sf_options_t *o, const char *channel);
 
 #endif

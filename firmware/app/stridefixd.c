@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "sf_batch.h"
 #include "sf_error.h"
 #include "sf_estimator.h"
 #include "sf_input.h"
@@ -51,8 +52,7 @@ typedef struct {
     sf_input_item_t item; /* large (a whole scan): here, not on the stack */
     sf_lcm_out_t *out;
     sf_estimator_t est;
-    sf_site_store_t site_store;
-    sf_site_t site;
+    sf_site_t site; /* a view of sf_batch_site's copy */
     sf_fingerprint_workspace_t ws;
     void *ws_memory;
     sf_particle_mem_t particle_mem; /* the particle scheme's cloud and the site's wall index */
@@ -67,6 +67,8 @@ typedef struct {
     sf_publish_loop_t loop;
     sf_publish_sources_t sources; /* fixes offered and made, by source */
 } daemon_t;
+
+#define WRITES(d, NAME) SF_OPTIONS_WRITES(&(d)->opt, NAME)
 
 /* One bad-input message (file and line where there is one), at most opt.max_messages of them. */
 static void complain(daemon_t *const d, const int code)
@@ -94,13 +96,24 @@ static void refuse_rest(const daemon_t *const d)
     fprintf(stderr, "stridefixd: %s\n", text);
 }
 
+/* CONFIG, once, before the first input item (or at the end of an empty input). */
+static void write_config(daemon_t *const d)
+{
+    if (!d->config_written && WRITES(d, CONFIG)) {
+        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
+    }
+    d->config_written = true;
+}
+
 static void write_health(daemon_t *const d)
 {
     sf_input_counters_t ic;
     sf_input_counters(d->in, &ic);
     sf_estimator_status_t st;
     sf_estimator_status(&d->est, &st);
-    sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->sources, &d->loop);
+    if (WRITES(d, HEALTH)) {
+        sf_publish_health(d->out, d->host_t_us, d->board_t_us, &ic, &st, &d->sources, &d->loop);
+    }
     d->last_health_t_us = d->board_t_us;
 }
 
@@ -114,13 +127,13 @@ static void write_pose(daemon_t *const d)
     for (int scheme = 0; scheme < n_schemes; scheme++) {
         sf_pose_t p;
         if ((d->params.output_scheme < 0 || scheme == d->params.output_scheme) &&
-            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
+            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p) && WRITES(d, POSE)) {
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
     sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8) */
     const bool controller_out = d->params.output_scheme < 0 || d->params.output_scheme == sf_scheme_controller;
-    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p)) {
+    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p) && WRITES(d, POSE)) {
         sf_publish_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;
@@ -137,7 +150,7 @@ static void publish_fixes(daemon_t *const d, const int method, const int n, cons
     d->sources.offered[method]++;
     d->sources.made[method] += has_fix ? 1u : 0u;
     for (int i = 0; i < n; i++) {
-        if (d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) {
+        if ((d->params.output_scheme < 0 || audits[i].scheme == d->params.output_scheme) && WRITES(d, FIX)) {
             sf_publish_fix(d->out, d->host_t_us, &audits[i]);
         }
     }
@@ -199,7 +212,7 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     memcpy(in.gyro_radps, s->gyro_radps, sizeof in.gyro_radps);
     sf_step_t steps[SF_ESTIMATOR_MAX_STEPS];
     const int n_steps = sf_estimator_imu(&d->est, &d->params, &in, steps);
-    for (int i = 0; i < n_steps; i++) {
+    for (int i = 0; i < n_steps && WRITES(d, STEP); i++) {
         sf_publish_step(d->out, d->host_t_us, &steps[i]);
     }
     sf_estimator_status_t st;
@@ -220,7 +233,9 @@ static void drain_contexts(daemon_t *const d)
     sf_fix_audit_t audits[sf_scheme_count];
     int n;
     while (sf_estimator_next_context(&d->est, &d->params, &ev, &fix, &has_fix, audits, &n)) {
-        sf_publish_context(d->out, d->host_t_us, &ev, &d->site, &d->params);
+        if (WRITES(d, CONTEXT)) {
+            sf_publish_context(d->out, d->host_t_us, &ev, &d->site, &d->params);
+        }
         if (n > 0) {
             publish_fixes(d, sf_fix_port, n, has_fix, audits); /* and the POSE */
         } else {
@@ -233,7 +248,9 @@ static void drain_contexts(daemon_t *const d)
  * kind added to SF_RX_KINDS without a case here stops the build (-Wswitch, -Werror). */
 static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
 {
-    sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
+    if (sf_options_channel_on(&d->opt, sf_rx_lcm_channel(ev->kind))) {
+        sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
+    }
     switch (ev->kind) {
     case sf_rx_imu:
         d->board_t_us = ev->u.imu.t_us;
@@ -268,10 +285,7 @@ static double monotonic_us(void)
 static void handle(daemon_t *const d, const sf_input_item_t *const item)
 {
     d->host_t_us = item->log_t_us;
-    if (!d->config_written) {
-        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
-        d->config_written = true;
-    }
+    write_config(d);
     const double t0 = monotonic_us();
     if (item->status < 0) {
         complain(d, item->status);
@@ -320,10 +334,7 @@ static int run(daemon_t *const d)
         handle(d, &d->item);
     }
     sf_signals_input_done();
-    if (!d->config_written) {
-        sf_publish_config(d->out, d->host_t_us, d->board_t_us, &d->params, SF_VERSION, SF_DBC_SHA256);
-        d->config_written = true;
-    }
+    write_config(d);
     write_health(d);
     return status;
 }
@@ -371,7 +382,7 @@ static int open_output(daemon_t *const d, char *const err, const size_t err_size
 static int load_site(daemon_t *const d)
 {
     char err[512];
-    if (sf_site_load(d->opt.site_path, &d->site_store, &d->site, err, sizeof err) != SF_OK) {
+    if (sf_batch_site(d->opt.site_path, &d->site, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return -1;
     }
@@ -460,9 +471,11 @@ static int serve(daemon_t *const d)
     return status;
 }
 
-int main(int argc, char **argv)
+/* One replay: options, serve, close. */
+static int run_once(const int argc, char **const argv)
 {
-    static daemon_t d; /* large (scan buffers): static, not on the stack */
+    static daemon_t d; /* large (scan buffers): static, not on the stack; zeroed for every run */
+    memset(&d, 0, sizeof d);
     const int prc = sf_options_parse(argc, argv, SF_VERSION, SF_DBC_SHA256, &d.opt, &d.params);
     if (prc != 0) {
         return prc;
@@ -472,8 +485,15 @@ int main(int argc, char **argv)
         (void)sf_lcm_out_close(d.out, NULL);
     }
     sf_input_close(d.in); /* only what was opened: never stdin on --replay */
-    sf_site_store_free(&d.site_store);
     sf_workspace_free(d.ws_memory);
     sf_particle_mem_free(&d.particle_mem);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    const int status = argc == 3 && strcmp(argv[1], "--batch") == 0 ? sf_batch_run(argv[2], run_once, stdout)
+                                                                     : run_once(argc, argv);
+    sf_batch_site_free();
     return status;
 }

@@ -15,20 +15,35 @@
 
 static const uint8_t magic[8] = {'S', 'F', 'S', 'I', 'T', 'E', 0u, 1u};
 
+/* Slicing-by-8 (Kounavis & Berry 2005): eight bytes per step through eight tables, each table k the
+ * CRC of a byte followed by k zero bytes; the same CRC as the bytewise loop, ~3x fewer instructions
+ * (a replay reads a 1.5 MB site: the CRC was a fifth of its instructions). */
 uint32_t sf_site_crc32(const void *const data, const size_t n)
 {
-    uint32_t table[256]; /* built per call (2 k shifts): no global state, negligible next to I/O */
+    uint32_t t[8][256]; /* built per call (~10 k operations): no global state, small next to a site */
     for (uint32_t i = 0; i < 256u; i++) {
         uint32_t c = i;
         for (int k = 0; k < 8; k++) {
             c = (c & 1u) != 0u ? 0xEDB88320u ^ (c >> 1) : c >> 1;
         }
-        table[i] = c;
+        t[0][i] = c;
     }
-    const uint8_t *const p = data;
+    for (uint32_t i = 0; i < 256u; i++) {
+        for (int k = 1; k < 8; k++) {
+            t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xFFu];
+        }
+    }
+    const uint8_t *p = data;
+    size_t left = n;
     uint32_t crc = 0xFFFFFFFFu;
-    for (size_t i = 0; i < n; i++) {
-        crc = table[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
+    for (; left >= 8u; left -= 8u, p += 8) {
+        const uint32_t lo = crc ^ ((uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24));
+        const uint32_t hi = (uint32_t)p[4] | ((uint32_t)p[5] << 8) | ((uint32_t)p[6] << 16) | ((uint32_t)p[7] << 24);
+        crc = t[7][lo & 0xFFu] ^ t[6][(lo >> 8) & 0xFFu] ^ t[5][(lo >> 16) & 0xFFu] ^ t[4][lo >> 24] ^
+              t[3][hi & 0xFFu] ^ t[2][(hi >> 8) & 0xFFu] ^ t[1][(hi >> 16) & 0xFFu] ^ t[0][hi >> 24];
+    }
+    for (; left > 0u; left--, p++) {
+        crc = t[0][(crc ^ *p) & 0xFFu] ^ (crc >> 8);
     }
     return crc ^ 0xFFFFFFFFu;
 }

@@ -255,6 +255,23 @@ static void test_crc32_reference(void **state)
                                 ((uint32_t)buf[19] << 24);
     assert_int_equal(sf_site_crc32(buf + SF_SITE_HEADER_SIZE, size - SF_SITE_HEADER_SIZE), header_crc); /* = zlib */
     free(buf);
+    /* slicing-by-8 against the bytewise definition at every length and alignment up to 64 bytes */
+    uint8_t bytes[72];
+    for (size_t i = 0; i < sizeof bytes; i++) {
+        bytes[i] = (uint8_t)(i * 37u + 11u);
+    }
+    for (size_t off = 0; off < 8; off++) {
+        for (size_t n = 0; n <= 64; n++) {
+            uint32_t crc = 0xFFFFFFFFu;
+            for (size_t i = 0; i < n; i++) {
+                crc ^= bytes[off + i];
+                for (int k = 0; k < 8; k++) {
+                    crc = (crc & 1u) != 0u ? 0xEDB88320u ^ (crc >> 1) : crc >> 1;
+                }
+            }
+            assert_int_equal(sf_site_crc32(bytes + off, n), crc ^ 0xFFFFFFFFu);
+        }
+    }
 }
 
 /* Every variant of variants.txt: code from its kind, message "<path>: <text>" (exact or contained). */

@@ -157,8 +157,8 @@ class RawWalk:
 
 def finite(values: list[str]) -> list[float]:
     """The fields as floats. Raises ValueError on a field that is not a finite number."""
-    out = [float(x) for x in values]
-    if not all(math.isfinite(x) for x in out):
+    out = list(map(float, values))
+    if not all(map(math.isfinite, out)):  # map, not a generator: called once per sensor record
         raise ValueError("non-finite value")
     return out
 

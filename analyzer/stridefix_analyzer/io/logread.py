@@ -406,9 +406,16 @@ def read_table(path: str | os.PathLike[str], channel: str) -> Table | None:
 
     Raises :class:`LogReadError` when the channel's messages carry another type hash than this build
     knows: a benchmark must not score a stale firmware's log as if it had no such messages."""
+    return read_tables(path, (channel,))[channel]
+
+
+def read_tables(path: str | os.PathLike[str], channels: Iterable[str]) -> dict[str, Table | None]:
+    """:func:`read_table` of several channels of one log, the file read once."""
+    channels = tuple(channels)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)
-        data = read_logs([path], decode=(channel,))
-    if channel in data.type_mismatches:
-        raise LogReadError(os.fspath(path), _mismatch_text(channel, data.type_mismatches[channel]))
-    return data.table(channel)
+        data = read_logs([path], decode=channels)
+    for channel in channels:
+        if channel in data.type_mismatches:
+            raise LogReadError(os.fspath(path), _mismatch_text(channel, data.type_mismatches[channel]))
+    return {channel: data.table(channel) for channel in channels}

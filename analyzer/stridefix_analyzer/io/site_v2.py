@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from stridefix import site_t
 
 #: Port kinds (``site_t.PORT_*``) and their names in building descriptions and summaries.
@@ -77,10 +78,27 @@ def validate_geo(site: site_t) -> None:
         raise SiteV2ValidationError(f"geo_rotation_deg is {site.geo_rotation_deg:g}, must be finite")
 
 
+def _walls_pass(site: site_t, lowest: int, top: int) -> bool:
+    """Whether every wall keeps the rules of :func:`validate_plan`, checked at once with numpy; False
+    (or anything numpy cannot hold) sends the per-wall loop, which names the first one broken."""
+    try:
+        x0, y0, x1, y1 = (
+            np.asarray(getattr(site, f), float) for f in ("wall_x0_m", "wall_y0_m", "wall_x1_m", "wall_y1_m")
+        )
+        f = np.asarray(site.wall_floor, np.int64)
+        return bool(
+            np.all(np.isfinite(x0) & np.isfinite(y0) & np.isfinite(x1) & np.isfinite(y1))
+            and np.all((f >= lowest) & (f <= top))
+            and not np.any((x0 == x1) & (y0 == y1))
+        )
+    except (TypeError, ValueError, OverflowError):
+        return False
+
+
 def validate_plan(site: site_t, lowest: int, top: int) -> None:
     """Walls, ports and beacons against the floors ``lowest`` … ``top``; raise on the first broken."""
     n_walls = _lens(site, "n_walls")
-    for i in range(n_walls):
+    for i in range(0 if _walls_pass(site, lowest, top) else n_walls):
         x0, y0, x1, y1 = site.wall_x0_m[i], site.wall_y0_m[i], site.wall_x1_m[i], site.wall_y1_m[i]
         f = site.wall_floor[i]
         if not finite(x0, y0, x1, y1):

@@ -26,6 +26,7 @@ Cost O(n_outline + n_ports + n_links + n_contexts² + n_cdd) (n_contexts is a ha
 
 from __future__ import annotations
 
+import numpy as np
 from stridefix import fix_t, pose_t, site_t
 
 from stridefix_analyzer.io.site_v2 import SiteV2ValidationError, check_len, finite
@@ -161,8 +162,28 @@ def _validate_context_rows(site: site_t, n_buildings: int, lowest: int, top: int
         seen[key] = i
 
 
+def _cdd_pass(site: site_t) -> bool:
+    """Whether every cdd row keeps the rules of :func:`_validate_cdd`, checked at once with numpy;
+    False (or anything numpy cannot hold) sends the per-row loop, which names the first one broken."""
+    try:
+        c = np.asarray(site.cdd_context, np.int64)
+        ident, dbm = np.asarray(site.cdd_id, np.int64), np.asarray(site.cdd_min_dbm, float)
+        method = np.asarray(site.context_cdd_method, np.int64)
+        if not (len(c) == len(ident) == len(dbm) == site.n_cdd and np.all((c >= 0) & (c < site.n_contexts))):
+            return False
+        return bool(
+            len(method) >= site.n_contexts
+            and np.all(c[1:] >= c[:-1])
+            and np.all((ident >= 0) & (ident < ID_LIMIT))
+            and np.all(np.isfinite(dbm))
+            and not np.any(method[c] == fix_t.METHOD_GNSS)
+        )
+    except (TypeError, ValueError, OverflowError, IndexError):
+        return False
+
+
 def _validate_cdd(site: site_t) -> None:
-    for i in range(site.n_cdd):
+    for i in range(0 if _cdd_pass(site) else site.n_cdd):
         c, ident, dbm = site.cdd_context[i], site.cdd_id[i], site.cdd_min_dbm[i]
         if not 0 <= c < site.n_contexts:
             raise _bad(f"cdd {i}: context {c} outside 0..{site.n_contexts - 1}")

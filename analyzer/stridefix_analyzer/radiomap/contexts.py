@@ -106,20 +106,37 @@ def inside(x: np.ndarray, y: np.ndarray, polygon: list[tuple[float, float]]) -> 
 
 def _members(ids: np.ndarray, rps: np.ndarray, means: np.ndarray, own: np.ndarray) -> list[tuple[int, float]]:
     """(id, cdd_min_dbm) of the members among per-(id, RP) mean RSSIs for a context whose RPs are
-    ``own`` (bool per RP): the rules of the module docstring."""
-    out = []
+    ``own`` (bool per RP): the rules of the module docstring, for every id at once. Per id: its
+    loudest level at the context's RPs against its loudest elsewhere, then the median of its levels
+    there (the middle one, or the mean of the two middle ones; NaN with a NaN, as ``np.median``) or
+    a margin above elsewhere, whichever is higher (Python's ``max`` of the two, in that order)."""
     mine = own[rps]
-    for ident in np.unique(ids[mine]):
-        sel = ids == ident
-        at_own, elsewhere = means[sel & mine], means[sel & ~mine]
-        loud = float(at_own.max())
-        if elsewhere.size and not loud >= float(elsewhere.max()) + CDD_MARGIN_DB:
-            continue
-        floor_dbm = float(np.median(at_own))
-        if elsewhere.size:
-            floor_dbm = max(float(elsewhere.max()) + CDD_ABOVE_ELSEWHERE_DB, floor_dbm)
-        out.append((int(ident), floor_dbm))
-    return out
+    if not mine.any():
+        return []
+    uniq, group = np.unique(ids, return_inverse=True)
+    group = group.reshape(-1)
+    n = len(uniq)
+    loud = np.full(n, -np.inf)
+    np.maximum.at(loud, group[mine], means[mine])
+    has_else = np.bincount(group[~mine], minlength=n) > 0
+    else_max = np.full(n, -np.inf)
+    np.maximum.at(else_max, group[~mine], means[~mine])
+    g, v = group[mine], means[mine]
+    order = np.lexsort((v, g))  # each id's levels at its own RPs, ascending (NaN last)
+    g, v = g[order], v[order]
+    count = np.bincount(g, minlength=n)
+    start = np.cumsum(count) - count
+    has_own = count > 0
+    h = np.where(has_own, count // 2, 0)
+    hi = v[np.minimum(start + h, len(v) - 1)]
+    lo = v[np.minimum(start + np.maximum(h - 1, 0), len(v) - 1)]
+    median = np.where(count % 2 == 1, hi, (lo + hi) / 2)
+    median = np.where(np.isnan(v[np.minimum(start + count - 1, len(v) - 1)]), np.nan, median)
+    with np.errstate(invalid="ignore"):
+        member = has_own & ~(has_else & ~(loud >= else_max + CDD_MARGIN_DB))
+        above = else_max + CDD_ABOVE_ELSEWHERE_DB
+        floor_dbm = np.where(has_else, np.where(median > above, median, above), median)
+    return [(int(uniq[k]), float(floor_dbm[k])) for k in np.flatnonzero(member)]
 
 
 def _ble_means(site: site_t, placed: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

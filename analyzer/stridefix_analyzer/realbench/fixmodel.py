@@ -207,6 +207,8 @@ def measure(
     tasks: TaskRunner,
     stream: TextIO,
     n_blocks: int = rs.DEFAULT_BLOCKS,
+    cache: rs.ReplayCache | None = None,
+    site_dir: Path | None = None,
 ) -> tuple[list[dict[str, Any] | None], list[float], dict[str, Any]]:
     """The model of every walk's fold (site_t fields, None where too few fixes), its σ_c, and the
     group's report (results.json)."""
@@ -223,9 +225,11 @@ def measure(
         tasks=tasks,
         n_blocks=n_blocks,
         progress=prog.step,
-        replay=rs.replay_task,
+        replay=None,
         stage="fixmodel",
         block_sets=block_sets,
+        cache=cache,
+        site_dir=site_dir,
     )
     pooled: dict[int, list[np.ndarray]] = {a: [] for a in range(n_blocks)}
     for r in results:

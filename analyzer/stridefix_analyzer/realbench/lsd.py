@@ -27,7 +27,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
 from stridefix_analyzer.parallel import TaskRunner
@@ -40,40 +39,13 @@ SITE_KEY = "controller_lsd_scheme"
 #: the scheme a fold gets when no choice can be made (fewer walks than the inner CV needs)
 DEFAULT_SCHEME = "ekf"
 #: the candidates: every fusion scheme (the controller itself is not one)
-CANDIDATES = tuple(s.name for s in schemes.FUSION_SCHEMES)
+CANDIDATES = rs.FUSION_NAMES
 
 
 def scheme_pose_errors_m(fw_log: str | Path, wp_t_us: ArrayLike, wp_xy_m: ArrayLike) -> dict[str, np.ndarray]:
     """Per fusion scheme of one stridefixd log: the 2-D error [m] at each waypoint of the scheme's
     latest initialised POSE at or before it (waypoints before its first pose are left out)."""
-    pose = read_table(fw_log, "POSE")
-    wp_t_us = np.asarray(wp_t_us, np.int64)
-    wp = np.asarray(wp_xy_m, float).reshape(-1, 2)
-    out: dict[str, np.ndarray] = {}
-    if pose is None or not len(pose):
-        return out
-    pose = pose.rows(np.isfinite(pose["sigma_m"]) & (pose["sigma_m"] < 1e6))
-    for code in np.unique(pose["scheme"]):
-        name = schemes.scheme_name(int(code))
-        if name not in CANDIDATES:
-            continue
-        p = pose.rows(pose["scheme"] == code)
-        k = np.searchsorted(p["t_us"], wp_t_us, side="right") - 1
-        ok = k >= 0
-        out[name] = np.hypot(p["x_m"][k[ok]] - wp[ok, 0], p["y_m"][k[ok]] - wp[ok, 1])
-    return out
-
-
-def replay_all_schemes(job: dict[str, Any]) -> dict[str, Any]:
-    """One inner-CV replay with every scheme; ``errors`` is the per-scheme dict (None on failure)."""
-    proc = Firmware(job["stridefixd"]).run(
-        input=f"lcmlog:{job['import_log']}", site=job["site"], log=job["log"], sets=job["sets"], check=False
-    )
-    if proc.returncode != 0:
-        return {**job, "errors": None, "failure": proc.stderr.strip()[-200:]}
-    err = scheme_pose_errors_m(job["log"], job["wp_t_us"], job["wp_xy_m"])
-    Path(job["log"]).unlink(missing_ok=True)
-    return {**job, "errors": err, "failure": None}
+    return rs.scheme_pose_errors(read_table(fw_log, "POSE"), wp_t_us, wp_xy_m)
 
 
 def choose_lsd(
@@ -87,6 +59,8 @@ def choose_lsd(
     tasks: TaskRunner,
     stream: Any,
     n_blocks: int = rs.DEFAULT_BLOCKS,
+    cache: rs.ReplayCache | None = None,
+    site_dir: Path | None = None,
 ) -> tuple[list[str], dict[str, Any]]:
     """The scheme of every walk's fold and the group's report (see the module text)."""
     n_blocks = min(n_blocks, len(sub))
@@ -105,9 +79,11 @@ def choose_lsd(
         tasks=tasks,
         n_blocks=n_blocks,
         progress=prog.step,
-        replay=replay_all_schemes,
+        replay=None,
         stage="lsd",
         block_sets=block_sets,
+        cache=cache,
+        site_dir=site_dir,
     )
     pooled: dict[int, dict[str, list[np.ndarray]]] = {a: {n: [] for n in CANDIDATES} for a in range(n_blocks)}
     failures = []

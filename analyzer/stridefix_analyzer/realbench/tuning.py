@@ -75,6 +75,8 @@ class Group:
     base_sets: Sequence[str]
     tasks: TaskRunner  # where the replays run
     stream: TextIO
+    #: the group's inner-CV replays, shared by every row that replays (:class:`.select.ReplayCache`)
+    replays: rs.ReplayCache = dataclasses.field(default_factory=rs.ReplayCache)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -136,6 +138,7 @@ class InnerCV:
             progress=prog.step,
             stage=self.stage,
             block_sets={a: list(s) for a, s in block_sets.items()},
+            cache=group.replays,
         )
         chosen = report.get("choice_of_block", {})
         sets = {a: list(axis.candidates[n]) for a, n in chosen.items()}
@@ -163,6 +166,8 @@ class Measured:
             block_sets,
             group.tasks,
             group.stream,
+            cache=group.replays,
+            site_dir=group.work_dir,
         )
         extra = [
             {f"{axis.name}_site_fields": f, f"{axis.name}_correlated_sigma_m": c}
@@ -193,6 +198,8 @@ class SchemeByError:
             block_sets=block_sets,
             tasks=group.tasks,
             stream=group.stream,
+            cache=group.replays,
+            site_dir=group.work_dir,
         )
         fields: list[dict[str, Any] | None] = [{lsd.SITE_KEY: s} for s in per_walk]
         extra = [{f"{axis.name}_scheme": s} for s in per_walk]

@@ -374,3 +374,88 @@ def test_mean_and_rmse_equal_evo_ape(realbench_fusion_small, tmp_path):
             assert_allclose(row["fixes"][name]["mean"], ours["mean"], rtol=0, atol=1e-9)
             checked += 1
     assert checked >= 6
+
+
+def test_inner_cv_replay_mode_scores_as_the_stage_replays_did(realbench_fusion_small, tmp_path):
+    """The inner cross-validation replays once per (walk, site, --set list) as ``--fusion adaptive
+    --channels FIX,POSE`` (realbench.select.MODES) and scores the matcher's Wi-Fi fix errors on those
+    FIX rows, where it once replayed ``--fusion wifi_only`` with every channel, and with a one-particle
+    cloud: --fusion only picks what is published, a FIX record's fix fields are the fix as offered,
+    the same for every scheme, and neither the fixes nor the adaptive scheme read the particle cloud.
+    GIVEN a real walk on its fold's site, WHEN replayed the three ways, THEN the fix residuals and the
+    adaptive POSE errors are bit-identical and the filtered log holds FIX and POSE only."""
+    from stridefix_analyzer.firmware import Firmware
+    from stridefix_analyzer.realbench import select as rs
+
+    r = realbench_fusion_small
+    row = r["doc"]["groups"][0]["walk_rows"][1]
+    imp = r["out"] / "cache" / "site1-F2" / f"{row['walk']}.lcmlog"
+    truth = read_logs([imp], decode=("TRUTH",)).table("TRUTH")
+    wp_t, wp_xy = truth["t_us"], np.column_stack([truth["x_m"], truth["y_m"]])
+    fw, site = Firmware(r["stridefixd"]), f"{row['dir']}/site.sfsite"
+    sets = [*MSINDOOR_SETS, "fingerprint.average_scans=2"]
+    logs = {}
+    for tag, fusion, channels in (
+        ("wifi_only", "wifi_only", None),
+        ("adaptive", "adaptive", None),
+        ("mode", *rs.MODES["one"][:2]),
+    ):
+        logs[tag] = tmp_path / f"{tag}.lcmlog"
+        extra = list(rs.MODES["one"][2]) if tag == "mode" else []
+        fw.run(
+            input=f"lcmlog:{imp}",
+            site=site,
+            fusion=fusion,
+            log=logs[tag],
+            sets=[*sets, *extra],
+            channels=channels,
+        )
+    counts = read_logs([logs["mode"]], decode=()).messages
+    assert set(counts) == {"FIX", "POSE"} and counts["FIX"] > 5
+    fix = rs.fix_residuals_m(logs["wifi_only"], wp_t, wp_xy)
+    assert len(fix) > 5
+    assert_array_equal(rs.fix_residuals_m(logs["mode"], wp_t, wp_xy), fix)
+    assert_array_equal(
+        rs.pose_errors_m(logs["mode"], wp_t, wp_xy), rs.pose_errors_m(logs["adaptive"], wp_t, wp_xy)
+    )
+    job = {"mode": "one", "stridefixd": str(r["stridefixd"]), "import_log": str(imp), "site": site}
+    got = rs.replay_products(
+        {**job, "log": str(tmp_path / "p.lcmlog"), "sets": sets, "wp_t_us": wp_t, "wp_xy_m": wp_xy}
+    )
+    assert got["failure"] is None
+    assert_array_equal(got["fix"], fix)
+    assert_array_equal(rs.SCORES["matcher"](got), rs.fix_errors_m(logs["wifi_only"], wp_t, wp_xy))
+
+
+def test_a_batch_replays_as_separate_processes_do(realbench_fusion_small, tmp_path):
+    """`stridefixd --batch FILE` (the inner cross-validation's replays, realbench.select.replay_batch):
+    GIVEN two real walks on one site, with and without a setting, and a replay that cannot run,
+    WHEN run in one batch and each alone, THEN every channel but HEALTH (its loop timing is the
+    host's) is the same, message for message, and the batch reports each exit status."""
+    from stridefix_analyzer.firmware import Firmware
+    from stridefix_analyzer.io.logread import KNOWN_CHANNELS
+
+    r = realbench_fusion_small
+    rows = r["doc"]["groups"][0]["walk_rows"]
+    site = f"{rows[0]['dir']}/site.sfsite"
+    imports = [r["out"] / "cache" / "site1-F2" / f"{row['walk']}.lcmlog" for row in rows[1:3]]
+    runs = [
+        {"input": f"lcmlog:{imp}", "site": site, "sets": [*MSINDOOR_SETS, *extra]}
+        for imp in imports
+        for extra in ([], ["fingerprint.powed_beta=2"])
+    ]
+    fw = Firmware(r["stridefixd"])
+    batch = [{**kw, "log": tmp_path / f"batch{i}.lcmlog"} for i, kw in enumerate(runs)]
+    missing = {"input": f"lcmlog:{tmp_path / 'missing.lcmlog'}", "log": tmp_path / "missing_out.lcmlog"}
+    assert fw.run_batch([*batch, missing], tmp_path / "jobs.batch") == [0, 0, 0, 0, 2]
+    channels = [c for c in KNOWN_CHANNELS if c != "HEALTH"]
+    for i, kw in enumerate(runs):
+        alone = tmp_path / f"alone{i}.lcmlog"
+        fw.run(**kw, log=alone)
+        a, b = (read_logs([p], decode=channels) for p in (batch[i]["log"], alone))
+        assert a.messages == b.messages and a.config == b.config
+        for c in channels:
+            ta, tb = a.table(c), b.table(c)
+            assert (ta is None) == (tb is None), c
+            for k in ta.names if ta is not None else ():
+                assert_array_equal(ta[k], tb[k], err_msg=f"{c}.{k}")

@@ -182,3 +182,42 @@ def test_selection_maps_are_smaller_than_fold_maps(realbench_eight):
             if a != b:
                 site = read_site(work / "select" / f"site_{a}_{b}.sfsite")
                 assert 0 < int(np.sum(site.rp_scans)) < int(np.sum(fold.rp_scans))
+
+
+def test_a_replay_asked_for_twice_runs_once(monkeypatch):
+    """The group's ReplayCache: tasks of any stage with the same (mode, walk, import log, site, --set
+    list) share one replay (the adaptive stage's "table x 1" is the matcher's replay of block a's
+    choice, the fix model's the adaptive stage's), each scored by its own stage, in task order."""
+    ran = []
+
+    def fake(job):
+        ran.append((job["walk"], tuple(job["sets"])))
+        n = len(job["sets"])
+        return {
+            "failure": None,
+            "fix": np.array([[3.0 * n, 4.0 * n, 1.0, 0.0]]),
+            "pose": np.array([float(n)]),
+        }
+
+    monkeypatch.setattr(rs, "replay_batch", lambda jobs: [fake(j) for j in jobs])
+    runner = rs.TaskRunner(None, 1)
+    base = {"mode": "one", "import_log": "x.lcmlog", "site": "s", "stridefixd": "fw", "a": 0, "name": "c"}
+    cache = rs.ReplayCache()
+    m = cache.run(
+        [{**base, "walk": w, "stage": "matcher", "sets": s} for w in ("w0", "w1") for s in ([], ["k=1"])],
+        runner,
+        None,
+    )
+    assert [r["errors"].tolist() for r in m] == [[0.0], [5.0], [0.0], [5.0]]
+    again = cache.run(
+        [
+            {**base, "walk": "w1", "stage": "adaptive", "sets": ["k=1"]},
+            {**base, "walk": "w1", "stage": "fixmodel", "sets": ["k=1", "j=2"]},
+        ],
+        runner,
+        None,
+    )
+    assert again[0]["errors"].tolist() == [1.0]
+    assert again[1]["errors"].tolist() == [[6.0, 8.0, 1.0, 0.0]]
+    assert ran == [("w0", ()), ("w0", ("k=1",)), ("w1", ()), ("w1", ("k=1",)), ("w1", ("k=1", "j=2"))]
+    assert (cache.ran, cache.reused) == (5, 1)

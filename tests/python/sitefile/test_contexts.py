@@ -293,3 +293,40 @@ def test_documented_campus_example_is_the_test_campus():
     got, want = read_building(path), campus_building()
     assert (got.buildings, got.port_extras, got.contexts) == (want.buildings, want.port_extras, want.contexts)
     assert got.ports == want.ports and [b[:4] for b in got.beacons] == [b[:4] for b in want.beacons]
+
+
+def _members_reference(ids, rps, means, own):
+    """The constellation rules one id at a time (the loop the vectorised builder replaced)."""
+    out, mine = [], own[rps]
+    for ident in np.unique(ids[mine]):
+        sel = ids == ident
+        at_own, elsewhere = means[sel & mine], means[sel & ~mine]
+        loud = float(at_own.max())
+        if elsewhere.size and not loud >= float(elsewhere.max()) + contexts.CDD_MARGIN_DB:
+            continue
+        floor_dbm = float(np.median(at_own))
+        if elsewhere.size:
+            floor_dbm = max(float(elsewhere.max()) + contexts.CDD_ABOVE_ELSEWHERE_DB, floor_dbm)
+        out.append((int(ident), floor_dbm))
+    return out
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_members_of_every_id_at_once_follow_the_rules_one_id_at_a_time():
+    """GIVEN random per-(id, RP) levels (ties, NaN and -inf among them), WHEN the members are taken
+    for every id at once, THEN they are the per-id rules' members and levels, exactly."""
+    rng = np.random.default_rng(7)
+    for trial in range(500):
+        n, n_rp = int(rng.integers(0, 60)), int(rng.integers(1, 12))
+        ids = rng.integers(0, int(rng.integers(1, 10)), n).astype(np.int64)
+        rps = rng.integers(0, n_rp, n)
+        means = np.round(rng.normal(-70.0, 6.0, n), int(rng.integers(0, 2)))
+        if trial % 3 == 0 and n:
+            means[rng.integers(0, n, 2)] = np.nan
+        if trial % 5 == 0 and n:
+            means[rng.integers(0, n, 1)] = -np.inf
+        own = rng.random(n_rp) < rng.random()
+        got, want = contexts._members(ids, rps, means, own), _members_reference(ids, rps, means, own)
+        assert [i for i, _ in got] == [i for i, _ in want], trial
+        for (_, g), (_, w) in zip(got, want, strict=True):
+            assert g == w or (math.isnan(g) and math.isnan(w)), trial
