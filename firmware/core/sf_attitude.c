@@ -390,7 +390,7 @@ double sf_attitude_yaw_rad(const sf_attitude_t *const att)
     return sf_atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
 }
 
-void sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)
+double sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)
 {
     const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
     const double a = 1 - 2 * (y * y + z * z), b = 2 * (x * y + w * z);
@@ -398,11 +398,12 @@ void sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, 
     if (h > 0.0) {
         *cos_yaw = a / h;
         *sin_yaw = b / h;
-        return;
+        return sf_atan2_hyp(b, a, h); /* sf_attitude_yaw_rad's sf_atan2(b, a), its sqrt shared */
     }
     const double yaw = atan2(b, a);
     *cos_yaw = cos(yaw);
     *sin_yaw = sin(yaw);
+    return sf_atan2(b, a);
 }
 
 double sf_attitude_tilt_rad(const sf_attitude_t *const att)

@@ -193,9 +193,8 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
     e->accel_v_mps2 = a_v;
 
     /* one atan2 per sample: the heading filter and the walking direction read the same yaw */
-    const double yaw = sf_attitude_yaw_rad(&e->attitude);
     double cos_yaw, sin_yaw;
-    sf_attitude_yaw_dir(&e->attitude, &cos_yaw, &sin_yaw);
+    const double yaw = sf_attitude_yaw_dir(&e->attitude, &cos_yaw, &sin_yaw);
     sf_heading_update_dir(&e->heading, p, s->t_us, f_nav, cos_yaw, sin_yaw);
     sf_activity_accel(&e->activity, p, s->t_us, a_v);
     sf_activity_gyro(&e->activity, p, s->t_us, s->gyro_radps);
