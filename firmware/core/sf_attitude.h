@@ -155,6 +155,12 @@ void sf_attitude_init(sf_attitude_t *att);
 void sf_attitude_update_imu(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double accel_mps2[3],
                             const double gyro_radps[3]);
 
+/* sf_attitude_update_imu for a caller whose samples are finite already (sf_estimator_imu: its sample
+ * gates refuse the others), without the check that counts imu_invalid (≈ 22 instructions); a
+ * non-finite sample is a contract violation (SF_ASSERT). */
+void sf_attitude_update_imu_finite(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double accel_mps2[3],
+                                   const double gyro_radps[3]);
+
 /* One magnetometer sample (sensor axes, calibrated: hard/soft iron removed). Sets the counters and
  * last_mag; see the header comment for the verdicts. */
 void sf_attitude_update_mag(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double field_ut[3]);

@@ -173,12 +173,15 @@ static bool admit(sf_estimator_t *const e, const sf_params_t *const p, const sf_
 int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const sf_imu_sample_t *const s,
                      sf_step_t steps[SF_ESTIMATOR_MAX_STEPS])
 {
-    if (!admit(e, p, sf_gate_accel, s->t_us, s->accel_mps2) ||
-        !admit(e, p, sf_gate_gyro, s->t_us, s->gyro_radps)) {
+    const sf_gate_verdict_t v = sf_sample_gate_imu(&e->gates[sf_gate_accel], &e->gates[sf_gate_gyro], p, s->t_us,
+                                                   s->accel_mps2, s->gyro_radps);
+    if (v != sf_gate_accepted) { /* admit's count, for the first gate that refused */
+        e->samples_refused[v]++;
         return 0;
     }
     sf_gap_bridge_on_imu(&e->gap, p, e->started ? e->t_us : 0, s->t_us);
-    sf_attitude_update_imu(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
+    /* the gates refused every non-finite sample (|x| ≤ full scale ≤ DBL_MAX) */
+    sf_attitude_update_imu_finite(&e->attitude, p, s->t_us, s->accel_mps2, s->gyro_radps);
     double f_nav[3];
     sf_attitude_body_to_nav(&e->attitude, s->accel_mps2, f_nav);
     if (!e->started) {
