@@ -393,11 +393,16 @@ void sf_attitude_nav_to_body(const sf_attitude_t *const att, const double v_nav[
 
 double sf_attitude_yaw_rad(const sf_attitude_t *const att)
 {
-    const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
+    return sf_attitude_q_yaw_rad(att->q);
+}
+
+double sf_attitude_q_yaw_rad(const double q[4])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
     return sf_atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
 }
 
-double sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)
+void sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw, double *const sin_yaw)
 {
     const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
     const double a = 1 - 2 * (y * y + z * z), b = 2 * (x * y + w * z);
@@ -405,12 +410,11 @@ double sf_attitude_yaw_dir(const sf_attitude_t *const att, double *const cos_yaw
     if (h > 0.0) {
         *cos_yaw = a / h;
         *sin_yaw = b / h;
-        return sf_atan2_hyp(b, a, h); /* sf_attitude_yaw_rad's sf_atan2(b, a), its sqrt shared */
+        return;
     }
     const double yaw = atan2(b, a);
     *cos_yaw = cos(yaw);
     *sin_yaw = sin(yaw);
-    return sf_atan2(b, a);
 }
 
 double sf_attitude_tilt_rad(const sf_attitude_t *const att)

@@ -174,11 +174,13 @@ void sf_attitude_nav_to_body(const sf_attitude_t *att, const double v_nav[3], do
 /* Heading of body x projected on the horizontal plane, CCW from nav +x (magnetic east), (−π, π]. */
 double sf_attitude_yaw_rad(const sf_attitude_t *att);
 
+/* sf_attitude_yaw_rad of the attitude q (a copy of sf_attitude_t's q; the same double). */
+double sf_attitude_q_yaw_rad(const double q[4]);
+
 /* cos and sin of sf_attitude_yaw_rad from the quaternion (the horizontal projection of body x,
  * normalised: a sqrt and two divisions, not a sincos; within a few ulp of cos/sin of the yaw). A body
- * x exactly vertical has no projection: then cos/sin of atan2's answer there. Returns the yaw itself,
- * the same double as sf_attitude_yaw_rad (the two share the sqrt: one call for a caller of both). */
-double sf_attitude_yaw_dir(const sf_attitude_t *att, double *cos_yaw, double *sin_yaw);
+ * x exactly vertical has no projection: then cos/sin of atan2's answer there. */
+void sf_attitude_yaw_dir(const sf_attitude_t *att, double *cos_yaw, double *sin_yaw);
 
 /* Angle between body "up" as estimated and the nav z axis image: the tilt of the body z axis from
  * vertical, [0, π]. Handy for tests and health. */

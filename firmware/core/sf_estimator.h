@@ -106,7 +106,15 @@ typedef struct {
     double accel_v_mps2; /* latest a_v */
     double x_m;
     double y_m;
-    double heading_rad; /* latest walking direction, map frame */
+    /* the latest walking direction (map frame) is computed when read (sf_estimator_pose, a step),
+     * from what it depends on at the latest IMU sample: the attitude q (its yaw), the heading filter's
+     * offset and the map rotation or start heading; heading_rad before the first sample */
+    double heading_rad;
+    bool heading_from_q;
+    bool heading_yaw_absolute;
+    double heading_q[4];
+    double heading_offset_rad; /* sf_heading_offset_rad */
+    double heading_base_rad;   /* heading_map_rotation (yaw absolute) or init_heading [rad] */
     double distance_m;  /* walked since start */
     double sigma_m;
     double weinberg_sum; /* Σ range^¼ since the last stride calibration (for absolute fixes) */

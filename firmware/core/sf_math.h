@@ -70,15 +70,7 @@ static inline double sf_atan2_half(const double y, const double x, const double 
  * roundings of the steps keep it within 2e-15 rad of atan2 (test_yaw_matches_atan2, test_attitude.c),
  * where the gyro's noise alone moves a yaw by ≈ 1e-5 rad per 100 Hz sample. Zero, infinite and NaN
  * arguments go to atan2, so its signed-zero and ±π conventions hold. */
-static inline double sf_atan2_hyp(const double y, const double x, const double h);
 static inline double sf_atan2(const double y, const double x)
-{
-    return sf_atan2_hyp(y, x, sqrt(x * x + y * y));
-}
-/* sf_atan2 given h = √(x² + y²) as the caller computed it (x·x + y·y, then sqrt: the same double as
- * the quarter turn's u² + v², whose terms are those squares in some order), for a caller that needs
- * h anyway (sf_attitude_yaw_dir); the same result bit for bit. */
-static inline double sf_atan2_hyp(const double y, const double x, const double h)
 {
     const double ax = fabs(x), ay = fabs(y);
     if (!(ax + ay > 0.0) || !isfinite(ax + ay)) {
@@ -94,7 +86,7 @@ static inline double sf_atan2_hyp(const double y, const double x, const double h
     } else {
         u = -x, v = -y, base = signbit(y) ? -SF_PI : SF_PI;
     }
-    const double t1 = v / (h + u);                     /* tan(φ/2), |t1| ≤ tan(π/8); h = √(u² + v²) */
+    const double t1 = v / (sqrt(u * u + v * v) + u);  /* tan(φ/2), |t1| ≤ tan(π/8) */
     const double t = t1 / (1.0 + sqrt(1.0 + t1 * t1)); /* tan(φ/4), |t| ≤ tan(π/16) */
     const double t2 = t * t;
     const double p = /* atan(t)/t = 1 − t²/3 + t⁴/5 − … + t²⁰/21 */
