@@ -61,10 +61,11 @@
  * slow local difference is learned but a disturbance can never walk the reference away.
  * Time for the mag blend is the interval since the previous mag sample, clamped to [0, 0.2] s.
  *
- * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 430
- * instructions per sf_attitude_update_imu and ≈ 545 per sf_attitude_update_mag (the dip's asin ≈ 75),
- * ≈ 700 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float) takes 331
- * (issue 16 asks ≤ 1.5×, ≈ 500).
+ * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 385
+ * instructions per sf_attitude_update_imu_finite (sf_attitude_update_imu's finiteness check ≈ 22
+ * more) and ≈ 500 per sf_attitude_update_mag (the dip's asin ≈ 75, the yaw correction's rotation
+ * ≈ 80), ≈ 636 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float)
+ * takes 331 (× 1.9; issue 16 asks ≤ 1.5×, ≈ 500).
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
  * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at sf_qexp in sf_quat.h,
  * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory
