@@ -135,6 +135,13 @@ void sf_attitude_update_imu(sf_attitude_t *const att, const sf_params_t *const p
         att->imu_invalid++;
         return;
     }
+    sf_attitude_update_imu_finite(att, p, t_us, accel_mps2, gyro_radps);
+}
+
+void sf_attitude_update_imu_finite(sf_attitude_t *const att, const sf_params_t *const p, const int64_t t_us,
+                                   const double accel_mps2[3], const double gyro_radps[3])
+{
+    SF_ASSERT(att != NULL && p != NULL && sf_finite3(accel_mps2) && sf_finite3(gyro_radps));
     const double a_norm = sf_norm3(accel_mps2);
     const bool accel_usable = a_norm > MIN_ACCEL_MPS2;
 
@@ -386,7 +393,12 @@ void sf_attitude_nav_to_body(const sf_attitude_t *const att, const double v_nav[
 
 double sf_attitude_yaw_rad(const sf_attitude_t *const att)
 {
-    const double w = att->q[0], x = att->q[1], y = att->q[2], z = att->q[3];
+    return sf_attitude_q_yaw_rad(att->q);
+}
+
+double sf_attitude_q_yaw_rad(const double q[4])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
     return sf_atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z));
 }
 

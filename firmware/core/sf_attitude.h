@@ -61,10 +61,11 @@
  * slow local difference is learned but a disturbance can never walk the reference away.
  * Time for the mag blend is the interval since the previous mag sample, clamped to [0, 0.2] s.
  *
- * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 430
- * instructions per sf_attitude_update_imu and ≈ 545 per sf_attitude_update_mag (the dip's asin ≈ 75),
- * ≈ 700 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float) takes 331
- * (issue 16 asks ≤ 1.5×, ≈ 500).
+ * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 385
+ * instructions per sf_attitude_update_imu_finite (sf_attitude_update_imu's finiteness check ≈ 22
+ * more) and ≈ 500 per sf_attitude_update_mag (the dip's asin ≈ 75, the yaw correction's rotation
+ * ≈ 80), ≈ 636 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float)
+ * takes 331 (× 1.9; issue 16 asks ≤ 1.5×, ≈ 500).
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
  * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at sf_qexp in sf_quat.h,
  * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory
@@ -155,6 +156,12 @@ void sf_attitude_init(sf_attitude_t *att);
 void sf_attitude_update_imu(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double accel_mps2[3],
                             const double gyro_radps[3]);
 
+/* sf_attitude_update_imu for a caller whose samples are finite already (sf_estimator_imu: its sample
+ * gates refuse the others), without the check that counts imu_invalid (≈ 22 instructions); a
+ * non-finite sample is a contract violation (SF_ASSERT). */
+void sf_attitude_update_imu_finite(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double accel_mps2[3],
+                                   const double gyro_radps[3]);
+
 /* One magnetometer sample (sensor axes, calibrated: hard/soft iron removed). Sets the counters and
  * last_mag; see the header comment for the verdicts. */
 void sf_attitude_update_mag(sf_attitude_t *att, const sf_params_t *p, int64_t t_us, const double field_ut[3]);
@@ -167,6 +174,9 @@ void sf_attitude_nav_to_body(const sf_attitude_t *att, const double v_nav[3], do
 
 /* Heading of body x projected on the horizontal plane, CCW from nav +x (magnetic east), (−π, π]. */
 double sf_attitude_yaw_rad(const sf_attitude_t *att);
+
+/* sf_attitude_yaw_rad of the attitude q (a copy of sf_attitude_t's q; the same double). */
+double sf_attitude_q_yaw_rad(const double q[4]);
 
 /* cos and sin of sf_attitude_yaw_rad from the quaternion (the horizontal projection of body x,
  * normalised: a sqrt and two divisions, not a sincos; within a few ulp of cos/sin of the yaw). A body

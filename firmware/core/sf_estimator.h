@@ -50,7 +50,7 @@
  * nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 15 456 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
+ * Memory: sizeof(sf_estimator_t) = 15 536 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
  * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
  * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
  * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's
@@ -58,11 +58,12 @@
  * the particle cloud's arrays (32 kB at 1 000 particles) and the wall index are the caller's
  * (sf_particle.h, sf_wall_grid.h), its header (≤ 128 B) is here (a cloud without walls points at a
  * constant empty grid). Cost (callgrind, x86-64, `stridefix bench perf`'s sensors walk; the sensor
- * modules at -O3, firmware/CMakeLists.txt): ≈ 1 510 instructions per sf_estimator_imu without the
- * particle scheme (the attitude filter ≈ 430 of them, the steps ≈ 180, the activity ≈ 170, the two
- * sample gates ≈ 130, the yaw ≈ 90), ≈ 980 per sf_estimator_mag (the attitude's magnetometer fusion
- * ≈ 545, sf_magcal ≈ 315), ≈ 520 per sf_estimator_baro (sf_floor ≈ 380, a third of it the pow):
- * ≈ 2 100 per IMU sample at 100/50/20 Hz, all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is
+ * modules at -O3, firmware/CMakeLists.txt): ≈ 1 325 instructions per sf_estimator_imu without the
+ * particle scheme (the attitude filter ≈ 385 of them, the activity ≈ 175, the steps ≈ 155, the two
+ * sample gates ≈ 115, the heading filter ≈ 105 and the yaw's direction ≈ 35; the walking direction's
+ * atan2 only when it is read: a step, a POSE), ≈ 935 per sf_estimator_mag (the attitude's
+ * magnetometer fusion ≈ 500, sf_magcal ≈ 315), ≈ 410 per sf_estimator_baro (sf_floor ≈ 275):
+ * ≈ 1 875 per IMU sample at 100/50/20 Hz, all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is
  * sf_fingerprint.h's, a particle step
  * sf_particle.h's. */
 #ifndef SF_ESTIMATOR_H
@@ -106,7 +107,15 @@ typedef struct {
     double accel_v_mps2; /* latest a_v */
     double x_m;
     double y_m;
-    double heading_rad; /* latest walking direction, map frame */
+    /* the latest walking direction (map frame) is computed when read (sf_estimator_pose, a step),
+     * from what it depends on at the latest IMU sample: the attitude q (its yaw), the heading filter's
+     * offset and the map rotation or start heading; heading_rad before the first sample */
+    double heading_rad;
+    bool heading_from_q;
+    bool heading_yaw_absolute;
+    double heading_q[4];
+    double heading_offset_rad; /* sf_heading_offset_rad */
+    double heading_base_rad;   /* heading_map_rotation (yaw absolute) or init_heading [rad] */
     double distance_m;  /* walked since start */
     double sigma_m;
     double weinberg_sum; /* Σ range^¼ since the last stride calibration (for absolute fixes) */

@@ -53,11 +53,13 @@
  * Errors: sf_floor_set_heights returns SF_OK or SF_EINVAL (NULL, n_floors outside
  * [1, SF_FLOOR_CAPACITY], a height not finite or not strictly above the one below, or a table that
  * would leave int16 floor numbers). Everything else cannot fail.
- * Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 380 instructions per
- * sf_floor_update, a third of them the pow(); the low-pass gains are remembered per (dt, τ)
+ * Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 275 instructions per
+ * sf_floor_update (≈ 380 with a pow() per sample: the pressure's height is now a series around the
+ * last pressure that needed one, sf_floor_baro_height_m, a pow per ≈ 8.5 m of climb, within 2e-9 m of
+ * sf_floor_pressure_to_height_m); the low-pass gains are remembered per (dt, τ)
  * (sf_lp_gain: an expm1 only when the rate changes) and the nearest floor is a bisection,
- * O(log n_floors) (the 64-floor scan was ≈ 800). Memory: sizeof(sf_floor_t) = 712 B on x86-64
- * (i686 not rechecked) (at most 720 B, checked). No heap, no I/O, no clock. */
+ * O(log n_floors) (the 64-floor scan was ≈ 800). Memory: sizeof(sf_floor_t) = 736 B on x86-64
+ * (i686 not rechecked) (at most 744 B, checked). No heap, no I/O, no clock. */
 #ifndef SF_FLOOR_H
 #define SF_FLOOR_H
 
@@ -99,10 +101,13 @@ typedef struct {
     double recent_height_m;
     /* the low-pass gains of the last (dt, τ): one expm1 per rate change, not three per sample */
     sf_lp_gain_t gain_height, gain_vspeed, gain_drift;
+    /* the pressure → height series' reference (sf_floor_baro_height_m): r [Pa] (0: none yet), 1/r,
+     * (r/p0)^0.190263 */
+    double baro_ref_pa, baro_ref_inv_pa, baro_ref_pow;
     /* counters, never decrease */
     uint32_t changes, rereferences, shifts, gaps, backwards, bad;
 } sf_floor_t;
-_Static_assert(sizeof(sf_floor_t) <= 720, "sf_floor.h promises at most 720 B");
+_Static_assert(sizeof(sf_floor_t) <= 744, "sf_floor.h promises at most 744 B");
 
 /* Default uniform table from floor_height_m around init_floor; current floor = init_floor. */
 void sf_floor_init(sf_floor_t *f, const sf_params_t *p);
@@ -139,5 +144,9 @@ void sf_floor_shift(sf_floor_t *f, int32_t delta, bool rereference_now);
 
 /* ICAO standard-atmosphere height for a pressure [Pa → m]. */
 double sf_floor_pressure_to_height_m(double pressure_pa);
+
+/* sf_floor_pressure_to_height_m as sf_floor_update computes it: a series around the last pressure that
+ * needed a pow (the reference in f, updated here), within 2e-9 m of the pow form (sf_floor.c). */
+double sf_floor_baro_height_m(sf_floor_t *f, double pressure_pa);
 
 #endif

@@ -121,8 +121,8 @@ sf_gate_verdict_t sf_sample_gate_check(sf_sample_gate_t *const g, const sf_sampl
     return check(g, lim, t_us, v, n);
 }
 
-sf_gate_verdict_t sf_sample_gate_stream(sf_sample_gate_t *const g, const sf_params_t *const p,
-                                        const sf_gate_stream_t stream, const int64_t t_us, const double *const v)
+static inline sf_gate_verdict_t stream_check(sf_sample_gate_t *const g, const sf_params_t *const p,
+                                             const sf_gate_stream_t stream, const int64_t t_us, const double *const v)
 {
     /* accel, gyro and mag: three axes and a symmetric full scale ±fs, so "finite and within [−fs, fs]"
      * is one test, |x| ≤ min(fs, DBL_MAX) (exact: −fs is exact; an infinite fs still refuses ±inf and
@@ -154,4 +154,19 @@ sf_gate_verdict_t sf_sample_gate_stream(sf_sample_gate_t *const g, const sf_para
         return sf_gate_out_of_range;
     }
     return check_ordered(g, &lim, t_us, v, 3);
+}
+
+sf_gate_verdict_t sf_sample_gate_stream(sf_sample_gate_t *const g, const sf_params_t *const p,
+                                        const sf_gate_stream_t stream, const int64_t t_us, const double *const v)
+{
+    return stream_check(g, p, stream, t_us, v);
+}
+
+sf_gate_verdict_t sf_sample_gate_imu(sf_sample_gate_t *const accel_gate, sf_sample_gate_t *const gyro_gate,
+                                     const sf_params_t *const p, const int64_t t_us, const double accel_mps2[3],
+                                     const double gyro_radps[3])
+{
+    /* the streams are constants here, so each check's switch folds away (one call, not two) */
+    const sf_gate_verdict_t v = stream_check(accel_gate, p, sf_gate_accel, t_us, accel_mps2);
+    return v != sf_gate_accepted ? v : stream_check(gyro_gate, p, sf_gate_gyro, t_us, gyro_radps);
 }

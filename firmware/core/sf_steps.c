@@ -62,8 +62,11 @@ static bool emit(sf_steps_t *const s, const sf_params_t *const p, const int64_t 
         if (s->ring_t_us[i] <= s->last_step_t_us) {
             break;
         }
-        ev.amax_mps2 = fmax(ev.amax_mps2, s->ring_mps2[i]);
-        ev.amin_mps2 = fmin(ev.amin_mps2, s->ring_mps2[i]);
+        /* the ring holds finite values only (sf_steps_update refuses the others), so a comparison is
+         * fmax/fmin without their NaN rules: inline, not two libm calls per grid point of the step */
+        const double x = s->ring_mps2[i];
+        ev.amax_mps2 = x > ev.amax_mps2 ? x : ev.amax_mps2;
+        ev.amin_mps2 = x < ev.amin_mps2 ? x : ev.amin_mps2;
         i = (i + SF_STEPS_WINDOW - 1) % SF_STEPS_WINDOW;
     }
     if (s->ring_count == 0) { /* cannot happen: a detection needs grid points; keep the event sane */

@@ -67,7 +67,7 @@
  * than steps_max_gap_ms is counted in `gaps` and restarts filters, grid and detector (the previous
  * step's time is kept, so the period rule above still applies).
  *
- * Cost: O(1) per grid point and per sample, a few dozen flops (≈ 180 instructions per sample in
+ * Cost: O(1) per grid point and per sample, a few dozen flops (≈ 155 instructions per sample in
  * `stridefix bench perf`); the two low-pass gains' expm1 run only when the interval changes
  * (sf_expm1_memo); the grid loop runs at most steps_max_gap_ms / 20 ms times in one call. Memory:
  * sizeof(sf_steps_t) = 2 464 B on x86-64 (i686 not rechecked; at most 2.5 KiB, checked), the amax/amin ring most of it.

@@ -482,7 +482,9 @@ static sf_attitude_t random_attitude(rng_t *const rng)
 }
 
 /* GIVEN 10 000 seeded random attitudes, WHEN the yaw's cosine and sine come from the quaternion
- * (sf_attitude_yaw_dir, no sincos), THEN they are cos and sin of sf_attitude_yaw_rad within 1e-15. */
+ * (sf_attitude_yaw_dir, no sincos), THEN they are cos and sin of sf_attitude_yaw_rad within 1e-15;
+ * and the yaw of a copy of q (sf_attitude_q_yaw_rad, the estimator's walking direction) is
+ * sf_attitude_yaw_rad's bit for bit. */
 static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
 {
     (void)state;
@@ -493,6 +495,7 @@ static void test_yaw_dir_is_cos_sin_of_yaw(void **state)
         double c, s;
         sf_attitude_yaw_dir(&att, &c, &s);
         const double yaw = sf_attitude_yaw_rad(&att);
+        assert_true(sf_attitude_q_yaw_rad(att.q) == yaw);
         worst = fmax(worst, fmax(fabs(c - cos(yaw)), fabs(s - sin(yaw))));
     }
     printf("yaw_dir: largest |difference| from cos/sin of the yaw %.2e\n", worst);

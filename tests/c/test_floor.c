@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "sf_error.h"
@@ -106,6 +107,34 @@ static void test_pressure_to_height(void **state)
     /* 1000 hPa ≈ 111 m, 900 hPa ≈ 989 m (ICAO table) */
     assert_true(fabs(sf_floor_pressure_to_height_m(100000.0) - 110.9) < 0.5);
     assert_true(fabs(sf_floor_pressure_to_height_m(90000.0) - 988.5) < 1.0);
+}
+
+/* GIVEN a barometer's samples (noise, a 30 m climb and descent, the extremes of the range) WHEN
+ * sf_floor_update's series turns them into heights (sf_floor_baro_height_m) THEN every height is within
+ * 1e-8 m of the pow form (the bound sf_floor.c derives: 2e-9 m), and a pow runs only once per ≈ 8.5 m of
+ * climb (the reference moves ~8 times, not on every sample). */
+static void test_baro_height_series_matches_pow(void **state)
+{
+    (void)state;
+    sf_floor_t f = {0};
+    double worst_m = 0.0;
+    int anchors = 0;
+    for (int k = 0; k < 20000; k++) {
+        const double climb_m = 30.0 * sin(3.14159265358979323846 * k / 20000.0); /* up and back down */
+        const double noise_pa = 2.0 * sin(12.9898 * k) * cos(78.233 * k);         /* deterministic jitter */
+        const double p_pa = 101325.0 - 12.0 * climb_m + noise_pa;
+        const double ref_pa = f.baro_ref_pa;
+        worst_m = fmax(worst_m, fabs(sf_floor_baro_height_m(&f, p_pa) - sf_floor_pressure_to_height_m(p_pa)));
+        anchors += f.baro_ref_pa != ref_pa;
+    }
+    const double ends_pa[] = {SF_FLOOR_MIN_PA, SF_FLOOR_MIN_PA + 29.0, SF_FLOOR_MAX_PA, SF_FLOOR_MAX_PA - 50.0};
+    for (size_t i = 0; i < sizeof ends_pa / sizeof ends_pa[0]; i++) {
+        worst_m = fmax(worst_m, fabs(sf_floor_baro_height_m(&f, ends_pa[i]) - sf_floor_pressure_to_height_m(ends_pa[i])));
+    }
+    printf("baro height series: largest |difference| from pow %.2e m, %d references for a 2 x 30 m climb\n", worst_m,
+           anchors);
+    assert_true(worst_m < 1e-8);
+    assert_true(anchors >= 2 && anchors <= 20);
 }
 
 /* GIVEN a walker on floor 0, WHEN she climbs 3.5 m of stairs in 10 s and stays on the landing, THEN
@@ -406,6 +435,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pressure_to_height),
+        cmocka_unit_test(test_baro_height_series_matches_pow),
         cmocka_unit_test(test_stair_climb_25hz),
         cmocka_unit_test(test_stair_climb_10hz),
         cmocka_unit_test(test_stair_descent),

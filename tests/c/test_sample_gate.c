@@ -87,6 +87,52 @@ static void test_a_long_gap_allows_a_large_change(void **state)
     assert_int_equal(feed(&g, 1020000, -100.0), sf_gate_accepted); /* 1 s later: anything in range */
 }
 
+/* GIVEN a stream of IMU samples with noise, jumps, out-of-range and non-finite values on either sensor
+ * and repeated or backwards times, WHEN sf_sample_gate_imu judges each THEN its verdict and both gates'
+ * state are those of the two sf_sample_gate_stream calls it stands for (accel, then gyro only when
+ * accel accepted). */
+static void test_imu_gate_is_the_two_stream_gates(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_sample_gate_t a1, g1, a2, g2;
+    sf_sample_gate_init(&a1);
+    sf_sample_gate_init(&g1);
+    sf_sample_gate_init(&a2);
+    sf_sample_gate_init(&g2);
+    uint64_t r = 0x1234567887654321ULL;
+    int64_t t_us = 0;
+    int refused = 0;
+    for (int k = 0; k < 5000; k++) {
+        r = r * 6364136223846793005ULL + 1442695040888963407ULL;
+        const unsigned pick = (unsigned)(r >> 59); /* 0..31 */
+        t_us += pick == 3 ? 0 : (pick == 4 ? -5000 : 10000);
+        double acc[3] = {0.1 * (double)(pick % 7), -0.2, 9.81}, gyr[3] = {0.01, 0.02 * (double)(pick % 5), -0.03};
+        if (pick == 5) {
+            acc[2] = 300.0; /* a jump */
+        } else if (pick == 6) {
+            gyr[0] = 40.0; /* a gyro jump */
+        } else if (pick == 7) {
+            acc[1] = (double)NAN;
+        } else if (pick == 8) {
+            gyr[2] = (double)INFINITY;
+        } else if (pick == 9) {
+            acc[0] = 1e6; /* beyond full scale */
+        }
+        sf_gate_verdict_t two = sf_sample_gate_stream(&a1, &p, sf_gate_accel, t_us, acc);
+        if (two == sf_gate_accepted) {
+            two = sf_sample_gate_stream(&g1, &p, sf_gate_gyro, t_us, gyr);
+        }
+        const sf_gate_verdict_t one = sf_sample_gate_imu(&a2, &g2, &p, t_us, acc, gyr);
+        assert_int_equal(one, two);
+        assert_memory_equal(&a1, &a2, sizeof a1);
+        assert_memory_equal(&g1, &g2, sizeof g1);
+        refused += one != sf_gate_accepted;
+    }
+    assert_true(refused > 500 && refused < 4500); /* both kinds of sample were seen */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -95,6 +141,7 @@ int main(void)
         cmocka_unit_test(test_a_real_step_change_is_accepted_on_the_second_sample),
         cmocka_unit_test(test_full_scale_not_finite_and_order),
         cmocka_unit_test(test_a_long_gap_allows_a_large_change),
+        cmocka_unit_test(test_imu_gate_is_the_two_stream_gates),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -23,6 +23,9 @@
  *                               (truth, fix, the readings by AP index).
  *   The wifi modes' JSON has match_s: the wall time inside sf_fingerprint_match (CLOCK_MONOTONIC).
  *   core_cost samples SECONDS   the sensors walk's IMU and MAG samples as text, for a peer filter.
+ *   core_cost yaw SECONDS       the sensors walk, printing "t_s yaw_rad" per IMU sample instead of the
+ *                               JSON: our attitude's device yaw after the sample (and the tick's MAG
+ *                               sample), to set beside the peer's on the samples mode's lines.
  *   core_cost sizes             sizeof of the core's state structs.
  *
  * Prints one JSON object (counts and what was built); exit 0, 2 on bad usage. The harness may use the
@@ -45,7 +48,7 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: core_cost sensors SECONDS | samples SECONDS | wifi N_RP SCANS [full] | wifidump N_RP SCANS PATH [full] | "
+    fprintf(stderr, "usage: core_cost sensors SECONDS | yaw SECONDS | samples SECONDS | wifi N_RP SCANS [full] | wifidump N_RP SCANS PATH [full] | "
                     "wifiheard N_RP SCANS HEARD_DBM | sizes\n");
     return 2;
 }
@@ -81,7 +84,9 @@ static sf_imu_sample_t walk_imu(walk_t *const w, const int64_t k)
 
 static const double k_field_ut[3] = {20.0 + 12.0, 0.0 - 7.0, -45.0 + 3.0}; /* 50 µT + hard iron */
 
-static int run_sensors(const double seconds)
+/* yaw: NULL, or where "t_s yaw_rad" goes after each IMU sample's tick (its MAG and BARO samples
+ * included): the attitude filter's device yaw (sf_attitude_yaw_rad; nav x east, y north, z up). */
+static int run_sensors(const double seconds, FILE *const yaw)
 {
     static sf_params_t p;
     static sf_estimator_t est;
@@ -104,6 +109,12 @@ static int run_sensors(const double seconds)
             sf_estimator_baro(&est, &p, s.t_us + 2000, 101325.0 + 2.0 * rng_gauss(&w.r));
             baro++;
         }
+        if (yaw != NULL) {
+            fprintf(yaw, "%.6f %.17g\n", (double)s.t_us * 1e-6, sf_attitude_yaw_rad(&est.attitude));
+        }
+    }
+    if (yaw != NULL) {
+        return 0;
     }
     printf("{\"mode\": \"sensors\", \"seconds\": %.1f, \"imu\": %ld, \"mag\": %ld, \"baro\": %ld, \"steps\": %ld}\n",
            seconds, imu, mag, baro, steps);
@@ -294,7 +305,11 @@ int main(const int argc, char **const argv)
 {
     if (argc == 3 && strcmp(argv[1], "sensors") == 0) {
         const double s = atof(argv[2]);
-        return s > 0.0 ? run_sensors(s) : usage();
+        return s > 0.0 ? run_sensors(s, NULL) : usage();
+    }
+    if (argc == 3 && strcmp(argv[1], "yaw") == 0) {
+        const double s = atof(argv[2]);
+        return s > 0.0 ? run_sensors(s, stdout) : usage();
     }
     if ((argc == 4 || (argc == 5 && strcmp(argv[4], "full") == 0)) && strcmp(argv[1], "wifi") == 0) {
         const int n_rp = atoi(argv[2]), n_scans = atoi(argv[3]);

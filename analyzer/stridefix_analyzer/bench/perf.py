@@ -7,7 +7,8 @@ Each figure says how it was measured:
   time; callgrind counts the instructions inside it (``--toggle-collect=FUNCTION``), divided by the
   calls the harness reports. Sensors: a 120 s walk at the board's rates (IMU 100 Hz, MAG 50 Hz, BARO
   20 Hz); "all core work per IMU sample" is the three calls' instructions over the IMU samples, and the
-  attitude filter's share is ``sf_attitude_update_imu`` + ``sf_attitude_update_mag``. Wi-Fi: 50 fixes
+  attitude filter's share is ``sf_attitude_update_imu_finite`` (the estimator's call: its gates checked
+  the sample) + ``sf_attitude_update_mag``. Wi-Fi: 50 fixes
   (``sf_fingerprint_match``) on synthetic maps of 100, 2 000 and 20 000 reference points of a building
   that grows with the map (one AP per 40 m², ~31–42 heard per scan; the harness's docstring), with the
   workspace stridefixd gives it (the candidate pre-selection, ``sf_fingerprint.h``) and, on the same
@@ -29,10 +30,12 @@ Each figure says how it was measured:
 
 The attitude peer is x-io Fusion (PyPI ``imufusion``, the C library compiled into its wheel): the same
 samples (``sf_core_cost samples``) through ``FusionAhrsUpdate`` (gyro + accelerometer + magnetometer on
-every IMU sample), counted by callgrind inside that function only; ours is ``sf_attitude_update_imu`` +
+every IMU sample), counted by callgrind inside that function only; ours is ``sf_attitude_update_imu_finite`` +
 ``sf_attitude_update_mag`` per IMU sample (MAG at 50 Hz). The Python peers (:mod:`.perf_peers`,
 ``python_peers`` in the JSON, informative, no budget): the ``ahrs`` package's Madgwick and imufusion's
-Python API on the same samples, wall time per sample and their yaw agreement; scikit-learn's
+Python API on the same samples, wall time per sample and their yaw agreement, and our attitude's yaw
+(``sf_core_cost yaw``) against Fusion's: RMS, max and mean of the wrapped difference after the
+settle time (``python_peers.attitude.ours_vs_fusion_*``); scikit-learn's
 ``KNeighborsRegressor`` against ``sf_fingerprint_match`` on the harness's synthetic map, mean error and
 queries/s. Writes ``perf.json``.
 """
@@ -104,7 +107,10 @@ def measure_sensors(harness: Path, out: Path) -> dict[str, Any]:
         )
     }
     att = _callgrind(
-        harness, ("sf_attitude_update_imu", "sf_attitude_update_mag"), args, out / "perf.attitude.callgrind"
+        harness,
+        ("sf_attitude_update_imu_finite", "sf_attitude_update_mag"),
+        args,
+        out / "perf.attitude.callgrind",
     )
     return {
         "walk": walk,
@@ -141,6 +147,13 @@ def measure_attitude_peer(harness: Path, out: Path) -> dict[str, Any]:
         raise StageError(f"perf: {harness} samples failed ({proc.returncode}): {proc.stderr[-400:]}")
     samples.write_text(proc.stdout)
     n = proc.stdout.count("\n")
+    # our attitude's yaw on the same walk, for perf_peers' heading agreement with Fusion
+    yaw = subprocess.run(
+        [str(harness), "yaw", str(SENSOR_SECONDS)], capture_output=True, text=True, check=False
+    )
+    if yaw.returncode != 0:
+        raise StageError(f"perf: {harness} yaw failed ({yaw.returncode}): {yaw.stderr[-400:]}")
+    (out / "perf.yaw.txt").write_text(yaw.stdout)
     script = out / "perf.fusion_peer.py"
     script.write_text(_PEER)
     ir = callgrind.instructions(
@@ -340,7 +353,7 @@ def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[s
         flush=True,
     )
     python_peers = {
-        "attitude": perf_peers.measure_madgwick_peer(out / "perf.samples.txt"),
+        "attitude": perf_peers.measure_madgwick_peer(out / "perf.samples.txt", ours_yaw=out / "perf.yaw.txt"),
         "wifi": perf_peers.measure_knn_peer(harness, out),
     }
     not_measured = []

@@ -14,6 +14,11 @@ these rows are wall times on this machine (informative, no budget), with what ea
   of the wrapped yaw difference [deg] between the two after :data:`SETTLE_S` s (Fusion's start-up
   ramp). The harness's field is constant in the body frame while the gyro turns, so the yaw is a tug
   of war between gyro and magnetometer: the agreement says how alike the two weigh them, not accuracy.
+  **Ours against Fusion** (issue 16's "heading agrees with Fusion"): with ``ours_yaw`` (the lines of
+  ``sf_core_cost yaw``, our attitude's device yaw after each IMU sample of the same walk, its MAG
+  sample included) the RMS, max and mean of the wrapped difference ours − Fusion after
+  :data:`SETTLE_S`; Fusion runs in its default NWU frame (yaw 0 with body x north), ours in ENU (yaw 0
+  with body x east), so Fusion's yaw + 90° is compared.
 * **Wi-Fi** (:func:`measure_knn_peer`): ``sf_core_cost wifidump`` writes the harness's synthetic map
   (2 m grid, one AP per 40 m², 3 scans per RP) and scans with each scan's C fix; the map becomes a dense
   RP × AP matrix at the matcher's fill (−100 dBm for an AP missing at an RP or in a scan) over every map
@@ -44,6 +49,8 @@ from stridefix_analyzer.stages import StageError
 REPEATS = 3
 SETTLE_S = 5.0
 SAMPLE_RATE_HZ = 100.0
+#: ours (ENU, yaw from east) minus Fusion's default NWU yaw (from north), in the same body [deg]
+NWU_TO_ENU_DEG = 90.0
 #: the matcher's fingerprint_fill_dbm default (firmware/core/sf_params.h)
 FILL_DBM = -100.0
 KNN_RPS = 2000
@@ -78,9 +85,27 @@ def _triad_q0(acc: np.ndarray, mag: np.ndarray) -> np.ndarray:
     return np.array([qw, qx, qy, qz])
 
 
-def measure_madgwick_peer(samples: Path, repeats: int = REPEATS) -> dict[str, Any]:
+def _wrapped_deg(a: np.ndarray) -> np.ndarray:
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def read_yaw(path: Path, t_s: np.ndarray) -> np.ndarray:
+    """Our yaw [deg] from a ``sf_core_cost yaw`` file (``t_s yaw_rad`` per IMU sample), checked to be on
+    the samples' times ``t_s``."""
+    y = np.loadtxt(path, ndmin=2)
+    if y.shape != (len(t_s), 2) or not np.allclose(y[:, 0], t_s, rtol=0.0, atol=1e-5):
+        raise StageError(
+            f"perf peers: {path}: want 't_s yaw_rad' on the {len(t_s)} sample times, got {y.shape}"
+        )
+    return np.degrees(y[:, 1])
+
+
+def measure_madgwick_peer(
+    samples: Path, repeats: int = REPEATS, ours_yaw: Path | None = None
+) -> dict[str, Any]:
     """Madgwick (ahrs) and Fusion (imufusion's Python API) on the samples file: wall time per sample and
-    their yaw agreement (module docstring)."""
+    their yaw agreement, and with ``ours_yaw`` (a ``sf_core_cost yaw`` file of the same walk) ours
+    against Fusion's (module docstring)."""
     import ahrs  # noqa: PLC0415 - bench-only dependencies
     import imufusion  # noqa: PLC0415
     from ahrs.filters import Madgwick  # noqa: PLC0415
@@ -110,9 +135,22 @@ def measure_madgwick_peer(samples: Path, repeats: int = REPEATS) -> dict[str, An
     m_s, q_m = _median_wall_s(madgwick, repeats)
     f_s, q_f = _median_wall_s(fusion, repeats)
     settled = d[:, 0] - d[0, 0] >= SETTLE_S
-    dyaw = (_yaw_deg(q_m) - _yaw_deg(q_f) + 180.0) % 360.0 - 180.0
+    yaw_f = _yaw_deg(q_f)
+    dyaw = _wrapped_deg(_yaw_deg(q_m) - yaw_f)
     n = len(d)
-    return {
+    ours: dict[str, Any] = {}
+    if ours_yaw is not None:
+        dours = _wrapped_deg(read_yaw(ours_yaw, d[:, 0]) - (yaw_f + NWU_TO_ENU_DEG))[settled]
+        ours = {
+            "ours_vs_fusion": (
+                f"our attitude's yaw (sf_core_cost yaw, ENU) - Fusion's (NWU) + {NWU_TO_ENU_DEG:.0f} deg, wrapped, "
+                f"over the {int(settled.sum())} samples after {SETTLE_S:.0f} s"
+            ),
+            "ours_vs_fusion_yaw_rms_deg": float(np.sqrt(np.mean(dours**2))),
+            "ours_vs_fusion_yaw_max_abs_deg": float(np.max(np.abs(dours))),
+            "ours_vs_fusion_yaw_mean_deg": float(np.mean(dours)),
+        }
+    return ours | {
         "measured": (
             f"wall time per IMU sample, median of {repeats} runs over the {n} samples of sf_core_cost samples "
             f"(gyro + accel + mag on every sample at {SAMPLE_RATE_HZ:.0f} Hz), file parsing excluded; "
@@ -268,7 +306,13 @@ def format_rows(att: dict[str, Any], knn: dict[str, Any]) -> list[str]:
         f"  attitude peers, wall time per sample ({att['samples']} samples, median of {REPEATS}, Python): "
         f"ahrs Madgwick MARG {att['madgwick_us_per_sample']:,.1f} us, imufusion Python API "
         f"{att['fusion_python_us_per_sample']:,.1f} us; yaw Madgwick vs Fusion after {SETTLE_S:.0f} s: "
-        f"RMS {att['yaw_rms_diff_deg']:.2f} deg, max {att['yaw_max_abs_diff_deg']:.2f} deg",
+        f"RMS {att['yaw_rms_diff_deg']:.2f} deg, max {att['yaw_max_abs_diff_deg']:.2f} deg"
+        + (
+            f"; ours vs Fusion: RMS {att['ours_vs_fusion_yaw_rms_deg']:.2f} deg, max "
+            f"{att['ours_vs_fusion_yaw_max_abs_deg']:.2f} deg, mean {att['ours_vs_fusion_yaw_mean_deg']:+.2f} deg"
+            if "ours_vs_fusion_yaw_rms_deg" in att
+            else ""
+        ),
         format_knn_row(knn, "the synthetic map"),
     ]
 

@@ -67,6 +67,8 @@ def test_the_attitude_peer_runs_on_the_same_samples(harness, tmp_path, monkeypat
     monkeypatch.setattr(perf, "SENSOR_SECONDS", 10)
     peer = perf.measure_attitude_peer(harness, tmp_path)
     assert peer["samples"] == 1000
+    # our yaw on the same walk, one line per sample, for the heading agreement with Fusion
+    assert len((tmp_path / "perf.yaw.txt").read_text().splitlines()) == 1000
     assert 100 < peer["ir_per_sample"] < 2000
 
 
