@@ -93,7 +93,8 @@
  * site load. The scratch is left as found (n_common and ap_query_w all zero) on every return.
  * Cost. sf_fingerprint_prepare: O(n_ap + n_rp + n_entries), once per map (and again after
  * fingerprint_fill_dbm, _nb_p_min, _min_rssi_dbm, _map_level or _powed_beta change). sf_fingerprint_match: O(n_scan·255) to store the
- * scan, O(m log m) (m ≤ 1020) to build the query, O(|Q| log n_ap) lookups, then either the full visit,
+ * scan (O(n_scan) when its BSSIDs come ascending), O(m log m) (m ≤ 1020) to build the query (O(m) when
+ * one ascending scan is averaged), O(|Q| log n_ap) lookups, then either the full visit,
  * O(E_Q) for the visited entries (E_Q = total entries of the used APs; one log and one division per
  * entry for naive Bayes) and O(T·k) to select among the T touched RPs, or the pre-selection,
  * O(E_S + T_S log C + C·e) (E_S: the S APs' entries, T_S ≤ E_S the RPs they reach, C = preselect_rps,

@@ -15,6 +15,9 @@ static int32_t filter_scan(sf_fingerprint_t *const fp, const sf_params_t *const 
                            int32_t *const weak, int32_t *const unknown)
 {
     int32_t n = 0;
+    /* an upper bound on the AP indices kept so far: a reading above it cannot repeat one, so the
+     * usual scan (BSSIDs ascending, as receivers and importers list them) skips the O(n) search */
+    int32_t ap_bound = -1;
     for (int32_t i = 0; i < scan->n_ap; i++) {
         const float v = scan->rssi_dbm[i];
         if (!isfinite(v)) {
@@ -30,10 +33,11 @@ static int32_t filter_scan(sf_fingerprint_t *const fp, const sf_params_t *const 
             (*unknown)++;
             continue;
         }
-        int32_t j = 0;
+        int32_t j = a > ap_bound ? n : 0;
         while (j < n && ap[j] != (uint16_t)a) {
             j++;
         }
+        ap_bound = a > ap_bound ? a : ap_bound;
         if (j < n) { /* repeated BSSID: keep the strongest */
             rssi[j] = v > rssi[j] ? v : rssi[j];
             continue;
@@ -152,8 +156,18 @@ void sf_fp_build_query(sf_fingerprint_t *const fp, sf_fingerprint_workspace_t *c
         }
         n_scans++;
     }
-    /* cppcheck-suppress uninitvar ; sf_sort reads only the n readings written above (none when n = 0) */
-    sf_sort(readings, n, sizeof readings[0], reading_cmp);
+    /* One scan of ascending BSSIDs is in order already (its APs are distinct): the check is O(n), the
+     * sort O(n log n) with a call per comparison. Keys are distinct (an AP once per scan), so either
+     * way gives the same order. */
+    bool sorted = true;
+    for (int32_t i = 1; i < n && sorted; i++) {
+        /* cppcheck-suppress uninitvar ; only the n readings written above are read */
+        sorted = reading_cmp(&readings[i - 1], &readings[i]) < 0;
+    }
+    if (!sorted) {
+        /* cppcheck-suppress uninitvar ; sf_sort reads only the n readings written above (none when n = 0) */
+        sf_sort(readings, n, sizeof readings[0], reading_cmp);
+    }
     ws->n_query = 0;
     fp->audit.n_scans_averaged = n_scans;
     fp->audit.n_unknown = fp->ring[fp->newest].n_unknown;

@@ -454,6 +454,16 @@ static void test_duplicates_and_unknown(void **state)
     assert_int_equal(match3(&fp, &p, &map, &m, 2, 4, bd, rd, &fix), SF_OK);
     assert_near(m.ws.query_rssi_dbm[0], -45.0, 0.0);
     assert_near(fix.y_m, 1.5248295278, 1e-9);
+    /* the same readings in descending BSSID order (no fast path for the repeat, the query sorted):
+     * the same query and fix, to the bit */
+    const int64_t bv[4] = {0x300, 0x100, 0x200, 0x100};
+    const float rv[4] = {-60, -45, -62, -50};
+    sf_fingerprint_t fv;
+    sf_fingerprint_init(&fv);
+    sf_fix_t fix_v = {0};
+    assert_int_equal(match3(&fv, &p, &map, &m, 2, 4, bv, rv, &fix_v), SF_OK);
+    assert_true(fix_v.x_m == fix.x_m && fix_v.y_m == fix.y_m && fix_v.accuracy_m == fix.accuracy_m);
+    assert_near(m.ws.query_rssi_dbm[0], -45.0, 0.0);
 }
 
 /* A map of 300 APs, all heard at both of its RPs (r0 strong, r1 weak). */
