@@ -64,7 +64,8 @@ class LineReader:
                 for line_no, line in enumerate(f, 1):
                     self.n_lines += 1
                     line = line.rstrip("\r\n")
-                    if line.strip():
+                    # = line.strip() != "" without building the stripped copy
+                    if line and not line.isspace():
                         yield line_no, line
         except OSError as exc:
             raise self.error(self.path, f"cannot read ({exc.strerror or exc})") from exc
