@@ -8,6 +8,7 @@
 
 #include "sf_error.h"
 #include "sf_options.h"
+#include "sf_workspace.h"
 
 static struct {
     char path[SF_OPTIONS_PATH_MAX];
@@ -15,6 +16,8 @@ static struct {
     sf_site_store_t store;
     sf_site_t site;
     int loaded;
+    sf_fingerprint_workspace_t ws; /* for site.radiomap, as the last run left it; ws_memory NULL: none yet */
+    void *ws_memory;
 } cached;
 
 int sf_batch_site(const char *const path, sf_site_t *const site, char *const err, const size_t err_size)
@@ -42,8 +45,30 @@ int sf_batch_site(const char *const path, sf_site_t *const site, char *const err
 
 void sf_batch_site_free(void)
 {
+    sf_workspace_free(cached.ws_memory);
+    cached.ws_memory = NULL;
+    memset(&cached.ws, 0, sizeof cached.ws);
     sf_site_store_free(&cached.store);
     cached.loaded = 0;
+}
+
+int sf_batch_workspace(const sf_radiomap_t *const map, sf_fingerprint_workspace_t *const ws)
+{
+    if (cached.ws_memory == NULL) {
+        if (sf_workspace_alloc(map, &cached.ws, &cached.ws_memory) != SF_OK) {
+            return SF_EIO;
+        }
+        cached.ws.reuse_prepared = true; /* the site's arrays are const while it is cached */
+    }
+    *ws = cached.ws;
+    return SF_OK;
+}
+
+void sf_batch_workspace_keep(const sf_fingerprint_workspace_t *const ws)
+{
+    if (cached.ws_memory != NULL && ws->rp_fill_sq_db2 == cached.ws.rp_fill_sq_db2) {
+        cached.ws = *ws; /* what it was prepared for, with the arrays it filled */
+    }
 }
 
 int sf_batch_run(const char *const path, int (*const run)(int argc, char **argv), FILE *const out)

@@ -33,7 +33,6 @@
 #include "sf_summary.h"
 #include "sf_site.h"
 #include "sf_particle_mem.h"
-#include "sf_workspace.h"
 
 #ifndef SF_VERSION
 #define SF_VERSION "0.0.0"
@@ -53,8 +52,7 @@ typedef struct {
     sf_lcm_out_t *out;
     sf_estimator_t est;
     sf_site_t site; /* a view of sf_batch_site's copy */
-    sf_fingerprint_workspace_t ws;
-    void *ws_memory;
+    sf_fingerprint_workspace_t ws; /* a copy of sf_batch_workspace's, handed back at the end */
     sf_particle_mem_t particle_mem; /* the particle scheme's cloud and the site's wall index */
     char log_path[SF_LOG_FILE_PATH_MAX];
     long messages_printed;
@@ -387,7 +385,7 @@ static int load_site(daemon_t *const d)
         return -1;
     }
     d->params.heading_map_rotation_deg = d->site.map_rotation_deg;
-    if (sf_workspace_alloc(&d->site.radiomap, &d->ws, &d->ws_memory) != SF_OK) {
+    if (sf_batch_workspace(&d->site.radiomap, &d->ws) != SF_OK) {
         fprintf(stderr, "stridefixd: out of memory for the radio map workspace\n");
         return -1;
     }
@@ -485,7 +483,7 @@ static int run_once(const int argc, char **const argv)
         (void)sf_lcm_out_close(d.out, NULL);
     }
     sf_input_close(d.in); /* only what was opened: never stdin on --replay */
-    sf_workspace_free(d.ws_memory);
+    sf_batch_workspace_keep(&d.ws);
     sf_particle_mem_free(&d.particle_mem);
     return status;
 }

@@ -118,6 +118,13 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     if (any_pre && (!all_pre || ws->n_entries < map->n_entries || ws->n_ap < map->n_ap)) {
         return SF_EINVAL;
     }
+    if (ws->reuse_prepared && ws->prepared && ws->map_entry_mean_dbm == map->entry_mean_dbm &&
+        ws->map_n_ap == map->n_ap && ws->map_n_rp == map->n_rp && ws->map_n_entries == map->n_entries &&
+        ws->fill_dbm == p->fingerprint_fill_dbm && ws->nb_p_min == p->fingerprint_nb_p_min &&
+        ws->min_rssi_dbm == p->fingerprint_min_rssi_dbm && ws->map_level == p->fingerprint_map_level &&
+        ws->powed_beta == p->fingerprint_powed_beta) {
+        return SF_OK; /* the scratch is all zero between calls, the prepared arrays are this map's */
+    }
     ws->prepared = false;
     if (sf_radiomap_check(map, NULL) != SF_OK || map->n_ap > SF_FINGERPRINT_MAX_MAP_APS) {
         return SF_ERANGE;
@@ -147,6 +154,7 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
     ws->map_n_ap = map->n_ap;
     ws->map_n_rp = map->n_rp;
     ws->map_n_entries = map->n_entries;
+    ws->map_entry_mean_dbm = map->entry_mean_dbm;
     ws->fill_dbm = fill;
     ws->nb_p_min = p_min;
     ws->min_rssi_dbm = p->fingerprint_min_rssi_dbm;

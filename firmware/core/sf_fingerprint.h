@@ -157,8 +157,13 @@ typedef struct {
     double *rp_entry_level_db;  /* [n_entries] prepared: g(μ) RP-major; 0 = censored */
     double *entry_level_db;     /* [n_entries] prepared, AP-major: g(μ) as the full visit uses it; −1 = censored */
     double *ap_query_w;         /* [n_ap] scratch: −2·g(s) of a used AP, 0 for the others */
+    /* set by the caller: the map is never changed in place, so a workspace already prepared for it
+     * (the same arrays, the same counts) with the same parameters is kept as it is (a process that
+     * replays many walks on one site prepares it once) */
+    bool reuse_prepared;
     /* set by sf_fingerprint_prepare */
     bool prepared;
+    const float *map_entry_mean_dbm; /* the map's arrays it was prepared for (with the counts below) */
     int32_t map_n_ap, map_n_rp, map_n_entries; /* the map it was prepared for */
     double fill_dbm, nb_p_min, min_rssi_dbm;    /* the parameters it was prepared with */
     int32_t map_level;

@@ -419,6 +419,42 @@ static void test_averaging(void **state)
     assert_near(m.ws.query_rssi_dbm[0], -42.5, 0.0);
 }
 
+/* reuse_prepared: a workspace prepared for the same map arrays and the same parameters is kept as it is
+ * (a sentinel in its prepared arrays survives); another parameter the preparation reads, another map,
+ * or reuse_prepared off prepares it again. */
+static void test_reuse_prepared(void **state)
+{
+    (void)state;
+    const sf_radiomap_t map = tiny_map(k_floor0);
+    sf_params_t p = params(0, 0);
+    ws_mem_t m;
+    ws_setup(&m, 4);
+    m.ws.reuse_prepared = true;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    const double fill0 = m.ws.rp_fill_sq_db2[0];
+    m.ws.rp_fill_sq_db2[0] = 12345.0;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_true(m.ws.rp_fill_sq_db2[0] == 12345.0); /* kept */
+    p.fingerprint_powed_beta = 2.0;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_true(m.ws.rp_fill_sq_db2[0] != 12345.0); /* prepared again for the new representation */
+    p.fingerprint_powed_beta = 1.0;
+    m.ws.reuse_prepared = false;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_true(m.ws.rp_fill_sq_db2[0] == fill0);
+    m.ws.rp_fill_sq_db2[0] = 12345.0;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &map, &p), SF_OK);
+    assert_true(m.ws.rp_fill_sq_db2[0] == fill0); /* off: always prepared */
+    m.ws.reuse_prepared = true;
+    static float mean_copy[11]; /* another map of the same counts and levels: its own arrays */
+    memcpy(mean_copy, map.entry_mean_dbm, sizeof mean_copy);
+    sf_radiomap_t other = map;
+    other.entry_mean_dbm = mean_copy;
+    m.ws.rp_fill_sq_db2[0] = 12345.0;
+    assert_int_equal(sf_fingerprint_prepare(&m.ws, &other, &p), SF_OK);
+    assert_true(m.ws.rp_fill_sq_db2[0] == fill0);
+}
+
 /* A repeated BSSID keeps its strongest reading; readings of APs the map lacks are counted, not kept, so
  * however many there are they never crowd out the map's APs. */
 static void test_duplicates_and_unknown(void **state)
@@ -926,6 +962,7 @@ int main(void)
         cmocka_unit_test(test_misuse),
         cmocka_unit_test(test_averaging),
         cmocka_unit_test(test_duplicates_and_unknown),
+        cmocka_unit_test(test_reuse_prepared),
         cmocka_unit_test(test_truncation_and_pool),
         cmocka_unit_test(test_map_level_and_censoring),
         cmocka_unit_test(test_powed_representation),

@@ -429,7 +429,8 @@ def test_inner_cv_replay_mode_scores_as_the_stage_replays_did(realbench_fusion_s
 
 def test_a_batch_replays_as_separate_processes_do(realbench_fusion_small, tmp_path):
     """`stridefixd --batch FILE` (the inner cross-validation's replays, realbench.select.replay_batch):
-    GIVEN two real walks on one site, with and without a setting, and a replay that cannot run,
+    GIVEN two real walks on one site, without a setting, again (the site's workspace kept prepared:
+    reuse_prepared), with a setting the preparation depends on, and a replay that cannot run,
     WHEN run in one batch and each alone, THEN every channel but HEALTH (its loop timing is the
     host's) is the same, message for message, and the batch reports each exit status."""
     from stridefix_analyzer.firmware import Firmware
@@ -442,12 +443,12 @@ def test_a_batch_replays_as_separate_processes_do(realbench_fusion_small, tmp_pa
     runs = [
         {"input": f"lcmlog:{imp}", "site": site, "sets": [*MSINDOOR_SETS, *extra]}
         for imp in imports
-        for extra in ([], ["fingerprint.powed_beta=2"])
+        for extra in ([], [], ["fingerprint.powed_beta=2"])
     ]
     fw = Firmware(r["stridefixd"])
     batch = [{**kw, "log": tmp_path / f"batch{i}.lcmlog"} for i, kw in enumerate(runs)]
     missing = {"input": f"lcmlog:{tmp_path / 'missing.lcmlog'}", "log": tmp_path / "missing_out.lcmlog"}
-    assert fw.run_batch([*batch, missing], tmp_path / "jobs.batch") == [0, 0, 0, 0, 2]
+    assert fw.run_batch([*batch, missing], tmp_path / "jobs.batch") == [0] * len(runs) + [2]
     channels = [c for c in KNOWN_CHANNELS if c != "HEALTH"]
     for i, kw in enumerate(runs):
         alone = tmp_path / f"alone{i}.lcmlog"
