@@ -166,12 +166,14 @@ static uint64_t eight_digits(uint64_t w)
            32;
 }
 
-/* 16 hex digits (either case) at p as 8 bytes into out; false when one is not a hex digit. A byte b
- * below 0x80 is in [lo, hi] when b + (0x80 - lo) has its high bit and b + (0x7F - hi) has not; the
- * letters are tested on b | 0x20, which folds 'A'-'F' onto 'a'-'f' and nothing else onto them. */
-static bool sixteen_hex(const char *const p, uint8_t out[8])
+/* 16 hex digits (either case) at p as 8 bytes, the first in the lowest (*bytes); false when one is
+ * not a hex digit. A byte b below 0x80 is in [lo, hi] when b + (0x80 - lo) has its high bit and
+ * b + (0x7F - hi) has not; the letters are tested on b | 0x20, which folds 'A'-'F' onto 'a'-'f' and
+ * nothing else onto them. */
+static bool sixteen_hex(const char *const p, uint64_t *const bytes)
 {
-    for (int half = 0; half < 2; half++) {
+    uint64_t all = 0;
+    for (unsigned half = 0; half < 2u; half++) {
         const uint64_t w = load8(p + 8 * half);
         const uint64_t folded = w | (0x20u * ONES);
         const uint64_t digit = (w + 0x50u * ONES) & ~(w + 0x46u * ONES);
@@ -183,9 +185,9 @@ static bool sixteen_hex(const char *const p, uint8_t out[8])
         uint64_t v = ((nibbles << 4) | (nibbles >> 8)) & 0x00FF00FF00FF00FFULL; /* bytes 0, 2, 4, 6 */
         v = (v | (v >> 8)) & 0x0000FFFF0000FFFFULL;
         v = (v | (v >> 16)) & 0xFFFFFFFFULL;
-        const uint32_t four = (uint32_t)v;
-        memcpy(out + 4 * half, &four, sizeof four);
+        all |= v << (32u * half);
     }
+    *bytes = all;
     return true;
 }
 
@@ -215,14 +217,18 @@ static int fast_line(const char *const line, const size_t len, sf_can_frame_t *c
     if (kind_of(tail[0]) != BLANK || tail[4] != '#' || i0 > 7u || i1 > 15u || i2 > 15u) {
         return SF_ESYNTAX; /* i0 > 7: not a hex digit, or an id above 0x7FF */
     }
-    sf_can_frame_t f = {.host_t_us = (int64_t)((eight_digits(s8) * 100u + s9 * 10u + s10) * 1000000u +
-                                               eight_digits(u6)),
-                        .id = i0 << 8 | i1 << 4 | i2,
-                        .dlc = 8};
-    if (!sixteen_hex(tail + 5, f.data)) {
+    uint64_t data;
+    if (!sixteen_hex(tail + 5, &data)) {
         return SF_ESYNTAX;
     }
-    *frame = f;
+    /* field by field, the data in one store: a frame built aside and copied whole stalled on reading
+     * back its data's narrower stores (store forwarding: a fifth of the function's cycles, perf) */
+    frame->host_t_us = (int64_t)((eight_digits(s8) * 100u + s9 * 10u + s10) * 1000000u + eight_digits(u6));
+    frame->id = i0 << 8 | i1 << 4 | i2;
+    frame->extended = false;
+    frame->remote = false;
+    frame->dlc = 8;
+    memcpy(frame->data, &data, sizeof data);
     return SF_OK;
 }
 #endif
