@@ -255,6 +255,9 @@ static void drain_contexts(daemon_t *const d)
  * kind added to SF_RX_KINDS without a case here stops the build (-Wswitch, -Werror). */
 static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
 {
+    if (ev->kind == sf_rx_none) {
+        return; /* no sample (4 in 10 replay frames): nothing to log or feed, so no controller event */
+    }
     if (sf_options_channel_on(&d->opt, sf_rx_lcm_channel(ev->kind))) {
         sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
     }

@@ -404,8 +404,9 @@ static void feed_both(side_t *const a, side_t *const b, const frame_t *const f, 
     } else {
         int64_t ta = 0, tb = 0, ua = 0, ub = 0;
         uint32_t la = 0, lb = 0;
-        const int ra = sf_stream_time_resolve(&a->st[f->stream], &a->clock, f->seq, f->t_lo, f->host_us, &ta, &ua, &la);
-        const int rb = ref_stream_time_resolve(&b->st[f->stream], &b->clock, f->seq, f->t_lo, f->host_us, &tb, &ub, &lb);
+        const int i = f->stream;
+        const int ra = sf_stream_time_resolve(&a->st[i], &a->clock, f->seq, f->t_lo, f->host_us, &ta, &ua, &la);
+        const int rb = ref_stream_time_resolve(&b->st[i], &b->clock, f->seq, f->t_lo, f->host_us, &tb, &ub, &lb);
         if (ra != rb || ta != tb || ua != ub || la != lb) {
             fail_msg("stream %d seq %u t_lo %u host %lld: %d t %lld useq %lld lost %u; reference %d t %lld useq %lld "
                      "lost %u", f->stream, f->seq, f->t_lo, (long long)f->host_us, ra, (long long)ta, (long long)ua,
