@@ -44,11 +44,6 @@
 
 #define LOG_QUEUE_MESSAGES 8192
 #define LOG_NAME_ATTEMPTS 100 /* default names tried before giving up (each one EEXIST) */
-/* HEALTH's loop timing reads the clock twice an item, ~30 ns each here: a tenth of a file replay's
- * CPU (1 M items an hour of walking). A replay of a regular file therefore times one item in 16, the
- * first included (loop_mean_us stays the mean of an item's time, loop_max_us is the sampled items'
- * max); any other input, a live bus at a few hundred frames a second, times every item. */
-#define LOOP_STRIDE_FILE 16u
 
 typedef struct {
     sf_options_t opt;
@@ -70,8 +65,6 @@ typedef struct {
     int16_t last_pose_floor;
     bool config_written;
     sf_publish_loop_t loop;
-    unsigned loop_stride;    /* items per timed item (HEALTH's loop timing) */
-    unsigned loop_countdown; /* items until the next timed one */
     sf_publish_sources_t sources; /* fixes offered and made, by source */
 } daemon_t;
 
@@ -255,9 +248,6 @@ static void drain_contexts(daemon_t *const d)
  * kind added to SF_RX_KINDS without a case here stops the build (-Wswitch, -Werror). */
 static void feed(daemon_t *const d, const sf_rx_event_t *const ev)
 {
-    if (ev->kind == sf_rx_none) {
-        return; /* no sample (4 in 10 replay frames): nothing to log or feed, so no controller event */
-    }
     if (sf_options_channel_on(&d->opt, sf_rx_lcm_channel(ev->kind))) {
         sf_rx_lcm_write(d->out, d->host_t_us, ev); /* the raw input first, as it came */
     }
@@ -291,30 +281,23 @@ static double monotonic_us(void)
 }
 
 /* One input item: CONFIG before the first, the sample fed, HEALTH every output.health_period_ms of
- * board time, and the loop timing of one item in loop_stride (see LOOP_STRIDE_FILE). */
+ * board time, and the loop timing (of one item in loop.stride: sf_publish.h). */
 static void handle(daemon_t *const d, const sf_input_item_t *const item)
 {
     d->host_t_us = item->log_t_us;
     write_config(d);
-    const bool timed = --d->loop_countdown == 0;
+    const bool timed = sf_publish_loop_due(&d->loop);
     const double t0 = timed ? monotonic_us() : 0.0;
     if (item->status < 0) {
         complain(d, item->status);
-    } else {
+    } else if (item->event.kind != sf_rx_none) { /* 4 in 10 replay frames: no sample, no controller event */
         feed(d, &item->event);
     }
     if (d->board_t_us - d->last_health_t_us >= (int64_t)d->params.output_health_period_ms * 1000) {
         write_health(d);
     }
-    if (!timed) {
-        return;
-    }
-    d->loop_countdown = d->loop_stride;
-    const double dt = monotonic_us() - t0;
-    d->loop.sum_us += dt;
-    d->loop.n++;
-    if (dt > d->loop.max_us) {
-        d->loop.max_us = dt;
+    if (timed) {
+        sf_publish_loop_add(&d->loop, monotonic_us() - t0);
     }
 }
 
@@ -456,8 +439,7 @@ static int serve(daemon_t *const d)
                 d->particle_mem.grid_bytes, (int)d->site.ports.n_ports);
     }
     d->last_pose_t_us = INT64_MIN / 2;
-    d->loop_stride = sf_input_is_regular_file(d->in) ? LOOP_STRIDE_FILE : 1u;
-    d->loop_countdown = 1;
+    d->loop.stride = sf_input_is_regular_file(d->in) ? SF_PUBLISH_LOOP_STRIDE_FILE : 1u;
     const double t0 = monotonic_us();
     int status = run(d);
     sf_lcm_out_counters_t oc;
