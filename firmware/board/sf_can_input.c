@@ -76,6 +76,7 @@ int sf_can_input_open(sf_can_input_t *const in, const char *const spec, char *er
     }
     memset(in, 0, sizeof *in);
     in->fd = -1;
+    in->line = "";
     snprintf(in->name, sizeof in->name, "%s", spec);
     if (strncmp(spec, SF_CAN_INPUT_SOCKETCAN_PREFIX, strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX)) == 0) {
         return open_socketcan(in, spec + strlen(SF_CAN_INPUT_SOCKETCAN_PREFIX), err_text, err_size);
@@ -166,7 +167,7 @@ static int fill(sf_can_input_t *const in)
 
 /* The longest line taken whole (without its newline): what fgets into line[512] took, 510
  * characters and the newline; a longer one is skipped as bad syntax. */
-#define LINE_MAX_CHARS (sizeof(((sf_can_input_t *)0)->line) - 2)
+#define LINE_MAX_CHARS (sizeof(((sf_can_input_t *)0)->overlong) - 2)
 
 /* The rest of an overlong line, up to and with its newline: 1 done, or as fill. */
 static int skip_rest(sf_can_input_t *const in)
@@ -189,11 +190,12 @@ static int skip_rest(sf_can_input_t *const in)
     }
 }
 
-/* The next line from the chunk buffer (a line per call, no copy until it is whole): the candump
- * replay read a million lines an hour through fgets + strlen at ~170 instructions a line, here one
- * memchr. Lines as fgets read them: blank ones skipped, trailing CR/LF dropped, an overlong one bad
- * syntax; a NUL inside a line makes it bad syntax (regression: with fgets, strlen stopped at the NUL,
- * the line looked cut short and the line after it was swallowed as its rest). */
+/* The next line from the chunk buffer (a line per call, no copy): the candump replay read a million
+ * lines an hour through fgets + strlen at ~170 instructions a line, here one memchr, and the line is
+ * parsed where it lies (in->line points at it). Lines as fgets read them: blank ones skipped, trailing
+ * CR/LF dropped, an overlong one bad syntax; a NUL inside a line makes it bad syntax (regression: with
+ * fgets, strlen stopped at the NUL, the line looked cut short and the line after it was swallowed as
+ * its rest). */
 static int next_line(sf_can_input_t *const in, sf_can_frame_t *const frame)
 {
     if (in->chunk == NULL) {
@@ -227,8 +229,9 @@ static int next_line(sf_can_input_t *const in, sf_can_frame_t *const frame)
         size_t len = nl != NULL ? (size_t)(nl - start) : avail;
         in->line_no++;
         if (len > LINE_MAX_CHARS) { /* longer than any candump line: skipped, its start kept for the message */
-            memcpy(in->line, start, sizeof in->line - 1);
-            in->line[sizeof in->line - 1] = '\0';
+            memcpy(in->overlong, start, sizeof in->overlong - 1);
+            in->overlong[sizeof in->overlong - 1] = '\0';
+            in->line = in->overlong;
             in->chunk_pos += nl != NULL ? len + 1 : avail;
             in->skipping = nl == NULL;
             return SF_ESYNTAX;
@@ -237,12 +240,12 @@ static int next_line(sf_can_input_t *const in, sf_can_frame_t *const frame)
         while (len > 0 && start[len - 1] == '\r') {
             len--;
         }
-        memcpy(in->line, start, len);
-        in->line[len] = '\0';
+        start[len] = '\0'; /* over its newline (or CR), or the byte after the chunk's last: parsed in place */
+        in->line = start;
         if (len == 0) {
             continue; /* blank lines are not frames */
         }
-        return sf_candump_parse_line(in->line, len, frame) == SF_OK ? 1 : SF_ESYNTAX;
+        return sf_candump_parse_line(start, len, frame) == SF_OK ? 1 : SF_ESYNTAX;
     }
 }
 

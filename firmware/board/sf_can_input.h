@@ -27,7 +27,9 @@ typedef struct {
     FILE *file;     /* file kind */
     int fd;         /* socketcan kind */
     long line_no;   /* file kind: number of the line last read (1-based) */
-    char line[512]; /* file kind: the line last read, newline stripped, for messages */
+    const char *line; /* file kind: the line last read, newline stripped, for messages; in the read
+                       * buffer (or overlong), valid until the next call */
+    char overlong[512]; /* file kind: the start of a line too long to be a candump line */
     char *chunk;    /* file kind: SF_CAN_INPUT_CHUNK_BYTES read ahead (malloc'd at the first read) */
     size_t chunk_len, chunk_pos; /* bytes in chunk, and consumed */
     bool eof;       /* the end was read */

@@ -1,6 +1,7 @@
 /* sf_candump.c — strict reader and writer of candump -L lines (see sf_candump.h). */
 #include "sf_candump.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -130,11 +131,118 @@ int sf_candump_parse(const char *const line, sf_can_frame_t *const frame)
     return parse(line, frame, &end);
 }
 
+/* ---- the replay's own shape, eight characters a step ---------------------------------------------
+ * Nearly every line of a board's candump is one shape: "(" 10 + 6 digits ") " iface " " 3 hex "#" 16
+ * hex. fast_line reads such a line with word-wide (SWAR) tests and arithmetic on 8 characters at a
+ * time (~90 instructions instead of ~430) and hands every other line, and any doubt, to parse(): it
+ * accepts only lines parse() accepts, with the same frame (test_candump_model holds both to the
+ * reference parser). The words are loaded in little-endian byte order; elsewhere parse() does all. */
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define FAST_LINE 1
+#define ONES 0x0101010101010101ULL
+#define HIGH (0x80u * ONES)
+
+static uint64_t load8(const char *const p)
+{
+    uint64_t w;
+    memcpy(&w, p, sizeof w);
+    return w;
+}
+
+/* Whether all 8 bytes of w are decimal digits. */
+static bool all_digits(const uint64_t w)
+{
+    return (w & (0xF0u * ONES)) == 0x30u * ONES && (((w + 0x06u * ONES) & (0xF0u * ONES)) == 0x30u * ONES);
+}
+
+/* The value of 8 decimal digits, the first in the lowest byte (Lemire's eight-digit SWAR parse). */
+static uint64_t eight_digits(uint64_t w)
+{
+    w -= 0x30u * ONES;
+    w = w * 10u + (w >> 8);
+    return (((w & 0x000000FF000000FFULL) * (100u + (1000000ULL << 32))) +
+            (((w >> 16) & 0x000000FF000000FFULL) * (1u + (10000ULL << 32)))) >>
+           32;
+}
+
+/* 16 hex digits (either case) at p as 8 bytes, the first in the lowest (*bytes); false when one is
+ * not a hex digit. A byte b below 0x80 is in [lo, hi] when b + (0x80 - lo) has its high bit and
+ * b + (0x7F - hi) has not; the letters are tested on b | 0x20, which folds 'A'-'F' onto 'a'-'f' and
+ * nothing else onto them. */
+static bool sixteen_hex(const char *const p, uint64_t *const bytes)
+{
+    uint64_t all = 0;
+    for (unsigned half = 0; half < 2u; half++) {
+        const uint64_t w = load8(p + 8 * half);
+        const uint64_t folded = w | (0x20u * ONES);
+        const uint64_t digit = (w + 0x50u * ONES) & ~(w + 0x46u * ONES);
+        const uint64_t letter = (folded + 0x1Fu * ONES) & ~(folded + 0x19u * ONES);
+        if ((w & HIGH) != 0 || ((digit | letter) & HIGH) != HIGH) {
+            return false;
+        }
+        const uint64_t nibbles = (w & (0x0Fu * ONES)) + ((letter & HIGH) >> 7) * 9u;
+        uint64_t v = ((nibbles << 4) | (nibbles >> 8)) & 0x00FF00FF00FF00FFULL; /* bytes 0, 2, 4, 6 */
+        v = (v | (v >> 8)) & 0x0000FFFF0000FFFFULL;
+        v = (v | (v >> 16)) & 0xFFFFFFFFULL;
+        all |= v << (32u * half);
+    }
+    *bytes = all;
+    return true;
+}
+
+/* SF_OK with *frame for a line of the replay's shape that parse() accepts, else SF_ESYNTAX: then
+ * parse() decides. line[0..len) is the line; line[len] is not read. */
+static int fast_line(const char *const line, const size_t len, sf_can_frame_t *const frame)
+{
+    enum { IFACE_AT = 20, TAIL = 21 }; /* "(sssssssssss.uuuuuu) " before the iface, " iii#" + 16 after */
+    if (len < IFACE_AT + 1 + TAIL || line[0] != '(' || line[11] != '.' || line[18] != ')' ||
+        kind_of(line[19]) != BLANK) {
+        return SF_ESYNTAX;
+    }
+    const uint64_t s8 = load8(line + 1);
+    const uint64_t u6 = (load8(line + 12) << 16) | 0x3030u; /* "00" and the 6 digits; ") " shifted out */
+    const unsigned s9 = (unsigned)line[9] - '0', s10 = (unsigned)line[10] - '0';
+    if (!all_digits(s8) || !all_digits(u6) || s9 > 9u || s10 > 9u) {
+        return SF_ESYNTAX;
+    }
+    const char *const tail = line + len - TAIL;
+    for (const char *c = line + IFACE_AT; c < tail; c++) { /* the iface: anything but a blank or NUL */
+        const unsigned k = kind_of(*c);
+        if (k == BLANK || k == NUL_END) {
+            return SF_ESYNTAX;
+        }
+    }
+    const unsigned i0 = kind_of(tail[1]), i1 = kind_of(tail[2]), i2 = kind_of(tail[3]);
+    if (kind_of(tail[0]) != BLANK || tail[4] != '#' || i0 > 7u || i1 > 15u || i2 > 15u) {
+        return SF_ESYNTAX; /* i0 > 7: not a hex digit, or an id above 0x7FF */
+    }
+    uint64_t data;
+    if (!sixteen_hex(tail + 5, &data)) {
+        return SF_ESYNTAX;
+    }
+    /* field by field, the data in one store: a frame built aside and copied whole stalled on reading
+     * back its data's narrower stores (store forwarding: a fifth of the function's cycles, perf) */
+    frame->host_t_us = (int64_t)((eight_digits(s8) * 100u + s9 * 10u + s10) * 1000000u + eight_digits(u6));
+    frame->id = i0 << 8 | i1 << 4 | i2;
+    frame->extended = false;
+    frame->remote = false;
+    frame->dlc = 8;
+    memcpy(frame->data, &data, sizeof data);
+    return SF_OK;
+}
+#endif
+
 int sf_candump_parse_line(const char *const line, const size_t len, sf_can_frame_t *const frame)
 {
     if (line == NULL || frame == NULL) {
         return SF_EINVAL;
     }
+#ifdef FAST_LINE
+    if (fast_line(line, len, frame) == SF_OK) {
+        return SF_OK;
+    }
+#endif
     sf_can_frame_t f;
     const char *end;
     if (parse(line, &f, &end) != SF_OK || end != line + len) {

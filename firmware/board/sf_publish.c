@@ -274,3 +274,19 @@ void sf_publish_config(sf_lcm_out_t *const out, const int64_t log_t_us, const in
     /* the header: every rotated log file starts with a copy, so each reads alone */
     SF_LCM_WRITE_AS(true, out, SF_CHANNEL_CONFIG, log_t_us, stridefix_config_t, &msg);
 }
+
+bool sf_publish_loop_due(sf_publish_loop_t *const loop)
+{
+    const bool due = loop->since == 0;
+    loop->since = loop->since + 1u >= loop->stride ? 0u : loop->since + 1u;
+    return due;
+}
+
+void sf_publish_loop_add(sf_publish_loop_t *const loop, const double dt_us)
+{
+    loop->sum_us += dt_us;
+    loop->n++;
+    if (dt_us > loop->max_us) {
+        loop->max_us = dt_us;
+    }
+}

@@ -296,11 +296,23 @@ static void test_input_nul_inside_a_line_spoils_that_line_only(void **state)
 
 #define N_CHUNK_LINES 6000
 
-/* Line i of the chunk-boundary test: a frame of i % 9 bytes, every 7th line CRLF, every 11th
- * followed by a blank line; the text into buf, its length. */
+/* Line i's time and length: every third of the shape a board's replay has (10-digit seconds, 8 bytes:
+ * the parser's fast path), the others of i % 9 bytes. */
+static int64_t numbered_t_us(const int i)
+{
+    return (i % 3 == 0 ? 1700000000000000LL : 0) + 1000000LL * i + i;
+}
+
+static uint8_t numbered_dlc(const int i)
+{
+    return i % 3 == 0 ? 8 : (uint8_t)(i % 9);
+}
+
+/* Line i of the chunk-boundary test: a frame of numbered_dlc(i) bytes at numbered_t_us(i), every 7th
+ * line CRLF, every 11th followed by a blank line; the text into buf, its length. */
 static size_t numbered_line(const int i, char *const buf, const size_t size)
 {
-    sf_can_frame_t f = {.host_t_us = 1000000LL * i + i, .id = (uint32_t)i & 0x7FFu, .dlc = (uint8_t)(i % 9)};
+    sf_can_frame_t f = {.host_t_us = numbered_t_us(i), .id = (uint32_t)i & 0x7FFu, .dlc = numbered_dlc(i)};
     for (int k = 0; k < f.dlc; k++) {
         f.data[k] = (uint8_t)(i + k);
     }
@@ -325,8 +337,9 @@ static void read_numbered_lines(sf_can_input_t *const in)
         assert_int_equal(sf_can_input_next(in, &f), 1);
         line_no += 1 + (i > 0 && (i - 1) % 11 == 0); /* the blank line after the previous one */
         assert_int_equal(in->line_no, line_no);
-        assert_int_equal(f.host_t_us, 1000000LL * i + i);
-        assert_int_equal(f.dlc, i % 9);
+        assert_int_equal(f.host_t_us, numbered_t_us(i));
+        assert_int_equal(f.id, (uint32_t)i & 0x7FFu);
+        assert_int_equal(f.dlc, numbered_dlc(i));
         for (int k = 0; k < f.dlc; k++) {
             assert_int_equal(f.data[k], (uint8_t)(i + k));
         }

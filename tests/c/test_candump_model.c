@@ -10,6 +10,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -164,7 +165,9 @@ static size_t valid_line(rng_t *const r, char *const buf, const size_t size)
     return (size_t)n;
 }
 
-static void mutate(rng_t *const r, char *const buf, size_t len, const size_t size)
+/* Mutates the line in buf (of len characters, NUL-terminated again after); its new length, which a
+ * NUL put inside it does not shorten. */
+static size_t mutate(rng_t *const r, char *const buf, size_t len, const size_t size)
 {
     const char interesting[] = {' ', '\t', '\r', '\n', '\0', '#', '.', '(', ')', 'R', '0', '9', 'a', 'f',
                                 'A', 'F', 'g', 'G', '/', ':', '@', '`', (char)0xFF, (char)0x80};
@@ -183,6 +186,7 @@ static void mutate(rng_t *const r, char *const buf, size_t len, const size_t siz
         }
     }
     buf[len] = '\0';
+    return len;
 }
 
 static void test_table_parser_agrees_with_the_reference(void **state)
@@ -208,10 +212,74 @@ static void test_table_parser_agrees_with_the_reference(void **state)
     assert_true(valid > N_LINES / 5 && invalid > N_LINES / 5); /* both verdicts well covered */
 }
 
+/* A line of the shape a board's replay has (sf_candump.c's fast_line): 10-digit seconds, a standard
+ * id of 3 hex digits (some above 0x7FF), 8 data bytes; either case, sometimes a tab. Its length. */
+static size_t replay_line(rng_t *const r, char *const buf, const size_t size)
+{
+    const char *const ifaces[] = {"can0", "vcan12", "x", "can-bus_0", "a\rb"};
+    const unsigned long long sec = 1000000000ull + (unsigned long long)(rng_uniform01(r) * 8.9e9);
+    const unsigned usec = pick(r, 1000000u), id = pick(r, 8) == 0 ? 0x800u + pick(r, 0x800u) : pick(r, 0x800u);
+    char data[17];
+    for (int i = 0; i < 16; i++) {
+        data[i] = "0123456789ABCDEF"[pick(r, 16)];
+    }
+    data[16] = '\0';
+    const int n = snprintf(buf, size, "(%llu.%06u)%c%s%c%03X#%s", sec, usec, pick(r, 8) == 0 ? '\t' : ' ',
+                           ifaces[pick(r, 5)], pick(r, 8) == 0 ? '\t' : ' ', id, data);
+    assert_true(n > 0 && (size_t)n < size);
+    if (pick(r, 4) == 0) {
+        for (int i = 0; i < n; i++) {
+            if (buf[i] >= 'A' && buf[i] <= 'F') {
+                buf[i] = (char)(buf[i] - 'A' + 'a');
+            }
+        }
+    }
+    return (size_t)n;
+}
+
+/* sf_candump_parse_line, the reader's entry (with its replay-shaped fast path), against the reference
+ * on the line up to its NUL: the same verdict and frame, except that a NUL inside the len characters
+ * is SF_ESYNTAX. Replay-shaped lines and lines of every shape, both mutated. */
+static void test_line_parser_agrees_with_the_reference(void **state)
+{
+    (void)state;
+    rng_t rng = {0x5eed1e55ULL};
+    int valid = 0, invalid = 0;
+    for (int i = 0; i < N_LINES; i++) {
+        char buf[128];
+        size_t len = i % 4 == 3 ? valid_line(&rng, buf, sizeof buf) : replay_line(&rng, buf, sizeof buf);
+        if (len > 0 && buf[len - 1] == '\n') {
+            buf[--len] = '\0'; /* the reader drops the newline */
+        }
+        len = pick(&rng, 3) == 0 ? len : mutate(&rng, buf, len, sizeof buf);
+        sf_can_frame_t a, b;
+        memset(&a, 0x5A, sizeof a);
+        memset(&b, 0x5A, sizeof b);
+        const int ra = sf_candump_parse_line(buf, len, &a);
+        int rb = reference_parse(buf, &b);
+        if (rb == SF_OK && strlen(buf) != len) {
+            rb = SF_ESYNTAX; /* a NUL inside the line */
+            memset(&b, 0x5A, sizeof b);
+        }
+        const bool same_frame = ra != SF_OK
+                                    ? memcmp(&a, &b, sizeof a) == 0
+                                    : a.host_t_us == b.host_t_us && a.id == b.id && a.extended == b.extended &&
+                                          a.remote == b.remote && a.dlc == b.dlc &&
+                                          memcmp(a.data, b.data, sizeof a.data) == 0;
+        if (ra != rb || !same_frame) {
+            fail_msg("line \"%s\" (%zu chars): parser %d, reference %d (or different frames)", buf, len, ra, rb);
+        }
+        valid += ra == SF_OK;
+        invalid += ra != SF_OK;
+    }
+    assert_true(valid > N_LINES / 5 && invalid > N_LINES / 5);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_parser_agrees_with_the_reference),
+        cmocka_unit_test(test_line_parser_agrees_with_the_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
