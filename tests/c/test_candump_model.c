@@ -189,6 +189,15 @@ static size_t mutate(rng_t *const r, char *const buf, size_t len, const size_t s
     return len;
 }
 
+/* The same verdict's frame: field by field after a parse (a struct copy need not carry its padding,
+ * e.g. clang's), every byte untouched after a refusal (both start as 0x5A). */
+static bool same_frame(const int rc, const sf_can_frame_t *const a, const sf_can_frame_t *const b)
+{
+    return rc != SF_OK ? memcmp(a, b, sizeof *a) == 0
+                       : a->host_t_us == b->host_t_us && a->id == b->id && a->extended == b->extended &&
+                             a->remote == b->remote && a->dlc == b->dlc && memcmp(a->data, b->data, sizeof a->data) == 0;
+}
+
 static void test_table_parser_agrees_with_the_reference(void **state)
 {
     (void)state;
@@ -203,7 +212,7 @@ static void test_table_parser_agrees_with_the_reference(void **state)
         memset(&b, 0x5A, sizeof b);
         const int ra = sf_candump_parse(buf, &a);
         const int rb = reference_parse(buf, &b);
-        if (ra != rb || memcmp(&a, &b, sizeof a) != 0) {
+        if (ra != rb || !same_frame(ra, &a, &b)) {
             fail_msg("line \"%s\": parser %d, reference %d (or different frames)", buf, ra, rb);
         }
         valid += ra == SF_OK;
@@ -261,12 +270,7 @@ static void test_line_parser_agrees_with_the_reference(void **state)
             rb = SF_ESYNTAX; /* a NUL inside the line */
             memset(&b, 0x5A, sizeof b);
         }
-        const bool same_frame = ra != SF_OK
-                                    ? memcmp(&a, &b, sizeof a) == 0
-                                    : a.host_t_us == b.host_t_us && a.id == b.id && a.extended == b.extended &&
-                                          a.remote == b.remote && a.dlc == b.dlc &&
-                                          memcmp(a.data, b.data, sizeof a.data) == 0;
-        if (ra != rb || !same_frame) {
+        if (ra != rb || !same_frame(ra, &a, &b)) {
             fail_msg("line \"%s\" (%zu chars): parser %d, reference %d (or different frames)", buf, len, ra, rb);
         }
         valid += ra == SF_OK;
