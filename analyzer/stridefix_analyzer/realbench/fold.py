@@ -92,6 +92,7 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
     from stridefix_analyzer.io.sitefile import write_site
     from stridefix_analyzer.radiomap.build import RadioMapInputError
     from stridefix_analyzer.scoring.analyze import run_analyze
+    from stridefix_analyzer.scoring.floor_height import from_table
     from stridefix_analyzer.scoring.metrics import MetricsInputError
 
     t0 = time.perf_counter()
@@ -174,13 +175,18 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
             "every scheme from its first fix" if tag == "fixes" else "truth-initialised"
         )
         logs = [str(fw_log), job.import_log]
+        heights = from_table(
+            site.floor_height_m, site.lowest_floor, f"the fold's site ({job.floor_heights_source})"
+        )
         try:
             try:
-                analysis, metrics = run_analyze(logs, str(adir), label=label, truth_source="waypoint")
+                analysis, metrics = run_analyze(
+                    logs, str(adir), label=label, truth_source="waypoint", heights=heights
+                )
             except MetricsInputError as exc:
                 if "source" not in str(exc):
                     raise
-                analysis, metrics = run_analyze(logs, str(adir), label=label)
+                analysis, metrics = run_analyze(logs, str(adir), label=label, heights=heights)
         except (LogReadError, MetricsInputError) as exc:
             out["error"] = f"cannot score: {exc}"
             return out
@@ -191,7 +197,8 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
 
 
 def score_walk(metrics: Any) -> dict[str, dict[str, Any]]:
-    """Per scheme of one walk: stats, floor hit rate, IPIN score and the raw per-sample errors."""
+    """Per scheme of one walk: stats, floor hit rate, IPIN score, ISO/IEC 18305 terms and the raw
+    per-sample errors."""
     from stridefix_analyzer.scoring.metrics import scored_errors
 
     res = {}
@@ -202,6 +209,7 @@ def score_walk(metrics: Any) -> dict[str, dict[str, Any]]:
             "unscored": s.summary["unscored"],
             "floor_hit_rate": s.summary["floor_hit_rate"],
             "ipin_score": s.summary["ipin_score"],
+            "iso18305": s.summary["iso18305"],
             "errors_m": err.tolist(),
             "floor_errors": ferr.tolist(),
         }

@@ -41,8 +41,10 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.scoring import floor_height, iso18305
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
+from stridefix_analyzer.scoring.floor_height import FloorHeightError, FloorHeights
 from stridefix_analyzer.scoring.metrics import (
     IPIN_FLOOR_PENALTY_M,
     Metrics,
@@ -102,6 +104,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         metavar="DIR",
         help="also write TUM trajectories into DIR: truth.tum and <scheme>.tum with the "
         "POSE matched causally to each scored truth time (for evo)",
+    )
+    p.add_argument(
+        "--site",
+        default=None,
+        metavar="FILE",
+        help="site file whose floor-height table gives each floor its height: the vertical "
+        "ISO/IEC 18305 terms and the TUM z (default: the log's CONFIG floor.height_m, uniform)",
     )
     p.add_argument(
         "--all-channels",
@@ -196,8 +205,13 @@ def run_analyze(
     all_channels: bool = False,
     label: str | None = None,
     truth_source: str | None = None,
+    site: str | None = None,
+    heights: FloorHeights | None = None,
 ) -> tuple[dict, Metrics]:
     """Read ``logs``, score them and write the outputs; return (summary, metrics).
+
+    Floor heights (vertical ISO/IEC 18305 terms, TUM z): ``heights`` when given, else those of
+    :func:`stridefix_analyzer.scoring.floor_height.resolve` (``site``'s table, else the CONFIG's).
 
     Raises
     ------
@@ -205,12 +219,16 @@ def run_analyze(
         A log is missing or unreadable.
     MetricsInputError
         No TRUTH or no POSE, or the requested scheme is absent.
+    FloorHeightError
+        The site or the CONFIG's floor.height_m is unusable.
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)  # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
-    metrics = run_metrics(data, scheme=code, truth_source=truth_source)
+    if heights is None:
+        heights = floor_height.resolve(data.config, site)
+    metrics = run_metrics(data, scheme=code, truth_source=truth_source, heights=heights)
     summary = build_summary(data, metrics, label)
     write_outputs(out_dir, summary, metrics)
     return summary, metrics
@@ -220,22 +238,28 @@ def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
         summary, metrics = run_analyze(
-            args.logs, args.out, args.scheme, args.all_channels, args.label, args.truth_source
+            args.logs, args.out, args.scheme, args.all_channels, args.label, args.truth_source, args.site
         )
-    except (LogReadError, MetricsInputError) as exc:
+    except (LogReadError, MetricsInputError, FloorHeightError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     for note in summary["warnings"]:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
     print(format_summary(summary))
+    print(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
     print(format_fix_sources(summary["fix_sources"]))
     print(format_context_line(summary.get("context")))
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
-        from stridefix_analyzer.io.tum import write_tum
+        from stridefix_analyzer.io.tum import TumError, write_tum
 
-        paths = write_tum(metrics, args.tum)
-        print(f"wrote {len(paths)} TUM trajectories into {args.tum}")
+        try:
+            paths = write_tum(metrics, args.tum)
+        except TumError as exc:
+            print(f"stridefix analyze: error: {exc}", file=sys.stderr)
+            return 2
+        z_source = metrics.heights.source if metrics.heights is not None else "0"
+        print(f"wrote {len(paths)} TUM trajectories into {args.tum} (z: {z_source})")
     if summary["position_error_m"]["n"] == 0:
         print(
             "stridefix analyze: error: no truth sample could be scored (all precede the first "

@@ -5,7 +5,7 @@ with ``t_us ≤ t`` (of the same fusion scheme); the position error is the horiz
 between the two [m]. Truth samples before the scheme's first POSE are not scored but counted as
 ``unscored``. Statistics: n, mean, median, 75th/90th/95th percentile (numpy's default linear
 interpolation), max and RMSE, plus the empirical CDF. Also floor hit rate, the IPIN score (the IPIN
-competition's metric, :func:`ipin_score`), step count against the truth, distance walked along the
+competition's metric, :func:`ipin_score`), the ISO/IEC 18305 terms (:mod:`.iso18305`), step count against the truth, distance walked along the
 truth, and the final error.
 
 When a log holds POSE messages of several schemes (``pose_t.scheme``), each is scored on its own
@@ -26,6 +26,8 @@ from stridefix_analyzer import schemes as registry
 from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
+from stridefix_analyzer.scoring import iso18305
+from stridefix_analyzer.scoring.floor_height import FloorHeights
 
 #: preference when several schemes have equally many POSE messages (first wins); ``controller`` (the
 #: multi-scheme controller's pose, pose_t.SCHEME_CONTROLLER) is the product's primary pose and wins
@@ -242,7 +244,8 @@ class SchemeScore:
         pose_t.scheme code and its name.
     summary : dict
         JSON-ready numbers: ``n_pose``, ``position_error_m`` (see :func:`error_stats`),
-        ``unscored``, ``floor_hit_rate``, ``ipin_score`` [m] (:func:`ipin_score`),
+        ``unscored``, ``floor_hit_rate``, ``ipin_score`` [m] (:func:`ipin_score`), ``iso18305``
+        (:func:`stridefix_analyzer.scoring.iso18305.terms`),
         ``within_1sigma_rate``, ``steps``, ``final_error_m``, ``final_error_pct_of_distance``.
     match : Table
         Per-truth-sample series from :func:`match_causal`, shape (n_truth,).
@@ -267,9 +270,15 @@ def scored_errors(match: Table) -> tuple[np.ndarray, np.ndarray]:
 
 
 def score_scheme(
-    pose: Table, truth: Table, n_step_messages: int, distance_m: float, code: int
+    pose: Table,
+    truth: Table,
+    n_step_messages: int,
+    distance_m: float,
+    code: int,
+    heights: FloorHeights | None = None,
 ) -> SchemeScore:
-    """Score one scheme's POSE rows (sorted by time) against the TRUTH rows (sorted by time)."""
+    """Score one scheme's POSE rows (sorted by time) against the TRUTH rows (sorted by time);
+    ``heights`` gives the ISO/IEC 18305 terms their vertical part (:mod:`.iso18305`)."""
     m = match_causal(pose, truth)
     scored = m["scored"]
     err, floor_err = scored_errors(m)
@@ -284,6 +293,7 @@ def score_scheme(
         "unscored": int(np.count_nonzero(~scored)),
         "floor_hit_rate": floor_hit,
         "ipin_score": ipin_score(err, floor_err),
+        "iso18305": iso18305.terms(m, heights),
         "within_1sigma_rate": within,
         "heading_error": heading_stats(m["heading_error_rad"][scored]),
         "steps": step_metrics(pose, truth, n_step_messages),
@@ -335,12 +345,15 @@ class Metrics:
         TRUTH rows sorted by time.
     distance_walked_m : float
         Horizontal path length of the truth [m].
+    heights : FloorHeights or None
+        Floor index → height used for the vertical terms (and TUM z); None when not given.
     """
 
     primary: int
     schemes: dict
     truth: Table
     distance_walked_m: float
+    heights: FloorHeights | None = None
 
     def summary(self) -> dict:
         """JSON-ready dict: the primary scheme's numbers at the top level plus ``per_scheme``."""
@@ -352,6 +365,8 @@ class Metrics:
             "n_truth": len(self.truth),
             "floor_hit_rate": top["floor_hit_rate"],
             "ipin_score": top["ipin_score"],
+            "iso18305": top["iso18305"],
+            "floor_heights": self.heights.source if self.heights is not None else None,
             "floors_in_truth": sorted({int(f) for f in self.truth["floor"]}),
             "within_1sigma_rate": top["within_1sigma_rate"],
             "heading_error": top["heading_error"],
@@ -397,7 +412,12 @@ class Metrics:
 TRUTH_SOURCES = {"simulation": 1, "waypoint": 2}
 
 
-def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | None = None) -> Metrics:
+def run_metrics(
+    data: LogData,
+    scheme: int | None = None,
+    truth_source: str | None = None,
+    heights: FloorHeights | None = None,
+) -> Metrics:
     """Score every POSE scheme in ``data`` against its TRUTH.
 
     Parameters
@@ -409,6 +429,8 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     truth_source : {"simulation", "waypoint"}, optional
         Score only TRUTH rows of this source (truth_t.SOURCE_*): e.g. the reference points of a
         walk ("waypoint") instead of the simulator's 10 Hz truth. Default: every TRUTH row.
+    heights : FloorHeights, optional
+        Floor index → height, for the vertical ISO/IEC 18305 terms (none without).
 
     Raises
     ------
@@ -437,5 +459,5 @@ def run_metrics(data: LogData, scheme: int | None = None, truth_source: str | No
     schemes = {}
     for code in np.unique(pose["scheme"]):
         rows = pose.rows(pose["scheme"] == code)  # stays sorted by time
-        schemes[int(code)] = score_scheme(rows, truth, n_steps, distance, int(code))
-    return Metrics(primary=primary, schemes=schemes, truth=truth, distance_walked_m=distance)
+        schemes[int(code)] = score_scheme(rows, truth, n_steps, distance, int(code), heights)
+    return Metrics(primary=primary, schemes=schemes, truth=truth, distance_walked_m=distance, heights=heights)

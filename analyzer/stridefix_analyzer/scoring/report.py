@@ -132,6 +132,38 @@ def _scheme_table(summary: dict) -> str:
     return f"<table>{head}{''.join(rows)}</table>"
 
 
+#: the ISO/IEC 18305 columns: (header, group in the terms dict or None for top level, key)
+_ISO_COLS = (
+    ("accuracy: mean [m]", "accuracy", "mean_error_m"),
+    ("RMS [m]", "accuracy", "rms_error_m"),
+    ("CE50 [m]", "accuracy", "ce50_m"),
+    ("CE95 [m]", "accuracy", "ce95_m"),
+    ("bias [m]", "accuracy", "bias_m"),
+    ("precision: spread [m]", "precision", "spread_m"),
+    ("σ of |error| [m]", "precision", "error_std_m"),
+    ("vertical [m]", "vertical", "mean_error_m"),
+    ("3-D [m]", "vertical", "mean_3d_error_m"),
+)
+
+
+def _iso18305_table(summary: dict) -> str:
+    head = (
+        "<tr><th class='k'>scheme</th>"
+        + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in _ISO_COLS)
+        + "<th>floor detection probability</th></tr>"
+    )
+    rows = []
+    for name, s in summary["per_scheme"].items():
+        t = s.get("iso18305") or {}
+        cls = " class='primary'" if name == summary["primary_scheme"] else ""
+        cells = "".join(f"<td>{_cell((t.get(g) or {}).get(k))}</td>" for _, g, k in _ISO_COLS)
+        rows.append(
+            f"<tr{cls}><td class='k'>{html.escape(name)}</td>{cells}"
+            f"<td>{_cell(_pct(t.get('floor_detection_probability')))}</td></tr>"
+        )
+    return f"<table>{head}{''.join(rows)}</table>"
+
+
 def _steps_table(summary: dict) -> str:
     head = (
         "<tr><th class='k'>scheme</th><th>detected</th><th>truth</th><th>error</th>"
@@ -153,6 +185,15 @@ def _steps_table(summary: dict) -> str:
 def _img(png: bytes, alt: str) -> str:
     data = base64.b64encode(png).decode("ascii")
     return f"<img alt='{html.escape(alt)}' src='data:image/png;base64,{data}'>"
+
+
+def _iso_overview(t: dict | None) -> str | None:
+    if not t or not t.get("n"):
+        return None
+    return (
+        f"{_cell(t['accuracy']['mean_error_m'])} / {_cell(t['precision']['spread_m'])}, "
+        f"{_pct(t['floor_detection_probability'])}"
+    )
 
 
 def render_html(summary: dict, series: dict, title: str = "StrideFix walk report") -> str:
@@ -177,6 +218,10 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         ("final error [m]", summary.get("final_error_m")),
         ("floor hit rate", _pct(summary.get("floor_hit_rate"))),
         ("IPIN score [m]", summary.get("ipin_score")),
+        (
+            "ISO/IEC 18305 accuracy / precision [m], floor detection",
+            _iso_overview(summary.get("iso18305")),
+        ),
         ("floors in truth", ", ".join(str(f) for f in summary.get("floors_in_truth", []))),
     ]
     health = summary.get("health") or {}
@@ -200,6 +245,13 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         f"<ul>{warnings_html}</ul>" if warnings_html else "",
         "<h2>Position error by scheme</h2>",
         _scheme_table(summary),
+        "<h2>ISO/IEC 18305 terms by scheme</h2>",
+        "<p class='note'>Accuracy: closeness to the truth (mean horizontal error, RMS, CE50/CE95, bias = "
+        "length of the mean error vector). Precision: spread of the error vector about its mean "
+        "(√trace of its covariance) and the σ of the error magnitude. Vertical and 3-D: the estimated "
+        f"floor's height against the true floor's ({html.escape(str(summary.get('floor_heights') or 'heights unknown'))})."
+        " Floor detection probability: share of scored samples on the true floor.</p>",
+        _iso18305_table(summary),
         "<div class='figs'>",
         _img(figs["trajectory"], "trajectory"),
         _img(figs["error_cdf"], "error CDF"),
