@@ -29,6 +29,7 @@ SUBCOMMANDS = {
     "realbench": "stridefix_analyzer.realbench.cli",
     "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
+    "compare": "stridefix_analyzer.scoring.compare",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing

@@ -33,8 +33,10 @@ from stridefix_analyzer.realbench.summary import (  # noqa: E402
     pdr_true_start_text,
 )
 from stridefix_analyzer.schemes import PDR_ONLY, UnknownSchemeError, scheme_code, scheme_colour  # noqa: E402
+from stridefix_analyzer.scoring import style  # noqa: E402
 from stridefix_analyzer.scoring.fixsources import fix_sources_html  # noqa: E402
 from stridefix_analyzer.scoring.plots import to_png  # noqa: E402
+from stridefix_analyzer.scoring.style import CSS  # noqa: E402
 
 WORST_WALKS = 3
 #: a floor plan as drawn: the image and its extent (0, width, 0, height) [m]
@@ -126,18 +128,18 @@ def plot_walk(
     fig, ax = plt.subplots(figsize=(7.5, 6.0))
     if plan is not None:
         img, extent = plan
-        ax.imshow(img, extent=extent, origin="upper", alpha=0.6, zorder=0)
+        ax.imshow(img, extent=extent, origin="upper", **style.PLAN_IMAGE)
     tx, ty = series["truth_x_m"], series["truth_y_m"]
-    ax.plot(tx, ty, "k-o", lw=2, ms=4, label="truth (waypoints)", zorder=3)
+    ax.plot(tx, ty, **{**style.TRUTH, "marker": "o", "markersize": 4, "label": "truth (waypoints)"})
     if len(tx):
-        ax.plot(tx[0], ty[0], "g*", ms=14, label="start (truth)", zorder=4)
+        ax.plot(tx[0], ty[0], **style.START, zorder=4)
     codes = [int(c) for c in series["scheme_codes"]]
     for name in schemes:
         c = scheme_code(name)
         if c not in codes:
             continue
         px, py = series[f"s{c}_pose_x_m"], series[f"s{c}_pose_y_m"]
-        ax.plot(px, py, "-", color=_colour(name), lw=1.2, label=name, zorder=2)
+        ax.plot(px, py, **{**style.TRACK, "color": _colour(name), "label": name})
         err_x = series[f"s{c}_error_m"]
         ok = np.isfinite(err_x)
         # the matched estimate at each truth time, joined to its truth point
@@ -304,14 +306,9 @@ def render(doc: dict) -> str:
                 )
             )
         parts.append("<h3>Per walk</h3>" + _table(head, trows))
-    style = (
-        "body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
-        "collapse;margin:8px 0}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
-        "img{max-width:100%}"
-    )
     return (
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>StrideFix realbench fusion"
-        f"</title><style>{style}</style></head><body>{''.join(parts)}</body></html>"
+        f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>StrideFix realbench fusion"
+        f"</title><style>{CSS}</style></head><body>{''.join(parts)}</body></html>"
     )
 
 

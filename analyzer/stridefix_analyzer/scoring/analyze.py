@@ -106,6 +106,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "POSE matched causally to each scored truth time (for evo)",
     )
     p.add_argument(
+        "--csv",
+        default=None,
+        metavar="DIR",
+        help="also write CSV files into DIR: <scheme>.csv (every POSE as logged), "
+        "<scheme>_matched.csv (the POSE matched to each truth sample, with its error) and truth.csv",
+    )
+    p.add_argument(
         "--site",
         default=None,
         metavar="FILE",
@@ -144,8 +151,9 @@ def _end_us(data: LogData) -> int | None:
     return int(pose["t_us"][-1]) if pose is not None and len(pose) else None
 
 
-def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, str]:
-    """Write metrics.json and analysis.npz into ``out_dir``; return their paths."""
+def write_outputs(out_dir: str, summary: dict, metrics: Metrics, site: Any = None) -> tuple[str, str]:
+    """Write metrics.json and analysis.npz into ``out_dir``; return their paths. With a ``site``
+    (site_t) the npz also holds its walls (``site_wall_*``: the report's floor plans)."""
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, METRICS_FILE)
     npz_path = os.path.join(out_dir, SERIES_FILE)
@@ -153,6 +161,10 @@ def write_outputs(out_dir: str, summary: dict, metrics: Metrics) -> tuple[str, s
         json.dump(summary, f, indent=2, allow_nan=False)
         f.write("\n")
     series: dict[str, Any] = metrics.series()
+    if site is not None:
+        for col in ("x0_m", "y0_m", "x1_m", "y1_m"):
+            series[f"site_wall_{col}"] = np.asarray(getattr(site, f"wall_{col}"), np.float64)
+        series["site_wall_floor"] = np.asarray(site.wall_floor, np.int64)
     np.savez_compressed(npz_path, **series)
     return json_path, npz_path
 
@@ -226,11 +238,12 @@ def run_analyze(
         warnings.simplefilter("ignore", LogTruncatedWarning)  # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
+    site_obj = floor_height.read_site_for_scoring(site) if site is not None else None
     if heights is None:
-        heights = floor_height.resolve(data.config, site)
+        heights = floor_height.resolve(data.config, site_obj, str(site))
     metrics = run_metrics(data, scheme=code, truth_source=truth_source, heights=heights)
     summary = build_summary(data, metrics, label)
-    write_outputs(out_dir, summary, metrics)
+    write_outputs(out_dir, summary, metrics, site_obj)
     return summary, metrics
 
 
@@ -260,6 +273,11 @@ def run(args: argparse.Namespace) -> int:
             return 2
         z_source = metrics.heights.source if metrics.heights is not None else "0"
         print(f"wrote {len(paths)} TUM trajectories into {args.tum} (z: {z_source})")
+    if getattr(args, "csv", None):
+        from stridefix_analyzer.io.pose_csv import write_csv
+
+        paths = write_csv(metrics, args.csv)
+        print(f"wrote {len(paths)} CSV files into {args.csv}")
     if summary["position_error_m"]["n"] == 0:
         print(
             "stridefix analyze: error: no truth sample could be scored (all precede the first "

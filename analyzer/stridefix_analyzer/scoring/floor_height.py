@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -70,8 +71,9 @@ def from_config(config: Mapping[str, str]) -> FloorHeights | None:
     return FloorHeights(source=f"CONFIG {CONFIG_KEY} = {h:g} m", spacing_m=h)
 
 
-def from_site(path: str | os.PathLike[str], config: Mapping[str, str] | None = None) -> FloorHeights:
-    """The floor-height table of a site file; outside it, the CONFIG's uniform height (see module)."""
+def read_site_for_scoring(path: str | os.PathLike[str]) -> Any:
+    """The site file ``analyze --site`` names (its floor heights and walls), errors as
+    :class:`FloorHeightError`."""
     from stridefix_analyzer.io.sitefile import SiteFileError, read_site  # LCM bindings only when needed
 
     try:
@@ -80,7 +82,7 @@ def from_site(path: str | os.PathLike[str], config: Mapping[str, str] | None = N
         raise FloorHeightError(str(exc)) from exc
     if not len(site.floor_height_m):
         raise FloorHeightError(f"{path}: the site has no floor_height_m table")
-    return from_table(site.floor_height_m, site.lowest_floor, f"site {os.fspath(path)}", config)
+    return site
 
 
 def from_table(
@@ -99,8 +101,10 @@ def from_table(
     )
 
 
-def resolve(config: Mapping[str, str], site: str | os.PathLike[str] | None = None) -> FloorHeights:
-    """The heights to use (module docstring's order); ``known`` is False when there are none."""
+def resolve(config: Mapping[str, str], site: Any = None, site_name: str = "") -> FloorHeights:
+    """The heights to use (module docstring's order): ``site`` (a site_t, e.g. from
+    :func:`read_site_for_scoring`) named ``site_name``, else the CONFIG; ``known`` is False when
+    there are none."""
     if site is not None:
-        return from_site(site, config)
+        return from_table(site.floor_height_m, site.lowest_floor, f"site {site_name}", config)
     return from_config(config) or FloorHeights(source="unknown (no site, no CONFIG)", spacing_m=float("nan"))

@@ -8,7 +8,6 @@ Every function takes the arrays of ``analysis.npz`` (see
 from __future__ import annotations
 
 import io
-from typing import Any
 
 import matplotlib
 
@@ -17,8 +16,8 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from stridefix_analyzer.schemes import scheme_colour, scheme_name  # noqa: E402
+from stridefix_analyzer.scoring import style  # noqa: E402
 
-_TRUTH_STYLE: dict[str, Any] = dict(color="black", linewidth=2.0, label="truth")
 _PERCENTILE_LINES = ((50, "p50", ":"), (75, "p75", "--"), (95, "p95", "-."))
 
 
@@ -43,41 +42,118 @@ def to_png(fig, dpi: int = 110) -> bytes:
     return buf.getvalue()
 
 
+def _floors(series: dict) -> list[int]:
+    """Every floor of the truth and of any scheme's POSE, lowest first."""
+    floors = {int(f) for f in series["truth_floor"]}
+    for code in _scheme_codes(series):
+        floors |= {int(f) for f in series[f"s{code}_pose_floor"]}
+    return sorted(floors) or [0]
+
+
+def _on_floor(x: np.ndarray, y: np.ndarray, floor: np.ndarray, f: int) -> tuple[np.ndarray, np.ndarray]:
+    """x, y with the samples off floor ``f`` as NaN: the line breaks where the walk leaves it."""
+    off = np.asarray(floor) != f
+    return np.where(off, np.nan, x), np.where(off, np.nan, y)
+
+
+def _walls(ax, series: dict, f: int) -> bool:
+    """Draw the site's walls of floor ``f`` (``site_wall_*``, when analyze had ``--site``)."""
+    if "site_wall_floor" not in series:
+        return False
+    on = np.asarray(series["site_wall_floor"]) == f
+    if not on.any():
+        return False
+    x = np.column_stack([series["site_wall_x0_m"][on], series["site_wall_x1_m"][on]]).T
+    y = np.column_stack([series["site_wall_y0_m"][on], series["site_wall_y1_m"][on]]).T
+    ax.plot(x, y, **style.WALL)
+    return True
+
+
 def plot_trajectory(series: dict):
-    """Truth path and every scheme's POSE track in the map frame, equal aspect.
+    """Truth path and every scheme's POSE track in the map frame, one panel per floor (the samples
+    on that floor; the site's walls under them when the analysis had a site), equal aspect.
 
     Parameters
     ----------
     series : dict
-        ``truth_x_m``, ``truth_y_m`` (n_truth,); ``scheme_codes``; ``s<c>_pose_x_m``,
-        ``s<c>_pose_y_m`` (n_pose,) per scheme code c. Positions in metres.
+        ``truth_x_m``, ``truth_y_m``, ``truth_floor`` (n_truth,); ``scheme_codes``; ``s<c>_pose_x_m``,
+        ``s<c>_pose_y_m``, ``s<c>_pose_floor`` (n_pose,) per scheme code c; optionally ``site_wall_*``.
     """
-    fig, ax = plt.subplots(figsize=(7.5, 6.5))
-    tx, ty = series["truth_x_m"], series["truth_y_m"]
-    ax.plot(tx, ty, **_TRUTH_STYLE)
+    floors = _floors(series)
+    cols = min(len(floors), 2)
+    rows = -(-len(floors) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(7.0 * cols, 6.0 * rows), squeeze=False)
+    tx, ty, tf = series["truth_x_m"], series["truth_y_m"], series["truth_floor"]
     colors = _colors(_scheme_codes(series))
-    for code, color in colors.items():
-        px, py = series[f"s{code}_pose_x_m"], series[f"s{code}_pose_y_m"]
-        ax.plot(px, py, color=color, linewidth=1.0, alpha=0.85, label=scheme_name(code))
-        if len(px):
-            ax.plot(px[-1], py[-1], marker="s", color=color, markersize=6, linestyle="none")
-    if len(tx):
-        ax.plot(
-            tx[0], ty[0], marker="o", color="green", markersize=10, linestyle="none", label="start (truth)"
-        )
-        ax.plot(tx[-1], ty[-1], marker="X", color="red", markersize=10, linestyle="none", label="end (truth)")
-    ax.plot([], [], marker="s", color="grey", linestyle="none", label="end (pose)")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title("Trajectory: POSE vs truth (map frame)")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
+    primary = int(series["primary_scheme"]) if "primary_scheme" in series else None
+    for k, f in enumerate(floors):
+        ax = axes[k // cols][k % cols]
+        walls = _walls(ax, series, f)
+        ax.plot(*_on_floor(tx, ty, tf, f), **style.TRUTH)
+        for code, color in colors.items():
+            px, py, pf = (
+                series[f"s{code}_pose_x_m"],
+                series[f"s{code}_pose_y_m"],
+                series[f"s{code}_pose_floor"],
+            )
+            lw = style.PRIMARY_LINEWIDTH if code == primary else style.TRACK["linewidth"]
+            ax.plot(
+                *_on_floor(px, py, pf, f),
+                **{**style.TRACK, "linewidth": lw, "color": color, "label": scheme_name(code)},
+            )
+            if len(px) and int(pf[-1]) == f:
+                ax.plot(px[-1], py[-1], color=color, **style.POSE_END)
+        if len(tx) and int(tf[0]) == f:
+            ax.plot(tx[0], ty[0], **style.START)
+        if len(tx) and int(tf[-1]) == f:
+            ax.plot(tx[-1], ty[-1], **style.END)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set(xlabel="x [m]", ylabel="y [m]", title=f"floor {f}" + (" (walls: site)" if walls else ""))
+        ax.grid(True, **style.GRID)
+        if k == 0:
+            ax.plot([], [], color="grey", **style.POSE_END, label="end (pose)")
+            ax.legend(loc="best", fontsize="small")
+    for k in range(len(floors), rows * cols):
+        axes[k // cols][k % cols].set_visible(False)
+    fig.suptitle("Trajectory: POSE vs truth (map frame), one panel per floor")
+    return fig
+
+
+def plot_floor_time(series: dict):
+    """The true floor and each scheme's estimated floor (its POSE) against time.
+
+    Parameters
+    ----------
+    series : dict
+        ``truth_t_us``, ``truth_floor`` (n_truth,); ``scheme_codes``; ``s<c>_pose_t_us``,
+        ``s<c>_pose_floor`` (n_pose,) per scheme.
+    """
+    fig, ax = plt.subplots(figsize=(9, 3.0))
+    t0 = _t0_us(series)
+    codes = _scheme_codes(series)
+    offsets = np.linspace(-0.12, 0.12, len(codes)) if len(codes) > 1 else [0.0]
+    # the truth first, wide and pale, so every scheme's line stays visible on it
+    truth = {**style.TRUTH, "linewidth": 6.0, "alpha": 0.25, "zorder": 1}
+    ax.step((series["truth_t_us"] - t0) / 1e6, series["truth_floor"], where="post", **truth)
+    for (code, color), off in zip(_colors(codes).items(), offsets):
+        t = (series[f"s{code}_pose_t_us"] - t0) / 1e6
+        f = series[f"s{code}_pose_floor"] + off
+        ax.step(t, f, where="post", color=color, linewidth=1.2, label=scheme_name(code), zorder=2)
+    floors = _floors(series)
+    ax.set_yticks(floors)
+    ax.set(
+        xlabel="time since first truth sample [s]",
+        ylabel="floor",
+        title="Floor: estimated (each scheme, offset a little) vs true",
+    )
+    ax.grid(True, **style.GRID)
+    ax.legend(loc="upper left", fontsize="small", ncol=min(len(codes) + 1, 5))
     return fig
 
 
 def plot_error_time(series: dict):
-    """Position error against time since the first truth sample, one line per scheme.
+    """Position error against time since the first truth sample: small multiples, one panel per
+    scheme on shared axes (the primary scheme first).
 
     Parameters
     ----------
@@ -85,23 +161,32 @@ def plot_error_time(series: dict):
         ``truth_t_us`` (n_truth,) [µs]; ``scheme_codes``; ``s<c>_error_m`` (n_truth,) [m], NaN
         where unscored; ``primary_scheme``.
     """
-    fig, ax = plt.subplots(figsize=(9, 3.8))
     t_s = (series["truth_t_us"] - _t0_us(series)) / 1e6
     primary = int(series["primary_scheme"])
-    for code, color in _colors(_scheme_codes(series)).items():
-        ax.plot(
-            t_s,
-            series[f"s{code}_error_m"],
-            color=color,
-            linewidth=1.6 if code == primary else 0.9,
-            label=scheme_name(code),
+    codes = sorted(_scheme_codes(series), key=lambda c: c != primary)
+    fig, axes = plt.subplots(
+        len(codes), 1, figsize=(9, 0.6 + 1.25 * len(codes)), sharex=True, sharey=True, squeeze=False
+    )
+    colors = _colors(codes)
+    for ax, code in zip(axes[:, 0], codes):
+        err = series[f"s{code}_error_m"]
+        ax.fill_between(t_s, 0, np.nan_to_num(err), color=colors[code], alpha=0.25, linewidth=0)
+        lw = style.PRIMARY_LINEWIDTH if code == primary else 1.0
+        ax.plot(t_s, err, color=colors[code], linewidth=lw)
+        mean = float(np.nanmean(err)) if np.isfinite(err).any() else float("nan")
+        ax.text(
+            0.995,
+            0.8,
+            f"{scheme_name(code)}{' (primary)' if code == primary else ''}: mean {mean:.2f} m",
+            transform=ax.transAxes,
+            ha="right",
+            fontsize="small",
         )
-    ax.set_xlabel("time since first truth sample [s]")
-    ax.set_ylabel("horizontal error [m]")
-    ax.set_title("Position error over time (latest POSE at or before each truth time)")
-    ax.set_ylim(bottom=0)
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", fontsize="small")
+        ax.set_ylim(bottom=0)
+        ax.grid(True, **style.GRID)
+    axes[-1, 0].set_xlabel("time since first truth sample [s]")
+    axes[len(codes) // 2, 0].set_ylabel("horizontal error [m]")
+    fig.suptitle("Position error over time (latest POSE at or before each truth time)")
     return fig
 
 
@@ -153,9 +238,10 @@ def plot_error_cdf(series: dict):
 
 
 def render_all(series: dict) -> dict[str, bytes]:
-    """All report figures as PNG bytes: ``trajectory``, ``error_time``, ``error_cdf``."""
+    """All report figures as PNG bytes: ``trajectory``, ``floor_time``, ``error_time``, ``error_cdf``."""
     return {
         "trajectory": to_png(plot_trajectory(series)),
+        "floor_time": to_png(plot_floor_time(series)),
         "error_time": to_png(plot_error_time(series)),
         "error_cdf": to_png(plot_error_cdf(series)),
     }

@@ -20,28 +20,16 @@ import numpy as np
 
 from stridefix_analyzer.scoring import plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
+from stridefix_analyzer.scoring.config_table import config_html
 from stridefix_analyzer.scoring.context import context_html
 from stridefix_analyzer.scoring.fixsources import fix_sources_html
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
+from stridefix_analyzer.scoring.style import CSS
 
 
 class ReportInputError(Exception):
     """An analysis directory lacks a file or holds an unreadable one; the message names it."""
 
-
-_CSS = """
-body { font-family: system-ui, -apple-system, 'Segoe UI', sans-serif; margin: 2em auto;
-       max-width: 1100px; color: #222; line-height: 1.4; padding: 0 1em; }
-h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { font-size: 1.2em; margin-top: 1.6em;
-     border-bottom: 1px solid #ddd; padding-bottom: 0.2em; }
-table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.92em; }
-th, td { border: 1px solid #ddd; padding: 0.25em 0.7em; text-align: right; }
-th { background: #f4f4f4; } td.k, th.k { text-align: left; }
-tr.primary td { font-weight: 600; background: #f3f8ff; }
-.note { color: #666; font-size: 0.9em; } .warn { color: #a40; }
-img { max-width: 100%; border: 1px solid #eee; margin: 0.4em 0; }
-.figs { display: flex; flex-wrap: wrap; gap: 1em; align-items: flex-start; }
-"""
 
 _STAT_COLS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
 
@@ -235,7 +223,7 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
     ]
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
         "<p class='note'>Error at each truth time = horizontal distance to the latest POSE at or "
         "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation. "
@@ -252,11 +240,10 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         f"floor's height against the true floor's ({html.escape(str(summary.get('floor_heights') or 'heights unknown'))})."
         " Floor detection probability: share of scored samples on the true floor.</p>",
         _iso18305_table(summary),
-        "<div class='figs'>",
-        _img(figs["trajectory"], "trajectory"),
+        _img(figs["trajectory"], "trajectory, one panel per floor"),
+        _img(figs["floor_time"], "estimated vs true floor over time"),
+        _img(figs["error_time"], "error over time, one panel per scheme"),
         _img(figs["error_cdf"], "error CDF"),
-        "</div>",
-        _img(figs["error_time"], "error over time"),
         "<h2>Steps</h2>",
         _steps_table(summary),
         "<h2>Fix sources</h2>",
@@ -277,9 +264,7 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         "<table><tr><th class='k'>log</th><th>bytes</th><th>events</th><th>truncated bytes</th>"
         f"<th>skipped bytes</th></tr>{input_rows}</table>",
         "<h2>Configuration</h2>",
-        _kv_table(version_rows + sorted(params.items()), ("key", "value"))
-        if (params or version_rows)
-        else "<p class='note'>no CONFIG message in the logs</p>",
+        config_html(version_rows, params),
         "</body></html>",
     ]
     return "\n".join(parts)

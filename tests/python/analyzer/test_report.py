@@ -11,7 +11,7 @@ def test_report_embeds_png_images(walk_logs, tmp_path, cli_main):
     assert cli_main(["report", str(out)]) == 0
     page = (out / "report.html").read_text()
     images = re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", page)
-    assert len(images) == 3
+    assert len(images) == 4  # trajectory per floor, floor over time, error over time, error CDF
     for img in images:
         assert base64.b64decode(img).startswith(b"\x89PNG\r\n\x1a\n")
     for text in ("adaptive", "pdr_only", "frames_total", "fusion.mode", "<style>"):
