@@ -24,7 +24,7 @@ step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcm
                 --mode survey --name office --map-rotation-deg "$rotation" --out "$out/site.sfsite"
 step sim        "$venv/bin/stridefix" sim --out "$out"
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
-step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" \
+step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" --site "$out/site.sfsite" \
                 --scheme kalman --label "default SIL walk, office radio map, every scheme from its first fix"
 step report     "$venv/bin/stridefix" report "$out"
 echo "demo: the same walk, every scheme TRUTH-INITIALISED (read pdr_only: PDR alone from the true start)"
@@ -32,7 +32,7 @@ mkdir -p "$out/true_start"
 step true-start "$stridefixd" --input "$out/board.candump" --log "$out/true_start/stridefixd.lcmlog" \
                 --site "$out/site.sfsite" --config "$out/init_truth.ini" --set init.use_config_pose=1 -q
 step analyze-ts "$venv/bin/stridefix" analyze "$out/true_start/stridefixd.lcmlog" "$out/truth.lcmlog" \
-                --out "$out/true_start" --scheme pdr_only \
+                --out "$out/true_start" --site "$out/site.sfsite" --scheme pdr_only \
                 --label "default SIL walk, office radio map, every scheme truth-initialised (init_truth.ini)"
 step report-ts  "$venv/bin/stridefix" report "$out/true_start"
 echo "demo: wrote $out/report.html and $out/metrics.json (from the first fix)," \

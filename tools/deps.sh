@@ -19,6 +19,9 @@ DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev
 DEBS+=(crossbuild-essential-armhf libc6-dev-armhf-cross qemu-user libcmocka-dev:armhf)
 # valgrind: callgrind counts the core's instructions (bench perf, bench particle-cost and their tests).
 DEBS+=(valgrind)
+# chromium: `stridefix live`'s page is tested in headless Chromium (playwright drives Debian's browser;
+# no browser download).
+DEBS+=(chromium)
 
 missing=()
 for p in "${DEBS[@]}"; do

@@ -30,6 +30,7 @@ SUBCOMMANDS = {
     "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
     "compare": "stridefix_analyzer.scoring.compare",
+    "live": "stridefix_analyzer.live.server",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing

@@ -32,7 +32,7 @@ from stridefix_analyzer.scoring.floor_height import FloorHeights
 #: preference when several schemes have equally many POSE messages (first wins); ``controller`` (the
 #: multi-scheme controller's pose, pose_t.SCHEME_CONTROLLER) is the product's primary pose and wins
 #: whenever it is present, whatever its count (it has none before the controller's first context)
-_PRIMARY_PREFERENCE = ["controller", "adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
+PRIMARY_PREFERENCE = ["controller", "adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
 _ALWAYS_PRIMARY = "controller"
 
 #: percentiles reported, in percent
@@ -325,7 +325,7 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
 
     def rank(i: int):
         name = scheme_name(codes[i])
-        pref = _PRIMARY_PREFERENCE.index(name) if name in _PRIMARY_PREFERENCE else 99
+        pref = PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else 99
         return (-counts[i], pref, int(codes[i]))
 
     return int(codes[min(range(len(codes)), key=rank)])

@@ -1,0 +1,221 @@
+"""``stridefix live --lcm-url URL``: serve the live view on 127.0.0.1 (aiohttp: the page and a websocket).
+
+An LCM thread subscribes to what the page draws (POSE and the per-scheme POSE_* channels, STEP, FIX,
+HEALTH, CONTEXT, TRUTH), decodes each message with its generated type (the channel table,
+lcmtypes/channels.csv) and folds it into a :class:`~.state.LiveState` under a lock. The page (``/``,
+:mod:`.page`) opens ``/ws``; every :data:`PUSH_S` the server sends what changed since its last
+message to that client (new track points only). ``/state`` answers the whole snapshot as JSON (for
+scripts and tests). A ``file://`` URL replays a log (``file:///path/run.lcmlog?speed=1``, LCM's log
+provider): the page then says when the log has ended. Nothing is fetched from outside: the page has
+no external scripts, fonts or images.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import json
+import socket
+import sys
+import threading
+from typing import Any
+
+from stridefix_analyzer.live.state import LiveState
+
+PUSH_S = 0.2
+DEFAULT_PORT = 8765
+#: the channels the view folds (a regular expression, as LCM subscribes)
+SUBSCRIBE = "POSE|POSE_.*|STEP|FIX|HEALTH|CONTEXT|TRUTH"
+
+
+class LiveInputError(ValueError):
+    """The LCM URL or the site cannot be used (the message says which and why)."""
+
+
+def _decoder(channel: str) -> Any:
+    from stridefix_analyzer.io.channels import CHANNELS
+
+    if channel in CHANNELS:
+        return CHANNELS[channel].msg_type
+    if channel.startswith("POSE_") and "POSE" in CHANNELS:
+        return CHANNELS["POSE"].msg_type
+    return None
+
+
+class LcmFeed:
+    """The LCM thread: ``lcm_url`` folded into ``state`` until :meth:`stop` or the log's end."""
+
+    def __init__(self, lcm_url: str, state: LiveState, lock: threading.Lock) -> None:
+        import lcm
+
+        try:
+            self.lc = lcm.LCM(lcm_url)
+        except (OSError, RuntimeError, ValueError) as exc:
+            raise LiveInputError(f"--lcm-url {lcm_url}: cannot open LCM: {exc}") from exc
+        self.state, self.lock = state, lock
+        self.decode_errors = 0
+        self._stop = threading.Event()
+        self.lc.subscribe(SUBSCRIBE, self._on_message)
+        self.thread = threading.Thread(target=self._run, name="lcm-feed", daemon=True)
+
+    def _on_message(self, channel: str, data: bytes) -> None:
+        msg_type = _decoder(channel)
+        if msg_type is None:
+            return
+        try:
+            msg = msg_type.decode(data)
+        except (ValueError, IndexError, UnicodeDecodeError):
+            self.decode_errors += 1  # a bad message is counted and skipped
+            return
+        with self.lock:
+            self.state.add(channel, msg)
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                self.lc.handle_timeout(100)
+            except OSError:  # LCM's log provider at the end of a file:// log
+                break
+        with self.lock:
+            self.state.ended = True
+
+    def start(self) -> None:
+        self.thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self.thread.join(timeout=2)
+
+
+def make_app(state: LiveState, lock: threading.Lock) -> Any:
+    """The aiohttp application: ``/`` the page, ``/state`` the snapshot, ``/ws`` the pushes."""
+    from aiohttp import WSMsgType, web
+
+    from stridefix_analyzer.live.page import PAGE
+
+    async def page(_request: web.Request) -> web.Response:
+        return web.Response(text=PAGE, content_type="text/html")
+
+    async def snapshot(_request: web.Request) -> web.Response:
+        with lock:
+            doc = state.snapshot()
+        return web.json_response(doc)
+
+    async def ws(request: web.Request) -> web.WebSocketResponse:
+        sock = web.WebSocketResponse(heartbeat=10)
+        await sock.prepare(request)
+        sent: dict[int, tuple[int, int]] = {}
+        version = -1
+        reader = asyncio.ensure_future(sock.receive())
+        try:
+            while not sock.closed:
+                with lock:
+                    doc = state.snapshot(sent) if state.version != version or state.ended else None
+                    version = state.version
+                if doc is not None:
+                    await sock.send_str(json.dumps(doc, allow_nan=False, default=str))
+                done, _ = await asyncio.wait({reader}, timeout=PUSH_S)
+                if done:
+                    msg = reader.result()
+                    if msg.type in (WSMsgType.CLOSE, WSMsgType.CLOSED, WSMsgType.ERROR):
+                        break
+                    reader = asyncio.ensure_future(sock.receive())
+        finally:
+            reader.cancel()
+        return sock
+
+    async def no_icon(_request: web.Request) -> web.Response:
+        return web.Response(status=204)  # no icon, and no 404 in the browser's console
+
+    app = web.Application()
+    app.add_routes(
+        [
+            web.get("/", page),
+            web.get("/state", snapshot),
+            web.get("/ws", ws),
+            web.get("/favicon.ico", no_icon),
+        ]
+    )
+    return app
+
+
+def walls_of(site_path: str | None) -> list[tuple[float, float, float, float, int]]:
+    """The site's walls [(x0, y0, x1, y1, floor)], none without a site."""
+    if not site_path:
+        return []
+    from stridefix_analyzer.io.sitefile import SiteFileError, read_site
+
+    try:
+        s = read_site(site_path)
+    except SiteFileError as exc:
+        raise LiveInputError(str(exc)) from exc
+    return [
+        (float(a), float(b), float(c), float(d), int(f))
+        for a, b, c, d, f in zip(s.wall_x0_m, s.wall_y0_m, s.wall_x1_m, s.wall_y1_m, s.wall_floor)
+    ]
+
+
+async def serve(lcm_url: str, site: str | None, host: str, port: int, ready: Any = None) -> None:
+    """Run the view until cancelled; ``ready(url)`` is called once it listens."""
+    from aiohttp import web
+
+    state, lock = LiveState(walls_of(site), source=lcm_url), threading.Lock()
+    feed = LcmFeed(lcm_url, state, lock)
+    runner = web.AppRunner(make_app(state, lock), access_log=None)
+    await runner.setup()
+    try:
+        # our own socket: with port 0 the kernel picks a free port, and we can say which
+        sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind((host, port))
+        except OSError as exc:
+            sock.close()
+            raise LiveInputError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from exc
+        bound = sock.getsockname()[1]
+        await web.SockSite(runner, sock).start()
+        feed.start()
+        url = f"http://{host}:{bound}/"
+        if ready is not None:
+            ready(url)
+        await asyncio.Event().wait()  # until cancelled (Ctrl-C)
+    finally:
+        feed.stop()
+        await runner.cleanup()
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "live",
+        help="a live view of a walk in the browser: every scheme on the floor plan, floor, steps, fixes, health",
+        description="Subscribe to the logger's LCM messages and serve a page that draws the walk as it "
+        "happens. A file:// URL replays a log: file:///path/run.lcmlog?speed=1.",
+    )
+    p.add_argument(
+        "--lcm-url", required=True, metavar="URL", help="LCM URL to listen on (udpm://…, file://…)"
+    )
+    p.add_argument("--site", metavar="FILE", help="site file whose walls are the floor plan")
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to serve on (default: 127.0.0.1, this machine only)"
+    )
+    p.add_argument(
+        "--port",
+        type=int,
+        default=DEFAULT_PORT,
+        help=f"port to serve on, 0 = any free one (default: {DEFAULT_PORT})",
+    )
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    def ready(url: str) -> None:
+        print(f"stridefix live: {args.lcm_url} -> {url} (Ctrl-C to stop)", flush=True)
+
+    try:
+        with contextlib.suppress(KeyboardInterrupt):
+            asyncio.run(serve(args.lcm_url, args.site, args.host, args.port, ready))
+    except LiveInputError as exc:
+        print(f"stridefix live: error: {exc}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,210 @@
+"""What the live view shows, folded from the LCM messages as they arrive (no network, no clock).
+
+:class:`LiveState` takes each decoded message (:meth:`LiveState.add`) and keeps, per scheme, the last
+pose and its track (every :data:`TRACK_EVERY_S` of walk time, at most :data:`TRACK_MAX` points: a
+long walk costs the page a fixed amount), the step count (STEP), the fix verdicts per scheme and
+source (FIX: accepted, rejected by reason, and the last :data:`RECENT_FIXES` records), the last
+HEALTH counters and CONTEXT, and the truth track when the log carries TRUTH. :meth:`snapshot` is the
+JSON-ready document the page draws; ``version`` grows with every message so a client asks only
+for what changed. POSE of any scheme goes to that scheme's track, whether it came on ``POSE`` or on
+a per-scheme ``POSE_<SCHEME>`` channel. The primary pose: the ``POSE`` channel's latest once
+per-scheme channels are seen (POSE then carries the primary only), else the latest of the scheme
+the analyzer would make primary (:data:`~stridefix_analyzer.scoring.metrics.PRIMARY_PREFERENCE`).
+"""
+
+from __future__ import annotations
+
+import collections
+import dataclasses
+from typing import Any
+
+from stridefix_analyzer.schemes import UnknownSchemeError, scheme_colour, scheme_name
+from stridefix_analyzer.scoring.fixsources import method_name, reason_name
+from stridefix_analyzer.scoring.metrics import PRIMARY_PREFERENCE
+
+TRACK_EVERY_S = 0.5
+TRACK_MAX = 4000
+RECENT_FIXES = 12
+#: the truth track's key among the schemes' in a client's ``sent`` record
+TRUTH_KEY = -1
+
+
+@dataclasses.dataclass
+class _Scheme:
+    name: str
+    colour: str
+    last: dict[str, Any] = dataclasses.field(default_factory=dict)
+    track: list[tuple[float, float, int]] = dataclasses.field(default_factory=list)
+    last_track_t_us: int | None = None
+    every_us: float = TRACK_EVERY_S * 1e6
+    epoch: int = 0  # grows when the track is thinned: a client holding its points starts again
+    poses: int = 0
+
+    def append(self, t_us: int, point: tuple[float, float, int]) -> None:
+        """Keep a point every ``every_us`` of walk time; past TRACK_MAX points, every other one
+        and twice the interval (a fixed cost for any walk length)."""
+        if self.last_track_t_us is not None and t_us - self.last_track_t_us < self.every_us:
+            return
+        self.track.append(point)
+        self.last_track_t_us = t_us
+        if len(self.track) >= TRACK_MAX:
+            self.track = self.track[::2]
+            self.every_us *= 2
+            self.epoch += 1
+
+
+def _pose_fields(m: Any) -> dict[str, Any]:
+    return {
+        "t_us": int(m.t_us),
+        "x_m": float(m.x_m),
+        "y_m": float(m.y_m),
+        "floor": int(m.floor),
+        "heading_rad": float(m.heading_rad),
+        "sigma_m": float(m.sigma_m),
+        "step_count": int(m.step_count),
+    }
+
+
+class LiveState:
+    """The folded view (module docstring); ``walls`` are the site's [(x0, y0, x1, y1, floor)]."""
+
+    def __init__(
+        self, walls: list[tuple[float, float, float, float, int]] | None = None, source: str = ""
+    ) -> None:
+        self.walls = walls or []
+        self.source = source
+        self.version = 0
+        self.messages: collections.Counter[str] = collections.Counter()
+        self.schemes: dict[int, _Scheme] = {}
+        self.primary: dict[str, Any] | None = None
+        self.steps = 0
+        self.fix_counts: dict[str, dict[str, dict[str, Any]]] = {}
+        self.recent_fixes: collections.deque = collections.deque(maxlen=RECENT_FIXES)
+        self.health: dict[str, Any] = {}
+        self.context: dict[str, Any] | None = None
+        self.truth = _Scheme("truth", "#000000")
+        self.last_t_us: int | None = None
+        self.ended = False
+        self.per_scheme_channels = False  # POSE_<SCHEME> seen: POSE then carries the primary alone
+
+    def _scheme(self, code: int) -> _Scheme:
+        if code not in self.schemes:
+            try:
+                name, colour = scheme_name(code), scheme_colour(code)
+            except UnknownSchemeError:
+                name, colour = f"scheme_{code}", "#000000"
+            self.schemes[code] = _Scheme(name, colour)
+        return self.schemes[code]
+
+    def add(self, channel: str, msg: Any) -> None:
+        """Fold one decoded message of ``channel`` into the view."""
+        self.version += 1
+        self.messages[channel] += 1
+        t = getattr(msg, "t_us", None)
+        if t is not None:
+            self.last_t_us = int(t) if self.last_t_us is None else max(self.last_t_us, int(t))
+        if channel == "POSE" or channel.startswith("POSE_"):
+            self._pose(channel, msg)
+        elif channel == "STEP":
+            self.steps = max(self.steps, int(msg.index))  # step_t: the first step is 1
+        elif channel == "FIX":
+            self._fix(msg)
+        elif channel == "HEALTH":
+            self.health = {f: _plain(getattr(msg, f)) for f in msg.__slots__}
+        elif channel == "CONTEXT":
+            self.context = {f: _plain(getattr(msg, f)) for f in msg.__slots__}
+        elif channel == "TRUTH":
+            self.truth.append(
+                int(msg.t_us), (round(float(msg.x_m), 3), round(float(msg.y_m), 3), int(msg.floor))
+            )
+
+    def _pose(self, channel: str, m: Any) -> None:
+        s = self._scheme(int(m.scheme))
+        p = _pose_fields(m)
+        s.last, s.poses = p, s.poses + 1
+        s.append(p["t_us"], (round(p["x_m"], 3), round(p["y_m"], 3), p["floor"]))
+        if channel != "POSE":
+            self.per_scheme_channels = True
+            return
+        if self.per_scheme_channels or self._rank(s.name) <= self._rank(
+            self.primary["scheme"] if self.primary else ""
+        ):
+            self.primary = {**p, "scheme": s.name}
+
+    @staticmethod
+    def _rank(name: str) -> int:
+        """The analyzer's preference for the primary scheme (controller first) when every scheme
+        shares POSE; lower is preferred."""
+        return PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else len(PRIMARY_PREFERENCE)
+
+    def _fix(self, m: Any) -> None:
+        scheme = self._scheme(int(m.scheme)).name
+        method = method_name(int(m.method))
+        c = self.fix_counts.setdefault(scheme, {}).setdefault(
+            method, {"offered": 0, "accepted": 0, "rejected": 0, "rejected_by_reason": {}}
+        )
+        c["offered"] += 1
+        if m.accepted:
+            c["accepted"] += 1
+        else:
+            c["rejected"] += 1
+            r = reason_name(int(m.reason))
+            c["rejected_by_reason"][r] = c["rejected_by_reason"].get(r, 0) + 1
+        self.recent_fixes.appendleft(
+            {
+                "t_us": int(m.t_us),
+                "scheme": scheme,
+                "method": method,
+                "accepted": bool(m.accepted),
+                "reason": reason_name(int(m.reason)),
+                "test_ratio": float(m.test_ratio),
+                "alpha": float(m.alpha),
+            }
+        )
+
+    def snapshot(self, sent: dict[int, tuple[int, int]] | None = None) -> dict[str, Any]:
+        """The JSON-ready document of the page (module docstring). ``sent`` (scheme code → (epoch,
+        points) a client already holds) is updated in place and each track then carries only the
+        points after those (``track_start``); a thinned track (new epoch) is sent whole."""
+        sent = {} if sent is None else sent
+        tracks = {}
+        for c, s in [*self.schemes.items(), (TRUTH_KEY, self.truth)]:
+            epoch, n = sent.get(c, (-1, 0))
+            start = n if epoch == s.epoch else 0
+            tracks[c] = (start, s.track[start:])
+            sent[c] = (s.epoch, len(s.track))
+        return {
+            "version": self.version,
+            "source": self.source,
+            "ended": self.ended,
+            "t_us": self.last_t_us,
+            "messages": dict(self.messages),
+            "steps": self.steps,
+            "primary": self.primary,
+            "schemes": [
+                {
+                    "code": c,
+                    "name": s.name,
+                    "colour": s.colour,
+                    "poses": s.poses,
+                    "last": s.last,
+                    "track_start": tracks[c][0],
+                    "track": tracks[c][1],
+                }
+                for c, s in sorted(self.schemes.items())
+            ],
+            "fix_counts": self.fix_counts,
+            "recent_fixes": list(self.recent_fixes),
+            "health": self.health,
+            "context": self.context,
+            "truth": {"track_start": tracks[TRUTH_KEY][0], "track": tracks[TRUTH_KEY][1]},
+            "walls": self.walls,
+        }
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, (bool, int, float, str)) or v is None:
+        return v
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    return str(v)

@@ -1,0 +1,170 @@
+"""stridefix live: the folded state against the analyzer's reading of the same log, the server over
+HTTP, and the page in headless Chromium (DOM and a screenshot) against a replayed log."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import lcm
+import numpy as np
+import pytest
+from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.channels import CHANNELS
+from stridefix_analyzer.io.logread import read_logs
+from stridefix_analyzer.live.server import SUBSCRIBE, walls_of
+from stridefix_analyzer.live.state import LiveState
+from stridefix_analyzer.scoring.fixsources import fix_source_counts
+
+
+@pytest.fixture(scope="module")
+def campus_walk(tmp_path_factory, stridefixd):
+    """The campus (walls, Wi-Fi, BLE, GNSS, landmarks) surveyed into a site, then a 2-minute walk
+    replayed with it: a log with every scheme's POSE and FIX records of every source."""
+    from stridefix_analyzer.bench import fusion, sources
+
+    out = tmp_path_factory.mktemp("live")
+    fw = Firmware(stridefixd)
+    site, _ = sources.build_site(fw, out / "survey")
+    fusion.simulate_and_log("campus", 1, fw, out / "walk", site)
+    log = out / "walk" / "stridefixd.lcmlog"
+    data = read_logs([log], decode=("POSE", "STEP", "FIX", "HEALTH"))
+    return {"site": site, "log": log, "data": data}
+
+
+def _fold(log: Path, walls) -> LiveState:
+    state = LiveState(walls)
+    pattern = re.compile(f"^(?:{SUBSCRIBE})$")
+    for event in lcm.EventLog(str(log), "r"):
+        if pattern.match(event.channel):
+            key = "POSE" if event.channel.startswith("POSE_") else event.channel
+            state.add(event.channel, CHANNELS[key].msg_type.decode(event.data))
+    return state
+
+
+def _expected(data):
+    pose, step = data.table("POSE"), data.table("STEP")
+    last = {}
+    for code in np.unique(pose["scheme"]):
+        rows = pose.rows(pose["scheme"] == code)
+        last[int(code)] = (float(rows["x_m"][-1]), float(rows["y_m"][-1]), int(rows["floor"][-1]), len(rows))
+    return {"steps": len(step), "last": last, "fix": fix_source_counts(data.table("FIX"))}
+
+
+def test_state_folds_what_the_analyzer_reads(campus_walk):
+    """GIVEN the campus log folded message by message, THEN steps, every scheme's last pose and pose
+    count, and the FIX verdicts per scheme and source equal the analyzer's reading of the same log."""
+    exp = _expected(campus_walk["data"])
+    doc = _fold(campus_walk["log"], walls_of(str(campus_walk["site"]))).snapshot()
+    assert doc["steps"] == exp["steps"] > 100
+    got = {
+        s["code"]: (s["last"]["x_m"], s["last"]["y_m"], s["last"]["floor"], s["poses"])
+        for s in doc["schemes"]
+    }
+    assert got == exp["last"]
+    assert doc["fix_counts"] == exp["fix"]
+    assert sum(c["offered"] for m in exp["fix"].values() for c in m.values()) > 100
+    assert len(doc["walls"]) > 10
+    assert doc["primary"]["scheme"] == "adaptive"  # the analyzer's preference without a controller
+    # a client that holds every point gets none again; the tracks are thinned to a fixed size
+    sent: dict = {}
+    first = _fold(campus_walk["log"], []).snapshot(sent)
+    assert all(s["track_start"] == 0 and 100 < len(s["track"]) < 400 for s in first["schemes"])
+
+
+def _start_live(url: str, site: Path | None = None) -> tuple[subprocess.Popen, str]:
+    exe = Path(sys.executable).with_name("stridefix")
+    cmd = [str(exe), "live", "--lcm-url", url, "--port", "0"] + (["--site", str(site)] if site else [])
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = proc.stdout.readline()
+    m = re.search(r"(http://127\.0\.0\.1:\d+/)", line)
+    assert m, line + proc.stderr.read()
+    return proc, m.group(1)
+
+
+def _state(base: str) -> dict:
+    with urllib.request.urlopen(base + "state", timeout=10) as r:
+        return json.load(r)
+
+
+def test_server_serves_the_state_of_a_replayed_log(campus_walk):
+    exp = _expected(campus_walk["data"])
+    proc, base = _start_live(f"file://{campus_walk['log']}?speed=0", campus_walk["site"])
+    try:
+        deadline = time.time() + 60
+        doc = _state(base)
+        while not doc["ended"] and time.time() < deadline:
+            time.sleep(0.2)
+            doc = _state(base)
+        assert doc["ended"] and doc["steps"] == exp["steps"] and doc["fix_counts"] == exp["fix"]
+        with urllib.request.urlopen(base, timeout=10) as r:
+            page = r.read().decode()
+        assert '<canvas id="map"' in page and "http://" not in page and "https://" not in page
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+def test_bad_lcm_url_exits_2(cli):
+    p = cli("live", "--lcm-url", "nosuch://x", "--port", "0")
+    assert p.returncode == 2 and "--lcm-url" in p.stderr
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (tools/deps.sh installs it)")
+def test_page_in_headless_chromium(campus_walk, tmp_path):
+    """GIVEN the log replayed at 20x through `stridefix live`, WHEN headless Chromium opens the page,
+    THEN as the log ends the DOM shows the step count, every scheme, the FIX verdicts and HEALTH, the
+    page's tracks are the server's, the map is drawn (walls and tracks), and no script error."""
+    from playwright.sync_api import sync_playwright
+
+    exp = _expected(campus_walk["data"])
+    proc, base = _start_live(f"file://{campus_walk['log']}?speed=20", campus_walk["site"])
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"], headless=True)
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            errors: list[str] = []
+            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(base)
+            page.wait_for_function(
+                "document.getElementById('status').textContent === 'log ended'", timeout=60000
+            )
+            page.wait_for_timeout(500)  # the last push after the end
+            assert int(page.inner_text("#steps")) == exp["steps"]
+            assert page.inner_text("#primary") == "adaptive"
+            names = page.eval_on_selector_all(
+                "#schemes tr[data-scheme]", "rows => rows.map(r => r.dataset.scheme)"
+            )
+            assert len(names) == len(exp["last"])
+            row = page.query_selector("#fix-table tr[data-scheme='adaptive'][data-method='wifi']")
+            cells = [c.inner_text() for c in row.query_selector_all("td")]
+            c = exp["fix"]["adaptive"]["wifi"]
+            assert cells[2:5] == [str(c["offered"]), str(c["accepted"]), str(c["rejected"])]
+            assert page.query_selector("#health-table tr[data-key='frames_total']") is not None
+            srv = _state(base)
+            for s in srv["schemes"]:
+                assert page.evaluate(f"S.schemes[{s['code']}].track") == s["track"], s["name"]
+            inked = page.evaluate(
+                """() => { const c = document.getElementById('map'); const d = c.getContext('2d')
+                   .getImageData(0, 0, c.width, c.height).data; let n = 0;
+                   for (let i = 3; i < d.length; i += 4) if (d[i] > 0) n++; return n; }"""
+            )
+            assert inked > 5000  # walls and tracks drawn, not an empty canvas
+            shot = tmp_path / "live.png"
+            page.screenshot(path=str(shot), full_page=True)
+            assert shot.read_bytes().startswith(b"\x89PNG") and shot.stat().st_size > 20_000
+            assert errors == []
+            browser.close()
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
