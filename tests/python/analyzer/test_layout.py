@@ -170,6 +170,7 @@ LAYERS = (
     "datasets",
     "radiomap",
     "scoring",
+    "live",
     "crowd",
     "realbench",
     "bench",
