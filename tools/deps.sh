@@ -19,6 +19,9 @@ DEBS=(liblcm-dev liblcm-bin libeigen3-dev libceres-dev libcmocka-dev libinih-dev
 DEBS+=(crossbuild-essential-armhf libc6-dev-armhf-cross qemu-user libcmocka-dev:armhf)
 # valgrind: callgrind counts the core's instructions (bench perf, bench particle-cost and their tests).
 DEBS+=(valgrind)
+# can-utils: log2asc and asc2log, candump and canplayer (tests/python/can: the Vector ASC round trip,
+# whose asc2log writes the direction flags the candump parser reads; README "CAN tools").
+DEBS+=(can-utils)
 
 missing=()
 for p in "${DEBS[@]}"; do
