@@ -32,10 +32,10 @@ int sf_candump_parse(const char *line, sf_can_frame_t *frame);
 
 /* As sf_candump_parse on the len characters of line that its NUL follows; a NUL inside them is
  * SF_ESYNTAX (the line reader's check, without another pass over the line). Cost: a line of a board
- * replay's shape (10-digit seconds, 3-digit id, 8 data bytes) is read 8 characters a step, ~270
- * instructions (callgrind: 269 a line over a 60 s SIL replay, 16858 lines); the same line with
- * asc2log's direction flag ~400 (a failed try, then the same read before the flag); any other line
- * as sf_candump_parse. */
+ * replay's shape (10-digit seconds, 3-digit id, 8 data bytes) is read 8 characters a step, ~260
+ * instructions (callgrind over a 60 s SIL replay, 16858 lines: 269 a line at -O2, 255 at -O3; 275
+ * and 262 before the direction flag); the same line with asc2log's direction flag ~400 (a failed
+ * try, then the same read before the flag); any other line as sf_candump_parse. */
 int sf_candump_parse_line(const char *line, size_t len, sf_can_frame_t *frame);
 
 /* Formats one frame as a candump -L line with a newline; returns the length, or SF_EINVAL when

@@ -262,7 +262,7 @@ static void test_format_parse_round_trip(void **state)
         f.id = f.extended ? (uint32_t)rand() & 0x1FFFFFFFu : (uint32_t)rand() & 0x7FFu;
         f.host_t_us = (int64_t)rand() * 1000 + i;
         f.dlc = (uint8_t)(f.remote ? 0 : i % 9);
-        for (int k = 0; k < f.dlc; k++) {
+        for (size_t k = 0; k < f.dlc && k < sizeof f.data; k++) { /* the bound: gcc 12 -O3 -Wstringop-overflow */
             f.data[k] = (uint8_t)rand();
         }
         char buf[80];
@@ -424,8 +424,8 @@ static uint8_t numbered_dlc(const int i)
 static size_t numbered_line(const int i, char *const buf, const size_t size)
 {
     sf_can_frame_t f = {.host_t_us = numbered_t_us(i), .id = (uint32_t)i & 0x7FFu, .dlc = numbered_dlc(i)};
-    for (int k = 0; k < f.dlc; k++) {
-        f.data[k] = (uint8_t)(i + k);
+    for (size_t k = 0; k < f.dlc && k < sizeof f.data; k++) { /* the bound: gcc 12 -O3 -Wstringop-overflow */
+        f.data[k] = (uint8_t)((size_t)i + k);
     }
     int n = sf_candump_format(&f, i % 2 ? "can0" : "a-much-longer-interface-name", buf, size);
     assert_true(n > 0);
