@@ -22,6 +22,9 @@ DEBS+=(valgrind)
 # chromium: `stridefix live`'s page is tested in headless Chromium (playwright drives Debian's browser;
 # no browser download).
 DEBS+=(chromium)
+# can-utils: log2asc and asc2log, candump and canplayer (tests/python/can: the Vector ASC round trip,
+# whose asc2log writes the direction flags the candump parser reads; README "CAN tools").
+DEBS+=(can-utils)
 
 missing=()
 for p in "${DEBS[@]}"; do

@@ -13,9 +13,9 @@ void sf_summary_print(FILE *const f, const sf_input_counters_t *const in, const 
     fprintf(f,
             "stridefixd: %" PRIu64 " frames (%" PRIu64 " ok): %" PRIu64 " bad syntax, %" PRIu64 " unknown id, %" PRIu64
             " truncated, %" PRIu64 " decode errors, %" PRIu64 " seq gaps, %" PRIu64 " unsynced, %" PRIu64
-            " unpaired IMU halves, %" PRIu64 " incomplete scans\n",
+            " unpaired IMU halves, %" PRIu64 " incomplete scans, %" PRIu64 " CAN FD (of the unknown ids)\n",
             ic.frames_total, c->frames_ok, ic.bad_syntax, c->unknown_id, c->bad_length, c->decode_errors,
-            c->seq_gaps, c->unsynced, c->imu_unpaired, c->wifi_incomplete);
+            c->seq_gaps, c->unsynced, c->imu_unpaired, c->wifi_incomplete, ic.can_fd);
     fprintf(f,
             "stridefixd: faults: %" PRIu64 " duplicates, %" PRIu64 " late, %" PRIu64 " corrupt seq, %" PRIu64
             " silences, %" PRIu64 " board restarts, %" PRIu64 " BOARD_TIME not believed, %" PRIu64

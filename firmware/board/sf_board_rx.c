@@ -11,10 +11,12 @@
 
 #define DEG_TO_RAD (3.14159265358979323846 / 180.0)
 
-/* Nominal periods only seed the learnt period: the board may run mag and baro at other rates. */
-#define IMU_PERIOD_MS 10.0
-#define MAG_PERIOD_MS 20.0
-#define BARO_PERIOD_MS 50.0
+/* Nominal periods (board.dbc's GenMsgCycleTime) only seed the learnt period: the board may run mag
+ * and baro at other rates. */
+#define IMU_PERIOD_MS ((double)BOARD_IMU_ACCEL_CYCLE_TIME_MS)
+#define MAG_PERIOD_MS ((double)BOARD_MAG_CYCLE_TIME_MS)
+#define BARO_PERIOD_MS ((double)BOARD_BARO_CYCLE_TIME_MS)
+_Static_assert(BOARD_IMU_ACCEL_CYCLE_TIME_MS == BOARD_IMU_GYRO_CYCLE_TIME_MS, "one IMU sample is an ACCEL and a GYRO frame");
 /* No frame for this long is a silence of the bus (the board sends at least 100 IMU frames a second). */
 #define SILENCE_US 1000000
 

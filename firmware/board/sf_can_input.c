@@ -245,7 +245,8 @@ static int next_line(sf_can_input_t *const in, sf_can_frame_t *const frame)
         if (len == 0) {
             continue; /* blank lines are not frames */
         }
-        return sf_candump_parse_line(start, len, frame) == SF_OK ? 1 : SF_ESYNTAX;
+        const int rc = sf_candump_parse_line(start, len, frame);
+        return rc == SF_OK ? 1 : rc; /* SF_ESYNTAX, or SF_ENOTCLASSIC (a CAN FD line) */
     }
 }
 

@@ -42,8 +42,9 @@ typedef struct {
 int sf_can_input_open(sf_can_input_t *in, const char *spec, char *err_text, size_t err_size);
 
 /* Reads the next frame: 1 a frame, 0 end of input, SF_ESYNTAX a line that is not candump -L (the
- * line is skipped; in->line_no and in->line name it), SF_EIO a read error, SF_EINTR a blocking read
- * interrupted by a signal (call again to go on). */
+ * line is skipped; in->line_no and in->line name it), SF_ENOTCLASSIC a well-formed CAN FD line
+ * (skipped: *frame has its time, id and extended flag, dlc 0; sf_candump.h), SF_EIO a read error,
+ * SF_EINTR a blocking read interrupted by a signal (call again to go on). */
 int sf_can_input_next(sf_can_input_t *in, sf_can_frame_t *frame);
 
 /* Closes the file or socket that sf_can_input_open opened (never stdin, never a descriptor of a

@@ -18,6 +18,7 @@ struct sf_input {
     sf_board_rx_t rx;       /* the decoder (CAN) and the counters (both) */
     sf_can_frame_t frame;   /* the latest frame, for messages */
     uint64_t bad_syntax;
+    uint64_t can_fd;        /* CAN FD lines: counted as frames of an unknown id too */
     bool flushed;           /* the end of a CAN input handed back the decoder's open BLE window */
     char name[256];
 };
@@ -84,6 +85,17 @@ int sf_input_next(sf_input_t *const in, sf_input_item_t *const item)
         in->bad_syntax++;
         return rc;
     }
+    if (rc == SF_ENOTCLASSIC) {
+        /* a frame on the bus, but not one of the board's (classic CAN only): counted as the decoder
+         * counts a frame of an unknown id, not handed to it (its header would match a board id) */
+        in->rx.counters.frames++;
+        in->rx.counters.unknown_id++;
+        in->can_fd++;
+        item->log_t_us = in->frame.host_t_us;
+        item->status = SF_ENOTCLASSIC;
+        item->event.kind = sf_rx_none;
+        return 1;
+    }
     if (rc == 0 && !in->flushed) {
         in->flushed = true; /* the end: what the decoder still holds, as one more item */
         item->log_t_us = in->frame.host_t_us;
@@ -109,6 +121,10 @@ static const char *what(const sf_input_t *const in, const int code, char *const 
     switch (code) {
     case SF_ESYNTAX:
         return "not a candump -L line; skipped";
+    case SF_ENOTCLASSIC:
+        snprintf(buf, size, "CAN id 0x%" PRIX32 "%s is a CAN FD frame; the board sends classic CAN only; skipped",
+                 f->id, f->extended ? " (extended)" : "");
+        return buf;
     case SF_EUNKNOWN_ID:
         snprintf(buf, size, "CAN id 0x%" PRIX32 "%s is not in board.dbc; skipped", f->id,
                  f->extended ? " (extended)" : f->remote ? " (remote)" : "");
@@ -156,6 +172,7 @@ void sf_input_counters(const sf_input_t *const in, sf_input_counters_t *const co
 {
     counters->rx = in->rx.counters;
     counters->bad_syntax = in->bad_syntax;
+    counters->can_fd = in->can_fd;
     counters->frames_total = in->rx.counters.frames + in->bad_syntax;
     sf_lcm_input_counters_t lc = {0};
     if (in->lcm != NULL) {

@@ -10,7 +10,7 @@
  * Errors: sf_input_open SF_OK, SF_ENOENT (no such file or interface), SF_EIO (unreadable, or a
  * directory or device: sf_file_kind.h; a FIFO is read like stdin),
  * SF_EUNSUPPORTED (no AF_CAN here), SF_EINVAL (no spec), with a message in err_text.
- * sf_input_next: see below. Memory: one heap block per open input (6688 B on x86-64, asserted
+ * sf_input_next: see below. Memory: one heap block per open input (6704 B on x86-64, asserted
  * ≤ 7 KiB: the decoder with its Wi-Fi scan and BLE window in progress, the candump line buffer), allocated by
  * sf_input_open, and for a candump file or stdin the reader's 64 KiB chunk (SF_CAN_INPUT_CHUNK_BYTES,
  * at the first read), freed by sf_input_close; sf_input_item_t is ≈ 4 KiB (the caller's). */
@@ -33,6 +33,7 @@ typedef struct sf_input sf_input_t;
 typedef struct {
     uint64_t frames_total; /* frames, lines or sensor events read, good or bad: rx.frames + bad_syntax */
     uint64_t bad_syntax;   /* candump lines that do not parse, SocketCAN reads that are not a frame */
+    uint64_t can_fd;       /* well-formed CAN FD lines (not the board's: also in rx.unknown_id), skipped */
     uint64_t replay_oversized; /* LCM replay: events above the size cap, skipped (sf_lcm_input.h) */
     uint64_t replay_truncated; /* LCM replay: a last event cut short (0 or 1) */
     uint64_t replay_refused;   /* LCM replay: an untrusted header, the rest of the log refused (0 or 1) */
@@ -40,7 +41,8 @@ typedef struct {
 } sf_input_counters_t;
 
 /* One unit of input: a CAN frame (which may complete a sample, or only update the decoder, or be
- * skipped), or one replayed sensor event. */
+ * skipped: status SF_EUNKNOWN_ID .., or SF_ENOTCLASSIC for a CAN FD line), or one replayed sensor
+ * event. */
 typedef struct {
     int64_t log_t_us;    /* timestamp for the log: the frame's host receive time, or the event's log time */
     int status;          /* SF_OK, or the negative code of a frame the decoder skipped (counted) */

@@ -21,6 +21,7 @@ const char *sf_strerror(const int code)
     case SF_EIMPLAUSIBLE: return "sample beyond full scale or a physically impossible jump";
     case SF_EINTR: return "interrupted by a signal";
     case SF_ECORRUPT: return "corrupt framing, rest of the file refused";
+    case SF_ENOTCLASSIC: return "a CAN FD frame, not a classic CAN frame";
     default: return "unknown error";
     }
 }

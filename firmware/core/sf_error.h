@@ -23,6 +23,7 @@
 #define SF_EIMPLAUSIBLE (-14) /* a sample beyond full scale or a physically impossible jump */
 #define SF_EINTR (-15)       /* a blocking read was interrupted by a signal; nothing was lost, call again */
 #define SF_ECORRUPT (-16)    /* a file's framing cannot be trusted: the rest of it is refused */
+#define SF_ENOTCLASSIC (-17) /* a well-formed CAN FD frame where only classic CAN is taken (not a board frame) */
 
 /* Short English text for a code; never NULL. */
 const char *sf_strerror(int code);

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE
 
-from .pipeline import simulate, write_outputs
+from .pipeline import CANDUMP_SUFFIXES, candump_path, simulate, write_outputs
 from .scenario import BUILTIN, ScenarioError, resolve_scenario
 
 
@@ -22,7 +22,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "sim",
         help="simulate a walk: write the board's candump log, truth LCM log and a summary",
-        description="Simulate a walk with the wearable board and write board.candump (candump -L), "
+        description="Simulate a walk with the wearable board and write board.candump (candump -L; "
+        "board.log with --candump-suffix .log), "
         "truth.lcmlog (TRUTH, 10 Hz), sim_summary.json and init_truth.ini into --out.",
     )
     p.add_argument(
@@ -36,6 +37,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--stdout",
         action="store_true",
         help="stream the candump lines to stdout instead of DIR/board.candump",
+    )
+    p.add_argument(
+        "--candump-suffix",
+        choices=CANDUMP_SUFFIXES,
+        default=CANDUMP_SUFFIXES[0],
+        help="name the CAN log DIR/board.log instead of DIR/board.candump (the same candump -L lines): "
+        "python-can's can.LogReader reads a candump log by the .log suffix; stridefixd takes either",
     )
     p.add_argument(
         "--duration-s", type=float, metavar="S", help="simulated duration [s] (0: until the walk ends)"
@@ -69,15 +77,21 @@ def run(args) -> int:
     except ScenarioError as e:
         print(f"stridefix sim: error: {e}", file=sys.stderr)
         return EXIT_USAGE
+    suffix = getattr(args, "candump_suffix", CANDUMP_SUFFIXES[0])
     try:
         result = simulate(scenario)
         out_dir = Path(args.out)
-        summary = write_outputs(result, out_dir, candump_stream=sys.stdout if args.stdout else None)
+        summary = write_outputs(
+            result,
+            out_dir,
+            candump_stream=sys.stdout if args.stdout else None,
+            candump_suffix=suffix,
+        )
     except OSError as e:
         print(f"stridefix sim: error: cannot write output: {e}", file=sys.stderr)
         return EXIT_FAILURE
     elapsed = time.perf_counter() - t_start
-    where = "stdout" if args.stdout else str(out_dir / "board.candump")
+    where = "stdout" if args.stdout else str(candump_path(out_dir, suffix))
     print(
         f"stridefix sim: seed {summary['seed']}, {summary['duration_s']:.1f} s simulated, "
         f"{summary['steps']} steps, {summary['distance_m']:.1f} m, floors {summary['floors_visited']}, "

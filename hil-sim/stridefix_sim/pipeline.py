@@ -6,7 +6,8 @@ faults (faults.py), so e.g. changing
 the loss rate does not change the sensor noise, and changing the pace does not change the person. The
 same scenario and seed give byte-identical outputs.
 
-Outputs (``write_outputs``): ``board.candump`` (or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
+Outputs (``write_outputs``): ``board.candump`` (or ``board.log`` with ``candump_suffix=".log"``, the
+same candump -L lines under the suffix python-can's ``can.LogReader`` reads them by; or a stream), ``truth.lcmlog`` (channel TRUTH, truth_t at
 10 Hz, t_us = unwrapped board time in µs, also the event timestamp; x, y, the true floor, the true
 heading = walking direction in the map frame, steps so far; source SIMULATION), ``sim_summary.json``
 ``init_truth.ini`` (the true start pose for the firmware), ``building.toml`` (the world's building
@@ -381,13 +382,32 @@ def write_init_ini(result: SimResult, path: Path) -> None:
     )
 
 
-def write_outputs(result: SimResult, out_dir: Path, candump_stream: TextIO | None = None) -> dict:
-    """Write the run's files into ``out_dir``; candump lines go to ``candump_stream`` when given."""
+#: The CAN log's name suffixes: candump -L lines either way; python-can's ``can.LogReader`` picks its
+#: candump reader (``CanutilsLogReader``) from ``.log`` and refuses ``.candump``.
+CANDUMP_SUFFIXES = (".candump", ".log")
+
+
+def candump_path(out_dir: Path, suffix: str = CANDUMP_SUFFIXES[0]) -> Path:
+    """Where :func:`write_outputs` writes the candump lines: ``out_dir/board<suffix>``."""
+    if suffix not in CANDUMP_SUFFIXES:
+        raise ValueError(f"candump suffix {suffix!r}: not one of {', '.join(CANDUMP_SUFFIXES)}")
+    return out_dir / f"board{suffix}"
+
+
+def write_outputs(
+    result: SimResult,
+    out_dir: Path,
+    candump_stream: TextIO | None = None,
+    candump_suffix: str = CANDUMP_SUFFIXES[0],
+) -> dict:
+    """Write the run's files into ``out_dir``; candump lines go to ``candump_stream`` when given, else
+    to :func:`candump_path` (``board.candump``, or ``board.log`` with ``candump_suffix=".log"``)."""
+    path = candump_path(out_dir, candump_suffix)
     out_dir.mkdir(parents=True, exist_ok=True)
     lines = result.board.lines or [""]  # (no frame: one empty line, as before)
     step = 100_000  # in pieces: an 8-hour walk's text would be another 400 MB at once
     if candump_stream is None:
-        with open(out_dir / "board.candump", "w", encoding="ascii") as f:
+        with open(path, "w", encoding="ascii") as f:
             for i in range(0, len(lines), step):
                 f.write("\n".join(lines[i : i + step]) + "\n")
     else:

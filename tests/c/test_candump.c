@@ -1,6 +1,7 @@
-/* test_candump.c — the candump -L parser and formatter (sf_candump.h) and the frame inputs
- * (sf_can_input.h): files, bad lines with their line numbers, a NUL inside a line, lines across the
- * reader's chunks from a file and a pipe, missing files, SocketCAN where the kernel has no AF_CAN. */
+/* test_candump.c — the candump -L parser and formatter (sf_candump.h: asc2log's direction flags and
+ * CAN FD lines too) and the frame inputs (sf_can_input.h): files, bad lines with their line numbers,
+ * a NUL inside a line, lines across the reader's chunks from a file and a pipe, missing files,
+ * SocketCAN where the kernel has no AF_CAN. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -112,9 +113,18 @@ static void test_parse_garbage_is_syntax_error(void **state)
         "(1700000000.123456) can0 100#001",                /* odd hex digits */
         "(1700000000.123456) can0 100#0g",                 /* not hex */
         "(1700000000.123456) can0 100#001122334455667788", /* 9 bytes */
-        "(1700000000.123456) can0 100##0011",              /* CAN FD */
-        "(1700000000.123456) can0 100##10011",             /* CAN FD with flags */
+        "(1700000000.123456) can0 100##0011",              /* CAN FD, an odd digit after the flags */
+        "(1700000000.123456) can0 100##",                  /* CAN FD without flags */
+        "(1700000000.123456) can0 100##g0011",             /* CAN FD, flags not hex */
+        "(1700000000.123456) can0 100##1R",                /* CAN FD has no remote frames */
         "(1700000000.123456) can0 100#00 junk",            /* junk after the data */
+        "(1700000000.123456) can0 100#00R",                /* a direction flag without its blank */
+        "(1700000000.123456) can0 100#00 r",               /* a direction flag in lower case */
+        "(1700000000.123456) can0 100#00 X",               /* no such direction */
+        "(1700000000.123456) can0 100#00 RT",              /* two flags */
+        "(1700000000.123456) can0 100#00 R T",             /* two flags */
+        "(1700000000.123456) can0 100#00 R0",              /* junk after the flag */
+        "(1700000000.123456) can0 100#00\r R",             /* a flag after a line end */
         "(1700000000.123456) can0 100#R00",                /* data after R */
         "(1700000000.123456) can0 100",                    /* no # */
         "(1700000000.123456) can0 10#00",                  /* 2-digit id */
@@ -137,6 +147,101 @@ static void test_parse_garbage_is_syntax_error(void **state)
     }
 }
 
+/* asc2log writes a direction flag after every frame ("R" received, "T" sent: can-utils' asc2log
+ * output, issue 17); each line is the frame of the line without it, whichever entry reads it (the
+ * replay-shaped line takes sf_candump_parse_line's fast path). */
+static void test_parse_direction_flag_is_the_same_frame(void **state)
+{
+    (void)state;
+    const char *const pairs[][2] = {
+        {"(1700000000.123456) can0 100#0011223344556677 R", "(1700000000.123456) can0 100#0011223344556677"},
+        {"(1700000000.123456) can0 100#0011223344556677 T", "(1700000000.123456) can0 100#0011223344556677"},
+        {"(1700000000.123456) can0 7F0#00112233445566aa\tR", "(1700000000.123456) can0 7F0#00112233445566aa"},
+        {"(1700000000.123456) can0 100#0011 R", "(1700000000.123456) can0 100#0011"},
+        {"(1700000000.123456) can0 100#0011  T  \r", "(1700000000.123456) can0 100#0011"},
+        {"(1700000000.123456) can0 12345678#00 R", "(1700000000.123456) can0 12345678#00"},
+        {"(1700000000.123456) can0 101#R R", "(1700000000.123456) can0 101#R"},
+        {"(1700000000.123456) can0 124# T", "(1700000000.123456) can0 124#"},
+        {"(1.000000) vcan12 080#0102 R\n", "(1.000000) vcan12 080#0102"},
+    };
+    for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; i++) {
+        sf_can_frame_t f, g, h;
+        memset(&f, 0, sizeof f);
+        memset(&g, 0, sizeof g);
+        memset(&h, 0, sizeof h);
+        assert_int_equal(sf_candump_parse(pairs[i][0], &f), SF_OK);
+        assert_int_equal(sf_candump_parse(pairs[i][1], &g), SF_OK);
+        const size_t len = strcspn(pairs[i][0], "\n");
+        char line[96];
+        memcpy(line, pairs[i][0], len);
+        line[len] = '\0';
+        if (sf_candump_parse_line(line, len, &h) != SF_OK) {
+            fail_msg("pair %zu: sf_candump_parse_line refused \"%s\"", i, line);
+        }
+        assert_memory_equal(&f, &g, sizeof f);
+        assert_int_equal(h.host_t_us, g.host_t_us);
+        assert_int_equal(h.id, g.id);
+        assert_int_equal(h.extended, g.extended);
+        assert_int_equal(h.remote, g.remote);
+        assert_int_equal(h.dlc, g.dlc);
+        assert_memory_equal(h.data, g.data, sizeof h.data);
+    }
+}
+
+/* A CAN FD line (candump -L: "##", a flags nibble, the data) of n bytes into line; its length. */
+static size_t fd_line(char *const line, const size_t size, const char *const id, const unsigned flags,
+                      const unsigned n, const char *const tail)
+{
+    int k = snprintf(line, size, "(1700000000.654321) can0 %s##%X", id, flags);
+    for (unsigned i = 0; i < n; i++) {
+        k += snprintf(line + k, size - (size_t)k, "%02X", (i * 37u) & 0xFFu);
+    }
+    k += snprintf(line + k, size - (size_t)k, "%s", tail);
+    assert_true(k > 0 && (size_t)k < size);
+    return (size_t)k;
+}
+
+/* Every length 0..65 bytes: the FD lengths (0..8, 12, 16, 20, 24, 32, 48, 64) are SF_ENOTCLASSIC
+ * with the frame's time and id (not a board frame: the input layer counts and skips it), the others
+ * bad syntax with *frame untouched; both entries, with and without a direction flag. */
+static void test_parse_can_fd_lines(void **state)
+{
+    (void)state;
+    int n_fd = 0;
+    for (unsigned n = 0; n <= 65; n++) {
+        const bool valid = n <= 8 || n == 12 || n == 16 || n == 20 || n == 24 || n == 32 || n == 48 || n == 64;
+        for (int variant = 0; variant < 4; variant++) {
+            char line[200];
+            const char *const id = variant % 2 ? "1ABCDEF0" : "123";
+            const size_t len = fd_line(line, sizeof line, id, (unsigned)variant * 5u, n, variant >= 2 ? " R" : "");
+            sf_can_frame_t f, g;
+            memset(&f, 0x5A, sizeof f);
+            memset(&g, 0x5A, sizeof g);
+            const int rc = sf_candump_parse(line, &f);
+            const int rl = sf_candump_parse_line(line, len, &g);
+            if (rc != (valid ? SF_ENOTCLASSIC : SF_ESYNTAX) || rl != rc) {
+                fail_msg("\"%s\" (%u bytes): got %d and %d, want %d", line, n, rc, rl,
+                         valid ? SF_ENOTCLASSIC : SF_ESYNTAX);
+            }
+            if (!valid) {
+                assert_int_equal(f.id, 0x5A5A5A5A);
+                assert_int_equal(g.id, 0x5A5A5A5A);
+                continue;
+            }
+            n_fd++;
+            assert_int_equal(f.host_t_us, 1700000000654321LL);
+            assert_int_equal(f.id, variant % 2 ? 0x1ABCDEF0u : 0x123u);
+            assert_int_equal(f.extended, variant % 2 == 1);
+            assert_false(f.remote);
+            assert_int_equal(f.dlc, 0); /* the data is not carried */
+            assert_int_equal(g.host_t_us, f.host_t_us);
+            assert_int_equal(g.id, f.id);
+            assert_int_equal(g.dlc, 0);
+        }
+    }
+    assert_int_equal(n_fd, 16 * 4);
+}
+
 static void test_parse_null_is_einval(void **state)
 {
     (void)state;
@@ -157,7 +262,7 @@ static void test_format_parse_round_trip(void **state)
         f.id = f.extended ? (uint32_t)rand() & 0x1FFFFFFFu : (uint32_t)rand() & 0x7FFu;
         f.host_t_us = (int64_t)rand() * 1000 + i;
         f.dlc = (uint8_t)(f.remote ? 0 : i % 9);
-        for (int k = 0; k < f.dlc; k++) {
+        for (size_t k = 0; k < f.dlc && k < sizeof f.data; k++) { /* the bound: gcc 12 -O3 -Wstringop-overflow */
             f.data[k] = (uint8_t)rand();
         }
         char buf[80];
@@ -213,9 +318,10 @@ static void test_input_file_good_blank_and_garbage(void **state)
                "garbage\n"                               /* 3 */
                "(2.000000) can0 100#00\r\n"              /* 4 */
                "   \n"                                   /* 5 spaces: not blank, bad */
-               "(3.000000) can0 100##00\n"               /* 6 CAN FD */
+               "(3.000000) can0 100##00\n"               /* 6 CAN FD, an odd digit */
                "\r\n"                                    /* 7 blank */
-               "(4.000000) can0 12345678#R");            /* 8, no final newline */
+               "(3.500000) can0 101##4001122 T\n"        /* 8 CAN FD, 3 bytes, a direction flag */
+               "(4.000000) can0 12345678#R");            /* 9, no final newline */
     sf_can_input_t in;
     char err[256] = "";
     assert_int_equal(sf_can_input_open(&in, path, err, sizeof err), SF_OK);
@@ -242,8 +348,13 @@ static void test_input_file_good_blank_and_garbage(void **state)
     assert_int_equal(in.line_no, 6);
     assert_string_equal(in.line, "(3.000000) can0 100##00");
 
-    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(sf_can_input_next(&in, &f), SF_ENOTCLASSIC);
     assert_int_equal(in.line_no, 8);
+    assert_int_equal(f.host_t_us, 3500000);
+    assert_int_equal(f.id, 0x101);
+
+    assert_int_equal(sf_can_input_next(&in, &f), 1);
+    assert_int_equal(in.line_no, 9);
     assert_true(f.extended);
     assert_true(f.remote);
 
@@ -313,8 +424,8 @@ static uint8_t numbered_dlc(const int i)
 static size_t numbered_line(const int i, char *const buf, const size_t size)
 {
     sf_can_frame_t f = {.host_t_us = numbered_t_us(i), .id = (uint32_t)i & 0x7FFu, .dlc = numbered_dlc(i)};
-    for (int k = 0; k < f.dlc; k++) {
-        f.data[k] = (uint8_t)(i + k);
+    for (size_t k = 0; k < f.dlc && k < sizeof f.data; k++) { /* the bound: gcc 12 -O3 -Wstringop-overflow */
+        f.data[k] = (uint8_t)((size_t)i + k);
     }
     int n = sf_candump_format(&f, i % 2 ? "can0" : "a-much-longer-interface-name", buf, size);
     assert_true(n > 0);
@@ -438,6 +549,8 @@ int main(void)
         cmocka_unit_test(test_parse_every_length),
         cmocka_unit_test(test_parse_line_endings),
         cmocka_unit_test(test_parse_garbage_is_syntax_error),
+        cmocka_unit_test(test_parse_direction_flag_is_the_same_frame),
+        cmocka_unit_test(test_parse_can_fd_lines),
         cmocka_unit_test(test_parse_null_is_einval),
         cmocka_unit_test(test_format_parse_round_trip),
         cmocka_unit_test(test_format_exact_text_and_small_buffer),

@@ -1,7 +1,8 @@
 /* test_input.c — sf_input (firmware/board/sf_input.h), the one input interface: a candump snippet of
  * every sample kind gives events; those events logged with sf_rx_lcm_write and replayed through
- * "lcmlog:" give the same events with the same log times and the same counters; bad lines and unknown
- * ids are counted and worded with file and line; and closing a replay leaves standard input open. */
+ * "lcmlog:" give the same events with the same log times and the same counters; so does the candump as
+ * asc2log writes it (direction flags, CAN FD lines); bad lines and unknown ids are counted and worded
+ * with file and line; and closing a replay leaves standard input open. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -275,6 +276,77 @@ static void test_describe_names_file_and_line(void **state)
     unlink(candump);
 }
 
+/* The candump in path as can-utils' asc2log writes it (issue 17), into out: a direction flag after
+ * every frame (" R", every third " T") and, after every fifth line, a CAN FD line of the same time
+ * (12 bytes; extended id every other one). Returns the number of FD lines. */
+static int write_asc2log(const char *const path, const char *const out)
+{
+    FILE *const in = fopen(path, "r");
+    FILE *const f = fopen(out, "w");
+    assert_true(in != NULL && f != NULL);
+    char line[128];
+    int n = 0, n_fd = 0;
+    while (fgets(line, sizeof line, in) != NULL) {
+        line[strcspn(line, "\n")] = '\0';
+        fprintf(f, "%s %c\n", line, n % 3 == 2 ? 'T' : 'R');
+        if (++n % 5 == 0 && line[0] == '(') {
+            fprintf(f, "%.*s can0 %s##1000102030405060708090A0B R\n", (int)strcspn(line, " "), line,
+                    n_fd % 2 ? "1ABCDEF0" : "123");
+            n_fd++;
+        }
+    }
+    fclose(in);
+    fclose(f);
+    return n_fd;
+}
+
+/* GIVEN the candump of every kind as asc2log writes it (direction flags, CAN FD lines among the
+ * frames), WHEN it is read, THEN it gives the candump's events at the same log times; each FD line is
+ * a frame read but not the board's (unknown id, can_fd), not bad syntax, and is worded with its line. */
+static void test_asc2log_output_gives_the_same_events(void **state)
+{
+    (void)state;
+    char candump[64], asc2log[64];
+    temp_path(candump, sizeof candump, "plain");
+    temp_path(asc2log, sizeof asc2log, "asc2log");
+    (void)write_candump(candump);
+    const int n_fd = write_asc2log(candump, asc2log);
+    assert_true(n_fd >= 4);
+
+    static events_t plain, flagged;
+    sf_input_counters_t pc, fc;
+    read_all(candump, &plain, &pc);
+    read_all(asc2log, &flagged, &fc);
+    assert_int_equal(flagged.n, plain.n);
+    for (int i = 0; i < plain.n; i++) {
+        assert_int_equal(flagged.log_t_us[i], plain.log_t_us[i]);
+        assert_same_event(&flagged.ev[i], &plain.ev[i]);
+    }
+    assert_int_equal(pc.can_fd, 0);
+    assert_int_equal(fc.can_fd, (uint64_t)n_fd);
+    assert_int_equal(fc.rx.unknown_id, pc.rx.unknown_id + (uint64_t)n_fd);
+    assert_int_equal(fc.bad_syntax, pc.bad_syntax); /* the garbage line only */
+    assert_int_equal(fc.frames_total, pc.frames_total + (uint64_t)n_fd);
+    assert_int_equal(fc.rx.frames_ok, pc.rx.frames_ok);
+    assert_true(fc.rx.imu == pc.rx.imu && fc.rx.wifi == pc.rx.wifi && fc.rx.ble_adverts == pc.rx.ble_adverts);
+
+    sf_input_t *in = NULL;
+    assert_int_equal(sf_input_open(&in, asc2log, NULL, 0), SF_OK);
+    static sf_input_item_t item;
+    int rc;
+    while ((rc = sf_input_next(in, &item)) != 0 && !(rc == 1 && item.status == SF_ENOTCLASSIC)) {
+    }
+    assert_int_equal(rc, 1);
+    assert_int_equal(item.event.kind, sf_rx_none);
+    char text[512];
+    assert_true(sf_input_describe(in, item.status, text, sizeof text));
+    /* line 11: the FD line after the tenth line (the fifth is the garbage, which gets none) */
+    assert_non_null(strstr(text, ":11: CAN id 0x123 is a CAN FD frame; the board sends classic CAN only; skipped"));
+    sf_input_close(in);
+    unlink(candump);
+    unlink(asc2log);
+}
+
 static bool stdin_open(void)
 {
     return fcntl(0, F_GETFD) != -1;
@@ -414,6 +486,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_candump_and_lcm_replay_give_the_same_events),
         cmocka_unit_test(test_describe_names_file_and_line),
+        cmocka_unit_test(test_asc2log_output_gives_the_same_events),
         cmocka_unit_test(test_replay_close_does_not_close_stdin),
         cmocka_unit_test(test_missing_inputs_fail_with_a_message),
         cmocka_unit_test(test_every_kind_has_a_channel),

@@ -1,7 +1,7 @@
 /* fuzz_candump.c — the candump -L input (sf_can_input.c line reading, sf_candump.c parser) on any
  * bytes: the input is a candump file read line by line, as `stridefixd --input FILE` reads it.
  * Reference check: every line that parses formats back (sf_candump_format) to a line that parses to
- * the same frame. */
+ * the same frame; a CAN FD line (SF_ENOTCLASSIC) carries its header only (no data, not remote). */
 #include <string.h>
 
 #include "sf_can_input.h"
@@ -29,7 +29,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *const data, const size_t size)
         if (rc == 0 || rc == SF_EIO) {
             break;
         }
-        SF_FUZZ_CHECK(rc == 1 || rc == SF_ESYNTAX);
+        SF_FUZZ_CHECK(rc == 1 || rc == SF_ESYNTAX || rc == SF_ENOTCLASSIC);
+        if (rc == SF_ENOTCLASSIC) {
+            SF_FUZZ_CHECK(frame.dlc == 0 && !frame.remote && frame.id <= (frame.extended ? 0x1FFFFFFFu : 0x7FFu));
+        }
         if (rc == 1) {
             SF_FUZZ_CHECK(frame.dlc <= 8);
             char line[96];

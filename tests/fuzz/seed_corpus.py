@@ -6,7 +6,8 @@ The seeds are committed; this script says where they came from and rewrites them
     .venv/bin/python tests/fuzz/seed_corpus.py --stridefixd build/firmware/stridefixd \\
         --candump /tmp/sim/board.candump --site-vectors build/tests/site_vectors --out tests/fuzz/corpus
 
-- candump: the first lines of a SIL walk and the lines of its first Wi-Fi scan;
+- candump: the first lines of a SIL walk and the lines of its first Wi-Fi scan, and those scan lines
+  as can-utils' asc2log writes them (a direction flag on each) with CAN FD lines among them;
 - board_rx: the same frames in fuzz_board_rx.c's 12-byte records;
 - lcm_input: the raw-sensor LCM log stridefixd writes for the walk's first seconds (IMU, MAG, BARO,
   WIFI, a few non-sensor events), with one GNSS event added (the SIL walk has none);
@@ -38,6 +39,19 @@ def parse_candump(line: str) -> tuple[int, int, bytes]:
     stamp, _iface, frame = line.split()
     can_id, data = frame.split("#")
     return round(float(stamp.strip("()")) * 1e6), int(can_id, 16), bytes.fromhex(data)
+
+
+def asc2log_lines(lines: list[str]) -> bytes:
+    """The lines with asc2log's direction flag (" R", every fifth " T") and, after every tenth, a CAN
+    FD line (candump -L ``id##<flags><data>``) of 3, 12 or 64 bytes at the same time."""
+    out = []
+    for i, line in enumerate(lines):
+        stamp, iface, _frame = line.split()
+        out.append(f"{line.rstrip()} {'T' if i % 5 == 4 else 'R'}\n")
+        if i % 10 == 9:
+            n = (3, 12, 64)[i // 10 % 3]
+            out.append(f"{stamp} {iface} 3{i:02X}##{i % 16:X}{bytes(range(n)).hex().upper()}\n")
+    return "".join(out).encode()
 
 
 def board_rx_records(lines: list[str]) -> bytes:
@@ -110,6 +124,7 @@ def main() -> int:
     seeds = {
         "candump/walk_start.candump": "".join(start).encode(),
         "candump/walk_scan.candump": "".join(scan).encode(),
+        "candump/asc2log_scan.candump": asc2log_lines(scan),
         "board_rx/walk_start.frames": board_rx_records(start),
         "board_rx/walk_scan.frames": board_rx_records(scan),
         "lcm_input/walk_start.lcmlog": lcm_log_seed(args.stridefixd, lines, args.lcmtypes_python),
