@@ -115,24 +115,49 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
-/* One POSE per fusion scheme that has a position (a scheme waiting for its first fix has none).
- * Without a site there are no fixes, so only pdr_only is published (the others would repeat it). */
+/* The primary pose (write_pose); false when there is none to publish. */
+static bool primary_pose(const daemon_t *const d, const bool has_site, sf_pose_t *const p)
+{
+    const int only = d->params.output_scheme;
+    if ((only < 0 || only == sf_scheme_controller) &&
+        sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, p)) {
+        return true;
+    }
+    if (only == sf_scheme_controller) {
+        return false; /* --fusion controller: the controller's pose or none */
+    }
+    const int follow = only >= 0 ? only : has_site ? d->params.controller_init_scheme : sf_scheme_pdr_only;
+    return sf_estimator_scheme_pose(&d->est, &d->params, follow, p) ||
+           (only < 0 && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_pdr_only, p));
+}
+
+/* One POSE_<SCHEME> per fusion scheme that has a position (a scheme waiting for its first fix has
+ * none), then the primary pose on POSE. Without a site there are no fixes, so only pdr_only is
+ * published (the others would repeat it).
+ *
+ * The primary pose is the multi-scheme controller's (scheme 8: the pose of the scheme its context
+ * selects). Without an active controller (no context map, controller.enabled = 0) POSE carries a copy
+ * of one scheme's pose, its scheme field naming it: the --fusion scheme when one is chosen, else
+ * controller.init_scheme (the scheme the controller follows before it knows a context), pdr_only
+ * while that has no position and without a site. The copy is one more pose per output, the one
+ * growth of the log over the single-channel POSE of before (which the controller's pose did not
+ * add to). --fusion controller publishes the controller's POSE alone, as before. */
 static void write_pose(daemon_t *const d)
 {
     sf_estimator_status_t st;
     sf_estimator_status(&d->est, &st);
     const int n_schemes = st.has_site ? sf_scheme_count : sf_scheme_pdr_only + 1;
+    const int only = d->params.output_scheme;
     for (int scheme = 0; scheme < n_schemes; scheme++) {
         sf_pose_t p;
-        if ((d->params.output_scheme < 0 || scheme == d->params.output_scheme) &&
-            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p) && WRITES(d, POSE)) {
+        if ((only < 0 || scheme == only) && sf_options_channel_on(&d->opt, sf_publish_pose_channel(scheme)) &&
+            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
-    sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8) */
-    const bool controller_out = d->params.output_scheme < 0 || d->params.output_scheme == sf_scheme_controller;
-    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p) && WRITES(d, POSE)) {
-        sf_publish_pose(d->out, d->host_t_us, &p);
+    sf_pose_t p;
+    if (WRITES(d, POSE) && primary_pose(d, st.has_site, &p)) {
+        sf_publish_primary_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;
     d->last_pose_floor = st.floor;

@@ -1,4 +1,5 @@
-/* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (one per scheme), FIX (the audit
+/* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (the primary pose) and POSE_<SCHEME>
+ * (one per fusion scheme), FIX (the audit
  * record), HEALTH (input, estimator, fix-source and log counters) and CONFIG (the effective
  * parameters), CONTEXT (the multi-scheme controller's changes). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h, from the same kind table the
  * replay reads.
@@ -53,7 +54,14 @@ bool sf_publish_loop_due(sf_publish_loop_t *loop);
 void sf_publish_loop_add(sf_publish_loop_t *loop, double dt_us);
 
 void sf_publish_step(sf_lcm_out_t *out, int64_t log_t_us, const sf_step_t *step);
+/* Poses: each fusion scheme's on its own channel POSE_<SCHEME> (sf_publish_pose_channel: POSE_EKF
+ * for pose_t.SCHEME_EKF, ...; a scheme outside the fusion schemes, the controller's, on POSE), and the
+ * primary pose on POSE (sf_publish_primary_pose: the controller's, or the copy of one scheme's pose
+ * stridefixd makes primary without an active controller), so lcm-spy and plotting tools can tell the
+ * schemes apart by channel; the scheme field says the same. */
+const char *sf_publish_pose_channel(int scheme);
 void sf_publish_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
+void sf_publish_primary_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
 
 /* FIX: every field of the audit, accuracy_factor and drift included (0 unless the adaptive scheme
  * blended the fix). */
