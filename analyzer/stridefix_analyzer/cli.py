@@ -29,6 +29,7 @@ SUBCOMMANDS = {
     "realbench": "stridefix_analyzer.realbench.cli",
     "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
+    "spy": "stridefix_analyzer.spy",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing

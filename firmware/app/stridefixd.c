@@ -115,33 +115,9 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
-/* The primary pose (write_pose); false when there is none to publish. */
-static bool primary_pose(const daemon_t *const d, const bool has_site, sf_pose_t *const p)
-{
-    const int only = d->params.output_scheme;
-    if ((only < 0 || only == sf_scheme_controller) &&
-        sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, p)) {
-        return true;
-    }
-    if (only == sf_scheme_controller) {
-        return false; /* --fusion controller: the controller's pose or none */
-    }
-    const int follow = only >= 0 ? only : has_site ? d->params.controller_init_scheme : sf_scheme_pdr_only;
-    return sf_estimator_scheme_pose(&d->est, &d->params, follow, p) ||
-           (only < 0 && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_pdr_only, p));
-}
-
 /* One POSE_<SCHEME> per fusion scheme that has a position (a scheme waiting for its first fix has
- * none), then the primary pose on POSE. Without a site there are no fixes, so only pdr_only is
- * published (the others would repeat it).
- *
- * The primary pose is the multi-scheme controller's (scheme 8: the pose of the scheme its context
- * selects). Without an active controller (no context map, controller.enabled = 0) POSE carries a copy
- * of one scheme's pose, its scheme field naming it: the --fusion scheme when one is chosen, else
- * controller.init_scheme (the scheme the controller follows before it knows a context), pdr_only
- * while that has no position and without a site. The copy is one more pose per output, the one
- * growth of the log over the single-channel POSE of before (which the controller's pose did not
- * add to). --fusion controller publishes the controller's POSE alone, as before. */
+ * none), then the primary pose on POSE (sf_publish_primary_of). Without a site there are no fixes,
+ * so only pdr_only is published (the others would repeat it). */
 static void write_pose(daemon_t *const d)
 {
     sf_estimator_status_t st;
@@ -156,7 +132,7 @@ static void write_pose(daemon_t *const d)
         }
     }
     sf_pose_t p;
-    if (WRITES(d, POSE) && primary_pose(d, st.has_site, &p)) {
+    if (WRITES(d, POSE) && sf_publish_primary_of(&d->est, &d->params, st.has_site, &p)) {
         sf_publish_primary_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;

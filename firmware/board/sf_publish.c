@@ -64,6 +64,21 @@ void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_p
     write_pose(out, sf_publish_pose_channel(p->scheme), log_t_us, p);
 }
 
+bool sf_publish_primary_of(const sf_estimator_t *const est, const sf_params_t *const p, const bool has_site,
+                           sf_pose_t *const pose)
+{
+    const int only = p->output_scheme;
+    if ((only < 0 || only == sf_scheme_controller) && sf_estimator_scheme_pose(est, p, sf_scheme_controller, pose)) {
+        return true;
+    }
+    if (only == sf_scheme_controller) {
+        return false; /* --fusion controller: the controller's pose or none */
+    }
+    const int follow = only >= 0 ? only : has_site ? p->controller_init_scheme : sf_scheme_pdr_only;
+    return sf_estimator_scheme_pose(est, p, follow, pose) ||
+           (only < 0 && sf_estimator_scheme_pose(est, p, sf_scheme_pdr_only, pose));
+}
+
 void sf_publish_primary_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_pose_t *const p)
 {
     write_pose(out, SF_CHANNEL_POSE, log_t_us, p);

@@ -60,6 +60,16 @@ void sf_publish_step(sf_lcm_out_t *out, int64_t log_t_us, const sf_step_t *step)
  * stridefixd makes primary without an active controller), so lcm-spy and plotting tools can tell the
  * schemes apart by channel; the scheme field says the same. */
 const char *sf_publish_pose_channel(int scheme);
+
+/* The primary pose into *pose; false when there is none to publish. It is the multi-scheme
+ * controller's (scheme 8: the pose of the scheme its context selects). Without an active controller
+ * (no context map, controller.enabled = 0) it is a copy of one scheme's pose, its scheme field naming
+ * it: the output.scheme (--fusion) one when a single fusion scheme is chosen, else
+ * controller.init_scheme's (the scheme the controller follows before it knows a context), pdr_only's
+ * while that has no position and without a site (has_site false). output.scheme = controller: the
+ * controller's pose or none. A copy is one more pose per output, the one growth of the log over the
+ * single POSE channel of before, which carried the controller's pose too. */
+bool sf_publish_primary_of(const sf_estimator_t *est, const sf_params_t *p, bool has_site, sf_pose_t *pose);
 void sf_publish_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
 void sf_publish_primary_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
 

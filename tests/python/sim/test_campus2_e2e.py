@@ -13,9 +13,11 @@ import subprocess
 import lcm
 import numpy as np
 import pytest
+import stridefix_channels
 from stridefix import health_t, pose_t, truth_t
 
 FLOOR_HIT_MIN = 0.97  # PDR + barometer alone; the stairs and rides are a few % of the walk
+SCHEME_POSE_CHANNELS = set(stridefix_channels.POSE_SCHEME_CHANNELS.values())  # POSE_PDR_ONLY, ...
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +35,7 @@ def replay(sim_run, stridefixd):
         counts[e.channel] = counts.get(e.channel, 0) + 1
         if e.channel == "HEALTH":
             health = health_t.decode(e.data)
-        elif e.channel == "POSE":
+        elif e.channel in SCHEME_POSE_CHANNELS:  # each fusion scheme's own poses
             p = pose_t.decode(e.data)
             poses.append((p.t_us, p.scheme, p.floor))
     for e in lcm.EventLog(str(out / "truth.lcmlog"), "r"):
