@@ -142,6 +142,36 @@ def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
     assert primary.count(pose_t.SCHEME_EKF) > 0.9 * len(primary)
 
 
+@pytest.mark.parametrize(
+    ("args", "channels", "scheme"),
+    [
+        # one scheme: its own channel, and POSE its copy (the primary of a one-scheme replay)
+        (["--fusion", "kalman"], {"POSE_KALMAN", "POSE"}, pose_t.SCHEME_KALMAN),
+        # --channels picks pose channels one by one: the primary (ekf's copy here) without the rest
+        (["--channels", "POSE"], {"POSE"}, pose_t.SCHEME_EKF),
+        (["--channels", "POSE_PARTICLE"], {"POSE_PARTICLE"}, pose_t.SCHEME_PARTICLE),
+    ],
+    ids=["fusion-kalman", "channels-POSE", "channels-POSE_PARTICLE"],
+)
+def test_pose_channels_follow_fusion_and_channels(walk, stridefixd, site, tmp_path, args, channels, scheme):
+    log = tmp_path / "one.lcmlog"
+    assert run_fw(stridefixd, walk["dir"], log, "--site", str(site), *args).returncode == 0
+    poses: dict[str, list[bytes]] = {}
+    for e in lcm.EventLog(str(log), "r"):
+        if e.channel in POSE_CHANNELS:
+            poses.setdefault(e.channel, []).append(e.data)
+    assert set(poses) == channels
+    # the poses themselves are those of the full run: --fusion and --channels only pick what is written
+    full = {ch: [e.data for e in walk["events"] if e.channel == ch] for ch in channels}
+    for ch, payloads in poses.items():
+        if ch != "POSE" or "--fusion" not in args:  # --fusion kalman: POSE copies kalman, not ekf
+            assert payloads == full[ch]
+        assert {pose_t.decode(d).scheme for d in payloads} <= {scheme, pose_t.SCHEME_PDR_ONLY}
+        assert pose_t.decode(payloads[-1]).scheme == scheme
+    if "POSE_KALMAN" in poses:
+        assert poses["POSE"] == poses["POSE_KALMAN"]
+
+
 def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
     proc = cli(
         "analyze",
