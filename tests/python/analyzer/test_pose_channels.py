@@ -3,18 +3,22 @@ and logs from before the split (every scheme on POSE) read into the same POSE ta
 
 A walk's poses are written both ways, with a controller (its pose, scheme 8, on POSE) and without
 (POSE a copy of one scheme's pose, which the reader leaves out: its scheme's channel has it); both
-readers (indexed and record by record) must give the old log's rows, and scoring the same numbers.
+readers (indexed and record by record) must give the old log's rows, and scoring the same numbers;
+lcmindex and lcmdecode take a new log's pose channels together, vectorised.
 """
 
 from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 import stridefix_channels
 from numpy.testing import assert_array_equal
 from stridefix import pose_t
-from stridefix_analyzer.io.channels import POSE_CHANNELS, POSE_SCHEME_CHANNELS, table_of
+from stridefix_analyzer.io.channels import CHANNELS, POSE_CHANNELS, POSE_SCHEME_CHANNELS, table_of
+from stridefix_analyzer.io.lcmdecode import decode_columns
+from stridefix_analyzer.io.lcmindex import index_file
 from stridefix_analyzer.io.logread import read_logs, read_table
 from stridefix_analyzer.scoring.metrics import run_metrics
 
@@ -112,3 +116,23 @@ def test_decoding_one_pose_channel_decodes_them_all(write_log, msg):
         data = read_logs([path], decode=[channel])
         assert len(data.table("POSE")) == 30 and set(data.tables) == {"POSE"}
     assert len(read_table(path, "POSE_PDR_ONLY")) == 30  # the one POSE table
+
+
+@pytest.mark.parametrize("controller", [True, False], ids=["controller", "no-controller"])
+def test_index_and_vectorised_decode_of_the_pose_channels(write_log, msg, controller):
+    """lcmindex finds each pose channel of a new log; lcmdecode decodes all their records at once
+    (one type, one layout) into the columns the binding gives message by message, in log order."""
+    path = _new_log(write_log, msg, controller, [])
+    index = index_file(str(path))
+    assert index is not None
+    assert set(index.channels) == {"POSE", "POSE_PDR_ONLY", "POSE_EKF"}
+    records = np.sort(np.concatenate([index.records_of(ch) for ch in index.channels]))
+    assert len(records) == len(index) == 30
+    spec = CHANNELS["POSE"]
+    cols = decode_columns(
+        spec.msg_type, spec.columns, index.data, index.payload_at[records], index.payload_len[records]
+    )
+    assert cols is not None  # the vectorised path, not the record-by-record fallback
+    rows = [spec.row(pose_t.decode(index.payload(int(r)))) for r in records]
+    for k, name in enumerate(spec.columns):
+        assert_array_equal(cols[name], [row[k] for row in rows], err_msg=name)
