@@ -61,6 +61,14 @@ def test_every_sample_and_source_is_logged(replay):
     assert (h.bad_syntax, h.unknown_id, h.bad_length, h.decode_errors, h.seq_gaps) == (0, 0, 0, 0, 0)
 
 
+def test_without_a_site_pdr_only_and_its_copy_on_pose(replay):
+    """No site, no fixes: only pdr_only publishes (POSE_PDR_ONLY), and POSE, the primary pose, is its
+    copy, one per output."""
+    c = replay["counts"]
+    assert {ch for ch in c if ch.startswith("POSE")} == {"POSE", "POSE_PDR_ONLY"}
+    assert c["POSE"] == c["POSE_PDR_ONLY"] > 1000
+
+
 def test_step_count_within_3_percent(replay):
     assert replay["counts"]["STEP"] == pytest.approx(replay["summary"]["steps"], rel=0.03)
 
