@@ -10,7 +10,7 @@ DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
 .PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
-	gates check-static check-clang check-asan reliability soak check-fuzz fuzz check-arm
+	gates check-static check-clang check-asan reliability soak check-fuzz fuzz check-arm spy
 
 all: build
 
@@ -22,6 +22,7 @@ help:
 	@echo "make reliability - the default SIL walk with each bus/board fault vs clean; out/bench/reliability.json"
 	@echo "make soak   - an 8-hour SIL walk with faults through stridefixd: RSS at 1 h and 8 h, events accounted"
 	@echo "make change-indication - rewrite tests/change_indication/*.csv (commit them with a behaviour change)"
+	@echo "make spy    - lcm-spy with the StrideFix Java types on LCM_URL (e.g. make spy LCM_URL='udpm://239.255.76.67:7667?ttl=0'; default: LCM's)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
 	@echo "make gates  - the C/C++ quality gates below, one after the other"
@@ -52,6 +53,11 @@ lint: deps
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
 	$(VENV)/bin/mypy
+
+# lcm-spy on the live channels (stridefix spy: java -cp lcm.jar:stridefix_lcmtypes.jar lcm.spy.Spy).
+spy: build
+	STRIDEFIX_LCMTYPES_JAR=$(abspath $(BUILD))/lcmtypes/java/stridefix_lcmtypes.jar \
+		$(PY) -m stridefix_analyzer.cli spy $(if $(LCM_URL),--lcm-url '$(LCM_URL)')
 
 test-c:
 	cd $(BUILD) && ctest --output-on-failure

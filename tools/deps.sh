@@ -25,6 +25,12 @@ DEBS+=(chromium)
 # can-utils: log2asc and asc2log, candump and canplayer (tests/python/can: the Vector ASC round trip,
 # whose asc2log writes the direction flags the candump parser reads; README "CAN tools").
 DEBS+=(can-utils)
+# lcm-spy and the Java types (lcmtypes/CMakeLists.txt builds build/lcmtypes/java/stridefix_lcmtypes.jar
+# when a JDK and lcm.jar are found; `stridefix spy` / make spy start lcm.spy.Spy from lcm.jar):
+# liblcm-java (lcm.jar: the LCM Java library, lcm-spy's classes), libjchart2d-java (lcm-spy's field
+# plots: its message view fails without it), openjdk-17-jdk-headless (javac and jar; lcm-spy's window
+# needs a display and the full JRE, openjdk-17-jre, which the headless JDK does not pull in).
+DEBS+=(liblcm-java libjchart2d-java openjdk-17-jdk-headless)
 
 missing=()
 for p in "${DEBS[@]}"; do

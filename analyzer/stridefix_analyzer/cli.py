@@ -31,6 +31,7 @@ SUBCOMMANDS = {
     "crowd": "stridefix_analyzer.crowd.cli",
     "compare": "stridefix_analyzer.scoring.compare",
     "live": "stridefix_analyzer.live.server",
+    "spy": "stridefix_analyzer.spy",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing

@@ -115,24 +115,25 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
-/* One POSE per fusion scheme that has a position (a scheme waiting for its first fix has none).
- * Without a site there are no fixes, so only pdr_only is published (the others would repeat it). */
+/* One POSE_<SCHEME> per fusion scheme that has a position (a scheme waiting for its first fix has
+ * none), then the primary pose on POSE (sf_publish_primary_of). Without a site there are no fixes,
+ * so only pdr_only is published (the others would repeat it). */
 static void write_pose(daemon_t *const d)
 {
     sf_estimator_status_t st;
     sf_estimator_status(&d->est, &st);
     const int n_schemes = st.has_site ? sf_scheme_count : sf_scheme_pdr_only + 1;
+    const int only = d->params.output_scheme;
     for (int scheme = 0; scheme < n_schemes; scheme++) {
         sf_pose_t p;
-        if ((d->params.output_scheme < 0 || scheme == d->params.output_scheme) &&
-            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p) && WRITES(d, POSE)) {
+        if ((only < 0 || scheme == only) && sf_options_channel_on(&d->opt, sf_publish_pose_channel(scheme)) &&
+            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
             sf_publish_pose(d->out, d->host_t_us, &p);
         }
     }
-    sf_pose_t p; /* the multi-scheme controller's primary pose (scheme 8) */
-    const bool controller_out = d->params.output_scheme < 0 || d->params.output_scheme == sf_scheme_controller;
-    if (controller_out && sf_estimator_scheme_pose(&d->est, &d->params, sf_scheme_controller, &p) && WRITES(d, POSE)) {
-        sf_publish_pose(d->out, d->host_t_us, &p);
+    sf_pose_t p;
+    if (WRITES(d, POSE) && sf_publish_primary_of(&d->est, &d->params, st.has_site, &p)) {
+        sf_publish_primary_pose(d->out, d->host_t_us, &p);
     }
     d->last_pose_t_us = st.t_us;
     d->last_pose_floor = st.floor;

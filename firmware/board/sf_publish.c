@@ -25,7 +25,22 @@ void sf_publish_step(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_s
     SF_LCM_WRITE(out, SF_CHANNEL_STEP, log_t_us, stridefix_step_t, &msg);
 }
 
-void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_pose_t *const p)
+/* POSE_<SCHEME> by scheme id, generated from pose_t.lcm through lcmtypes/channels.csv. */
+static const char *const pose_channels[] = {
+#define POSE_CHANNEL(name, id) [id] = SF_CHANNEL_##name,
+    SF_CHANNEL_POSE_SCHEMES(POSE_CHANNEL)
+#undef POSE_CHANNEL
+};
+_Static_assert(sizeof pose_channels / sizeof pose_channels[0] == (size_t)sf_scheme_count,
+               "one POSE_<SCHEME> channel per fusion scheme");
+
+const char *sf_publish_pose_channel(const int scheme)
+{
+    return scheme >= 0 && scheme < sf_scheme_count ? pose_channels[scheme] : SF_CHANNEL_POSE;
+}
+
+static void write_pose(sf_lcm_out_t *const out, const char *const channel, const int64_t log_t_us,
+                       const sf_pose_t *const p)
 {
     stridefix_pose_t msg = {.t_us = p->t_us,
                             .x_m = p->x_m,
@@ -41,7 +56,32 @@ void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_p
                             .ess = (float)p->ess,
                             .step_count = p->step_count,
                             .scheme = p->scheme};
-    SF_LCM_WRITE(out, SF_CHANNEL_POSE, log_t_us, stridefix_pose_t, &msg);
+    SF_LCM_WRITE(out, channel, log_t_us, stridefix_pose_t, &msg);
+}
+
+void sf_publish_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_pose_t *const p)
+{
+    write_pose(out, sf_publish_pose_channel(p->scheme), log_t_us, p);
+}
+
+bool sf_publish_primary_of(const sf_estimator_t *const est, const sf_params_t *const p, const bool has_site,
+                           sf_pose_t *const pose)
+{
+    const int only = p->output_scheme;
+    if ((only < 0 || only == sf_scheme_controller) && sf_estimator_scheme_pose(est, p, sf_scheme_controller, pose)) {
+        return true;
+    }
+    if (only == sf_scheme_controller) {
+        return false; /* --fusion controller: the controller's pose or none */
+    }
+    const int follow = only >= 0 ? only : has_site ? p->controller_init_scheme : sf_scheme_pdr_only;
+    return sf_estimator_scheme_pose(est, p, follow, pose) ||
+           (only < 0 && sf_estimator_scheme_pose(est, p, sf_scheme_pdr_only, pose));
+}
+
+void sf_publish_primary_pose(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_pose_t *const p)
+{
+    write_pose(out, SF_CHANNEL_POSE, log_t_us, p);
 }
 
 void sf_publish_fix(sf_lcm_out_t *const out, const int64_t log_t_us, const sf_fix_audit_t *const a)

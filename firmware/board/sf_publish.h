@@ -1,7 +1,8 @@
-/* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE (one per scheme), FIX (the audit
- * record), HEALTH (input, estimator, fix-source and log counters) and CONFIG (the effective
- * parameters), CONTEXT (the multi-scheme controller's changes). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h, from the same kind table the
- * replay reads.
+/* sf_publish.h — the estimator's outputs as LCM messages: STEP, POSE_<SCHEME> (each fusion scheme's
+ * pose) and POSE (the primary pose), FIX (the audit record), HEALTH (input, estimator, fix-source and
+ * log counters) and CONFIG (the effective parameters), CONTEXT (the multi-scheme controller's
+ * changes). The raw inputs (IMU, MAG, BARO, WIFI, GNSS, BLE, LANDMARK) are written by sf_rx_lcm.h,
+ * from the same kind table the replay reads.
  *
  * Each call converts a core struct into its generated stridefix type and queues it on the log with the
  * caller's log timestamp (the host receive time of the frame being handled, so replaying the same
@@ -53,7 +54,23 @@ bool sf_publish_loop_due(sf_publish_loop_t *loop);
 void sf_publish_loop_add(sf_publish_loop_t *loop, double dt_us);
 
 void sf_publish_step(sf_lcm_out_t *out, int64_t log_t_us, const sf_step_t *step);
+/* Poses: each fusion scheme's on its own channel POSE_<SCHEME> (sf_publish_pose_channel: POSE_EKF
+ * for pose_t.SCHEME_EKF, ...; a scheme outside the fusion schemes, the controller's, on POSE), and the
+ * primary pose on POSE (sf_publish_primary_pose, whatever its scheme), so lcm-spy and plotting tools
+ * can tell the schemes apart by channel; the scheme field says the same. */
+const char *sf_publish_pose_channel(int scheme);
 void sf_publish_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
+void sf_publish_primary_pose(sf_lcm_out_t *out, int64_t log_t_us, const sf_pose_t *pose);
+
+/* The primary pose into *pose; false when there is none to publish. It is the multi-scheme
+ * controller's (scheme 8: the pose of the scheme its context selects). Without an active controller
+ * (no context map, controller.enabled = 0) it is a copy of one scheme's pose, its scheme field naming
+ * it: the output.scheme (--fusion) one when a single fusion scheme is chosen, else
+ * controller.init_scheme's (the scheme the controller follows before it knows a context), pdr_only's
+ * while that has no position and without a site (has_site false). output.scheme = controller: the
+ * controller's pose or none. A copy is one more pose per output, the one growth of the log over the
+ * single POSE channel of before, which carried the controller's pose too. */
+bool sf_publish_primary_of(const sf_estimator_t *est, const sf_params_t *p, bool has_site, sf_pose_t *pose);
 
 /* FIX: every field of the audit, accuracy_factor and drift included (0 unless the adaptive scheme
  * blended the fix). */

@@ -152,7 +152,7 @@
     X(ble,    window_ms,           int32_t, 1000,    100,     60000,   "ms",    "BLE advertisements of this much board time (from the window's first) form one scan; a beacon heard several times in it is averaged in dBm")
 
 #define SF_PARAMS_OUTPUT(X)                                                                            \
-    X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_CONTROLLER, "", "fusion scheme published in POSE and FIX: -1 = every scheme side by side (and the controller's pose), else pose_t.SCHEME_* (SCHEME_CONTROLLER: only the controller's POSE)") \
+    X(output, scheme,              int32_t, -1,      -1,      SF_SCHEME_CONTROLLER, "", "fusion scheme published in POSE_<SCHEME> and FIX (POSE: the primary, its copy): -1 = every scheme side by side (and the controller's pose on POSE), else pose_t.SCHEME_* (SCHEME_CONTROLLER: only the controller's POSE)") \
     X(output, pose_period_ms,      int32_t, 100,     10,      60000,   "ms",    "POSE publish period between steps (also on every step and floor change)") \
     X(output, health_period_ms,    int32_t, 1000,    100,     60000,   "ms",    "HEALTH publish period (board time)") \
     X(output, fsync_interval_ms,   int32_t, 1000,    0,       60000,   "ms",    "the log writer fdatasyncs at least this often (0: after every event, one disk sync each: slow): what power loss may cost") \

@@ -1,7 +1,8 @@
 /* test_publish.c — sf_publish (firmware/board/sf_publish.h): what goes out is what the core said.
  * A FIX audit with the adaptive terms, a POSE, a STEP, a HEALTH and a CONFIG (and the controller's
  * CONTEXT events with their evidence in words, and HEALTH's controller counters) are written to a log,
- * read back with liblcm's reader and decoded with the generated types, field by field. */
+ * read back with liblcm's reader and decoded with the generated types, field by field. Each scheme's
+ * pose goes on its own channel POSE_<SCHEME> (the name from the scheme registry), the primary on POSE. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -9,6 +10,7 @@
 #include <setjmp.h>
 #include <cmocka.h>
 
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +19,7 @@
 #include <lcm/eventlog.h>
 
 #include "sf_error.h"
+#include "sf_fusion.h"
 #include "sf_publish.h"
 #include "stridefix_config_t.h"
 #include "stridefix_context_t.h"
@@ -72,7 +75,7 @@ static void test_every_output_round_trips(void **state)
 
     lcm_eventlog_t *const log = lcm_eventlog_create(path, "r");
     assert_non_null(log);
-    const char *const want[] = {"FIX", "POSE", "STEP", "HEALTH", "CONFIG"};
+    const char *const want[] = {"FIX", "POSE_KALMAN", "STEP", "HEALTH", "CONFIG"}; /* a kalman pose: its own channel */
     for (int i = 0; i < 5; i++) {
         lcm_eventlog_event_t *const e = lcm_eventlog_read_next_event(log);
         assert_non_null(e);
@@ -130,6 +133,56 @@ static void test_every_output_round_trips(void **state)
 
 /* The controller's outputs: CONTEXT field by field with the rule and its evidence in words (a stairs
  * exit with its recalibration, a door settled by the outline), HEALTH's controller counters. */
+/* Every fusion scheme's poses go on POSE_ + its upper-cased registry name (pose_t.SCHEME_*: POSE_EKF
+ * for ekf), the controller's and the primary pose on POSE, whatever scheme the primary copies. */
+static void test_pose_channels(void **state)
+{
+    (void)state;
+    for (int s = 0; s < sf_scheme_count; s++) {
+        char want[64] = "POSE_";
+        const char *const name = sf_fusion_scheme_name(s);
+        assert_non_null(name);
+        for (size_t k = 0; name[k] != '\0' && k + 6 < sizeof want; k++) {
+            want[5 + k] = (char)toupper((unsigned char)name[k]);
+        }
+        assert_string_equal(sf_publish_pose_channel(s), want);
+    }
+    assert_string_equal(sf_publish_pose_channel(sf_scheme_controller), "POSE");
+
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/sf_test_publish_XXXXXX");
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    sf_lcm_out_t *out = NULL;
+    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    const sf_pose_t ekf = {.t_us = 5, .x_m = 4.25, .y_m = -2.0, .scheme = sf_scheme_ekf};
+    const sf_pose_t controller = {.t_us = 6, .x_m = 4.25, .y_m = -2.0, .scheme = sf_scheme_controller};
+    sf_publish_pose(out, 21, &ekf);
+    sf_publish_primary_pose(out, 22, &ekf);
+    sf_publish_pose(out, 23, &controller);
+    assert_int_equal(sf_lcm_out_close(out, NULL), SF_OK);
+
+    lcm_eventlog_t *const log = lcm_eventlog_create(path, "r");
+    assert_non_null(log);
+    const char *const channel[] = {"POSE_EKF", "POSE", "POSE"};
+    const int scheme[] = {sf_scheme_ekf, sf_scheme_ekf, sf_scheme_controller};
+    for (int i = 0; i < 3; i++) {
+        lcm_eventlog_event_t *const e = lcm_eventlog_read_next_event(log);
+        assert_non_null(e);
+        assert_string_equal(e->channel, channel[i]);
+        assert_int_equal(e->timestamp, 21 + i);
+        stridefix_pose_t m;
+        assert_true(stridefix_pose_t_decode(e->data, 0, e->datalen, &m) > 0);
+        assert_true(m.x_m == 4.25 && m.y_m == -2.0 && m.scheme == scheme[i]);
+        lcm_eventlog_free_event(e);
+    }
+    assert_null(lcm_eventlog_read_next_event(log));
+    lcm_eventlog_destroy(log);
+    unlink(path);
+}
+
 static void test_context_round_trips(void **state)
 {
     (void)state;
@@ -212,6 +265,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_output_round_trips),
+        cmocka_unit_test(test_pose_channels),
         cmocka_unit_test(test_context_round_trips),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

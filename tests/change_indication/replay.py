@@ -61,12 +61,16 @@ def _stridefix() -> str:
 def state_csv(fw_log: Path) -> str:
     """The 1 Hz per-scheme state of a stridefixd log as CSV text."""
     import lcm
+    import stridefix_channels
     from stridefix import fix_t, pose_t
 
+    # every pose channel: POSE_<SCHEME> per fusion scheme and POSE (the primary: the controller's,
+    # or a copy of one scheme's pose, equal to it, so it changes no row); an older log: POSE alone
+    pose_channels = {"POSE", *stridefix_channels.POSE_SCHEME_CHANNELS.values()}
     poses: list[tuple[int, int, object]] = []
     fixes: list[tuple[int, int, bool, int]] = []
     for ev in lcm.EventLog(str(fw_log), "r"):
-        if ev.channel == "POSE":
+        if ev.channel in pose_channels:
             p = pose_t.decode(ev.data)
             poses.append((p.t_us, p.scheme, p))
         elif ev.channel == "FIX":

@@ -6,6 +6,10 @@ declaration order: a scalar field is one column; a fixed-length array ``<name>_<
 array (counted by an ``n_*`` field) is not a column (the Wi-Fi APs get their own table). A field
 added to a ``.lcm`` file appears as a column without an edit here. Column dtypes follow the field
 types: integers → int64, booleans → bool, strings → str, floating point → float64.
+
+The pose channels are one table: ``POSE`` (the primary pose) and ``POSE_<SCHEME>`` (each fusion
+scheme's, names generated from pose_t.lcm's schemes) are all ``pose_t`` and read into the ``POSE``
+table, told apart by its ``scheme`` column as in logs from before the split (all schemes on POSE).
 """
 
 from __future__ import annotations
@@ -88,3 +92,15 @@ CHANNELS: dict[str, Channel] = {
     if name != "CONFIG"
 }
 CONFIG_TYPE = stridefix.config_t
+
+#: pose_t.SCHEME_* id of each fusion scheme → the channel of its own poses (POSE_EKF, ...), generated
+POSE_SCHEME_CHANNELS: dict[int, str] = dict(stridefix_channels.POSE_SCHEME_CHANNELS)
+#: the channel of the primary pose, and the table every pose channel is read into
+POSE = "POSE"
+#: every pose channel: POSE and the per-scheme ones
+POSE_CHANNELS: frozenset[str] = frozenset((POSE, *POSE_SCHEME_CHANNELS.values()))
+
+
+def table_of(channel: str) -> str:
+    """The table a channel's messages go into: ``POSE`` for every pose channel, else its own."""
+    return POSE if channel in POSE_CHANNELS else channel

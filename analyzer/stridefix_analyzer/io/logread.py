@@ -18,7 +18,7 @@ GNSS      t_us, lat_deg, lon_deg, alt_m, accuracy_m
 STEP      t_us, index, length_m, accel_range_mps2, period_s, heading_rad, activity, floor
 FIX       t_us, method, scheme, x_m, y_m, floor, accuracy_m, n_ap_used, innovation_{x,y}_m,
           innovation_var_m2, test_ratio, accuracy_factor, drift, alpha, accepted, reason, reason_text
-POSE      t_us, x_m, y_m, floor, heading_rad, sigma_m, step_count, scheme
+POSE      t_us, x_m, y_m, floor, heading_rad, sigma_m, step_count, scheme  (every pose channel)
 TRUTH     t_us, x_m, y_m, floor, heading_rad, step_count, source
 HEALTH    every health_t field (counters over time); the last report is also in ``LogData.health``
 ========  ==========================================================================================
@@ -27,6 +27,13 @@ The columns are the fields of each channel's LCM type (:mod:`.channels` derives 
 added to a ``.lcm`` file appears here by itself; the list above is what the types hold today.
 
 ``CONFIG`` becomes the ``LogData.config`` key → value dict (plus ``LogData.versions``).
+
+Poses: a log of today has each fusion scheme's poses on ``POSE_<SCHEME>`` and the primary pose on
+``POSE`` (the controller's, scheme 8, or without an active controller a copy of one scheme's pose); a
+log from before the split has every scheme's poses on ``POSE``. Both read into one ``POSE`` table,
+the same rows either way: in a file with a ``POSE_<SCHEME>`` channel, the ``POSE`` messages of a
+fusion scheme are copies of that scheme's own and are left out (``decode`` of any pose channel
+decodes them all). ``LogData.messages`` counts each channel under its own name.
 
 Reading: an intact file (one unbroken chain of records) is indexed with numpy (:mod:`.lcmindex`),
 only the channels asked for are decoded, and the fixed-layout ones all at once (:mod:`.lcmdecode`);
@@ -49,8 +56,9 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import stridefix
 
-from stridefix_analyzer.io.channels import CHANNELS, CONFIG_TYPE
+from stridefix_analyzer.io.channels import CHANNELS, CONFIG_TYPE, POSE, POSE_CHANNELS, table_of
 from stridefix_analyzer.io.lcmdecode import decode_columns
 from stridefix_analyzer.io.lcmfile import (
     LogReadError,
@@ -174,6 +182,19 @@ class LogData:
 #: The channels :func:`read_logs` knows how to decode.
 KNOWN_CHANNELS = (*CHANNELS, "CONFIG")
 _KNOWN = frozenset(KNOWN_CHANNELS)
+#: the tables the channels are read into (every pose channel into POSE), in channel order
+_TABLES = tuple(dict.fromkeys(table_of(ch) for ch in CHANNELS))
+_SCHEME_CONTROLLER = stridefix.pose_t.SCHEME_CONTROLLER
+
+
+@dataclasses.dataclass
+class _PoseFile:
+    """One file's POSE rows that came on the POSE channel itself (absolute rows of the POSE table, in
+    log order) and whether the file has per-scheme pose channels (then those of a fusion scheme are
+    copies: module docstring)."""
+
+    primary_rows: list[int] = dataclasses.field(default_factory=list)
+    per_scheme: bool = False
 
 
 class _Collector:
@@ -183,12 +204,16 @@ class _Collector:
         self.decode = decode
         # channel -> its rows so far, in log order: lists of row tuples (decoded message by message)
         # and dicts of columns (decoded at once from an indexed file, :mod:`.lcmdecode`)
-        self.chunks: dict[str, list[list[Any] | dict[str, Array]]] = {ch: [] for ch in CHANNELS}
-        self.n_rows = dict.fromkeys(CHANNELS, 0)
+        self.chunks: dict[str, list[list[Any] | dict[str, Array]]] = {t: [] for t in _TABLES}
+        self.n_rows = dict.fromkeys(_TABLES, 0)
+        self.pose_files: list[_PoseFile] = []
         self.wifi_aps: list[tuple[int, int, float, int]] = []  # (scan row, bssid, rssi_dbm, freq_mhz)
         self.data = LogData()
         # channel -> leading 8 payload bytes that are not this build's type hash -> count
         self.foreign_hashes: dict[str, dict[bytes, int]] = {}
+
+    def begin_file(self) -> None:
+        self.pose_files.append(_PoseFile())
 
     def add_event(self, path: str, channel: str, payload: bytes) -> None:
         d = self.data
@@ -196,6 +221,8 @@ class _Collector:
         if channel not in _KNOWN:
             d.unknown_channels[channel] = d.unknown_channels.get(channel, 0) + 1
             return
+        if channel in POSE_CHANNELS and channel != POSE:
+            self.pose_files[-1].per_scheme = True
         if channel in self.decode:
             self.decode_event(path, channel, payload)
 
@@ -207,21 +234,24 @@ class _Collector:
             d.messages[channel] = d.messages.get(channel, 0) + n
             if channel not in _KNOWN:
                 d.unknown_channels[channel] = d.unknown_channels.get(channel, 0) + n
+        self.pose_files[-1].per_scheme = any(ch in POSE_CHANNELS and ch != POSE for ch in index.channels)
         one_by_one: list[tuple[str, Array]] = []
-        for channel in index.channels:
-            if channel not in _KNOWN or channel not in self.decode:
-                continue
-            records = index.records_of(channel)
+        for table, channels in _tables_of(index.channels, self.decode).items():
+            # the pose channels together, in log order (the record-by-record reader's order)
+            records = np.sort(np.concatenate([index.records_of(ch) for ch in channels]))
             columns = None
-            if channel != "CONFIG":
-                spec = CHANNELS[channel]
+            if table != "CONFIG":
+                spec = CHANNELS[table]
                 at, size = index.payload_at[records], index.payload_len[records]
                 columns = decode_columns(spec.msg_type, spec.columns, index.data, at, size)
             if columns is None:
-                one_by_one.append((channel, records))
+                one_by_one.extend((ch, index.records_of(ch)) for ch in channels)
                 continue
-            self.chunks[channel].append(columns)
-            self.n_rows[channel] += len(records)
+            if table == POSE and POSE in channels:
+                primary = np.flatnonzero(index.channel_of[records] == index.channels.index(POSE))
+                self.pose_files[-1].primary_rows.extend((self.n_rows[POSE] + primary).tolist())
+            self.chunks[table].append(columns)
+            self.n_rows[table] += len(records)
         # the rest in log order across channels: decode errors and CONFIG warnings keep their order
         if one_by_one:
             names = np.concatenate([np.full(len(r), i) for i, (_, r) in enumerate(one_by_one)])
@@ -235,7 +265,7 @@ class _Collector:
             if channel == "CONFIG":
                 self.add_config(CONFIG_TYPE.decode(payload), path)
                 return
-            spec = CHANNELS[channel]
+            spec = CHANNELS[table_of(channel)]
             msg = spec.msg_type.decode(payload)
             values = spec.row(msg)
         except Exception:  # noqa: BLE001 - any decode failure is bad data, counted not fatal
@@ -250,11 +280,14 @@ class _Collector:
             self.wifi_aps.extend(
                 (scan_row, b, r, f) for b, r, f in zip(msg.bssid, msg.rssi_dbm, msg.freq_mhz)
             )
-        chunks = self.chunks[channel]
+        table = table_of(channel)
+        if channel == POSE:
+            self.pose_files[-1].primary_rows.append(self.n_rows[POSE])
+        chunks = self.chunks[table]
         if not chunks or not isinstance(chunks[-1], list):
             chunks.append([])
         chunks[-1].append(values)  # type: ignore[union-attr]
-        self.n_rows[channel] += 1
+        self.n_rows[table] += 1
 
     def columns(self, channel: str) -> dict[str, Array] | None:
         """The channel's rows so far as columns (None without any)."""
@@ -285,13 +318,25 @@ class _Collector:
             d.config[key] = value
         d.versions.update(version=msg.version, dbc_sha256=msg.dbc_sha256)
 
+    def copies(self, pose: Table) -> Array:
+        """The rows of the POSE table that are copies of a fusion scheme's own poses (module
+        docstring), as a mask."""
+        copy = np.zeros(len(pose), dtype=bool)
+        for f in self.pose_files:
+            if f.per_scheme and f.primary_rows:
+                rows = np.asarray(f.primary_rows, dtype=np.int64)
+                copy[rows] = pose["scheme"][rows] != _SCHEME_CONTROLLER
+        return copy
+
     def finish(self) -> LogData:
         d = self.data
-        for channel in CHANNELS:
+        for channel in _TABLES:
             columns = self.columns(channel)
             if columns is None:
                 continue
             table = Table(columns)
+            if channel == POSE:
+                table = table.rows(~self.copies(table))
             if channel == "WIFI":
                 # sort scans by time and renumber the AP rows' scan_row to match
                 order = np.argsort(table["t_us"], kind="stable")
@@ -361,6 +406,8 @@ def read_logs(
     if not files:
         raise ValueError("read_logs: no log paths given")
     wanted = set(KNOWN_CHANNELS if decode is None else decode)
+    if wanted & POSE_CHANNELS:
+        wanted |= POSE_CHANNELS  # one table: the copies are told by the file's other pose channels
     unknown = wanted - set(KNOWN_CHANNELS)
     if unknown:
         raise ValueError(
@@ -369,6 +416,7 @@ def read_logs(
         )
     collector = _Collector(wanted)
     for path in files:
+        collector.begin_file()
         index = _index(path) if indexed else None
         if index is not None:
             # one unbroken chain of records: nothing to salvage, and lcm.EventLog would read the same
@@ -393,6 +441,16 @@ def _index(path: str) -> LogIndex | None:
         return None
 
 
+def _tables_of(channels: Iterable[str], decode: set[str]) -> dict[str, list[str]]:
+    """The known channels of a file to decode, grouped by the table they go into (first-record
+    order)."""
+    out: dict[str, list[str]] = {}
+    for channel in channels:
+        if channel in _KNOWN and channel in decode:
+            out.setdefault(table_of(channel), []).append(channel)
+    return out
+
+
 def _mismatch_text(channel: str, n: int) -> str:
     return (
         f"{n} message(s) on channel {channel} carry another LCM type hash than this build's: the log "
@@ -415,7 +473,7 @@ def read_tables(path: str | os.PathLike[str], channels: Iterable[str]) -> dict[s
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)
         data = read_logs([path], decode=channels)
-    for channel in channels:
-        if channel in data.type_mismatches:
-            raise LogReadError(os.fspath(path), _mismatch_text(channel, data.type_mismatches[channel]))
-    return {channel: data.table(channel) for channel in channels}
+    for channel, n in data.type_mismatches.items():
+        if table_of(channel) in {table_of(c) for c in channels}:
+            raise LogReadError(os.fspath(path), _mismatch_text(channel, n))
+    return {channel: data.table(table_of(channel)) for channel in channels}

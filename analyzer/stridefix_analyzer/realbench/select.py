@@ -27,7 +27,7 @@ are rows of :mod:`.tuning` (:data:`~.tuning.AXES`); this module only measures th
   (:class:`ReplayCache`, one per group): the adaptive stage's "table x 1" is the matcher's replay with
   block a's matcher, and the fix model's replays are the adaptive stage's with block a's choice;
 * the matcher, adaptive and fix-model stages replay in one mode (:data:`MODES`): ``--fusion adaptive``,
-  only FIX and POSE written. ``--fusion`` only picks what is published (the estimator runs every
+  only FIX and POSE written (POSE: the adaptive pose, the primary of a one-scheme replay). ``--fusion`` only picks what is published (the estimator runs every
   scheme either way), and a FIX record's fix fields (t_us, x_m, y_m, accuracy_m) are the fix as
   offered, the same in every scheme's audit (``firmware/core/sf_fusion.c``, ``audit_begin``), so
   the adaptive scheme's FIX rows give the Wi-Fi fix errors that wifi_only's gave. Those replays
@@ -50,6 +50,7 @@ from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.channels import POSE_SCHEME_CHANNELS, table_of
 from stridefix_analyzer.io.logread import Table, read_table, read_tables
 from stridefix_analyzer.parallel import TaskRunner
 
@@ -63,7 +64,7 @@ MIN_WALKS = 6
 #: replays serve the matcher, adaptive and fix-model stages alike (module text)
 MODES: dict[str, tuple[str | None, tuple[str, ...], tuple[str, ...]]] = {
     "one": ("adaptive", ("FIX", "POSE"), ("particle.count=1",)),
-    "all": (None, ("POSE",), ()),
+    "all": (None, tuple(POSE_SCHEME_CHANNELS.values()), ()),  # each fusion scheme's own poses
 }
 STAGE_MODE = {"matcher": "one", "adaptive": "one", "fixmodel": "one", "lsd": "all"}
 #: the fusion schemes whose POSE errors an "all" replay keeps (the controller is not one)
@@ -144,7 +145,8 @@ def _firmware_args(job: Mapping[str, Any]) -> dict[str, Any]:
 
 def _products(job: Mapping[str, Any]) -> dict[str, Any]:
     """The numbers of a finished replay's log (removed after)."""
-    tables = read_tables(job["log"], MODES[job["mode"]][1])
+    # the tables of the channels written (every pose channel reads into POSE)
+    tables = read_tables(job["log"], dict.fromkeys(table_of(ch) for ch in MODES[job["mode"]][1]))
     wp = (job["wp_t_us"], job["wp_xy_m"])
     out: dict[str, Any]
     if job["mode"] == "one":

@@ -164,6 +164,7 @@ LAYERS = (
     "exits",
     "schemes",
     "firmware",
+    "spy",
     "stages",
     "parallel",
     "io",

@@ -14,8 +14,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import lcm
 import pytest
+from stridefix import pose_t
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.channels import POSE_CHANNELS, POSE_SCHEME_CHANNELS
 from stridefix_sim.scenario import BUILTIN
 
 
@@ -59,3 +62,22 @@ def test_bench_controller_one_seed(stridefixd, cli, tmp_path):
     assert Path(doc["timelines"][0]).read_bytes().startswith(b"\x89PNG")
     assert {t["met"] for t in doc["targets"]} <= {True, False} and len(doc["targets"]) >= 5
     assert ("TARGET MISSED" in proc.stdout) == (proc.returncode == 1)
+    _assert_primary_pose_channels(tmp_path)
+
+
+def _assert_primary_pose_channels(out: Path) -> None:
+    """The walk's two logs: with the controller, POSE carries its pose only (scheme 8) and each fusion
+    scheme its own POSE_<SCHEME>; with it disabled (the fixed schemes' run), POSE is a copy of one
+    scheme's pose (controller.init_scheme, ekf, or pdr_only before ekf has a position)."""
+    (ctl_log,) = out.rglob("campus2-s1/stridefixd.lcmlog")
+    fixed_log = ctl_log.parent / "fixed" / "stridefixd.lcmlog"
+    for log, primary in (
+        (ctl_log, {pose_t.SCHEME_CONTROLLER}),
+        (fixed_log, {pose_t.SCHEME_EKF, pose_t.SCHEME_PDR_ONLY}),
+    ):
+        schemes: dict[str, set[int]] = {}
+        for e in lcm.EventLog(str(log), "r"):
+            if e.channel in POSE_CHANNELS:
+                schemes.setdefault(e.channel, set()).add(pose_t.decode(e.data).scheme)
+        assert schemes.pop("POSE") <= primary, log
+        assert schemes == {ch: {s} for s, ch in POSE_SCHEME_CHANNELS.items()}, log

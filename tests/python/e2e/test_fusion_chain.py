@@ -17,6 +17,7 @@ import lcm
 import numpy as np
 import pytest
 from stridefix import fix_t, pose_t, wifi_scan_t
+from stridefix_analyzer.io.channels import POSE_CHANNELS, POSE_SCHEME_CHANNELS
 from stridefix_analyzer.schemes import FUSION_SCHEMES as SCHEMES  # the controller judges no fix
 
 SCHEME_IDS = [s.id for s in SCHEMES]  # every fusion scheme of pose_t.lcm
@@ -110,9 +111,65 @@ def test_adaptive_fix_records_carry_accuracy_factor_and_drift(walk):
 
 def test_every_scheme_publishes_pose_after_its_first_fix(walk):
     first_scan_t = min(wifi_scan_t.decode(e.data).t_us for e in walk["events"] if e.channel == "WIFI")
-    poses = [pose_t.decode(e.data) for e in walk["events"] if e.channel == "POSE"]
+    poses = [pose_t.decode(e.data) for e in walk["events"] if e.channel in POSE_CHANNELS]
     assert sorted({p.scheme for p in poses}) == SCHEME_IDS
     assert min(p.t_us for p in poses) >= first_scan_t  # nobody has a position before the first fix
+
+
+def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
+    """Each fusion scheme's poses on POSE_<SCHEME> (its scheme field agreeing), and POSE the primary
+    pose only: without a context map (this site has none) one per output, a copy of
+    controller.init_scheme's pose (ekf), pdr_only's while ekf has none; the POSE record's payload
+    is the one its scheme's channel got just before, at the same log time."""
+    last: dict[str, tuple[int, bytes]] = {}
+    primary: list[int] = []
+    per_channel = Counter()
+    for e in walk["events"]:
+        if e.channel not in POSE_CHANNELS:
+            continue
+        per_channel[e.channel] += 1
+        p = pose_t.decode(e.data)
+        if e.channel == "POSE":
+            assert p.scheme in (pose_t.SCHEME_EKF, pose_t.SCHEME_PDR_ONLY)
+            assert last[POSE_SCHEME_CHANNELS[p.scheme]] == (e.timestamp, e.data)
+            primary.append(p.scheme)
+        else:
+            assert e.channel == POSE_SCHEME_CHANNELS[p.scheme]
+            last[e.channel] = (e.timestamp, e.data)
+    assert sorted(per_channel) == sorted(POSE_CHANNELS)
+    # one primary pose per output: as many as the scheme published most often
+    assert per_channel["POSE"] == max(n for ch, n in per_channel.items() if ch != "POSE")
+    assert primary.count(pose_t.SCHEME_EKF) > 0.9 * len(primary)
+
+
+@pytest.mark.parametrize(
+    ("args", "channels", "scheme"),
+    [
+        # one scheme: its own channel, and POSE its copy (the primary of a one-scheme replay)
+        (["--fusion", "kalman"], {"POSE_KALMAN", "POSE"}, pose_t.SCHEME_KALMAN),
+        # --channels picks pose channels one by one: the primary (ekf's copy here) without the rest
+        (["--channels", "POSE"], {"POSE"}, pose_t.SCHEME_EKF),
+        (["--channels", "POSE_PARTICLE"], {"POSE_PARTICLE"}, pose_t.SCHEME_PARTICLE),
+    ],
+    ids=["fusion-kalman", "channels-POSE", "channels-POSE_PARTICLE"],
+)
+def test_pose_channels_follow_fusion_and_channels(walk, stridefixd, site, tmp_path, args, channels, scheme):
+    log = tmp_path / "one.lcmlog"
+    assert run_fw(stridefixd, walk["dir"], log, "--site", str(site), *args).returncode == 0
+    poses: dict[str, list[bytes]] = {}
+    for e in lcm.EventLog(str(log), "r"):
+        if e.channel in POSE_CHANNELS:
+            poses.setdefault(e.channel, []).append(e.data)
+    assert set(poses) == channels
+    # the poses themselves are those of the full run: --fusion and --channels only pick what is written
+    full = {ch: [e.data for e in walk["events"] if e.channel == ch] for ch in channels}
+    for ch, payloads in poses.items():
+        if ch != "POSE" or "--fusion" not in args:  # --fusion kalman: POSE copies kalman, not ekf
+            assert payloads == full[ch]
+        assert {pose_t.decode(d).scheme for d in payloads} <= {scheme, pose_t.SCHEME_PDR_ONLY}
+        assert pose_t.decode(payloads[-1]).scheme == scheme
+    if "POSE_KALMAN" in poses:
+        assert poses["POSE"] == poses["POSE_KALMAN"]
 
 
 def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
@@ -140,7 +197,8 @@ def test_same_input_same_fix_and_pose_records(walk, stridefixd, site, tmp_path):
     assert run_fw(stridefixd, walk["dir"], log, "--site", str(site)).returncode == 0
 
     def records(events):
-        return [(e.timestamp, e.channel, e.data) for e in events if e.channel in ("FIX", "POSE", "STEP")]
+        wanted = {"FIX", "STEP", *POSE_CHANNELS}
+        return [(e.timestamp, e.channel, e.data) for e in events if e.channel in wanted]
 
     assert records(lcm.EventLog(str(log), "r")) == records(walk["events"])
 

@@ -13,9 +13,11 @@ import subprocess
 import lcm
 import numpy as np
 import pytest
+import stridefix_channels
 from stridefix import health_t, pose_t, truth_t
 
 FLOOR_HIT_MIN = 0.97  # PDR + barometer alone; the stairs and rides are a few % of the walk
+SCHEME_POSE_CHANNELS = set(stridefix_channels.POSE_SCHEME_CHANNELS.values())  # POSE_PDR_ONLY, ...
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +35,7 @@ def replay(sim_run, stridefixd):
         counts[e.channel] = counts.get(e.channel, 0) + 1
         if e.channel == "HEALTH":
             health = health_t.decode(e.data)
-        elif e.channel == "POSE":
+        elif e.channel in SCHEME_POSE_CHANNELS:  # each fusion scheme's own poses
             p = pose_t.decode(e.data)
             poses.append((p.t_us, p.scheme, p.floor))
     for e in lcm.EventLog(str(out / "truth.lcmlog"), "r"):
@@ -57,6 +59,14 @@ def test_every_sample_and_source_is_logged(replay):
     assert c["LANDMARK"] == s["sources"]["landmark_events"] == 3
     assert c["BLE"] >= 60  # one scan message per window with advertisements (B's corridor and room)
     assert (h.bad_syntax, h.unknown_id, h.bad_length, h.decode_errors, h.seq_gaps) == (0, 0, 0, 0, 0)
+
+
+def test_without_a_site_pdr_only_and_its_copy_on_pose(replay):
+    """No site, no fixes: only pdr_only publishes (POSE_PDR_ONLY), and POSE, the primary pose, is its
+    copy, one per output."""
+    c = replay["counts"]
+    assert {ch for ch in c if ch.startswith("POSE")} == {"POSE", "POSE_PDR_ONLY"}
+    assert c["POSE"] == c["POSE_PDR_ONLY"] > 1000
 
 
 def test_step_count_within_3_percent(replay):
