@@ -7,7 +7,8 @@ source (FIX: accepted, rejected by reason, and the last :data:`RECENT_FIXES` rec
 HEALTH counters and CONTEXT, and the truth track when the log carries TRUTH. :meth:`snapshot` is the
 JSON-ready document the page draws; ``version`` grows with every message so a client asks only
 for what changed. POSE of any scheme goes to that scheme's track, whether it came on ``POSE`` or on
-a per-scheme ``POSE_<SCHEME>`` channel. The primary pose: the ``POSE`` channel's latest once
+a per-scheme ``POSE_<SCHEME>`` channel; once a per-scheme channel is seen, ``POSE`` feeds no fusion
+scheme's track (it carries copies then, which the analyzer leaves out too). The primary pose: the ``POSE`` channel's latest once
 per-scheme channels are seen (POSE then carries the primary only), else the latest of the scheme
 the analyzer would make primary (:data:`~stridefix_analyzer.scoring.metrics.PRIMARY_PREFERENCE`).
 """
@@ -18,6 +19,8 @@ import collections
 import dataclasses
 from typing import Any
 
+from stridefix import pose_t
+
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_colour, scheme_name
 from stridefix_analyzer.scoring.fixsources import method_name, reason_name
 from stridefix_analyzer.scoring.metrics import PRIMARY_PREFERENCE
@@ -27,6 +30,7 @@ TRACK_MAX = 4000
 RECENT_FIXES = 12
 #: the truth track's key among the schemes' in a client's ``sent`` record
 TRUTH_KEY = -1
+SCHEME_CONTROLLER = pose_t.SCHEME_CONTROLLER
 
 
 @dataclasses.dataclass
@@ -90,10 +94,10 @@ class LiveState:
     def _scheme(self, code: int) -> _Scheme:
         if code not in self.schemes:
             try:
-                name, colour = scheme_name(code), scheme_colour(code)
+                colour = scheme_colour(code)
             except UnknownSchemeError:
-                name, colour = f"scheme_{code}", "#000000"
-            self.schemes[code] = _Scheme(name, colour)
+                colour = "#000000"
+            self.schemes[code] = _Scheme(self._scheme_name(code), colour)
         return self.schemes[code]
 
     def add(self, channel: str, msg: Any) -> None:
@@ -119,17 +123,31 @@ class LiveState:
             )
 
     def _pose(self, channel: str, m: Any) -> None:
-        s = self._scheme(int(m.scheme))
+        code = int(m.scheme)
         p = _pose_fields(m)
-        s.last, s.poses = p, s.poses + 1
-        s.append(p["t_us"], (round(p["x_m"], 3), round(p["y_m"], 3), p["floor"]))
-        if channel != "POSE":
+        if channel != "POSE" and not self.per_scheme_channels:
+            # the first per-scheme message: POSE carries the primary alone, and what it carried of
+            # a fusion scheme was a copy (the analyzer leaves those out): that scheme starts afresh
             self.per_scheme_channels = True
+            for c in [c for c in self.schemes if c != SCHEME_CONTROLLER]:
+                del self.schemes[c]
+        if channel != "POSE" or code == SCHEME_CONTROLLER or not self.per_scheme_channels:
+            s = self._scheme(code)
+            s.last, s.poses = p, s.poses + 1
+            s.append(p["t_us"], (round(p["x_m"], 3), round(p["y_m"], 3), p["floor"]))
+        if channel != "POSE":
             return
-        if self.per_scheme_channels or self._rank(s.name) <= self._rank(
+        name = self._scheme_name(code)
+        if self.per_scheme_channels or self._rank(name) <= self._rank(
             self.primary["scheme"] if self.primary else ""
         ):
-            self.primary = {**p, "scheme": s.name}
+            self.primary = {**p, "scheme": name}
+
+    def _scheme_name(self, code: int) -> str:
+        try:
+            return scheme_name(code)
+        except UnknownSchemeError:
+            return f"scheme_{code}"
 
     @staticmethod
     def _rank(name: str) -> int:

@@ -48,6 +48,15 @@ def _fold(log: Path, walls) -> LiveState:
     return state
 
 
+def _last_on_pose(log: Path) -> str:
+    """The scheme of the last message on POSE itself (the primary pose, whichever scheme it copies)."""
+    from stridefix import pose_t
+    from stridefix_analyzer.schemes import scheme_name
+
+    last = [e for e in lcm.EventLog(str(log), "r") if e.channel == "POSE"][-1]
+    return scheme_name(pose_t.decode(last.data).scheme)
+
+
 def _expected(data):
     pose, step = data.table("POSE"), data.table("STEP")
     last = {}
@@ -71,7 +80,7 @@ def test_state_folds_what_the_analyzer_reads(campus_walk):
     assert doc["fix_counts"] == exp["fix"]
     assert sum(c["offered"] for m in exp["fix"].values() for c in m.values()) > 100
     assert len(doc["walls"]) > 10
-    assert doc["primary"]["scheme"] == "adaptive"  # the analyzer's preference without a controller
+    assert doc["primary"]["scheme"] == _last_on_pose(campus_walk["log"])  # the firmware's primary pose
     # a client that holds every point gets none again; the tracks are thinned to a fixed size
     sent: dict = {}
     first = _fold(campus_walk["log"], []).snapshot(sent)
@@ -141,7 +150,7 @@ def test_page_in_headless_chromium(campus_walk, tmp_path):
             )
             page.wait_for_timeout(500)  # the last push after the end
             assert int(page.inner_text("#steps")) == exp["steps"]
-            assert page.inner_text("#primary") == "adaptive"
+            assert page.inner_text("#primary") == _last_on_pose(campus_walk["log"])
             names = page.eval_on_selector_all(
                 "#schemes tr[data-scheme]", "rows => rows.map(r => r.dataset.scheme)"
             )
@@ -168,3 +177,33 @@ def test_page_in_headless_chromium(campus_walk, tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def _pose(t_us: int, x: float, scheme: int):
+    from stridefix import pose_t
+
+    m = pose_t()
+    m.t_us, m.x_m, m.y_m, m.floor, m.scheme = t_us, x, 0.0, 0, scheme
+    return m
+
+
+def test_old_logs_all_on_pose_and_new_logs_with_copies():
+    """An old log (every scheme on POSE) feeds every scheme from POSE; a new one (POSE_<SCHEME> plus
+    a copy of one scheme on POSE) counts each pose once and takes the primary from POSE."""
+    from stridefix import pose_t
+
+    old = LiveState()
+    for k in range(10):
+        old.add("POSE", _pose(1_000_000 * k, k, pose_t.SCHEME_ADAPTIVE))
+        old.add("POSE", _pose(1_000_000 * k, -k, pose_t.SCHEME_PDR_ONLY))
+    doc = old.snapshot()
+    assert [(s["name"], s["poses"]) for s in doc["schemes"]] == [("pdr_only", 10), ("adaptive", 10)]
+    assert doc["primary"]["scheme"] == "adaptive" and doc["primary"]["x_m"] == 9
+    new = LiveState()
+    for k in range(10):
+        new.add("POSE", _pose(1_000_000 * k, k, pose_t.SCHEME_EKF))  # the copy comes first here
+        new.add("POSE_EKF", _pose(1_000_000 * k, k, pose_t.SCHEME_EKF))
+        new.add("POSE_PDR_ONLY", _pose(1_000_000 * k, -k, pose_t.SCHEME_PDR_ONLY))
+    doc = new.snapshot()
+    assert sorted((s["name"], s["poses"]) for s in doc["schemes"]) == [("ekf", 10), ("pdr_only", 10)]
+    assert doc["primary"]["scheme"] == "ekf" and doc["primary"]["x_m"] == 9
