@@ -3,7 +3,8 @@
 #  1. Debian packages (apt-get update first, only when something is missing).
 #  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
 #     re-installed only when requirements.txt or pyproject.toml changed.
-#  3. A .pth file so the venv imports what the build generates: the LCM Python bindings and the native
+#  3. A .pth file so the venv imports what the build generates (development; an installed logger gets the
+#     LCM types from `cmake --install`, README "Install on a logger"): the LCM Python bindings and the native
 #     solver module (stridefix_native, with its scipy reference beside it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,9 @@ DEBS+=(valgrind)
 # chromium: `stridefix live`'s page is tested in headless Chromium (playwright drives Debian's browser;
 # no browser download).
 DEBS+=(chromium)
+# help2man: stridefixd.1 from --help (cmake/install.cmake); man-db and groff-base render it
+# (tests/python/packaging/test_install.py).
+DEBS+=(help2man man-db groff-base)
 
 missing=()
 for p in "${DEBS[@]}"; do
@@ -45,7 +49,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
 fi
 stamp="$VENV/.stridefix-deps"
-want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+want=$(cat requirements.txt pyproject.toml VERSION | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "deps: installing Python packages into $VENV"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt

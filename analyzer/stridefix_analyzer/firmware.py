@@ -14,6 +14,7 @@ import dataclasses
 import functools
 import json
 import os
+import shutil
 import subprocess
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -55,8 +56,14 @@ class Param:
 
 
 def default_path() -> Path:
-    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary."""
-    return Path(os.environ.get("STRIDEFIXD") or DEFAULT_STRIDEFIXD)
+    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary, else (an installed
+    analyzer, no build beside it) the ``stridefixd`` on ``PATH`` (``cmake --install``'s bin/)."""
+    if os.environ.get("STRIDEFIXD"):
+        return Path(os.environ["STRIDEFIXD"])
+    if DEFAULT_STRIDEFIXD.is_file():
+        return DEFAULT_STRIDEFIXD
+    on_path = shutil.which("stridefixd")
+    return Path(on_path) if on_path else DEFAULT_STRIDEFIXD
 
 
 def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
@@ -65,7 +72,7 @@ def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
         "--stridefixd",
         default=str(default_path()),
         metavar="PATH",
-        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd)",
+        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd, else stridefixd on PATH)",
     )
 
 
