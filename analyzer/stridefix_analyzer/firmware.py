@@ -16,6 +16,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -56,14 +57,17 @@ class Param:
 
 
 def default_path() -> Path:
-    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary, else (an installed
-    analyzer, no build beside it) the ``stridefixd`` on ``PATH`` (``cmake --install``'s bin/)."""
+    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary; for an installed
+    analyzer (no build beside it) the ``stridefixd`` beside this Python (``cmake --install --prefix
+    VENV``), else the one on ``PATH``."""
     if os.environ.get("STRIDEFIXD"):
         return Path(os.environ["STRIDEFIXD"])
-    if DEFAULT_STRIDEFIXD.is_file():
-        return DEFAULT_STRIDEFIXD
+    beside = Path(sys.executable).parent / "stridefixd"
     on_path = shutil.which("stridefixd")
-    return Path(on_path) if on_path else DEFAULT_STRIDEFIXD
+    for found in (DEFAULT_STRIDEFIXD, beside, Path(on_path) if on_path else None):
+        if found is not None and found.is_file():
+            return found
+    return DEFAULT_STRIDEFIXD
 
 
 def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
@@ -72,7 +76,7 @@ def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
         "--stridefixd",
         default=str(default_path()),
         metavar="PATH",
-        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd, else stridefixd on PATH)",
+        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd, else the installed one)",
     )
 
 
