@@ -93,7 +93,7 @@ class Progress:
         elif _level == NORMAL and self.i and self.stream is not None:
             el = time.perf_counter() - self.t0
             print(
-                f"{self.prefix}: {self.what}: {self.i}/{self.n} done ({el:.0f} s)",
+                f"{self.prefix}: {self.what} {self.i}/{self.n} done ({el:.0f} s)",
                 file=self.stream,
                 flush=True,
             )

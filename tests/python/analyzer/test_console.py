@@ -46,7 +46,7 @@ def test_verbose_prints_a_line_per_step(level):
 def test_default_off_a_terminal_prints_one_line(level):
     level(console.NORMAL)
     lines = _phase(io.StringIO()).splitlines()
-    assert len(lines) == 1 and lines[0].startswith("realbench: fold: 1000/1000 done (")
+    assert len(lines) == 1 and lines[0].startswith("realbench: fold 1000/1000 done (")
 
 
 def test_default_on_a_terminal_draws_one_bar(level):
