@@ -11,7 +11,8 @@
 #   lib/systemd/system/stridefixd.service        tools/systemd's unit, ExecStart at P/bin/stridefixd
 #   share/man/man1/stridefixd.1                  from --help and --version (help2man, when installed)
 #   SF_INSTALL_PYTHONDIR/stridefix/, stridefix_channels.py   the LCM Python types (P a venv: its site dir)
-# Everything here is produced by the default build; tests/python/packaging/test_install.py installs it.
+# Everything here is produced by the default build (a cross build has no man page nor defaults file: both
+# run the built stridefixd); tests/python/packaging/test_install.py installs it.
 include(GNUInstallDirs)
 
 # The LCM Python types' site directory relative to the prefix: that of STRIDEFIX_PYTHON's default scheme
@@ -49,36 +50,7 @@ install(DIRECTORY ${CMAKE_BINARY_DIR}/lcmtypes/python/stridefix DESTINATION ${SF
         FILES_MATCHING PATTERN "*.py")
 install(FILES ${CMAKE_BINARY_DIR}/lcmtypes/python/stridefix_channels.py DESTINATION ${SF_INSTALL_PYTHONDIR})
 
-# Every key at its default, from the binary itself: it cannot drift from the parameter table.
-set(SF_DEFAULTS_INI ${CMAKE_BINARY_DIR}/firmware/stridefixd-defaults.ini)
-add_custom_command(
-  OUTPUT ${SF_DEFAULTS_INI}
-  COMMAND ${CMAKE_COMMAND} -DOUT=${SF_DEFAULTS_INI} -DEXE=$<TARGET_FILE:stridefixd> -DARG=--print-config
-          -P ${CMAKE_SOURCE_DIR}/cmake/run_to_file.cmake
-  DEPENDS stridefixd ${CMAKE_SOURCE_DIR}/cmake/run_to_file.cmake
-  COMMENT "stridefixd --print-config > stridefixd-defaults.ini")
-set(sf_install_generated ${SF_DEFAULTS_INI})
-
-# The man page from --help and --version (help2man: Debian package help2man, make deps installs it).
-find_program(HELP2MAN help2man)
-set(SF_MAN_PAGE ${CMAKE_BINARY_DIR}/firmware/stridefixd.1)
-if(HELP2MAN AND NOT CMAKE_CROSSCOMPILING)
-  add_custom_command(
-    OUTPUT ${SF_MAN_PAGE}
-    COMMAND ${HELP2MAN} --no-info --section=1 --include=${CMAKE_SOURCE_DIR}/tools/man/stridefixd.h2m
-            --name=logger\ of\ the\ StrideFix\ board:\ CAN\ frames\ to\ estimator\ to\ LCM\ log
-            --output=${SF_MAN_PAGE} $<TARGET_FILE:stridefixd>
-    DEPENDS stridefixd ${CMAKE_SOURCE_DIR}/tools/man/stridefixd.h2m
-    COMMENT "help2man: stridefixd.1")
-  list(APPEND sf_install_generated ${SF_MAN_PAGE})
-  install(FILES ${SF_MAN_PAGE} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
-else()
-  message(STATUS "help2man not found: no man page (make deps installs it)")
-endif()
-add_custom_target(sf_install_files ALL DEPENDS ${sf_install_generated})
-
-install(FILES ${CMAKE_SOURCE_DIR}/firmware/examples/stridefixd.ini
-              ${CMAKE_SOURCE_DIR}/firmware/examples/stridefixd.default ${SF_DEFAULTS_INI}
+install(FILES ${CMAKE_SOURCE_DIR}/firmware/examples/stridefixd.ini ${CMAKE_SOURCE_DIR}/firmware/examples/stridefixd.default
         DESTINATION ${CMAKE_INSTALL_DATADIR}/stridefix/examples)
 
 # The unit names the binary by its installed path: tools/systemd's says /usr/local/bin, rewritten at
@@ -91,3 +63,39 @@ install(CODE "
   file(MAKE_DIRECTORY \"\${dir}\")
   file(WRITE \"\${dir}/stridefixd.service\" \"\${unit}\")
 ")
+
+# Both generated files run the built stridefixd: not when cross-compiling; under check-asan/check-fuzz
+# without LeakSanitizer (what --help leaves allocated at exit is no finding of this build step).
+if(CMAKE_CROSSCOMPILING)
+  return()
+endif()
+set(SF_RUN_BUILT ${CMAKE_COMMAND} -E env ASAN_OPTIONS=detect_leaks=0)
+
+# Every key at its default, from the binary itself: it cannot drift from the parameter table.
+set(SF_DEFAULTS_INI ${CMAKE_BINARY_DIR}/firmware/stridefixd-defaults.ini)
+add_custom_command(
+  OUTPUT ${SF_DEFAULTS_INI}
+  COMMAND ${SF_RUN_BUILT} ${CMAKE_COMMAND} -DOUT=${SF_DEFAULTS_INI} -DEXE=$<TARGET_FILE:stridefixd> -DARG=--print-config
+          -P ${CMAKE_SOURCE_DIR}/cmake/run_to_file.cmake
+  DEPENDS stridefixd ${CMAKE_SOURCE_DIR}/cmake/run_to_file.cmake
+  COMMENT "stridefixd --print-config > stridefixd-defaults.ini")
+set(sf_install_generated ${SF_DEFAULTS_INI})
+install(FILES ${SF_DEFAULTS_INI} DESTINATION ${CMAKE_INSTALL_DATADIR}/stridefix/examples)
+
+# The man page from --help and --version (help2man: Debian package help2man, make deps installs it).
+find_program(HELP2MAN help2man)
+set(SF_MAN_PAGE ${CMAKE_BINARY_DIR}/firmware/stridefixd.1)
+if(HELP2MAN)
+  add_custom_command(
+    OUTPUT ${SF_MAN_PAGE}
+    COMMAND ${SF_RUN_BUILT} ${HELP2MAN} --no-info --section=1 --include=${CMAKE_SOURCE_DIR}/tools/man/stridefixd.h2m
+            --name=logger\ of\ the\ StrideFix\ board:\ CAN\ frames\ to\ estimator\ to\ LCM\ log
+            --output=${SF_MAN_PAGE} $<TARGET_FILE:stridefixd>
+    DEPENDS stridefixd ${CMAKE_SOURCE_DIR}/tools/man/stridefixd.h2m
+    COMMENT "help2man: stridefixd.1")
+  list(APPEND sf_install_generated ${SF_MAN_PAGE})
+  install(FILES ${SF_MAN_PAGE} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+else()
+  message(STATUS "help2man not found: no man page (make deps installs it)")
+endif()
+add_custom_target(sf_install_files ALL DEPENDS ${sf_install_generated})
