@@ -9,7 +9,7 @@ PY := $(VENV)/bin/python
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build test test-c test-python lint demo bench clean help change-indication \
+.PHONY: all deps build install test test-c test-python lint demo bench clean help change-indication \
 	gates check-static check-clang check-asan reliability soak check-fuzz fuzz check-arm spy
 
 all: build
@@ -25,6 +25,7 @@ help:
 	@echo "make spy    - lcm-spy with the StrideFix Java types on LCM_URL (e.g. make spy LCM_URL='udpm://239.255.76.67:7667?ttl=0'; default: LCM's)"
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
+	@echo "make install PREFIX=P - cmake --install $(BUILD) into P (default $(PREFIX)): stridefixd, unit, man page, configs, core library"
 	@echo "make gates  - the C/C++ quality gates below, one after the other"
 	@echo "make check-static - cppcheck on firmware/ (suppressions: tools/cppcheck.supp); fails on a finding"
 	@echo "make check-clang  - the whole tree with clang/clang++ (warnings are errors) into build-clang/, ctest"
@@ -44,6 +45,11 @@ configure = mkdir -p $(1) && cmake -S . -B $(1) -DSTRIDEFIX_PYTHON=$(abspath $(P
 build: deps
 	@$(call configure,$(BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE))
 	@cmake --build $(BUILD) -j $(JOBS)
+
+# What goes where: cmake/install.cmake (README "Install on a logger").
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 # Everything CI checks: the C and Python tests, the Python lint/type gates and the C/C++ gates.
 test: build

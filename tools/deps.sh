@@ -3,7 +3,8 @@
 #  1. Debian packages (apt-get update first, only when something is missing).
 #  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
 #     re-installed only when requirements.txt or pyproject.toml changed.
-#  3. A .pth file so the venv imports what the build generates: the LCM Python bindings and the native
+#  3. A .pth file so the venv imports what the build generates (development; an installed logger gets the
+#     LCM types from `cmake --install`, README "Install on a logger"): the LCM Python bindings and the native
 #     solver module (stridefix_native, with its scipy reference beside it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,6 +32,9 @@ DEBS+=(can-utils)
 # plots: its message view fails without it), openjdk-17-jdk-headless (javac and jar; lcm-spy's window
 # needs a display and the full JRE, openjdk-17-jre, which the headless JDK does not pull in).
 DEBS+=(liblcm-java libjchart2d-java openjdk-17-jdk-headless)
+# help2man: stridefixd.1 from --help (cmake/install.cmake); man-db and groff-base render it
+# (tests/python/packaging/test_install.py).
+DEBS+=(help2man man-db groff-base)
 
 missing=()
 for p in "${DEBS[@]}"; do
@@ -54,7 +58,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
 fi
 stamp="$VENV/.stridefix-deps"
-want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+want=$(cat requirements.txt pyproject.toml VERSION | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "deps: installing Python packages into $VENV"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt

@@ -8,16 +8,22 @@ argv``, applied only when that sub-command is the one given. This module registe
 and nothing else; nothing imports from it.
 Exit status: the one contract of :mod:`stridefix_analyzer.exits` (0 ok, 1 failed while running, 2 bad
 usage or unreadable input, 3 nothing valid in the input), stated in every sub-command's ``--help``.
+Global options, before the sub-command: ``-q``/``-v`` (:mod:`stridefix_analyzer.console`: what the
+long-running commands print on stderr) and ``--version`` (the analyzer's and the stridefixd's it runs).
+Every ``--help`` goes through :mod:`stridefix_analyzer.helptext` (no docstring markup).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Callable
 
+from stridefix_analyzer import __version__, console
 from stridefix_analyzer.exits import EXIT_FAILURE, HELP
+from stridefix_analyzer.helptext import plain_parser
 
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
@@ -53,6 +59,27 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         description="StrideFix tools: simulate a walk, analyze LCM logs, render reports.",
         epilog=HELP,
     )
+    talk = parser.add_mutually_exclusive_group()
+    talk.add_argument(
+        *GLOBAL_QUIET,
+        dest="verbosity",
+        action="store_const",
+        const=console.QUIET,
+        default=console.NORMAL,
+        help="nothing on stderr but errors (no progress)",
+    )
+    talk.add_argument(
+        *GLOBAL_VERBOSE,
+        dest="verbosity",
+        action="store_const",
+        const=console.VERBOSE,
+        help="a line per step of the long-running commands instead of one progress bar",
+    )
+    parser.add_argument(
+        "--version",
+        action=_VersionAction,
+        help="the analyzer's version and that of the stridefixd it runs (--stridefixd's default)",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, module_name in SUBCOMMANDS.items():
         if only is not None and name != only:
@@ -67,7 +94,34 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         p = module.add_parser(sub)
         _add_exit_help(p)
         p.set_defaults(_run=module.run)
+    plain_parser(parser)
     return parser
+
+
+GLOBAL_QUIET = ("-q", "--quiet")
+GLOBAL_VERBOSE = ("-v", "--verbose")
+
+
+def version_text() -> str:
+    """``stridefix --version``: this package's version, then the stridefixd that commands run by default
+    (its own ``--version`` line and path) or where it was looked for."""
+    from stridefix_analyzer.firmware import Firmware
+
+    fw = Firmware()
+    if fw.path.is_file() and os.access(fw.path, os.X_OK):
+        found = f"{fw.version()} at {fw.path}"
+    else:
+        found = f"stridefixd not found at {fw.path} (set $STRIDEFIXD, or put stridefixd on PATH)"
+    return f"stridefix {__version__} (analyzer)\n{found}"
+
+
+class _VersionAction(argparse.Action):
+    def __init__(self, option_strings: list[str], dest: str, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help=kwargs.get("help"))  # type: ignore[arg-type]
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: object) -> None:
+        print(version_text())
+        parser.exit()
 
 
 def _add_exit_help(parser: argparse.ArgumentParser) -> None:
@@ -101,10 +155,20 @@ def rewrite_argv(argv: list[str]) -> list[str]:
     return list(getattr(module, function)(argv))
 
 
+def split_global(argv: list[str]) -> tuple[list[str], list[str]]:
+    """``argv`` as (the global -q/-v before the sub-command, the rest)."""
+    n = 0
+    while n < len(argv) and argv[n] in (*GLOBAL_QUIET, *GLOBAL_VERBOSE):
+        n += 1
+    return argv[:n], argv[n:]
+
+
 def main(argv: list[str] | None = None) -> int:
-    argv = rewrite_argv(sys.argv[1:] if argv is None else list(argv))
-    chosen = argv[0] if argv and argv[0] in SUBCOMMANDS else None  # else: top-level help or a usage error
-    args = build_parser(chosen).parse_args(argv)
+    front, rest = split_global(sys.argv[1:] if argv is None else list(argv))
+    rest = rewrite_argv(rest)
+    chosen = rest[0] if rest and rest[0] in SUBCOMMANDS else None  # else: top-level help or a usage error
+    args = build_parser(chosen).parse_args([*front, *rest])
+    console.set_level(args.verbosity)
     return int(args._run(args) or 0)
 
 

@@ -14,7 +14,9 @@ import dataclasses
 import functools
 import json
 import os
+import shutil
 import subprocess
+import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
@@ -55,8 +57,17 @@ class Param:
 
 
 def default_path() -> Path:
-    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary."""
-    return Path(os.environ.get("STRIDEFIXD") or DEFAULT_STRIDEFIXD)
+    """``$STRIDEFIXD`` when set (make test sets it), else the CMake build's binary; for an installed
+    analyzer (no build beside it) the ``stridefixd`` beside this Python (``cmake --install --prefix
+    VENV``), else the one on ``PATH``."""
+    if os.environ.get("STRIDEFIXD"):
+        return Path(os.environ["STRIDEFIXD"])
+    beside = Path(sys.executable).parent / "stridefixd"
+    on_path = shutil.which("stridefixd")
+    for found in (DEFAULT_STRIDEFIXD, beside, Path(on_path) if on_path else None):
+        if found is not None and found.is_file():
+            return found
+    return DEFAULT_STRIDEFIXD
 
 
 def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
@@ -65,7 +76,7 @@ def add_stridefixd_argument(parser: argparse.ArgumentParser) -> None:
         "--stridefixd",
         default=str(default_path()),
         metavar="PATH",
-        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd)",
+        help="firmware binary ($STRIDEFIXD when set, else build/firmware/stridefixd, else the installed one)",
     )
 
 

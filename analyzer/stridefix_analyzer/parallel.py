@@ -78,6 +78,25 @@ def is_remote(scheduler: str | None) -> bool:
     return bool(scheduler) and "://" in str(scheduler)
 
 
+#: Worker processes of every command's ``--jobs``/``--workers`` (issue 17: realbench pdr-distance took
+#: the CPU count, the others 2): the development machine's 2 cores; a bigger one says -j N.
+DEFAULT_JOBS = 2
+
+
+def add_jobs_argument(parser: Any, help_text: str, dest: str = "jobs") -> None:
+    """Declare ``--jobs``/``-j``/``--workers N`` (the same spellings and default on every command)."""
+    parser.add_argument(
+        "--jobs",
+        "-j",
+        "--workers",
+        dest=dest,
+        type=int,
+        default=DEFAULT_JOBS,
+        metavar="N",
+        help=f"{help_text} (default {DEFAULT_JOBS})",
+    )
+
+
 def add_scheduler_argument(parser: Any, default: str = "serial") -> None:
     """Declare ``--scheduler`` on ``parser`` (the worker count is each command's own option)."""
     parser.add_argument(

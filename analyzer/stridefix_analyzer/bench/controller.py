@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -37,7 +36,7 @@ import numpy as np
 import tomllib
 from stridefix import pose_t
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import console, schemes
 from stridefix_analyzer.bench import controller_score as cs
 from stridefix_analyzer.bench import fusion
 from stridefix_analyzer.bench.controller_plot import write_timeline
@@ -265,7 +264,7 @@ def targets(
 def run_controller(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[str]) -> dict[str, Any]:
     """The bench (module docstring); writes ``out.parent/controller.json`` and the PNGs in ``out``."""
     t0 = time.perf_counter()
-    print("bench controller: campus2 survey and site (context map)", file=sys.stderr, flush=True)
+    console.say("bench controller: campus2 survey and site (context map)")
     site = build_site(firmware, out / "survey")
     outlines, names = outlines_of(site, out / "survey" / "building.toml")
     walks, per_seed, pngs = [], [], []
@@ -297,13 +296,11 @@ def run_controller(seeds: list[int], firmware: Firmware, out: Path, sets: Sequen
             }
         )
         ctl = _mean(one, CONTROLLER, WHOLE)
-        print(
+        console.say(
             f"bench controller: [{i + 1}/{len(seeds)}] seed {seed}: controller whole walk "
             f"{'-' if ctl is None else f'{ctl:.2f} m'}, {sum(t['within_target'] for t in w['transitions'])}/"
             f"{len(w['transitions'])} transitions within {cs.LATENCY_TARGET_S:g} s, "
-            f"{sum(s['false'] for s in w['switches'])} false switches",
-            file=sys.stderr,
-            flush=True,
+            f"{sum(s['false'] for s in w['switches'])} false switches"
         )
     table = pool(walks)
     transitions = [dict(t, seed=p["seed"]) for p in per_seed for t in p["transitions"]]

@@ -22,7 +22,6 @@ scores.
 from __future__ import annotations
 
 import json
-import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -30,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import console, schemes
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.scoring.analyze import run_analyze
@@ -158,14 +157,14 @@ def run_aadr2015(
     seeds: list[int], paces: list[str], firmware: Firmware, out: Path, sets: Sequence[str]
 ) -> dict[str, Any]:
     t0 = time.perf_counter()
-    print("bench aadr2015: survey and radio map", file=sys.stderr, flush=True)
+    console.say("bench aadr2015: survey and radio map")
     site = build_site("aadr2015_survey", firmware, out / "survey")
     pooled: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     runs = []
     n = len(seeds) * len(paces)
     for i, (pace, seed) in enumerate((p, s) for p in paces for s in seeds):
         scenario = "aadr2015" if pace == "normal" else f"aadr2015_{pace}"
-        print(f"bench aadr2015: [{i + 1}/{n}] {scenario} seed {seed}", file=sys.stderr, flush=True)
+        console.say(f"bench aadr2015: [{i + 1}/{n}] {scenario} seed {seed}")
         walk = out / f"{scenario}-s{seed}"
         simulate_and_log(scenario, seed, firmware, walk, site, sets)
         errors = score(walk, "waypoint", f"{scenario} seed {seed}, error at the reference points")
@@ -204,12 +203,12 @@ def run_aadr2015(
 
 def run_office(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[str]) -> dict[str, Any]:
     t0 = time.perf_counter()
-    print("bench office-wifi: survey of both floors and radio map", file=sys.stderr, flush=True)
+    console.say("bench office-wifi: survey of both floors and radio map")
     site = build_site("office_survey", firmware, out / "survey")
     pooled: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     runs = []
     for i, seed in enumerate(seeds):
-        print(f"bench office-wifi: [{i + 1}/{len(seeds)}] default seed {seed}", file=sys.stderr, flush=True)
+        console.say(f"bench office-wifi: [{i + 1}/{len(seeds)}] default seed {seed}")
         walk = out / f"default-s{seed}"
         simulate_and_log("default", seed, firmware, walk, site, sets)
         errors = score(walk, None, f"default seed {seed}, every scheme from its first fix")

@@ -52,6 +52,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from stridefix_analyzer import console
 from stridefix_analyzer.bench import callgrind, particle_cost, perf_knn_real, perf_peers
 from stridefix_analyzer.bench.soak import vm_hwm_kb
 from stridefix_analyzer.firmware import REPO, Firmware
@@ -196,10 +197,9 @@ def measure_wifi(harness: Path, out: Path) -> list[dict[str, Any]]:
                 "mean_error_m_full_visit": full["mean_error_m"],
             }
         )
-        print(
+        console.say(
             f"bench perf: Wi-Fi fix at {built['n_rp']} RPs: {ir / built['scans']:,.0f} instructions "
-            f"(full visit {ir_full / full['scans']:,.0f})",
-            file=sys.stderr,
+            f"(full visit {ir_full / full['scans']:,.0f})"
         )
     return rows
 
@@ -343,22 +343,18 @@ def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[s
     if not harness.is_file():
         raise StageError(f"perf: {harness} not found (build it: make build)")
     out.mkdir(parents=True, exist_ok=True)
-    print("bench perf: sensor calls under callgrind", file=sys.stderr, flush=True)
+    console.say("bench perf: sensor calls under callgrind")
     sensors = measure_sensors(harness, out)
-    print("bench perf: x-io Fusion on the same samples under callgrind", file=sys.stderr, flush=True)
+    console.say("bench perf: x-io Fusion on the same samples under callgrind")
     peer = measure_attitude_peer(harness, out)
-    print(
-        "bench perf: Python peers (ahrs Madgwick, scikit-learn KNN) by wall clock",
-        file=sys.stderr,
-        flush=True,
-    )
+    console.say("bench perf: Python peers (ahrs Madgwick, scikit-learn KNN) by wall clock")
     python_peers = {
         "attitude": perf_peers.measure_madgwick_peer(out / "perf.samples.txt", ours_yaw=out / "perf.yaw.txt"),
         "wifi": perf_peers.measure_knn_peer(harness, out),
     }
     not_measured = []
     if floor is not None and floor.is_dir():
-        print(f"bench perf: scikit-learn KNN on the radio map of {floor}", file=sys.stderr, flush=True)
+        console.say(f"bench perf: scikit-learn KNN on the radio map of {floor}")
         python_peers["wifi_real"] = perf_knn_real.measure_knn_peer_real(
             perf_knn_real.site_match_path(firmware.path), floor, out
         )
@@ -366,11 +362,11 @@ def run_perf(firmware: Firmware, out: Path, floor: Path | None = None) -> dict[s
         not_measured.append(f"scikit-learn's KNN on a real msindoor floor ({floor} not found)")
     wifi = measure_wifi(harness, out)
     wifi_heard = measure_wifi_heard(harness, out)
-    print("bench perf: the ekf and particle schemes under callgrind", file=sys.stderr, flush=True)
+    console.say("bench perf: the ekf and particle schemes under callgrind")
     schemes = measure_schemes(firmware.path, out)
     sizes = _harness_json(harness, "sizes")
     heap = check_no_heap(firmware.path)
-    print(f"bench perf: replaying a {REPLAY_SECONDS} s simulated walk", file=sys.stderr, flush=True)
+    console.say(f"bench perf: replaying a {REPLAY_SECONDS} s simulated walk")
     replay = measure_replay(firmware, out)
     by_n = {w["n_rp"]: w for w in wifi}
     mid = min(by_n, key=lambda n: abs(n - 2000))

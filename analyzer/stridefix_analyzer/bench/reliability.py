@@ -25,7 +25,6 @@ exit 1), as with the other benches.
 from __future__ import annotations
 
 import json
-import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -33,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import console, schemes
 from stridefix_analyzer.bench.fusion import build_site
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
@@ -207,13 +206,11 @@ def run_reliability(
         raise BenchError("bench reliability: the first case must be the clean run (no overrides)")
     site_path = None
     if site:
-        print(f"bench reliability: survey ({SURVEY}) and radio map", file=sys.stderr, flush=True)
+        console.say(f"bench reliability: survey ({SURVEY}) and radio map")
         site_path = build_site(SURVEY, firmware, out / "reliability" / "survey")
     rows: list[dict[str, Any]] = []
     for i, (name, rate, overrides) in enumerate(cases):
-        print(
-            f"bench reliability: [{i + 1}/{len(cases)}] {case_label(name, rate)}", file=sys.stderr, flush=True
-        )
+        console.say(f"bench reliability: [{i + 1}/{len(cases)}] {case_label(name, rate)}")
         where = out / "reliability" / case_dir(name, rate)
         rows.append(run_case(name, rate, overrides, firmware, where, site_path, duration_s, sets))
     clean = rows[0]

@@ -19,7 +19,6 @@ scored walk's truth enters the estimator; the person's true K is reported beside
 from __future__ import annotations
 
 import json
-import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -27,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import console, schemes
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.scoring.analyze import run_analyze
@@ -192,11 +191,11 @@ def run_sil_pdr(
     k_by_seed: dict[int, float] = {}
     if calibrate:
         for seed in seeds:
-            print(f"bench sil-pdr: calibration walk, seed {seed}", file=sys.stderr, flush=True)
+            console.say(f"bench sil-pdr: calibration walk, seed {seed}")
             k_by_seed[seed] = calibrate_k(seed, firmware, out / "sil_pdr" / f"calibration-s{seed}", sets)
     n = len(scenarios) * len(seeds)
     for i, (scenario, seed) in enumerate((s, k) for s in scenarios for k in seeds):
-        print(f"bench sil-pdr: [{i + 1}/{n}] {scenario} seed {seed}", file=sys.stderr, flush=True)
+        console.say(f"bench sil-pdr: [{i + 1}/{n}] {scenario} seed {seed}")
         row = run_one(
             scenario, seed, firmware, out / "sil_pdr" / f"{scenario}-s{seed}", k_by_seed.get(seed), sets
         )

@@ -30,12 +30,12 @@ import json
 import math
 import re
 import subprocess
-import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import IO, Any
 
+from stridefix_analyzer import console
 from stridefix_analyzer.bench.reliability import scenario_toml
 from stridefix_analyzer.bench.sil_pdr import BenchError
 from stridefix_analyzer.firmware import Firmware
@@ -190,11 +190,7 @@ def run_soak(
     work.mkdir(parents=True, exist_ok=True)
     overrides = soak_scenario(hours)
     (work / "scenario.toml").write_text(scenario_toml(overrides, hours * 3600.0))
-    print(
-        f"bench soak: {hours:g} h walk: simulating, then streaming into stridefixd",
-        file=sys.stderr,
-        flush=True,
-    )
+    console.say(f"bench soak: {hours:g} h walk: simulating, then streaming into stridefixd")
     log = work / "stridefixd.lcmlog"
     t0 = time.perf_counter()
     sim_cmd = [stridefix_exe(), "sim", "--scenario", str(work / "scenario.toml"), "--seed", str(SEED)]

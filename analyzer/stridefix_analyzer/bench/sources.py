@@ -29,7 +29,6 @@ from __future__ import annotations
 import json
 import math
 import subprocess
-import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -41,7 +40,7 @@ from stridefix import fix_t
 from stridefix_sim.radio import walls_crossed
 from stridefix_sim.world_sources import inside
 
-from stridefix_analyzer import schemes
+from stridefix_analyzer import console, schemes
 from stridefix_analyzer.bench import fusion
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import Table, read_table
@@ -249,11 +248,11 @@ def targets(table: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
 
 def run_sources(seeds: list[int], firmware: Firmware, out: Path, sets: Sequence[str]) -> dict[str, Any]:
     t0 = time.perf_counter()
-    print("bench sources: campus survey and site", file=sys.stderr, flush=True)
+    console.say("bench sources: campus survey and site")
     site, building = build_site(firmware, out / "survey")
     walks = []
     for i, seed in enumerate(seeds):
-        print(f"bench sources: [{i + 1}/{len(seeds)}] {SCENARIO} seed {seed}", file=sys.stderr, flush=True)
+        console.say(f"bench sources: [{i + 1}/{len(seeds)}] {SCENARIO} seed {seed}")
         walk = out / f"{SCENARIO}-s{seed}"
         fusion.simulate_and_log(SCENARIO, seed, firmware, walk, site, sets)
         walks.append(score_walk(walk, f"{SCENARIO} seed {seed}, every scheme from its first fix"))

@@ -41,7 +41,7 @@ from stridefix_analyzer.crowd.solve import RANGES, SOLVERS
 from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.logread import LogReadError
-from stridefix_analyzer.parallel import add_scheduler_argument
+from stridefix_analyzer.parallel import add_jobs_argument, add_scheduler_argument
 
 # action -> its command (experiment returns its own exit status)
 ACTIONS: dict[str, Callable[[argparse.Namespace], Any]] = {
@@ -156,9 +156,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "file records it and solve uses it",
     )
     add_scheduler_argument(f, "serial")  # the pair blocks; the bins are bit-identical on every scheduler
-    f.add_argument(
-        "--workers", type=int, default=2, help="--scheduler processes or local: worker processes (default 2)"
-    )
+    add_jobs_argument(f, "--scheduler processes or local: worker processes", dest="workers")
     f.add_argument(
         "--pair-fraction",
         type=float,

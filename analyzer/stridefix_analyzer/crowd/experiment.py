@@ -26,10 +26,10 @@ from __future__ import annotations
 import concurrent.futures
 import json
 import os
-import sys
 import time
 from pathlib import Path
 
+from stridefix_analyzer import console
 from stridefix_analyzer.crowd.experiment_msindoor import run_msindoor
 from stridefix_analyzer.crowd.experiment_table import format_table, run_table, stride_scale
 from stridefix_analyzer.crowd.experiment_targets import solve_targets
@@ -37,6 +37,7 @@ from stridefix_analyzer.crowd.fit import fit_walks, format_model
 from stridefix_analyzer.crowd.sites import build_crowd_sites
 from stridefix_analyzer.crowd.walks import CrowdInputError, load_walks
 from stridefix_analyzer.firmware import Firmware, add_stridefixd_argument
+from stridefix_analyzer.parallel import add_jobs_argument
 from stridefix_analyzer.scoring.targets import missed_lines, table_lines
 from stridefix_analyzer.stages import replay, run_stage, stridefix_exe
 
@@ -214,12 +215,12 @@ def add_arguments(p) -> None:
         action="store_true",
         help="msindoor: exit 1 when a floor misses its target (graph ≥ 20 %% better than anchor interpolation)",
     )
-    p.add_argument("--jobs", type=int, default=2, help="parallel sim/replay jobs (default 2)")
+    add_jobs_argument(p, "parallel sim/replay jobs")
 
 
 def run_experiment(args) -> int:
     def progress(msg):
-        print(msg, file=sys.stderr, flush=True)
+        console.say(msg)
 
     Path(args.out).mkdir(parents=True, exist_ok=True)
     status = 0

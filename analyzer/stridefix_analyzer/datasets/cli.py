@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from stridefix_analyzer import datasets
+from stridefix_analyzer import console, datasets
 from stridefix_analyzer.datasets.lines import MalformedLineWarning
 from stridefix_analyzer.datasets.protocol import Dataset, DatasetReadError
 from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, input_error_status, worst
@@ -135,13 +135,10 @@ def run_imports(
             statuses.append(EXIT_FAILURE)
             continue
         summaries.append(s)
-        print(
-            f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)",
-            file=sys.stderr,
-        )
+        console.say(f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)")
         print(json.dumps({k: s[k] for k in json_keys}))
     if args.json:
         Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
     where = args.output if args.output else args.out
-    print(f"{prog}: {len(summaries)}/{len(inputs)} {noun}(s) imported into {where}", file=sys.stderr)
+    console.say(f"{prog}: {len(summaries)}/{len(inputs)} {noun}(s) imported into {where}")
     return worst(statuses)

@@ -41,6 +41,7 @@ import numpy as np
 from stridefix_analyzer.datasets.gsd_convert import parse_origin, to_rawwalk
 from stridefix_analyzer.datasets.gsd_parse import MAX_LINE_WARNINGS, parse_log
 from stridefix_analyzer.datasets.protocol import (
+    DEFAULT_MAX_WIFI_AGE_S,
     Dataset,
     Defaults,
     PathLike,
@@ -101,7 +102,7 @@ class Gsd(Dataset):
         "origin",
     )
     version = 1
-    defaults = Defaults(max_wifi_age_s=2.0)
+    defaults = Defaults(max_wifi_age_s=DEFAULT_MAX_WIFI_AGE_S)
     # The magnetometer records are Android's TYPE_MAGNETIC_FIELD, which the OS has already corrected
     # for hard iron (TYPE_MAGNETIC_FIELD_UNCALIBRATED is the raw one): a second online fit (sf_magcal)
     # only adds error. Measured with realbench (first fix / true start, pdr_only mean): site1/F2

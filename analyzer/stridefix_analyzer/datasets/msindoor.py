@@ -37,8 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer.datasets.msindoor_parse import DEFAULT_MAX_WIFI_AGE_S, read_trace
+from stridefix_analyzer.datasets.msindoor_parse import read_trace
 from stridefix_analyzer.datasets.protocol import (
+    DEFAULT_MAX_WIFI_AGE_S,
     Dataset,
     Defaults,
     FloorPlan,

@@ -27,7 +27,7 @@ import re
 import numpy as np
 
 from stridefix_analyzer.datasets.lines import LineReader
-from stridefix_analyzer.datasets.protocol import DatasetReadError
+from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, DatasetReadError
 from stridefix_analyzer.datasets.rawwalk import (
     RawWalk,
     ble_scans,
@@ -39,9 +39,6 @@ from stridefix_analyzer.datasets.rawwalk import (
 )
 from stridefix_analyzer.io.logread import Table
 
-#: Default age beyond which a Wi-Fi entry counts as cached [s] (issue 5: "more than ~2 s older than
-#: its scan is a cached entry").
-DEFAULT_MAX_WIFI_AGE_S = 2.0
 #: Malformed lines reported one by one per file; the rest are summed up in one warning.
 MAX_LINE_WARNINGS = 20
 

@@ -84,6 +84,12 @@ class UnknownDatasetError(DatasetError):
     """No data set of that name is registered."""
 
 
+#: Default age beyond which a Wi-Fi entry counts as cached [s] (issue 5: "more than ~2 s older than
+#: its scan is a cached entry"): every data set's, and so every command's ``--max-wifi-age-s`` (import,
+#: realbench fusion and pdr-distance; issue 17: pdr-distance had 3).
+DEFAULT_MAX_WIFI_AGE_S = 2.0
+
+
 @dataclasses.dataclass(frozen=True)
 class Defaults:
     """A data set's import defaults."""
@@ -138,7 +144,7 @@ class Dataset(abc.ABC):
     summary_keys: ClassVar[tuple[str, ...]] = ("trace", "out", "messages", "skipped_lines", "duration_s")
     #: bump when the log content for the same input changes (caches compare it)
     version: ClassVar[int] = 1
-    defaults: ClassVar[Defaults] = Defaults(max_wifi_age_s=2.0)
+    defaults: ClassVar[Defaults] = Defaults(max_wifi_age_s=DEFAULT_MAX_WIFI_AGE_S)
     #: firmware overrides (KEY=VALUE) for what the recording device already did to its samples, so the
     #: firmware does not do it twice; realbench and crowd replay this set's walks with them, before any
     #: ``--set`` of the user (which wins)

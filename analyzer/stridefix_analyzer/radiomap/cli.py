@@ -19,6 +19,7 @@ from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
 from stridefix_analyzer.parallel import (
     SchedulerError,
     WorkerFiles,
+    add_jobs_argument,
     add_scheduler_argument,
     is_remote,
     task_runner,
@@ -192,13 +193,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="rooms of the plan smaller than this are no walls (default 0: every room)",
     )
     add_scheduler_argument(b, "serial")
-    b.add_argument(
-        "--workers",
-        type=int,
-        default=2,
-        metavar="N",
-        help="processes of --scheduler processes or local (default 2)",
-    )
+    add_jobs_argument(b, "processes of --scheduler processes or local", dest="workers")
     s = sub.add_parser(
         "show",
         help="summary (and PNG) of a site file",

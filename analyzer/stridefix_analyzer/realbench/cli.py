@@ -17,17 +17,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from stridefix_analyzer import datasets
-from stridefix_analyzer.datasets.protocol import seconds_arg
+from stridefix_analyzer import console, datasets
+from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, seconds_arg
 from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
-from stridefix_analyzer.parallel import SchedulerError, add_scheduler_argument
+from stridefix_analyzer.parallel import SchedulerError, add_jobs_argument, add_scheduler_argument
 from stridefix_analyzer.realbench import tuning
 from stridefix_analyzer.realbench.fold import DEFAULT_MIN_COUNT
 from stridefix_analyzer.realbench.fusion import DEFAULT_CELL_SIZE_M, FusionConfig, run_fusion
 from stridefix_analyzer.realbench.pdr_distance import (
-    DEFAULT_MAX_WIFI_AGE_S,
     DEFAULT_OUT,
     JSON_FILE,
     PNG_FILE,
@@ -95,27 +94,15 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         metavar="M",
         help=f"exclude shorter segments (default {DEFAULT_MIN_SEGMENT_M:g})",
     )
-    d.add_argument(
-        "--max-wifi-age-s",
-        type=seconds_arg,
-        default=DEFAULT_MAX_WIFI_AGE_S,
-        metavar="S",
-        help=f"importer: drop cached Wi-Fi entries older than S (default {DEFAULT_MAX_WIFI_AGE_S:g})",
-    )
-    _add_workers(
-        d,
-        default=None,
-        help_text="walks prepared in parallel: processes of --scheduler processes or local (default: CPU count)",
-    )
+    _add_max_wifi_age(d)
+    _add_workers(d, help_text="walks prepared in parallel: processes of --scheduler processes or local")
     d.add_argument("--reimport", action="store_true", help="ignore the cached imported logs")
+    _add_quiet(d)
     d.set_defaults(_bench=_run_pdr_distance_cli)
     return p
 
 
 def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
-    def progress(msg: str) -> None:
-        print(f"realbench: {msg}", file=sys.stderr, flush=True)
-
     try:
         doc = run_pdr_distance(
             args.floor,
@@ -126,7 +113,7 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
             args.max_wifi_age_s,
             args.jobs,
             args.reimport,
-            progress,
+            progress=not console.quiet(),
             scheduler=args.scheduler,
         )
     except (
@@ -150,7 +137,9 @@ def _run_pdr_distance_cli(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Entry point of ``stridefix realbench``."""
+    """Entry point of ``stridefix realbench``; its own ``-q`` is the global ``stridefix -q``."""
+    if getattr(args, "quiet", False):
+        console.set_level(console.QUIET)
     return int(args._bench(args) or 0)
 
 
@@ -194,12 +183,7 @@ def add_fusion_parser(sub: Any) -> None:
         default=DEFAULT_MIN_COUNT,
         help="radio map: drop (cell, AP) entries heard in fewer scans",
     )
-    d.add_argument(
-        "--max-wifi-age-s",
-        type=seconds_arg,
-        default=None,
-        help="importer: drop cached Wi-Fi entries older than this [s] (default: the importer's)",
-    )
+    _add_max_wifi_age(d)
     d.add_argument(
         "--set",
         dest="param_sets",
@@ -241,20 +225,34 @@ def add_fusion_parser(sub: Any) -> None:
         "scheme is not chosen on the training walks)",
     )
     d.add_argument("--no-report", action="store_true", help="skip the HTML report")
-    d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+    _add_quiet(d)
     d.set_defaults(_bench=_run_fusion_cli)
 
 
 def _add_workers(
     d: argparse.ArgumentParser,
-    default: int | None = 2,
     help_text: str = "worker processes of --scheduler processes or local (a scheduler address has its own)",
 ) -> None:
     """``--jobs``/``--workers`` and ``--scheduler`` (default: local processes) of the realbench commands."""
-    d.add_argument(
-        "--jobs", "-j", "--workers", dest="jobs", type=int, default=default, metavar="N", help=help_text
-    )
+    add_jobs_argument(d, help_text)
     add_scheduler_argument(d, "processes")
+
+
+def _add_quiet(d: argparse.ArgumentParser) -> None:
+    d.add_argument(
+        "--quiet", "-q", action="store_true", help="no progress on stderr (= stridefix -q realbench)"
+    )
+
+
+def _add_max_wifi_age(d: argparse.ArgumentParser) -> None:
+    """``--max-wifi-age-s S``: every data set's default (the import command's too)."""
+    d.add_argument(
+        "--max-wifi-age-s",
+        type=seconds_arg,
+        default=DEFAULT_MAX_WIFI_AGE_S,
+        metavar="S",
+        help=f"importer: drop cached Wi-Fi entries older than S seconds (default {DEFAULT_MAX_WIFI_AGE_S:g})",
+    )
 
 
 def _run_fusion_cli(args: argparse.Namespace) -> int:
@@ -274,7 +272,7 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
             min_count=args.min_count,
             cache_dir=args.cache,
             report=not args.no_report,
-            quiet=args.quiet,
+            quiet=console.quiet(),
             param_sets=args.param_sets,
             content=ContentOptions(
                 floor_plan=not args.no_floor_plan,
@@ -347,7 +345,7 @@ def add_crowd_map_parser(sub: Any) -> None:
         "--cache", default=None, metavar="DIR", help="import cache (default: <folder of results.json>/cache)"
     )
     d.add_argument("--reimport", action="store_true", help="ignore the cached imports")
-    d.add_argument("--quiet", "-q", action="store_true", help="no progress lines on stderr")
+    _add_quiet(d)
     d.set_defaults(_bench=_run_crowd_map_cli)
 
 
@@ -371,7 +369,7 @@ def _run_crowd_map_cli(args: argparse.Namespace) -> int:
             min_count=args.min_count,
             cache_dir=args.cache,
             report=False,
-            quiet=args.quiet,
+            quiet=console.quiet(),
             param_sets=args.param_sets,
         )
         doc = run_crowd_map(

@@ -27,10 +27,10 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any, TextIO
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.crowd.graph import FleetPriors, agreed_variant
 from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.radiomap.build import WalkStats
-from stridefix_analyzer.realbench.progress import Progress
 
 #: a (heading variant, fleet priors) pair: what one fold's crowd learned
 Choice = tuple[str, FleetPriors]

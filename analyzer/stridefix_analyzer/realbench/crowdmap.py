@@ -34,13 +34,13 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any, TextIO
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.datasets.protocol import WalkGroup
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench.crowdfolds import Choice, CrowdJob, choice_doc, fold_stats, solve_folds
 from stridefix_analyzer.realbench.fold import STATS_KEYS, FoldJob, run_fold
 from stridefix_analyzer.realbench.fusion import FusionConfig, Run, plan_group, prepare_walks, start_run
-from stridefix_analyzer.realbench.progress import Progress
 from stridefix_analyzer.realbench.summary import summarize_group
 
 #: the schemes the console table shows (the JSON has every scheme): the Wi-Fi fix itself, and the ekf

@@ -39,10 +39,10 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import select as rs
-from stridefix_analyzer.realbench.progress import Progress
 
 #: fewest walks in a group to measure the model (fewer: the firmware prior). Fewer than the inner
 #: cross-validation needs to choose (6): the inner maps then hold fewer walks than the fold's (2 of 3 on

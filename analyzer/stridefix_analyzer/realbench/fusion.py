@@ -41,6 +41,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.datasets.protocol import Dataset, WalkGroup
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.jsonio import json_ready
@@ -56,7 +57,6 @@ from stridefix_analyzer.realbench.heading import (
     learn_rotation_deg,
 )
 from stridefix_analyzer.realbench.prepare import PrepareJob, prepare
-from stridefix_analyzer.realbench.progress import Progress
 from stridefix_analyzer.realbench.select_sites import SelectionSites
 from stridefix_analyzer.realbench.sitecontent import ContentOptions, group_content
 from stridefix_analyzer.realbench.strides import build_segments, calibrate_lowo, stride_k

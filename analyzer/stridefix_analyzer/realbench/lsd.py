@@ -27,11 +27,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
 from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import select as rs
-from stridefix_analyzer.realbench.progress import Progress
 
 #: the fold's chosen scheme travels with the measured site fields under this key (not a site_t field:
 #: run_fold pops it and builds the context map with it)

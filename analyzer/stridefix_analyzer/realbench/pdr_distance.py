@@ -23,16 +23,17 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 import time
 import warnings
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from stridefix_analyzer.datasets.protocol import DatasetReadError
+from stridefix_analyzer.console import Progress
+from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, DatasetReadError
 from stridefix_analyzer.firmware import Firmware, FirmwareError
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
@@ -57,7 +58,6 @@ DATASET = "msindoor"
 DEFAULT_OUT = os.path.join("out", "realbench")
 JSON_FILE = "realbench_pdr_distance.json"
 PNG_FILE = "realbench_pdr_distance.png"
-DEFAULT_MAX_WIFI_AGE_S = 3.0
 #: The target of the benchmark: median absolute segment distance error [%].
 TARGET_MEDIAN_ABS_ERROR_PCT = 5.0
 #: Segment length bins of the error breakdown [m].
@@ -167,13 +167,14 @@ def run_pdr_distance(
     max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S,
     jobs: int | None = None,
     reimport: bool = False,
-    progress: Callable[[str], None] | None = None,
+    progress: bool = False,
     plot: bool = True,
     scheduler: str | None = "processes",
 ) -> dict[str, Any]:
     """Run the PDR distance benchmark on one floor; write JSON (+ PNG) into ``out_dir``.
 
-    ``stridefixd`` None: :func:`stridefix_analyzer.firmware.default_path`. The walks are prepared on
+    ``stridefixd`` None: :func:`stridefix_analyzer.firmware.default_path`. ``progress``: the walks'
+    preparation as a :class:`stridefix_analyzer.console.Progress` on stderr. The walks are prepared on
     ``scheduler`` with ``jobs`` workers (:mod:`stridefix_analyzer.parallel`). Returns the JSON document
     (a dict; non-finite numbers still as NaN).
 
@@ -194,14 +195,12 @@ def run_pdr_distance(
     out = Path(out_dir or os.path.join(DEFAULT_OUT, label.replace("/", "-")))
     out = out.resolve() if is_remote(scheduler) else out
     out.mkdir(parents=True, exist_ok=True)
-    say = progress or (lambda msg: None)
     n_jobs = max(1, jobs or os.cpu_count() or 1)
-    done = [0]
+    prog = Progress("walk", len(traces), sys.stderr if progress else None)
 
     def prepared(_: int, w: dict[str, Any]) -> None:
-        done[0] += 1
         state = w["error"] or (f"{len(w['step_t_us'])} steps, {len(w['waypoint_t_us'])} waypoints")
-        say(f"walk {done[0]}/{len(traces)} {w['walk']}: {state}")
+        prog.step(f"{w['walk']}: {state}")
 
     files = WorkerFiles(read=[floor_dir], write=[out], same=[fw.path])
     with task_runner(scheduler, n_jobs, files) as runner:

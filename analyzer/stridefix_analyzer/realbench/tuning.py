@@ -30,6 +30,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol, TextIO
 
+from stridefix_analyzer.console import Progress
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.parallel import TaskRunner
 from stridefix_analyzer.realbench import fixmodel, lsd
@@ -40,7 +41,6 @@ from stridefix_analyzer.realbench.heading import (
     choose_heading_variant,
     learn_heading,
 )
-from stridefix_analyzer.realbench.progress import Progress
 
 #: the matcher's candidates: scans averaged (1 or 2) × WkNN representation (dBm, or "powed" with beta
 #: 2 or e — Torres-Sospedra 2015's choice)

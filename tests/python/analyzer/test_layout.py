@@ -162,6 +162,8 @@ def test_cli_modules_are_imported_only_by_the_top_cli():
 # package or from one above it in this list.
 LAYERS = (
     "exits",
+    "console",
+    "helptext",
     "schemes",
     "firmware",
     "spy",
