@@ -82,7 +82,9 @@ def plot_trajectory(series: dict):
     floors = _floors(series)
     cols = min(len(floors), 2)
     rows = -(-len(floors) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(7.0 * cols, 6.0 * rows), squeeze=False)
+    fig, axes = plt.subplots(
+        rows, cols, figsize=(7.0 * cols, 6.0 * rows + 0.8), squeeze=False, layout="constrained"
+    )
     tx, ty, tf = series["truth_x_m"], series["truth_y_m"], series["truth_floor"]
     colors = _colors(_scheme_codes(series))
     primary = int(series["primary_scheme"]) if "primary_scheme" in series else None
@@ -112,7 +114,8 @@ def plot_trajectory(series: dict):
         ax.grid(True, **style.GRID)
         if k == 0:
             ax.plot([], [], color="grey", **style.POSE_END, label="end (pose)")
-            ax.legend(loc="best", fontsize="small")
+            # under the panels, not over the tracks
+            fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=6, fontsize="small")
     for k in range(len(floors), rows * cols):
         axes[k // cols][k % cols].set_visible(False)
     fig.suptitle("Trajectory: POSE vs truth (map frame), one panel per floor")
@@ -165,9 +168,19 @@ def plot_error_time(series: dict):
     primary = int(series["primary_scheme"])
     codes = sorted(_scheme_codes(series), key=lambda c: c != primary)
     fig, axes = plt.subplots(
-        len(codes), 1, figsize=(9, 0.6 + 1.25 * len(codes)), sharex=True, sharey=True, squeeze=False
+        len(codes),
+        1,
+        figsize=(9, 0.8 + 1.25 * len(codes)),
+        sharex=True,
+        sharey=True,
+        squeeze=False,
+        layout="constrained",
     )
     colors = _colors(codes)
+    # one scale for every panel, set once: each panel's own set_ylim would freeze the shared top at
+    # the first panel's data and clip the others
+    tops = [np.nanmax(series[f"s{c}_error_m"]) for c in codes if np.isfinite(series[f"s{c}_error_m"]).any()]
+    top = 1.08 * max(tops) if tops and max(tops) > 0 else 1.0
     for ax, code in zip(axes[:, 0], codes):
         err = series[f"s{code}_error_m"]
         ax.fill_between(t_s, 0, np.nan_to_num(err), color=colors[code], alpha=0.25, linewidth=0)
@@ -181,9 +194,10 @@ def plot_error_time(series: dict):
             transform=ax.transAxes,
             ha="right",
             fontsize="small",
+            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8),
         )
-        ax.set_ylim(bottom=0)
         ax.grid(True, **style.GRID)
+    axes[0, 0].set_ylim(0, top)
     axes[-1, 0].set_xlabel("time since first truth sample [s]")
     axes[len(codes) // 2, 0].set_ylabel("horizontal error [m]")
     fig.suptitle("Position error over time (latest POSE at or before each truth time)")
