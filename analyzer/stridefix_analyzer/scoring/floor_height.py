@@ -6,7 +6,8 @@ A floor index becomes a height from, in this order:
    ``lowest_floor + n − 1`` (increasing, site_t);
 2. the log's CONFIG: ``floor.height_m``, the uniform floor-to-floor height stridefixd ran with (floor
    0 at z = 0), the number the estimator's own floor detection used;
-3. otherwise the height is unknown: z is NaN (vertical and 3-D terms NaN, TUM export refused).
+3. otherwise the height is unknown: no vertical terms (``vertical`` is null), and a TUM export of a
+   walk on more than one floor is refused (a one-floor walk is written with z = 0).
 
 A floor outside a site's table continues from its nearest end at the uniform height of the CONFIG
 (or the table's mean spacing when the log has no CONFIG; a one-floor table and no CONFIG leave it NaN).
