@@ -32,6 +32,9 @@ DEBS+=(can-utils)
 # plots: its message view fails without it), openjdk-17-jdk-headless (javac and jar; lcm-spy's window
 # needs a display and the full JRE, openjdk-17-jre, which the headless JDK does not pull in).
 DEBS+=(liblcm-java libjchart2d-java openjdk-17-jdk-headless)
+# xvfb, xauth, x11-utils (xwininfo) and the full JRE (AWT's X11 toolkit): test_spy opens lcm-spy's
+# window on a virtual display (Xvfb: no screen, no network) and finds it by its title.
+DEBS+=(xvfb xauth x11-utils openjdk-17-jre)
 # help2man: stridefixd.1 from --help (cmake/install.cmake); man-db and groff-base render it
 # (tests/python/packaging/test_install.py).
 DEBS+=(help2man man-db groff-base)

@@ -17,6 +17,7 @@ import os
 import shlex
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import lcm
@@ -149,3 +150,32 @@ def test_java_decodes_what_python_wrote(jars, tmp_path):
             else:
                 assert got == want, name
     assert lines[0][2:] != lines[1][2:]  # the scheme field tells the copies apart too
+
+
+@pytest.mark.skipif(
+    shutil.which("xvfb-run") is None or shutil.which("xwininfo") is None,
+    reason="needs xvfb-run and xwininfo (tools/deps.sh)",
+)
+def test_spy_window_opens_on_a_virtual_display(jars, tmp_path):
+    """GIVEN a file:// replay of a log and a virtual X display (Xvfb: no screen, no network), WHEN
+    `stridefix spy` starts, THEN lcm-spy's window "LCM Spy" opens and lcm-spy finds every StrideFix
+    type on its classpath (one per .lcm file), with no Java exception."""
+    log = tmp_path / "w.lcmlog"
+    ev = lcm.EventLog(str(log), "w", overwrite=True)
+    m = pose_t()
+    for k in range(50):
+        m.t_us, m.x_m, m.scheme = 100_000 * k, 0.1 * k, pose_t.SCHEME_ADAPTIVE
+        ev.write_event(m.t_us, "POSE_ADAPTIVE", m.encode())
+    ev.close()
+    script = (
+        f"{shlex.quote(sys.executable)} -m stridefix_analyzer.cli spy --lcm-url "
+        f"{shlex.quote(f'file://{log}?speed=1')} > {shlex.quote(str(tmp_path / 'spy.out'))} 2>&1 & P=$!; "
+        "for i in $(seq 1 40); do xwininfo -root -tree | grep -q '\"LCM Spy\"' && break; sleep 0.5; done; "
+        "xwininfo -root -tree | grep '\"LCM Spy\"'; kill $P; wait $P 2>/dev/null; true"
+    )
+    proc = subprocess.run(["xvfb-run", "-a", "sh", "-c", script], capture_output=True, text=True, timeout=120)
+    out = (tmp_path / "spy.out").read_text()
+    assert '"LCM Spy"' in proc.stdout, proc.stdout + proc.stderr + out
+    n_types = len(list((HERE.parents[2] / "lcmtypes" / "stridefix").glob("*.lcm")))
+    assert f"Found {n_types} LCM types" in out, out
+    assert "Exception" not in out, out
