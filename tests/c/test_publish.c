@@ -28,17 +28,25 @@
 #include "stridefix_pose_t.h"
 #include "stridefix_step_t.h"
 
+/* An LCM output on a fresh name in /tmp (path receives it). The log is created O_EXCL: mkstemp gives
+ * the name only, not the file. */
+static sf_lcm_out_t *open_fresh_log(char *const path, const size_t size)
+{
+    snprintf(path, size, "/tmp/sf_test_publish_XXXXXX");
+    const int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    sf_lcm_out_t *out = NULL;
+    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    return out;
+}
+
 static void test_every_output_round_trips(void **state)
 {
     (void)state;
     char path[64];
-    snprintf(path, sizeof path, "/tmp/sf_test_publish_XXXXXX");
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(path); /* the log is created O_EXCL: the name only, not the file */
-    sf_lcm_out_t *out = NULL;
-    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    sf_lcm_out_t *const out = open_fresh_log(path, sizeof path);
 
     const sf_fix_audit_t audit = {.t_us = 7000000, .method = sf_fix_wifi, .x_m = 3.5, .y_m = -1.25, .floor = 1,
                                   .accuracy_m = 2.0, .n_ap_used = 5, .scheme = sf_scheme_adaptive,
@@ -150,13 +158,7 @@ static void test_pose_channels(void **state)
     assert_string_equal(sf_publish_pose_channel(sf_scheme_controller), "POSE");
 
     char path[64];
-    snprintf(path, sizeof path, "/tmp/sf_test_publish_XXXXXX");
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(path);
-    sf_lcm_out_t *out = NULL;
-    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    sf_lcm_out_t *const out = open_fresh_log(path, sizeof path);
     const sf_pose_t ekf = {.t_us = 5, .x_m = 4.25, .y_m = -2.0, .scheme = sf_scheme_ekf};
     const sf_pose_t controller = {.t_us = 6, .x_m = 4.25, .y_m = -2.0, .scheme = sf_scheme_controller};
     sf_publish_pose(out, 21, &ekf);
@@ -187,13 +189,7 @@ static void test_context_round_trips(void **state)
 {
     (void)state;
     char path[64];
-    snprintf(path, sizeof path, "/tmp/sf_test_publish_XXXXXX");
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(path);
-    sf_lcm_out_t *out = NULL;
-    assert_int_equal(sf_lcm_out_open(&out, path, NULL, 16, true, NULL, 0), SF_OK);
+    sf_lcm_out_t *const out = open_fresh_log(path, sizeof path);
     static const int16_t kind[] = {sf_context_outdoor, sf_context_floor, sf_context_floor};
     static const int16_t building[] = {-1, 0, 0};
     static const int16_t floor[] = {0, 0, 1};
