@@ -78,12 +78,11 @@ def write_tum(metrics: Metrics, out_dir: str | os.PathLike[str]) -> dict[str, st
     Raises :class:`TumError` when the floors' heights are unknown (``metrics.heights``) and the
     walk has more than one floor: z = 0 would hide every floor change and floor error from evo.
     """
-    heights = metrics.heights
-    known = heights is not None and heights.known
+    heights = metrics.heights if metrics.heights is not None and metrics.heights.known else None
     floors = {int(f) for f in metrics.truth["floor"]}
     for s in metrics.schemes.values():
         floors |= {int(f) for f in s.match["pose_floor"][s.match["scored"]]}
-    if not known and len(floors) > 1:
+    if heights is None and len(floors) > 1:
         raise TumError(
             f"TUM z is the floor's height, unknown here (floors {sorted(floors)}; the logs have no CONFIG "
             "floor.height_m): give the site file (--site)"
@@ -91,7 +90,7 @@ def write_tum(metrics: Metrics, out_dir: str | os.PathLike[str]) -> dict[str, st
 
     def write(name: str, sc: np.ndarray, m: Any, who: str, heading: np.ndarray) -> None:
         """``name``.tum: the scored rows ``sc`` of ``m``'s ``who`` (pose or truth) columns."""
-        z = heights.z_m(m[f"{who}_floor"][sc]) if heights is not None and known else None
+        z = heights.z_m(m[f"{who}_floor"][sc]) if heights is not None else None
         path = os.path.join(out_dir, f"{name}.tum")
         with open(path, "w", encoding="utf-8") as f:
             f.write(format_tum(m["t_us"][sc], m[f"{who}_x_m"][sc], m[f"{who}_y_m"][sc], heading, z))

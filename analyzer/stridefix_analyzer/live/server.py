@@ -21,12 +21,13 @@ import sys
 import threading
 from typing import Any
 
+from stridefix_analyzer.io.channels import POSE_CHANNELS
 from stridefix_analyzer.live.state import LiveState
 
 PUSH_S = 0.2
 DEFAULT_PORT = 8765
-#: the channels the view folds (a regular expression, as LCM subscribes)
-SUBSCRIBE = "POSE|POSE_.*|STEP|FIX|HEALTH|CONTEXT|TRUTH"
+#: the channels the view folds, from the channel table (a regular expression, as LCM subscribes)
+SUBSCRIBE = "|".join(sorted(POSE_CHANNELS | {"STEP", "FIX", "HEALTH", "CONTEXT", "TRUTH"}))
 
 
 class LiveInputError(ValueError):
@@ -36,11 +37,7 @@ class LiveInputError(ValueError):
 def _decoder(channel: str) -> Any:
     from stridefix_analyzer.io.channels import CHANNELS
 
-    if channel in CHANNELS:
-        return CHANNELS[channel].msg_type
-    if channel.startswith("POSE_") and "POSE" in CHANNELS:
-        return CHANNELS["POSE"].msg_type
-    return None
+    return CHANNELS[channel].msg_type if channel in CHANNELS else None
 
 
 class LcmFeed:

@@ -10,7 +10,8 @@ for what changed. POSE of any scheme goes to that scheme's track, whether it cam
 a per-scheme ``POSE_<SCHEME>`` channel; once a per-scheme channel is seen, ``POSE`` feeds no fusion
 scheme's track (it carries copies then, which the analyzer leaves out too). The primary pose: the ``POSE`` channel's latest once
 per-scheme channels are seen (POSE then carries the primary only), else the latest of the scheme
-the analyzer would make primary (:data:`~stridefix_analyzer.scoring.metrics.PRIMARY_PREFERENCE`).
+first in the analyzer's preference (:func:`~stridefix_analyzer.scoring.metrics.preference_rank`:
+the tie-break of its primary choice; a live view cannot count messages still to come).
 """
 
 from __future__ import annotations
@@ -21,9 +22,10 @@ from typing import Any
 
 from stridefix import pose_t
 
+from stridefix_analyzer.io.channels import POSE, POSE_CHANNELS
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_colour, scheme_name
 from stridefix_analyzer.scoring.fixsources import method_name, reason_name
-from stridefix_analyzer.scoring.metrics import PRIMARY_PREFERENCE
+from stridefix_analyzer.scoring.metrics import preference_rank
 
 TRACK_EVERY_S = 0.5
 TRACK_MAX = 4000
@@ -107,7 +109,7 @@ class LiveState:
         t = getattr(msg, "t_us", None)
         if t is not None:
             self.last_t_us = int(t) if self.last_t_us is None else max(self.last_t_us, int(t))
-        if channel == "POSE" or channel.startswith("POSE_"):
+        if channel in POSE_CHANNELS:
             self._pose(channel, msg)
         elif channel == "STEP":
             self.steps = max(self.steps, int(msg.index))  # step_t: the first step is 1
@@ -125,20 +127,20 @@ class LiveState:
     def _pose(self, channel: str, m: Any) -> None:
         code = int(m.scheme)
         p = _pose_fields(m)
-        if channel != "POSE" and not self.per_scheme_channels:
+        if channel != POSE and not self.per_scheme_channels:
             # the first per-scheme message: POSE carries the primary alone, and what it carried of
             # a fusion scheme was a copy (the analyzer leaves those out): that scheme starts afresh
             self.per_scheme_channels = True
             for c in [c for c in self.schemes if c != SCHEME_CONTROLLER]:
                 del self.schemes[c]
-        if channel != "POSE" or code == SCHEME_CONTROLLER or not self.per_scheme_channels:
+        if channel != POSE or code == SCHEME_CONTROLLER or not self.per_scheme_channels:
             s = self._scheme(code)
             s.last, s.poses = p, s.poses + 1
             s.append(p["t_us"], (round(p["x_m"], 3), round(p["y_m"], 3), p["floor"]))
-        if channel != "POSE":
+        if channel != POSE:
             return
         name = self._scheme_name(code)
-        if self.per_scheme_channels or self._rank(name) <= self._rank(
+        if self.per_scheme_channels or preference_rank(name) <= preference_rank(
             self.primary["scheme"] if self.primary else ""
         ):
             self.primary = {**p, "scheme": name}
@@ -148,12 +150,6 @@ class LiveState:
             return scheme_name(code)
         except UnknownSchemeError:
             return f"scheme_{code}"
-
-    @staticmethod
-    def _rank(name: str) -> int:
-        """The analyzer's preference for the primary scheme (controller first) when every scheme
-        shares POSE; lower is preferred."""
-        return PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else len(PRIMARY_PREFERENCE)
 
     def _fix(self, m: Any) -> None:
         scheme = self._scheme(int(m.scheme)).name

@@ -73,7 +73,7 @@ def load_run(path: str) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
 
 
 def _num(v: Any) -> float:
-    return float(v) if isinstance(v, (int, float)) and v is not None else float("nan")
+    return float(v) if isinstance(v, (int, float)) else float("nan")  # None (JSON null) → NaN
 
 
 def compare(a: dict, b: dict, metric: str = "mean") -> dict[str, Any]:

@@ -303,6 +303,12 @@ def score_scheme(
     return SchemeScore(code=int(code), name=scheme_name(code), summary=summary, match=m, pose=pose)
 
 
+def preference_rank(name: str) -> int:
+    """A scheme's place in :data:`PRIMARY_PREFERENCE` (lower is preferred; a scheme not listed comes
+    after every listed one)."""
+    return PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else len(PRIMARY_PREFERENCE)
+
+
 def choose_primary(pose: Table, requested: int | None = None) -> int:
     """The scheme whose numbers go at the top level.
 
@@ -324,9 +330,7 @@ def choose_primary(pose: Table, requested: int | None = None) -> int:
         return int(codes[names.index(_ALWAYS_PRIMARY)])
 
     def rank(i: int):
-        name = scheme_name(codes[i])
-        pref = PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else 99
-        return (-counts[i], pref, int(codes[i]))
+        return (-counts[i], preference_rank(scheme_name(codes[i])), int(codes[i]))
 
     return int(codes[min(range(len(codes)), key=rank)])
 

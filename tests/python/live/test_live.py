@@ -43,8 +43,7 @@ def _fold(log: Path, walls) -> LiveState:
     pattern = re.compile(f"^(?:{SUBSCRIBE})$")
     for event in lcm.EventLog(str(log), "r"):
         if pattern.match(event.channel):
-            key = "POSE" if event.channel.startswith("POSE_") else event.channel
-            state.add(event.channel, CHANNELS[key].msg_type.decode(event.data))
+            state.add(event.channel, CHANNELS[event.channel].msg_type.decode(event.data))
     return state
 
 
