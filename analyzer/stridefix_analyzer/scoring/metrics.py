@@ -5,8 +5,9 @@ with ``t_us ≤ t`` (of the same fusion scheme); the position error is the horiz
 between the two [m]. Truth samples before the scheme's first POSE are not scored but counted as
 ``unscored``. Statistics: n, mean, median, 75th/90th/95th percentile (numpy's default linear
 interpolation), max and RMSE, plus the empirical CDF. Also floor hit rate, the IPIN score (the IPIN
-competition's metric, :func:`ipin_score`), the ISO/IEC 18305 terms (:mod:`.iso18305`), step count against the truth, distance walked along the
-truth, and the final error.
+competition's metric, :func:`ipin_score`, by Matlab's ``quantile`` as the organisers compute it:
+:func:`matlab_quantile`), the ISO/IEC 18305 terms (:mod:`.iso18305`), step count against the truth,
+distance walked along the truth, and the final error.
 
 When a log holds POSE messages of several schemes (``pose_t.scheme``), each is scored on its own
 and reported under its name; one of them is the *primary* scheme whose numbers are repeated at the
@@ -172,9 +173,32 @@ def error_stats(error_m: np.ndarray) -> dict:
     return stats
 
 
+def matlab_quantile(values: ArrayLike, q: ArrayLike) -> np.ndarray:
+    """Quantiles as Matlab's ``quantile`` defines them (the IPIN organisers' scorer uses it).
+
+    The i-th of the n sorted values sits at probability (i − 0.5)/n; linear in between; below 0.5/n
+    the smallest value, above (n − 0.5)/n the largest. That is numpy's ``method="hazen"``
+    (Hyndman & Fan type 5); numpy's default (``"linear"``, type 7) puts the i-th at (i − 1)/(n − 1).
+
+    Parameters
+    ----------
+    values : array_like, shape (n,)
+        Finite samples (n ≥ 1), any unit.
+    q : float or array_like, shape (k,)
+        Probabilities in [0, 1].
+
+    Returns
+    -------
+    ndarray, shape () or (k,)
+        The quantiles, in the unit of ``values``.
+    """
+    return np.quantile(np.asarray(values, dtype=np.float64), q, method="hazen")
+
+
 def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:
-    """The IPIN competition score [m]: 75th percentile of 2-D error + :data:`IPIN_FLOOR_PENALTY_M`
-    × |floor error|, over the samples where that sum is finite (NaN when there is none).
+    """The IPIN competition score [m]: the 75th percentile by :func:`matlab_quantile` (as the
+    organisers compute it) of 2-D error + :data:`IPIN_FLOOR_PENALTY_M` × |floor error|, over the
+    samples where that sum is finite (NaN when there is none).
 
     Parameters
     ----------
@@ -185,7 +209,7 @@ def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:
     """
     e = np.asarray(error_m, float) + IPIN_FLOOR_PENALTY_M * np.abs(np.asarray(floor_error, float))
     e = e[np.isfinite(e)]
-    return float(np.percentile(e, 75)) if len(e) else float("nan")
+    return float(matlab_quantile(e, 0.75)) if len(e) else float("nan")
 
 
 def error_cdf(error_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
