@@ -36,6 +36,7 @@ SUBCOMMANDS = {
     "radiomap": "stridefix_analyzer.radiomap.cli",
     "crowd": "stridefix_analyzer.crowd.cli",
     "compare": "stridefix_analyzer.scoring.compare",
+    "score": "stridefix_analyzer.scoring.ipin_cli",
     "live": "stridefix_analyzer.live.server",
     "spy": "stridefix_analyzer.spy",
 }

@@ -43,7 +43,8 @@ SKIP_ROWS = 2
 #: an estimate counts for a point when its time is at or before the point's time + this [s]
 MATCH_SLACK_S = 0.01
 #: columns 5 and 6 of an estimate file are taken as latitude, longitude when the median of column 6
-#: is below this [deg] (the site's latitude is above it, its longitude below)
+#: is below this [deg] (the organisers' rule: a file written lat, lon at a site east of 0° and west of
+#: 10° E, north of 10° N)
 SWAP_BELOW_DEG = 10.0
 #: the estimate file's columns (1-based, as the format states them) and the truth file's
 EST_COLUMNS = {"time": 1, "longitude": 5, "latitude": 6, "floor": 7}
@@ -272,17 +273,17 @@ def team_of(ident: str) -> str:
     return re.sub(r"\d+$", "", ident) or ident
 
 
-def score_file(truth_path: str | Path, estimate_path: str | Path) -> dict[str, float | int | str]:
-    """Read both files and return ``{"id": file_id, **figures}`` (see :func:`figures`).
+def score_file(truth: tuple[Track, np.ndarray], estimate_path: str | Path) -> dict[str, float | int | str]:
+    """Score one estimate file against ``truth`` (:func:`read_truth`'s pair): ``{"id": file_id,
+    **figures}`` (see :func:`figures`).
 
     Raises
     ------
     IpinFileError
-        Either file unreadable or malformed (:class:`IpinNothingValidError`: no data row).
+        The estimate file unreadable or malformed (:class:`IpinNothingValidError`: no data row).
     """
-    truth, points = read_truth(truth_path)
     estimate = read_estimate(estimate_path)
-    return {"id": file_id(estimate_path), **figures(point_errors(truth, points, estimate))}
+    return {"id": file_id(estimate_path), **figures(point_errors(*truth, estimate))}
 
 
 def ranking(results: Sequence[dict]) -> list[tuple[str, float]]:
