@@ -213,18 +213,20 @@ def test_truth_source_waypoint_scores_only_reference_points(msg, write_log, stra
 # --- the IPIN score ---------------------------------------------------------------------------------
 
 # eight samples with 2-D errors 1..8 m; the last two one floor off (either sign): error + 15 m x |floor
-# error| = 1, 2, 3, 4, 5, 6, 22, 23; the 75th percentile (linear) sits at index 0.75 x 7 = 5.25, so
-# 6 + 0.25 x (22 - 6) = 10.0 m. Without the floor errors: 6 + 0.25 x 1 = 6.25 m.
+# error| = 1, 2, 3, 4, 5, 6, 22, 23; Matlab's quantile puts the i-th of 8 at (i - 0.5)/8, so 0.75 falls
+# halfway between the 6th (0.6875) and the 7th (0.8125): 6 + 0.5 x (22 - 6) = 14.0 m. Without the floor
+# errors: 6 + 0.5 x 1 = 6.5 m.
 IPIN_ERRORS_M = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
 IPIN_FLOOR_ERRORS = [0, 0, 0, 0, 0, 0, 1, -1]
 
 
 def test_ipin_score_of_a_handmade_series_is_the_formula():
     assert IPIN_FLOOR_PENALTY_M == 15.0
-    assert_allclose(ipin_score(IPIN_ERRORS_M, IPIN_FLOOR_ERRORS), 10.0, rtol=1e-12)
-    assert_allclose(ipin_score(IPIN_ERRORS_M, np.zeros(8)), 6.25, rtol=1e-12)
-    # a non-finite sample is left out, not counted as zero: [1, 2, 3, 4, 22] -> index 3 -> 4.0 m
-    assert_allclose(ipin_score([1.0, 2.0, np.nan, 3.0, 4.0, 7.0], [0, 0, 0, 0, 0, 1]), 4.0, rtol=1e-12)
+    assert_allclose(ipin_score(IPIN_ERRORS_M, IPIN_FLOOR_ERRORS), 14.0, rtol=1e-12)
+    assert_allclose(ipin_score(IPIN_ERRORS_M, np.zeros(8)), 6.5, rtol=1e-12)
+    # a non-finite sample is left out, not counted as zero: [1, 2, 3, 4, 22], 0.75 x 5 + 0.5 = 4.25th
+    # value -> 4 + 0.25 x (22 - 4) = 8.5 m
+    assert_allclose(ipin_score([1.0, 2.0, np.nan, 3.0, 4.0, 7.0], [0, 0, 0, 0, 0, 1]), 8.5, rtol=1e-12)
     assert np.isnan(ipin_score([], []))
 
 
@@ -236,6 +238,6 @@ def test_ipin_score_per_scheme_from_the_pose_stream(msg, write_log):
         events.append(("POSE", msg.pose(t, k + e_m, 0.0, floor=abs(f), scheme=pose_t.SCHEME_PDR_ONLY)))
         events.append(("TRUTH", msg.truth(t, float(k), 0.0, floor=0)))
     m = run_metrics(read_logs([write_log("ipin.lcmlog", events)])).summary()
-    assert_allclose(m["per_scheme"]["pdr_only"]["ipin_score"], 10.0, rtol=1e-12)
-    assert_allclose(m["ipin_score"], 10.0, rtol=1e-12)  # the primary scheme's, at the top level
+    assert_allclose(m["per_scheme"]["pdr_only"]["ipin_score"], 14.0, rtol=1e-12)
+    assert_allclose(m["ipin_score"], 14.0, rtol=1e-12)  # the primary scheme's, at the top level
     assert_allclose(m["floor_hit_rate"], 0.75, rtol=1e-12)
