@@ -243,7 +243,7 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
                 f"  adaptive vs wifi_only: mean error reduced by "
                 f"{_f(s['adaptive_vs_wifi_only_reduction_pct'], 1)} %  (>15m = share of walks "
                 f"whose mean error exceeds {ROBUST_MEAN_M:g} m; ipin = p75 of 2-D error + "
-                f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|)"
+                f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|, Matlab quantile)"
             )
         lines.append(f"  {pdr_true_start_text(doc['format'], g)}")
         if "fix_sources" in g:

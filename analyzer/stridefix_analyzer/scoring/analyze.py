@@ -3,7 +3,8 @@
 Outputs in ``--out DIR`` (default ``out/analyze``):
 
 - ``metrics.json``: the summary (see :meth:`stridefix_analyzer.metrics.Metrics.summary`; per scheme
-  and for the primary scheme the ``ipin_score`` [m], p75 of 2-D error + 15 m × |floor error|) plus
+  and for the primary scheme the ``ipin_score`` [m], p75 of 2-D error + 15 m × |floor error| by Matlab's
+  quantile: :func:`stridefix_analyzer.scoring.metrics.ipin_score`) plus
   ``inputs``, ``messages`` (events per channel), ``unknown_channels``, ``decode_errors``,
   ``health`` (last HEALTH fields), ``config`` (``version``, ``dbc_sha256``, ``params``) and
   ``warnings``. Non-finite numbers are written as ``null``.
@@ -202,7 +203,7 @@ def format_summary(summary: dict) -> str:
     st = summary["steps"]
     lines.append(
         f"(errors in m; ipin = IPIN score, p75 of 2-D error + {IPIN_FLOOR_PENALTY_M:g} m x |floor "
-        f"error|; final% of distance walked; hdgRMS in deg; * primary scheme; steps = detected - truth)  "
+        f"error| (Matlab quantile); final% of distance walked; hdgRMS in deg; * primary scheme; steps = detected - truth)  "
         f"truth samples {summary['n_truth']}, unscored {summary['unscored']}, "
         f"walked {summary['distance_walked_m']:.1f} m, "
         f"steps detected {st['detected']} / truth {_fmt(st['truth'])}"

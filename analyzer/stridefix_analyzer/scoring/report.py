@@ -228,7 +228,7 @@ def render_html(summary: dict, series: dict, title: str = "StrideFix walk report
         "<p class='note'>Error at each truth time = horizontal distance to the latest POSE at or "
         "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation. "
         f"IPIN score (the IPIN competition's metric): p75 of 2-D error + {IPIN_FLOOR_PENALTY_M:g} m "
-        "× |floor error|.</p>",
+        "× |floor error|, by Matlab's quantile as the organisers compute it.</p>",
         _kv_table(overview, ("summary", "")),
         f"<ul>{warnings_html}</ul>" if warnings_html else "",
         "<h2>Position error by scheme</h2>",
