@@ -103,7 +103,9 @@ def _read_rows(path: str | Path, columns: dict[str, int], skip: int) -> tuple[np
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise IpinFileError(path, f"cannot read: {exc.strerror if isinstance(exc, OSError) else exc}") from None
+        raise IpinFileError(
+            path, f"cannot read: {exc.strerror if isinstance(exc, OSError) else exc}"
+        ) from None
     need = max(columns.values())
     rows, lines = [], []
     for number, raw in enumerate(text.splitlines(), start=1):
@@ -125,7 +127,9 @@ def _read_rows(path: str | Path, columns: dict[str, int], skip: int) -> tuple[np
         rows.append(row)
         lines.append(number)
     if not rows:
-        raise IpinNothingValidError(path, f"no data row (after the first {skip} lines)" if skip else "no data row")
+        raise IpinNothingValidError(
+            path, f"no data row (after the first {skip} lines)" if skip else "no data row"
+        )
     return np.array(rows, dtype=np.float64), np.array(lines, dtype=np.int64)
 
 

@@ -192,7 +192,8 @@ def matlab_quantile(values: ArrayLike, q: ArrayLike) -> np.ndarray:
     ndarray, shape () or (k,)
         The quantiles, in the unit of ``values``.
     """
-    return np.quantile(np.asarray(values, dtype=np.float64), q, method="hazen")
+    probability = np.asarray(q, dtype=np.float64)
+    return np.asarray(np.quantile(np.asarray(values, dtype=np.float64), probability, method="hazen"))
 
 
 def ipin_score(error_m: ArrayLike, floor_error: ArrayLike) -> float:

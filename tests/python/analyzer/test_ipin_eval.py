@@ -30,7 +30,9 @@ KEYS = ("evaal_m", "mean_m", "rmse_m", "median_m", "p95_m", "floor_hit_rate_pct"
 
 def _evaluation() -> Path:
     if not OUTPUT.is_file():
-        pytest.skip(f"IPIN evaluation data not found at {EVALUATION} (needs ../shared/data beside the repository)")
+        pytest.skip(
+            f"IPIN evaluation data not found at {EVALUATION} (needs ../shared/data beside the repository)"
+        )
     return EVALUATION
 
 
@@ -77,7 +79,8 @@ def test_the_organisers_figures_of_the_four_sample_files(ident):
 def test_the_table_and_ranking_are_the_organisers_layout():
     evaluation = _evaluation()
     results = [
-        ipin_eval.score_file(ipin_eval.read_truth(_truth_of(i)), evaluation / f"{i}.est") for i in sorted(PUBLISHED)
+        ipin_eval.score_file(ipin_eval.read_truth(_truth_of(i)), evaluation / f"{i}.est")
+        for i in sorted(PUBLISHED)
     ]
     published = OUTPUT.read_text(encoding="utf-8").splitlines()
     table = ipin_eval.format_table(results).splitlines()
@@ -133,7 +136,9 @@ def test_planar_distance_is_the_wgs84_local_plane():
     lat0 = 49.46
     w = 1.0 - 6.69437999014e-3 * math.sin(math.radians(lat0)) ** 2
     m = 6378137.0 * (1.0 - 6.69437999014e-3) / w**1.5
-    d = ipin_eval.planar_distance_m(np.array([lat0 + 0.001]), np.array([11.0]), np.array([lat0]), np.array([11.0]))
+    d = ipin_eval.planar_distance_m(
+        np.array([lat0 + 0.001]), np.array([11.0]), np.array([lat0]), np.array([11.0])
+    )
     assert_allclose(d, [m * math.radians(0.001)], rtol=1e-9)
 
 
