@@ -101,11 +101,11 @@ def _read_rows(path: str | Path, columns: dict[str, int], skip: int) -> tuple[np
     """The named ``columns`` (1-based) of a comma-separated file after its first ``skip`` lines, as
     (values, shape (n, len(columns)); 1-based line numbers, shape (n,)); blank lines are ignored."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise IpinFileError(
-            path, f"cannot read: {exc.strerror if isinstance(exc, OSError) else exc}"
-        ) from None
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise IpinFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise IpinNothingValidError(path, f"not a text file (byte {exc.start}: {exc.reason})") from None
     need = max(columns.values())
     rows, lines = [], []
     for number, raw in enumerate(text.splitlines(), start=1):

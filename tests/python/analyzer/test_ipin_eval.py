@@ -180,4 +180,8 @@ def test_short_lines_ranges_and_empty_files(tmp_path, cli_main):
     truth_path = tmp_path / "gt.csv"
     truth_path.write_text(TRUTH_CSV)
     assert cli_main(["score", "--truth", str(truth_path), str(empty)]) == 3
+    junk = tmp_path / "junk.est"
+    junk.write_bytes(b"\x00\xff\xfe" * 100)
+    assert cli_main(["score", "--truth", str(truth_path), str(junk)]) == 3
+    assert cli_main(["score", "--truth", str(truth_path), str(tmp_path)]) == 2  # a directory
     assert cli_main(["score", "--truth", str(tmp_path / "missing.csv"), str(empty)]) == 2
