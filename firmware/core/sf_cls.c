@@ -3,6 +3,8 @@
 
 #include <stddef.h>
 
+#include "sf_error.h"
+
 static uint64_t bit(const int32_t i)
 {
     return (uint64_t)1 << (uint32_t)i;
@@ -34,18 +36,15 @@ static void identify(sf_cls_t *const cls, const int32_t context, const int64_t t
     cls->identifications++;
 }
 
-/* Members heard per candidate context of this CDD method, then the identifications. */
-static void constellations(sf_cls_t *const cls, const sf_context_map_t *const map, const int8_t method,
-                           const int64_t t_us, const int32_t n, const int64_t *const id, const float *const rssi_dbm)
+/* Members heard at their threshold per context of this CDD method among the candidates (each
+ * member counted once). */
+static void count_hits(const sf_context_map_t *const map, const uint64_t candidates, const int8_t method,
+                       const int32_t n, const int64_t *const id, const float *const rssi_dbm,
+                       int16_t hits[SF_CONTROLLER_MAX_CONTEXTS])
 {
-    if (!cls->searching) {
-        return;
-    }
-    cls->readings++;
-    int16_t hits[SF_CONTROLLER_MAX_CONTEXTS] = {0};
     for (int32_t k = 0; k < map->n_cdd; k++) {
         const int32_t ctx = map->cdd_context[k];
-        if (ctx >= n_contexts(map) || !sf_cls_searches(cls, ctx) || map->cdd_method[ctx] != method) {
+        if (ctx >= n_contexts(map) || (candidates & bit(ctx)) == 0 || map->cdd_method[ctx] != method) {
             continue;
         }
         for (int32_t j = 0; j < n; j++) {
@@ -55,6 +54,18 @@ static void constellations(sf_cls_t *const cls, const sf_context_map_t *const ma
             }
         }
     }
+}
+
+/* Members heard per candidate context of this CDD method, then the identifications. */
+static void constellations(sf_cls_t *const cls, const sf_context_map_t *const map, const int8_t method,
+                           const int64_t t_us, const int32_t n, const int64_t *const id, const float *const rssi_dbm)
+{
+    if (!cls->searching) {
+        return;
+    }
+    cls->readings++;
+    int16_t hits[SF_CONTROLLER_MAX_CONTEXTS] = {0};
+    count_hits(map, cls->candidates, method, n, id, rssi_dbm, hits);
     for (int32_t i = 0; i < n_contexts(map); i++) {
         if (hits[i] > 0 && hits[i] >= map->cdd_min_hits[i]) {
             identify(cls, i, t_us, hits[i], method);
@@ -70,6 +81,24 @@ void sf_cls_wifi(sf_cls_t *const cls, const sf_context_map_t *const map, const s
 void sf_cls_ble(sf_cls_t *const cls, const sf_context_map_t *const map, const sf_ble_scan_t *const scan)
 {
     constellations(cls, map, sf_fix_ble, scan->t_us, scan->n, scan->beacon_id, scan->rssi_dbm);
+}
+
+int sf_cls_ble_floor(const sf_context_map_t *const map, const sf_ble_scan_t *const scan, int16_t *const floor)
+{
+    int16_t hits[SF_CONTROLLER_MAX_CONTEXTS] = {0};
+    count_hits(map, sf_cls_all(map), sf_fix_ble, scan->n, scan->beacon_id, scan->rssi_dbm, hits);
+    bool found = false;
+    for (int32_t i = 0; i < n_contexts(map); i++) {
+        if (map->kind[i] != sf_context_floor || hits[i] == 0 || hits[i] < map->cdd_min_hits[i]) {
+            continue;
+        }
+        if (found && map->floor[i] != *floor) {
+            return SF_ERANGE; /* two floors heard at once */
+        }
+        *floor = map->floor[i];
+        found = true;
+    }
+    return found ? SF_OK : SF_ERANGE;
 }
 
 void sf_cls_gnss(sf_cls_t *const cls, const sf_context_map_t *const map, const int64_t t_us,

@@ -68,6 +68,13 @@ void sf_cls_stop(sf_cls_t *cls);
 /* One reading while searching (nothing otherwise). */
 void sf_cls_wifi(sf_cls_t *cls, const sf_context_map_t *map, const sf_wifi_scan_t *scan);
 void sf_cls_ble(sf_cls_t *cls, const sf_context_map_t *map, const sf_ble_scan_t *scan);
+/* The floor a BLE scan identifies by the site's constellations, outside any search: the floor of the
+ * one floor context with cdd_method BLE that the scan identifies (cdd_min_hits members at their
+ * cdd_min_dbm or louder). SF_OK and *floor, or SF_ERANGE when no floor context is identified or
+ * contexts of two floors are (a scan heard across a slab says nothing). The start-floor vote's BLE
+ * evidence when the site has BLE constellations (sf_estimator_fix.c): the site builder measured them
+ * on its survey, where the path-loss range only assumes what a slab costs. Cost O(n_cdd · n). */
+int sf_cls_ble_floor(const sf_context_map_t *map, const sf_ble_scan_t *scan, int16_t *floor);
 void sf_cls_gnss(sf_cls_t *cls, const sf_context_map_t *map, int64_t t_us, double accuracy_m,
                  double max_accuracy_m);
 

@@ -48,6 +48,9 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
      * stays where it is, its floor number changes, as when the floor vote renumbers) */
     const int32_t shift = (int32_t)c->floor - (int32_t)sf_floor_current(&e->floor); /* the context's floor */
     sf_floor_shift(&e->floor, shift, false);
+    if (e->floor_vote_active) { /* the start-floor vote renumbers with it (sf_floor_vote.h) */
+        sf_floor_vote_renumber(&e->floor_vote, shift);
+    }
 }
 
 bool sf_estimator_context_off(sf_estimator_t *const e, const sf_params_t *const p, const int8_t method, const int64_t t_us,

@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "sf_ble.h"
+#include "sf_cls.h"
 #include "sf_error.h"
 #include "sf_estimator.h"
 #include "sf_estimator_internal.h"
@@ -130,11 +131,16 @@ static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf
     if (e->site == NULL || e->site->beacons.n_beacons == 0) {
         return 0;
     }
-    /* the nearest known beacon by the path-loss model, if near enough, votes for its floor before the
-     * fix (which uses only the beacons of the caller's floor) */
-    sf_fix_t vote;
-    if (e->floor_vote_active && p->ble_floor_vote_range_m > 0.0 &&
-        sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK) {
+    /* the scan votes for a floor before the fix (which uses only the beacons of the caller's floor):
+     * with BLE constellations in the site, the floor they identify (measured on the survey, sf_cls.h);
+     * without, the nearest known beacon by the path-loss model, if near enough */
+    sf_fix_t vote = {.t_us = scan->t_us, .method = sf_fix_ble};
+    const sf_context_map_t *const map = &e->site->contexts;
+    const bool by_cdd = map->n_contexts > 0 && sf_cls_uses(map, sf_cls_all(map), sf_fix_ble);
+    const bool votes = by_cdd ? sf_cls_ble_floor(map, scan, &vote.floor) == SF_OK
+                              : p->ble_floor_vote_range_m > 0.0 &&
+                                    sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK;
+    if (e->floor_vote_active && votes) {
         vote.n_ap_used = (int16_t)p->fingerprint_accuracy_ref_aps; /* a full-weight vote (sf_floor_vote.h) */
         vote_floor(e, p, &vote);
         e->ble_floor_votes++;

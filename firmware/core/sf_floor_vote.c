@@ -107,6 +107,15 @@ int32_t sf_floor_vote_baro(sf_floor_vote_t *const v, const int16_t baro_floor, b
     return inside - baro_floor; /* s kept: the barometric floor moves, not the start */
 }
 
+void sf_floor_vote_renumber(sf_floor_vote_t *const v, const int32_t shift)
+{
+    SF_ASSERT(v != NULL);
+    if (shift != 0) {
+        v->start = (int16_t)clamp_floor(v, (int32_t)v->start + shift);
+        v->switches++;
+    }
+}
+
 int32_t sf_floor_vote_fix(sf_floor_vote_t *const v, const sf_params_t *const p, const sf_fix_t *const fix,
                           const int16_t baro_floor, const bool settled)
 {

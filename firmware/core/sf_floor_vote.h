@@ -27,7 +27,12 @@
  *     back into the table (the altimeter re-referenced there); the scores, cast in the old count, are
  *     cleared;
  *   - pinned (truth-initialised runs, init_use_config_pose: the start floor is given): only the proof
- *     and the spurious-change rule move s.
+ *     and the spurious-change rule move s;
+ *   - renumbered from outside (the multi-scheme controller identified a floor context and moved the
+ *     barometric floor there, sf_estimator_context.c): s moves with it, d and the scores stay. Without
+ *     this the vote would read the renumbering as a climb (d ± the shift) and refuse, as infeasible,
+ *     every later fix on the floor the walker is really on; with it those fixes vote on as before and
+ *     move s back when they lead by the margin.
  * Each call returns by how many floors the caller must renumber its barometric floor (sf_floor_shift):
  * the body stays where it is, its floor number changes with s.
  *
@@ -66,6 +71,10 @@ void sf_floor_vote_init(sf_floor_vote_t *v, int16_t lowest_floor, int32_t n_floo
 /* After a barometer sample: the barometric floor now. Returns the renumbering for sf_floor_shift and
  * sets *rereference (the spurious-change rule: re-reference at once). */
 int32_t sf_floor_vote_baro(sf_floor_vote_t *v, int16_t baro_floor, bool *rereference);
+
+/* The caller renumbered its barometric floor by shift for a reason of its own (the body did not
+ * move): s moves by the same amount (clamped to the table), d and the scores are kept. */
+void sf_floor_vote_renumber(sf_floor_vote_t *v, int32_t shift);
 
 /* One fix (Wi-Fi: votes; other methods carry no floor evidence here) while the barometer says
  * baro_floor and is settled or not. Returns the renumbering for sf_floor_shift (h_f − H kept). */

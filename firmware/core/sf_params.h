@@ -191,7 +191,7 @@
     X(ble,  same_floor,            int32_t, 1,       0,       1,       "",      "1 = only beacons on the caller's floor are used (a floor slab attenuates ~15-20 dB, which the model lacks)") \
     X(ble,  min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a BLE fix's accuracy (1 sigma)") \
     X(ble,  position_sigma_m,      double,  3.0,     0.0,     100.0,   "m",     "1 sigma of a beacon's position, added in quadrature to a BLE fix's accuracy (a beacon placed by walks with truth, radiomap/beacons.py, is known to metres; a surveyed table to about 1 m)") \
-    X(ble,  floor_vote_range_m,    double,  6.0,     0.0,     50.0,    "m",     "a beacon whose RSSI puts it this near by the site's path-loss model votes for its floor (one slab, 15-20 dB, makes a beacon of another floor read 5-10x farther); 0 = never") \
+    X(ble,  floor_vote_range_m,    double,  6.0,     0.0,     50.0,    "m",     "site without BLE constellations: a beacon whose RSSI puts it this near by the site's path-loss model votes for its floor (one slab, 15-20 dB, makes a beacon of another floor read 5-10x farther); 0 = never") \
     X(gnss, use,                   int32_t, 1,       0,       1,       "",      "1 = GNSS fixes are offered to the schemes (the site needs a geo-reference)") \
     X(gnss, max_accuracy_m,        double,  50.0,    0.0,     1e4,     "m",     "GNSS fixes reporting a worse accuracy are not used") \
     X(gnss, accuracy_scale,        double,  1.0,     0.1,     10.0,    "",      "the receiver's reported accuracy times this is the fix's 1 sigma") \

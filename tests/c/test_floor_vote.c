@@ -1,7 +1,7 @@
 /* test_floor_vote.c — the start-floor vote: a majority of fixes decides, one scan never flips a
  * decided vote, weights follow the APs used, the building's floors prove a start wrong (the gsd
  * Trial51 story), a change beyond the building is spurious, a truth-initialised start is pinned,
- * fixes on the stairs do not vote. */
+ * fixes on the stairs do not vote, a renumbering from outside (the controller) is not a climb. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdarg.h>
 #include <stddef.h>
@@ -198,6 +198,43 @@ static void test_pinned_start(void **state)
     assert_int_equal(v.start, -2);
 }
 
+/* A basement walk (ipin2023 Trial24): the controller's CLS named floor 0 from one beacon heard across
+ * the slab and renumbered the barometric floor by +2. The vote took that for a two-floor climb, so every
+ * later Wi-Fi fix on −2 asked for a start of −4, outside the building, and was dropped: floor 0 for the
+ * whole walk. Renumbered with the barometer, the fixes on −2 keep voting and win. */
+static void test_renumbering_is_not_a_climb(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    sf_floor_vote_t v;
+    int16_t baro = 0;
+    sf_floor_vote_init(&v, -2, 3, baro, false); /* floors -2 … 0 */
+    assert_int_equal(offer(&v, &p, &baro, -2, 8, true), -2); /* the first fix: -2 */
+    assert_int_equal(baro, -2);
+    /* the controller renumbers to 0 (the caller shifts its barometric floor, then tells the vote) */
+    baro = 0;
+    sf_floor_vote_renumber(&v, 2);
+    assert_int_equal(v.start, 0);
+    assert_int_equal(v.d_min, 0);
+    assert_int_equal(v.d_max, 0);
+    bool reref;
+    assert_int_equal(baro_to(&v, &baro, 0, &reref), 0); /* the same floor: no climb, nothing proven */
+    assert_false(reref);
+    /* fixes on -2 still vote for the start -2 (they would ask for -4 had the shift been a climb) */
+    int32_t moved = 0;
+    for (int i = 0; i < 3; i++) {
+        moved += offer(&v, &p, &baro, -2, 8, true);
+    }
+    assert_int_equal(moved, -2);
+    assert_int_equal(baro, -2);
+    assert_int_equal(v.start, -2);
+    assert_true(v.decided);
+    /* a renumbering past the table is clamped into it */
+    sf_floor_vote_renumber(&v, -5);
+    assert_int_equal(v.start, -2);
+}
+
 static void test_init_clamps_into_the_table(void **state)
 {
     (void)state;
@@ -223,6 +260,7 @@ int main(void)
         cmocka_unit_test(test_the_building_proves_the_start),
         cmocka_unit_test(test_change_beyond_the_building_is_spurious),
         cmocka_unit_test(test_pinned_start),
+        cmocka_unit_test(test_renumbering_is_not_a_climb),
         cmocka_unit_test(test_init_clamps_into_the_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

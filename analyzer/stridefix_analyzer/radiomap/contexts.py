@@ -23,8 +23,14 @@ one-building site without a description (the real data sets). Derivation (buildi
   RP hears it) — a floor-identifying RSSI range (§III-B); its ``cdd_min_dbm`` = max(loudest
   elsewhere + :data:`CDD_ABOVE_ELSEWHERE_DB`, the median of its mean RSSIs at the context's RPs).
   BLE floors use the survey's BLE readings, each at its nearest RP of its floor, when the build has
-  readings on that floor; else the beacons of the floor inside the outline are members at the
-  path-loss model's RSSI at :data:`BLE_MODEL_RANGE_M`;
+  readings on that floor, and then the threshold is also at least :data:`CDD_ABOVE_ELSEWHERE_DB`
+  above the loudest single reading of the beacon at any other RP (a live scan is single readings,
+  which pass a threshold set on means: a beacon heard across a slab, a stairwell or an atrium at
+  −64 dBm must not name its own floor there), and a beacon whose own loudest reading does not reach
+  that threshold is no member (it names no floor anywhere); only a beacon installed on the floor
+  (inside the outline) is its member: a survey that never reached a floor hears that floor's beacons
+  loudest elsewhere, and that names the wrong floor; else the beacons of the floor inside the
+  outline are members at the path-loss model's RSSI at :data:`BLE_MODEL_RANGE_M`;
 * ``cdd_min_hits`` = :data:`CDD_HITS_MANY` when the context has at least :data:`CDD_MANY_MEMBERS`
   members, else 1. A context without members cannot be identified by the CLS: the summary says so.
 
@@ -139,8 +145,11 @@ def _members(ids: np.ndarray, rps: np.ndarray, means: np.ndarray, own: np.ndarra
     return [(int(uniq[k]), float(floor_dbm[k])) for k in np.flatnonzero(member)]
 
 
-def _ble_means(site: site_t, placed: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each placed BLE reading at its nearest RP of its floor; mean RSSI per (beacon, RP)."""
+def _ble_means(
+    site: site_t, placed: dict[str, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each placed BLE reading at its nearest RP of its floor; (beacon, RP, mean RSSI, loudest single
+    RSSI) per (beacon, RP)."""
     from scipy.spatial import cKDTree
 
     rp_x, rp_y, rp_floor = (np.asarray(v) for v in (site.rp_x_m, site.rp_y_m, site.rp_floor))
@@ -157,13 +166,51 @@ def _ble_means(site: site_t, placed: dict[str, np.ndarray]) -> tuple[np.ndarray,
         rps.append(on[k])
         rssi.append(placed["rssi_dbm"][sel])
     if not ids:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
     keys, inv = np.unique(
         np.column_stack([np.concatenate(ids), np.concatenate(rps)]), axis=0, return_inverse=True
     )
     inv = inv.reshape(-1)
-    means = np.bincount(inv, weights=np.concatenate(rssi)) / np.bincount(inv)
-    return keys[:, 0].astype(np.int64), keys[:, 1].astype(np.int64), means
+    levels = np.concatenate(rssi)
+    means = np.bincount(inv, weights=levels) / np.bincount(inv)
+    loudest = np.full(len(keys), -np.inf)
+    np.maximum.at(loudest, inv, levels)
+    return keys[:, 0].astype(np.int64), keys[:, 1].astype(np.int64), means, loudest
+
+
+def _ble_members(
+    site: site_t, c: _Context, ble: tuple[np.ndarray, ...] | None
+) -> tuple[list[tuple[int, float]], str]:
+    """(id, cdd_min_dbm) of a BLE floor context's members and where they come from (the module
+    text): the beacons installed on the floor; each heard at the context's RPs by the survey's rule
+    (:func:`_members`; one heard there but not louder than elsewhere names no floor), one not heard
+    there at the path-loss model's RSSI at :data:`BLE_MODEL_RANGE_M`; either threshold raised to
+    :data:`CDD_ABOVE_ELSEWHERE_DB` above its loudest single reading elsewhere, and a beacon whose own
+    loudest reading stays below that dropped."""
+    model = {int(site.beacon_id[i]): _model_dbm(site, int(i)) for i in np.flatnonzero(c.beacons)}
+    if ble is None:
+        return sorted(model.items()), f"ble model at {BLE_MODEL_RANGE_M:g} m"
+    ids, rps, means, loudest = ble
+    mine = c.rps[rps]
+    by_survey = dict(_members(ids, rps, means, c.rps))
+    out: list[tuple[int, float]] = []
+    from_model = 0
+    for ident, dbm in model.items():
+        of = ids == ident
+        heard_here = bool(np.any(of & mine))
+        if heard_here and ident not in by_survey:
+            continue
+        from_model += not heard_here
+        level = max(
+            by_survey.get(ident, dbm),
+            float(loudest[of & ~mine].max(initial=-np.inf)) + CDD_ABOVE_ELSEWHERE_DB,
+        )
+        if not heard_here or float(loudest[of & mine].max()) >= level:
+            out.append((ident, level))
+    source = "ble readings" + (
+        f", {from_model} by the model at {BLE_MODEL_RANGE_M:g} m" if from_model else ""
+    )
+    return sorted(out), source
 
 
 def _model_dbm(site: site_t, i: int) -> float:
@@ -201,13 +248,7 @@ def _write(
         if c.method == fix_t.METHOD_WIFI:
             members, source = _members(*wifi, c.rps), "survey"
         elif c.method == fix_t.METHOD_BLE:
-            if ble is not None and np.any(c.rps[ble[1]]):
-                members, source = _members(ble[0], ble[1], ble[2], c.rps), "ble readings"
-            else:
-                members = [
-                    (int(site.beacon_id[i]), _model_dbm(site, int(i))) for i in np.flatnonzero(c.beacons)
-                ]
-                source = f"ble model at {BLE_MODEL_RANGE_M:g} m"
+            members, source = _ble_members(site, c, ble)
         members.sort()
         rows += [(c_index, ident, dbm) for ident, dbm in members]
         hits.append(CDD_HITS_MANY if len(members) >= CDD_MANY_MEMBERS else 1)
@@ -352,12 +393,15 @@ def hull_outline(
     return [(float(ring[v, 0]), float(ring[v, 1])) for v in hull.vertices]
 
 
-def single_building_context_map(site: site_t, scheme: str = DEFAULT_SCHEME) -> site_t:
+def single_building_context_map(
+    site: site_t, scheme: str = DEFAULT_SCHEME, ble_placed: dict[str, np.ndarray] | None = None
+) -> site_t:
     """A context map for a one-building site without a description, written into ``site`` (returned):
     one building (outline :func:`hull_outline` of every RP), one floor context per site floor with
     the LSD ``scheme`` and method ``ble`` where the site has beacons on the floor, else ``wifi``; CDD by
-    the module's rules; no outdoor context. Existing ports belong to the building; a staircase
-    without a step count gets height / :data:`STAIR_RISER_M`."""
+    the module's rules (BLE from ``ble_placed``, the build's placed readings, when given); no outdoor
+    context. Existing ports belong to the building; a staircase without a step count gets height /
+    :data:`STAIR_RISER_M`."""
     outline = hull_outline(np.asarray(site.rp_x_m), np.asarray(site.rp_y_m))
     code = scheme_code(scheme)
     site.port_building = [0] * site.n_ports
@@ -384,7 +428,7 @@ def single_building_context_map(site: site_t, scheme: str = DEFAULT_SCHEME) -> s
         f = site.lowest_floor + i
         method = fix_t.METHOD_BLE if np.any(bfl == f) else fix_t.METHOD_WIFI
         contexts.append(_Context(site_t.CONTEXT_FLOOR, 0, f, code, method, rp_floor == f, bfl == f))
-    _write(site, [site.name or "building"], [outline], contexts, None)
+    _write(site, [site.name or "building"], [outline], contexts, ble_placed)
     return site
 
 

@@ -23,7 +23,7 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import lsd
-from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields
+from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields, train_placed
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
 #: is already weak evidence, not noise to drop; 2 cost 2.4 m of Wi-Fi-only mean error on msindoor
@@ -124,7 +124,8 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
         # one building, one context per floor, the scheme chosen on the training walks (.lsd)
         from stridefix_analyzer.radiomap.contexts import single_building_context_map
 
-        site = single_building_context_map(site, scheme=lsd_scheme) or site
+        placed = train_placed(job.content, job.content_index) if job.content is not None else None
+        site = single_building_context_map(site, scheme=lsd_scheme, ble_placed=placed) or site
         content["controller_scheme"] = lsd_scheme
     site_path = job.dir / "site.sfsite"
     write_site(site_path, site)

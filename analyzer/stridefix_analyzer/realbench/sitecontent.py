@@ -96,6 +96,12 @@ class GroupContent:
         return fields, rec
 
 
+def train_placed(content: GroupContent, held: int) -> dict[str, np.ndarray] | None:
+    """The placed BLE readings of the fold's training walks (all but walk ``held``), or None."""
+    train = [p for k, p in enumerate(content.placed) if k != held]
+    return merge_placed(train) if train else None  # type: ignore[arg-type]
+
+
 def apply_fields(site: Any, fields: Mapping[str, Any]) -> dict[str, int]:
     """Write ``fields`` into ``site``, drop walls and beacons on floors the site does not have, and
     set the counts; returns how many were dropped."""

@@ -249,6 +249,40 @@ def test_single_building_context_map_per_floor(tmp_path):
     sitefile.write_site(tmp_path / "one.sfsite", site)
 
 
+def test_ble_threshold_clears_single_readings_across_the_slab():
+    """A beacon heard across a floor slab (a stairwell, an atrium: ipin2023's basement beacons reach
+    −64 dBm on the ground floor) passes a threshold set on mean levels in single live readings; the
+    threshold sits above its loudest single reading elsewhere, and a beacon never that loud at home
+    names no floor."""
+    site = campus_site()
+    near, far = 0xBEAC00000002, 0xBEAC00000003
+    site.beacon_id, site.beacon_x_m, site.beacon_y_m = [near, far], [5.0, 15.0], [5.0, 5.0]
+    site.beacon_floor, site.beacon_rssi_1m_dbm = [1, 1], [math.nan, math.nan]
+    site.ble_rssi_1m_dbm, site.ble_path_loss_exponent, site.ble_range_sigma_db = -59.0, 2.0, 6.0
+    sitefile.set_counts(site)
+    # (beacon, x, floor, dBm): every reading sits at an RP (x, y 5)
+    readings = [
+        (near, 5.0, 1, -54.0), (near, 5.0, 1, -56.0), (near, 15.0, 1, -80.0),  # home: means -55, -80
+        (near, 5.0, 0, -64.0), (near, 5.0, 0, -76.0),  # across the slab: mean -70, loudest -64
+        (far, 15.0, 1, -60.0), (far, 15.0, 1, -62.0),  # home: mean -61, loudest -60
+        (far, 15.0, 0, -85.0), (far, 15.0, 0, -61.0),  # across: mean -73, but one reading at -61
+    ]
+    placed = {
+        "beacon_id": np.array([r[0] for r in readings], np.int64),
+        "x_m": np.array([r[1] for r in readings]),
+        "y_m": np.full(len(readings), 5.0),
+        "floor": np.array([r[2] for r in readings], np.int64),
+        "rssi_dbm": np.array([r[3] for r in readings]),
+        "n_total": np.asarray(len(readings)),
+    }
+    contexts.single_building_context_map(site, ble_placed=placed)
+    assert list(site.context_method) == [fix_t.METHOD_WIFI, fix_t.METHOD_BLE]
+    # near: means alone give max(-70 + 3, median of -55 and -80 = -67.5) = -67; its single -64
+    # elsewhere lifts that to -61, which its own -54 still reaches. far: the means say member at -61,
+    # but -61 + 3 = -58 is above anything heard at home: no member.
+    assert _members(site, 1) == pytest.approx({near: -61.0})
+
+
 def _survey(msg):
     """Two floors of a building: AP 0xA loud on floor 0, 0xD on floor 1 only, 0xB everywhere alike."""
     points = [(0.0, 0.0, 0, -40.0), (4.0, 0.0, 0, -50.0), (0.0, 4.0, 1, -60.0), (4.0, 4.0, 1, -70.0)]
