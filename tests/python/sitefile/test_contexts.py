@@ -262,10 +262,15 @@ def test_ble_threshold_clears_single_readings_across_the_slab():
     sitefile.set_counts(site)
     # (beacon, x, floor, dBm): every reading sits at an RP (x, y 5)
     readings = [
-        (near, 5.0, 1, -54.0), (near, 5.0, 1, -56.0), (near, 15.0, 1, -80.0),  # home: means -55, -80
-        (near, 5.0, 0, -64.0), (near, 5.0, 0, -76.0),  # across the slab: mean -70, loudest -64
-        (far, 15.0, 1, -60.0), (far, 15.0, 1, -62.0),  # home: mean -61, loudest -60
-        (far, 15.0, 0, -85.0), (far, 15.0, 0, -61.0),  # across: mean -73, but one reading at -61
+        (near, 5.0, 1, -54.0),
+        (near, 5.0, 1, -56.0),
+        (near, 15.0, 1, -80.0),  # home: means -55, -80
+        (near, 5.0, 0, -64.0),
+        (near, 5.0, 0, -76.0),  # across the slab: mean -70, loudest -64
+        (far, 15.0, 1, -60.0),
+        (far, 15.0, 1, -62.0),  # home: mean -61, loudest -60
+        (far, 15.0, 0, -85.0),
+        (far, 15.0, 0, -61.0),  # across: mean -73, but one reading at -61
     ]
     placed = {
         "beacon_id": np.array([r[0] for r in readings], np.int64),
