@@ -38,6 +38,16 @@ int sf_controller_attach(sf_controller_t *const c, const sf_params_t *const p, c
         return rc;
     }
     c->site = site;
+    /* INIT follows the scheme every context names, when they name one (a one-building site): the site
+     * chose it, and a walk whose CLS never identifies a context (a floor without a constellation)
+     * keeps it; a map of several schemes starts on controller.init_scheme */
+    bool shared = true;
+    for (int32_t i = 1; i < n; i++) {
+        shared = shared && site->contexts.scheme[i] == site->contexts.scheme[0];
+    }
+    if (shared) {
+        c->init_scheme = (int8_t)site->contexts.scheme[0];
+    }
     c->active = p->controller_enabled == 1;
     if (c->active) {
         sf_cls_start(&c->cls, sf_cls_all(&site->contexts)); /* unlimited mode */

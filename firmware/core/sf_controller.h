@@ -78,7 +78,8 @@ typedef struct {
 } sf_context_event_t;
 
 /* What the controller sees of the walk at each update: the active scheme's position (in INIT the
- * controller.init_scheme's, or the PDR track's when that has none), the steps credited so far, and
+ * scheme every context names when they name one, else controller.init_scheme's, or the PDR track's
+ * when that has none), the steps credited so far, and
  * the activity of the latest step (sf_activity_*: elevator while riding, walking again after). */
 typedef struct {
     int64_t t_us;

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -331,9 +331,11 @@ class DoorSurvey:
         cw, cu, cs = crossings(walls, segs["seg"])
         return cls(np.asarray(walls, float), segs, cw, cu, segs["walk"][cs])
 
-    def fold_walls(self, held: int | None, **kw: Any) -> tuple[np.ndarray, int]:
-        """Walls opened by every walk but ``held`` (None: all walks); (walls, openings)."""
-        use = self.cross_walk != held if held is not None else np.ones(len(self.cross_walk), bool)
+    def fold_walls(self, held: int | Collection[int] | None, **kw: Any) -> tuple[np.ndarray, int]:
+        """Walls opened by every walk but ``held`` (one index or several; None: all walks);
+        (walls, openings)."""
+        out = [held] if isinstance(held, int) else list(held or [])
+        use = ~np.isin(self.cross_walk, out)
         return open_walls(self.walls, self.cross_wall[use], self.cross_u_m[use], **kw)
 
     def held_out_crossing(self, **kw: Any) -> dict[str, Any]:

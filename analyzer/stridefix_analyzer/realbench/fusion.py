@@ -259,14 +259,14 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
     rotation = [w["rotation"] for w in sub]
     info["K_all_walks"] = stride_k(seg, used)
     heading = next(a for a in run.axes if a.name == "heading").candidates
-    sites = SelectionSites(total, sub, seg, used, rotation, heading, run.cfg.min_count)
+    content = group_content(run.dataset, part.folder, part.floor_dir, sub, run.cfg.content)
+    sites = SelectionSites(total, sub, seg, used, rotation, heading, run.cfg.min_count, content)
     group = tuning.Group(
         sub, rotation, sites, run.firmware, part.work / "select", run.cfg.param_sets, run.tasks, run.stream
     )
     choices = tuning.choose(run.axes, group)
     for c in choices.values():
         info.update(c.info)
-    content = group_content(run.dataset, part.folder, part.floor_dir, sub, run.cfg.content)
     info["site_content"] = {
         "options": dataclasses.asdict(run.cfg.content),
         **content.report,

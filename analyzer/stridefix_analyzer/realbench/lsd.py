@@ -13,8 +13,8 @@ paper's context map names a scheme per context (Jäger et al. §III-C):
 * every held-out walk of block a gets the scheme with the lowest pooled mean error (ties: the
   registry's order).
 
-The selection sites carry the radio map only (no walls, beacons or geo-reference), so a scheme that
-gains from the building content (``particle`` from walls) is judged without it here.
+The selection sites carry the building content the fold sites carry (walls, beacons, geo-reference:
+:mod:`.select_sites`), so each scheme is judged with the sources it will have.
 Cost: (n_blocks − 1) replays of every walk (one per walk and block pair, not one per scheme).
 """
 
@@ -31,13 +31,15 @@ from stridefix_analyzer.console import Progress
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_table
 from stridefix_analyzer.parallel import TaskRunner
+from stridefix_analyzer.radiomap.contexts import DEFAULT_SCHEME as DEFAULT_CONTEXT_SCHEME
 from stridefix_analyzer.realbench import select as rs
 
 #: the fold's chosen scheme travels with the measured site fields under this key (not a site_t field:
 #: run_fold pops it and builds the context map with it)
 SITE_KEY = "controller_lsd_scheme"
-#: the scheme a fold gets when no choice can be made (fewer walks than the inner CV needs)
-DEFAULT_SCHEME = "ekf"
+#: the scheme a fold gets when no choice can be made (fewer walks than the inner CV needs): the
+#: site builder's default (radiomap/contexts.py)
+DEFAULT_SCHEME = DEFAULT_CONTEXT_SCHEME
 #: the candidates: every fusion scheme (the controller itself is not one)
 CANDIDATES = rs.FUSION_NAMES
 

@@ -1,6 +1,7 @@
 """The sites of the inner cross-validation (:mod:`.select`): a radio map of the group's total minus
 the left-out blocks, with the floors, map rotation, heading candidate and stride K learned from the
-remaining walks only.
+remaining walks only, and the building content (walls, geo-reference, beacons: :mod:`.sitecontent`)
+the fold sites carry, from those walks too: a choice is measured on what the folds will run.
 
 :class:`SelectionSites` is the ``build_site`` callable :func:`.select.select` takes. Every inner-CV
 row of :mod:`.tuning` uses the same block pairs, so each site is written once per group (``built``).
@@ -21,6 +22,7 @@ from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench.floors import fold_floors
 from stridefix_analyzer.realbench.fold import fold_site
 from stridefix_analyzer.realbench.heading import RotationSums, learn_heading
+from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields
 from stridefix_analyzer.realbench.strides import stride_k
 
 
@@ -35,6 +37,7 @@ class SelectionSites:
     rotation: Sequence[Mapping[str, RotationSums]]
     heading_candidates: Mapping[str, Sequence[str]]
     min_count: int
+    content: GroupContent | None = None
     built: dict[str, list[str]] = dataclasses.field(default_factory=dict)
 
     def __call__(self, removed: WalkStats, others: list[dict[str, Any]], name: str, path: Path) -> list[str]:
@@ -56,6 +59,8 @@ class SelectionSites:
             lowest_floor=lowest,
             min_count=self.min_count,
         )
+        if self.content is not None:
+            apply_fields(site, self.content.fold_fields(set(range(len(self.walks))) - set(idx))[0])
         write_site(path, site)
         k = stride_k(self.seg, self.used & np.isin(self.seg["walk"], idx))
         self.built[str(path)] = list(self.heading_candidates[variant]) + (

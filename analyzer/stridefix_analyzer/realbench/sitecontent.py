@@ -23,7 +23,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -75,9 +75,11 @@ class GroupContent:
     placed: Sequence[Mapping[str, np.ndarray]]
     report: Mapping[str, Any]
 
-    def fold_fields(self, held: int) -> tuple[dict[str, Any], dict[str, Any]]:
-        """site_t fields of the fold without walk ``held`` (index into the group's walks) and the
-        fold's record (walls, openings, beacons, seconds spent)."""
+    def fold_fields(self, held: int | Collection[int]) -> tuple[dict[str, Any], dict[str, Any]]:
+        """site_t fields of the fold without walk ``held`` (index into the group's walks; several for
+        an inner cross-validation's site) and the fold's record (walls, openings, beacons, seconds
+        spent)."""
+        out = {held} if isinstance(held, int) else set(held)
         t0 = time.perf_counter()
         fields: dict[str, Any] = {}
         rec: dict[str, Any] = {}
@@ -88,7 +90,7 @@ class GroupContent:
         if self.geo is not None:
             fields.update(self.geo)
         if self.placed:
-            train = [p for k, p in enumerate(self.placed) if k != held]
+            train = [p for k, p in enumerate(self.placed) if k not in out]
             ble = placed_beacons(merge_placed(train), dict(self.table) if self.table else None)  # type: ignore[arg-type]
             fields.update(ble["fields"])
             rec.update(beacons=len(ble["fields"].get("beacon_id", [])), ble_model=ble["report"].get("model"))
@@ -96,9 +98,10 @@ class GroupContent:
         return fields, rec
 
 
-def train_placed(content: GroupContent, held: int) -> dict[str, np.ndarray] | None:
-    """The placed BLE readings of the fold's training walks (all but walk ``held``), or None."""
-    train = [p for k, p in enumerate(content.placed) if k != held]
+def train_placed(content: GroupContent, held: int | Collection[int]) -> dict[str, np.ndarray] | None:
+    """The placed BLE readings of the fold's training walks (all but walk(s) ``held``), or None."""
+    out = {held} if isinstance(held, int) else set(held)
+    train = [p for k, p in enumerate(content.placed) if k not in out]
     return merge_placed(train) if train else None  # type: ignore[arg-type]
 
 

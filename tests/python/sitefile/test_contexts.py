@@ -167,8 +167,8 @@ def test_derivation_contexts_lsd_and_cdd_numbers(tmp_path):
     assert list(site.context_kind) == [site_t.CONTEXT_OUTDOOR] + [site_t.CONTEXT_FLOOR] * 3
     assert list(site.context_building) == [-1, 0, 0, 1]
     assert list(site.context_floor) == [0, 0, 1, 0]
-    ekf, particle = pose_t.SCHEME_EKF, pose_t.SCHEME_PARTICLE
-    assert list(site.context_scheme) == [ekf, ekf, ekf, particle]  # B/0's [[context]] override
+    kalman, particle = pose_t.SCHEME_KALMAN, pose_t.SCHEME_PARTICLE
+    assert list(site.context_scheme) == [kalman, kalman, kalman, particle]  # B/0's [[context]] override
     wifi, ble, gnss = fix_t.METHOD_WIFI, fix_t.METHOD_BLE, fix_t.METHOD_GNSS
     assert list(site.context_method) == [gnss, wifi, wifi, ble]  # B has a beacon: BLE
     assert list(site.context_cdd_method) == list(site.context_method)
@@ -319,7 +319,7 @@ def test_radiomap_build_and_show_print_the_context_map(write_log, msg, tmp_path,
     png = tmp_path / "h.png"
     assert stridefix_main(["radiomap", "show", out, "--png", png]) == 0
     shown = capsys.readouterr().out
-    assert "   1 floor H          floor   0  LSD ekf + wifi  CDD wifi: 1 members, 1 to hear" in shown
+    assert "   1 floor H          floor   0  LSD kalman + wifi  CDD wifi: 1 members, 1 to hear" in shown
     assert "port  0 door     floors 0..0  building H  outdoor" in shown
     assert png.stat().st_size > 0
 
