@@ -35,6 +35,7 @@ void sf_estimator_init(sf_estimator_t *const e, const sf_params_t *const p)
     e->y_m = p->init_y_m;
     e->heading_rad = p->init_heading_rad;
     sf_fingerprint_init(&e->fingerprint);
+    sf_source_quality_init(&e->quality);
     sf_controller_init(&e->controller, p);
     for (int s = 0; s < sf_scheme_count; s++) {
         (void)sf_fusion_init(&e->fusion[s], (int8_t)s);

@@ -50,7 +50,7 @@
  * nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 15 536 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
+ * Memory: sizeof(sf_estimator_t) = 15 728 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
  * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
  * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
  * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's
@@ -79,6 +79,7 @@
 #include "sf_fingerprint.h"
 #include "sf_floor.h"
 #include "sf_floor_vote.h"
+#include "sf_source_quality.h"
 #include "sf_fusion.h"
 #include "sf_gap_bridge.h"
 #include "sf_heading.h"
@@ -99,6 +100,7 @@ typedef struct {
     sf_activity_t activity;
     sf_floor_t floor;
     sf_floor_vote_t floor_vote; /* the start floor (sf_floor_vote.h); active once a site gives floors */
+    sf_source_quality_t quality; /* what GNSS and BLE deliver against the Wi-Fi fixes (sf_source_quality.h) */
     bool floor_vote_active;
     bool started;
     int64_t t_us;        /* newest input time */
@@ -193,7 +195,7 @@ int sf_estimator_attach_particles(sf_estimator_t *est, const sf_params_t *p, sf_
 int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_scan_t *scan, sf_fix_t *fix,
                       bool *has_fix, sf_fix_audit_t audits[sf_scheme_count]);
 
-/* The other absolute sources (issue 13), each with its own measurement model, offered to every scheme
+/* The other absolute sources, each with its own measurement model, offered to every scheme
  * like a Wi-Fi fix, with the same outputs and return value as sf_estimator_wifi (sf_scheme_count
  * audits, or 0 when the source cannot be used at all):
  *   GNSS      mapped into the site frame by the site's geo-reference (sf_geo.h); 1σ = the receiver's
@@ -202,9 +204,13 @@ int sf_estimator_wifi(sf_estimator_t *est, const sf_params_t *p, const sf_wifi_s
  *             with reason INACCURATE and no fix for an accuracy beyond gnss_max_accuracy_m or a
  *             position off the plane (sf_geo_to_map's SF_ERANGE).
  *   BLE       ranges to the site's known beacons (sf_ble.h: log-distance path loss) → a position and
- *             accuracy on the caller's floor; first, the nearest known beacon by the model, when within
- *             ble_floor_vote_range_m, votes for its own floor; 0 audits without beacons in the site;
+ *             accuracy on the caller's floor; first the scan votes for a floor: the one the site's BLE
+ *             constellations identify (sf_cls_ble_floor), or without them the nearest known beacon by
+ *             the model when within ble_floor_vote_range_m; 0 audits without beacons in the site;
  *             TOO_FEW_APS audits when fewer than ble_min_beacons usable beacons were heard.
+ *   GNSS and BLE fixes are offered with their accuracy × the factor the walk's Wi-Fi fixes give their
+ *   source (sf_source_quality.h: the variance it delivers against the one it claims, and the
+ *   persistence of its errors), unless quality_enable = 0.
  *   landmark  the landmark's own position, floor and accuracy (needs no site); it votes on the floor;
  *             every fusing scheme takes it whatever its gate (α = 1 in the fixed-gain blends,
  *             sf_fusion.h, Sources); INACCURATE audits for a non-finite position or accuracy.

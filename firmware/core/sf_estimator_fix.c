@@ -101,7 +101,17 @@ static int wifi_fix(sf_estimator_t *const e, const sf_params_t *const p, const s
                       audits);
     }
     *has_fix = true;
+    sf_source_quality_reference(&e->quality, fix, e->x_m, e->y_m, e->distance_m);
     return sf_estimator_offer_fix(e, p, fix, true, audits);
+}
+
+/* A GNSS or BLE fix at the accuracy its source delivers on this walk (sf_source_quality.h). */
+static void judge_source(sf_estimator_t *const e, const sf_params_t *const p, sf_fix_t *const fix)
+{
+    const double k = sf_source_quality_judge(&e->quality, p, fix, e->x_m, e->y_m, e->distance_m);
+    if (p->quality_enable) {
+        fix->accuracy_m *= k;
+    }
 }
 
 static int gnss_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_gnss_t *const gnss,
@@ -120,6 +130,7 @@ static int gnss_fix(sf_estimator_t *const e, const sf_params_t *const p, const s
     /* a GNSS fix knows no floor: it is on the caller's, and does not vote */
     *fix = (sf_fix_t){.t_us = gnss->t_us, .method = sf_fix_gnss, .x_m = x_m, .y_m = y_m,
                       .floor = sf_floor_current(&e->floor), .accuracy_m = fmax(acc_m, p->gnss_min_accuracy_m)};
+    judge_source(e, p, fix);
     *has_fix = true;
     return sf_estimator_offer_fix(e, p, fix, false, audits);
 }
@@ -149,6 +160,7 @@ static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf
     if (sf_ble_fix(&e->ble, p, &e->site->beacons, scan, sf_floor_current(&e->floor), fix, &n_used) != SF_OK) {
         return sf_estimator_refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
     }
+    judge_source(e, p, fix);
     *has_fix = true;
     return sf_estimator_offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
 }

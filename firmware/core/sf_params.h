@@ -195,7 +195,13 @@
     X(gnss, use,                   int32_t, 1,       0,       1,       "",      "1 = GNSS fixes are offered to the schemes (the site needs a geo-reference)") \
     X(gnss, max_accuracy_m,        double,  50.0,    0.0,     1e4,     "m",     "GNSS fixes reporting a worse accuracy are not used") \
     X(gnss, accuracy_scale,        double,  1.0,     0.1,     10.0,    "",      "the receiver's reported accuracy times this is the fix's 1 sigma") \
-    X(gnss, min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a GNSS fix's accuracy (receivers round and under-report)")
+    X(gnss, min_accuracy_m,        double,  1.0,     0.0,     100.0,   "m",     "lower bound on a GNSS fix's accuracy (receivers round and under-report)") \
+    X(quality, enable,             int32_t, 1,       0,       1,       "",      "1 = GNSS and BLE fixes are offered with their accuracy times what the walk's Wi-Fi fixes say they deliver (sf_source_quality.h); 0 = as reported") \
+    X(quality, ref_max_age_s,      double,  10.0,    0.0,     600.0,   "s",     "a Wi-Fi fix is the reference for this long (the PDR displacement since is added; 10 s of walking drifts less than a fix errs)") \
+    X(quality, memory_fixes,       double,  20.0,    1.0,     1e4,     "fixes", "a source's running means span this many comparisons (20 s of 1 Hz GNSS: long enough to average its noise, short enough to follow a walk into a basement)") \
+    X(quality, min_fixes,          int32_t, 5,       1,       1000,    "fixes", "comparisons before a source's factor is used") \
+    X(quality, max_factor,         double,  10.0,    1.0,     1000.0,  "",      "largest accuracy factor (a source 10x worse than it claims weighs 1 % of its claim)") \
+    X(quality, max_rho,            double,  0.95,    0.0,     0.999,   "",      "largest lag-one correlation of a source's errors taken (0.95: 39 fixes count as one)")
 
 /* sf_fusion.h */
 #define SF_PARAMS_FUSION(X)                                                                            \
