@@ -23,7 +23,8 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import lsd
-from stridefix_analyzer.realbench.reference import Track, run_references
+from stridefix_analyzer.realbench.reference import run_references
+from stridefix_analyzer.realbench.reference_sensors import Track
 from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields, train_placed
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection

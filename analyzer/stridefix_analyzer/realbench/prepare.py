@@ -24,7 +24,7 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 from stridefix_analyzer.realbench.floors import floor_heights_of_walk
 from stridefix_analyzer.realbench.heading import rotation_stats
-from stridefix_analyzer.realbench.reference import track_of
+from stridefix_analyzer.realbench.reference_sensors import track_of
 from stridefix_analyzer.realbench.walks import cached_import, new_walk
 
 

@@ -1,34 +1,26 @@
-"""Two textbook references for ``realbench fusion``, computed in Python from the imported walks: what a
-plain pedestrian dead reckoning and a plain Wi-Fi/PDR EKF score on the same walks, starts and truth.
+"""Two textbook references for ``realbench fusion``, computed in Python from the imported walks (their
+:class:`~stridefix_analyzer.datasets.rawwalk.RawWalk`, read into a :class:`.reference_sensors.Track`): what
+a plain pedestrian dead reckoning and a plain Wi-Fi/PDR EKF score on the same walks, training walks,
+starts and truth times as the firmware's schemes. Not schemes: the firmware never runs them.
 
-Phase 1 (:func:`track_of`, once per walk, from its :class:`~stridefix_analyzer.datasets.rawwalk.RawWalk`):
+* ``reference_pdr`` (step-and-heading PDR): each step of length K·(amax − amin)^¼ (Weinberg 2002, K
+  from the training walks) along the complementary-filter heading ψ plus one constant device-to-walk
+  offset per walk. From the true start (truth position at the first truth point, heading towards the next
+  one) the offset = that heading minus the circular mean of ψ over the first :data:`START_STEPS` steps
+  (magnetometer and gyroscope only); from the first fix (the first WkNN fix) the offset = the angle
+  between the fixes' displacement and the dead-reckoned displacement since that fix, taken once, when
+  a fix lies :data:`OFFSET_MIN_SPAN_M` from the first (0 until then; the track since the start turns
+  with it). No absolute fix after the start.
+* ``reference_ekf``: extended Kalman filter, state [E, N, heading bias] [m, m, rad]; prediction by the
+  same steps along ψ + bias (step-length σ :data:`STEP_LENGTH_SIGMA` × length, heading σ
+  :data:`STEP_HEADING_SIGMA_RAD` and bias random walk :data:`BIAS_WALK_RAD` per step); update by every
+  WkNN fix, σ :data:`FIX_SIGMA_M` per axis, behind a χ² gate (:data:`GATE_CHI2`: 2 dof, 99 %); after
+  :data:`MAX_REJECTS` consecutive rejections the position resets to the fix.
 
-* gravity = the accelerometer low-passed (first order, :data:`GRAVITY_TAU_S`), "up" in the device frame;
-* device heading ψ [rad, clockwise from the map's +y] by a complementary filter: the gyroscope's
-  rotation about "up" integrated, pulled towards the tilt-compensated magnetometer heading (east = m × up,
-  north = up × east; the heading of the device's +y axis, Android's azimuth) with time constant
-  :data:`HEADING_TAU_S`;
-* steps = peaks of the :data:`STEP_LOWPASS_HZ` low-passed |a| (2nd-order Butterworth, forward and
-  backward) above :data:`STEP_MIN_PEAK_MPS2` and at least :data:`STEP_MIN_INTERVAL_S` apart, with the
-  range amax − amin of the filtered |a| since the previous step (Weinberg 2002);
-* height = the barometric formula on the pressure (:func:`.floors.pressure_to_height_m`).
-
-Per fold (:func:`run_references`): the Weinberg K = Σ true / Σ range^¼ over the training walks'
-waypoint segments (:mod:`.strides`, the function the firmware's K comes from, on these steps); a WkNN
-fingerprint map of the training walks' raw scans at their interpolated truth positions (k =
-:data:`WKNN_K`, Euclidean in dBm with :data:`MISSING_DBM` for an unheard AP, weights 1 / distance);
-the floor = start floor + round(barometric height change / storey height of the fold's site).
-
-* ``reference_pdr``: steps of length K·range^¼ along ψ + one constant device-to-walk offset per walk:
-  from the true start, the truth heading (first truth point → the next) minus the circular mean of ψ over
-  the first :data:`START_STEPS` steps; from the first fix, the angle between the fixes' displacement and
-  the dead-reckoned displacement since the first fix, once the fixes are :data:`OFFSET_MIN_SPAN_M` apart
-  (0 until then). No absolute fix after the start.
-* ``reference_ekf``: EKF (state E, N, heading bias) predicting with the same steps, updated by every WkNN
-  fix (σ :data:`FIX_SIGMA_M` per axis) behind a χ² gate (:data:`GATE_CHI2`, 2 dof 99 %), reset to the fix
-  after :data:`MAX_REJECTS` consecutive rejections.
-
-Pure numpy; no constant is tuned per data set.
+Both take the floor from the barometer: start floor + round(height change since the start / storey
+height of the fold's site). Both emit poses at the start (not before the first IMU sample: the firmware
+emits none either), at every step and (ekf) every fix; they are scored like the schemes
+(:func:`.fold.score_poses`). Pure numpy; no constant is tuned per data set.
 """
 
 from __future__ import annotations
@@ -40,28 +32,16 @@ from typing import Any
 
 import numpy as np
 
-from stridefix_analyzer.datasets.rawwalk import RawWalk
 from stridefix_analyzer.io.logread import Table
-from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M, pressure_to_height_m
-from stridefix_analyzer.realbench.strides import WEINBERG_EXPONENT, build_segments, stride_k
+from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M
+from stridefix_analyzer.realbench.reference_sensors import Fingerprints, Track, weinberg_k
+from stridefix_analyzer.realbench.strides import WEINBERG_EXPONENT
 
 REFERENCE_PDR, REFERENCE_EKF = "reference_pdr", "reference_ekf"
 NAMES = (REFERENCE_PDR, REFERENCE_EKF)
-G_MPS2 = 9.80665
-#: gravity = accelerometer low-passed over a few gait cycles (a step lasts ~0.5 s) [s]
-GRAVITY_TAU_S = 1.0
-HEADING_TAU_S = 20.0
-#: gait acceleration lies below ~3 Hz (cadence ≤ ~2.5 steps/s) [Hz]
-STEP_LOWPASS_HZ = 3.0
-#: a step's peak must exceed 1 g: the heel strike pushes |a| above gravity [m/s²]
-STEP_MIN_PEAK_MPS2 = 1.05 * G_MPS2
-#: human walking cadence stays under ~200 steps/min, so two steps are ≥ 0.3 s apart [s]
-STEP_MIN_INTERVAL_S = 0.3
 START_STEPS = 4  # ≈ 2 s of walking: averages the hand-held phone's sway over two strides
 #: fixes this far apart (≈ 3 × the fix σ·√2) fix the device-to-walk offset within ~25° [m]
 OFFSET_MIN_SPAN_M = 10.0
-WKNN_K = 4
-MISSING_DBM = -100.0  # an AP not heard: the receivers' noise floor [dBm]
 FIX_SIGMA_M = 3.0
 GATE_CHI2 = 9.21  # χ²(2 dof) at 99 %
 MAX_REJECTS = 3
@@ -69,193 +49,6 @@ STEP_LENGTH_SIGMA = 0.1  # Weinberg's step-length error, share of the length
 STEP_HEADING_SIGMA_RAD = math.radians(5.0)  # per step: the hand-held phone's sway
 BIAS_WALK_RAD = math.radians(1.0)  # per step: slow gyro drift and magnetic disturbance
 START_BIAS_SIGMA_RAD = math.radians(90.0)  # from the first fix the offset is unknown
-
-
-@dataclasses.dataclass(frozen=True)
-class Track:
-    """What the references read from one walk (phase 1): steps, heights, scans and truth (µs, m, rad)."""
-
-    imu_t_us: tuple[int, int]  # first and last IMU sample
-    step_t_us: np.ndarray
-    step_range_mps2: np.ndarray
-    step_heading_rad: np.ndarray  # device heading ψ at each step
-    baro_t_us: np.ndarray
-    height_m: np.ndarray
-    scan_t_us: np.ndarray  # (n_scans,)
-    scan_bounds: np.ndarray  # (n_scans + 1,) rows of scan i in bssid / rssi_dbm
-    bssid: np.ndarray
-    rssi_dbm: np.ndarray
-    truth: Table  # t_us, x_m, y_m, floor
-
-    def segments_input(self) -> dict[str, Any]:
-        """This walk as :func:`.strides.build_segments` reads it."""
-        tr, n = self.truth, len(self.step_t_us)
-        return {
-            "walk": "", "error": None, "waypoint_t_us": tr["t_us"],
-            "waypoint_xy_m": np.column_stack([tr["x_m"], tr["y_m"]]), "step_t_us": self.step_t_us,
-            "step_range_mps2": self.step_range_mps2, "step_length_m": np.zeros(n),
-            "import": {"imu_t_first_us": self.imu_t_us[0], "imu_t_last_us": self.imu_t_us[1]},
-        }  # fmt: skip
-
-
-def _lowpass1(x: np.ndarray, dt_s: np.ndarray, tau_s: float) -> np.ndarray:
-    """First-order low-pass along axis 0, started at the first sample."""
-    y = np.empty_like(x)
-    y[0] = x[0]
-    alpha = dt_s / (tau_s + dt_s)
-    for i in range(1, len(x)):
-        y[i] = y[i - 1] + alpha[i] * (x[i] - y[i - 1])
-    return y
-
-
-def _butter2_filtfilt(x: np.ndarray, fs_hz: float, fc_hz: float) -> np.ndarray:
-    """2nd-order Butterworth low-pass (bilinear transform), run forward then backward (zero phase)."""
-    k = math.tan(math.pi * min(fc_hz, 0.45 * fs_hz) / fs_hz)
-    n = 1.0 / (1.0 + math.sqrt(2.0) * k + k * k)
-    b0, b1, b2 = k * k * n, 2 * k * k * n, k * k * n
-    a1, a2 = 2.0 * (k * k - 1.0) * n, (1.0 - math.sqrt(2.0) * k + k * k) * n
-
-    def one(v: list[float]) -> list[float]:
-        out, x1, x2, y1, y2 = [], v[0], v[0], v[0], v[0]
-        for xi in v:
-            yi = b0 * xi + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2
-            out.append(yi)
-            x2, x1, y2, y1 = x1, xi, y1, yi
-        return out
-
-    return np.asarray(one(one(x.tolist())[::-1])[::-1])
-
-
-def device_heading(t_us: np.ndarray, accel_mps2: np.ndarray, gyro_radps: np.ndarray,
-                   mag_t_us: np.ndarray, field_ut: np.ndarray) -> np.ndarray:  # fmt: skip
-    """Complementary-filter heading ψ [rad] of the device's +y axis at the IMU times (see the module)."""
-    dt = np.diff(t_us, prepend=t_us[0]) / 1e6
-    up = _lowpass1(accel_mps2, dt, GRAVITY_TAU_S)
-    up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
-    rate_radps = -np.einsum("ij,ij->i", gyro_radps, up)  # clockwise about up = heading rate
-    if len(mag_t_us):
-        m = np.column_stack([np.interp(t_us, mag_t_us, field_ut[:, j]) for j in range(3)])
-        east = np.cross(m, up)
-        north = np.cross(up, east)
-        mag = np.arctan2(east[:, 1], north[:, 1])
-    else:
-        mag = np.full(len(t_us), np.nan)
-    psi = np.empty(len(t_us))
-    psi[0] = mag[0] if np.isfinite(mag[0]) else 0.0
-    gain = dt / HEADING_TAU_S
-    for i in range(1, len(t_us)):
-        p = psi[i - 1] + rate_radps[i] * dt[i]
-        if math.isfinite(mag[i]):
-            p += gain[i] * (((mag[i] - p + math.pi) % (2 * math.pi)) - math.pi)
-        psi[i] = p
-    return psi
-
-
-def detect_steps(t_us: np.ndarray, accel_mps2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Step indices into the IMU samples and each step's range amax − amin [m/s²] (see the module)."""
-    if len(t_us) < 3:
-        return np.zeros(0, np.int64), np.zeros(0)
-    fs = 1e6 / max(float(np.median(np.diff(t_us))), 1.0)
-    a = _butter2_filtfilt(np.linalg.norm(accel_mps2, axis=1), fs, STEP_LOWPASS_HZ)
-    cand = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:]) & (a[1:-1] > STEP_MIN_PEAK_MPS2)) + 1
-    kept: list[int] = []
-    for i in cand:
-        if kept and (t_us[i] - t_us[kept[-1]]) < STEP_MIN_INTERVAL_S * 1e6:
-            if a[i] > a[kept[-1]]:
-                kept[-1] = int(i)
-        else:
-            kept.append(int(i))
-    idx = np.asarray(kept, np.int64)
-    lo = np.concatenate([[0], idx[:-1]])
-    rng = np.array([a[s : e + 1].max() - a[s : e + 1].min() for s, e in zip(lo, idx)])
-    return idx, rng
-
-
-def track_of(raw: RawWalk) -> Track:
-    """Phase 1 of the references for one walk (see the module docstring)."""
-    imu, t = raw.imu, raw.imu["t_us"].astype(np.int64)
-    if len(t) >= 3:
-        psi = device_heading(t, imu["accel_mps2"], imu["gyro_radps"], raw.mag["t_us"], raw.mag["field_ut"])
-        idx, rng = detect_steps(t, imu["accel_mps2"])
-        first_last = (int(t[0]), int(t[-1]))
-    else:
-        psi, idx, rng, first_last = np.zeros(0), np.zeros(0, np.int64), np.zeros(0), (0, 0)
-    tr = raw.truth
-    return Track(
-        imu_t_us=first_last,
-        step_t_us=t[idx] if len(t) else np.zeros(0, np.int64),
-        step_range_mps2=rng,
-        step_heading_rad=psi[idx] if len(psi) else np.zeros(0),
-        baro_t_us=raw.baro["t_us"].astype(np.int64),
-        height_m=pressure_to_height_m(raw.baro["pressure_pa"]),
-        scan_t_us=raw.scan_t_us(),
-        scan_bounds=raw.scan_bounds(),
-        bssid=raw.wifi["bssid"].astype(np.int64),
-        rssi_dbm=raw.wifi["rssi_dbm"].astype(float),
-        truth=Table({c: tr[c] for c in ("t_us", "x_m", "y_m", "floor")}),
-    )
-
-
-def weinberg_k(training: Sequence[Track]) -> float:
-    """K = Σ true distance / Σ range^¼ over the training walks' scored waypoint segments (:mod:`.strides`)."""
-    seg = build_segments([tr.segments_input() for tr in training])
-    return stride_k(seg, seg["excluded"] == "")
-
-
-class Fingerprints:
-    """The training walks' scans at their truth positions (linear in time between truth points)."""
-
-    def __init__(self, training: Sequence[Track]):
-        rows, aps, dbm, xy, floor = [], [], [], [], []
-        for tr in training:
-            tt, ts = tr.truth["t_us"], tr.scan_t_us
-            if not len(tt) or not len(ts):
-                continue
-            inside = (ts >= tt[0]) & (ts <= tt[-1])
-            scan_of_row = np.repeat(np.arange(len(ts)), np.diff(tr.scan_bounds))
-            keep = inside[scan_of_row]
-            renum = np.cumsum(inside) - 1 + sum(len(x) for x in xy)
-            rows.append(renum[scan_of_row[keep]])
-            aps.append(tr.bssid[keep])
-            dbm.append(tr.rssi_dbm[keep])
-            xy.append(np.column_stack([np.interp(ts[inside], tt, tr.truth[c]) for c in ("x_m", "y_m")]))
-            near = np.clip(np.searchsorted(tt, ts[inside]), 1, max(len(tt) - 1, 1))
-            prev_closer = (ts[inside] - tt[near - 1]) <= (tt[np.minimum(near, len(tt) - 1)] - ts[inside])
-            floor.append(tr.truth["floor"][np.where(prev_closer, near - 1, np.minimum(near, len(tt) - 1))])
-        cat = lambda v, dt: np.concatenate(v).astype(dt) if v else np.zeros(0, dt)  # noqa: E731
-        ap_ids, col = np.unique(cat(aps, np.int64), return_inverse=True)
-        self.ap = {int(b): j for j, b in enumerate(ap_ids)}
-        self.xy_m = np.concatenate(xy) if xy else np.zeros((0, 2))
-        self.floor = cat(floor, np.int64)
-        self.db = np.full((len(self.xy_m), len(ap_ids)), MISSING_DBM)
-        self.db[cat(rows, np.int64), col.reshape(-1)] = cat(dbm, float)
-
-    def locate(self, track: Track) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """WkNN fix of every scan of ``track`` sharing an AP with the map: (t_us, xy_m (n, 2), floor)."""
-        t, xy, fl = [], [], []
-        if not len(self.db):
-            return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros(0, np.int64)
-        sq_db = (self.db**2).sum(axis=1)
-        for i, ts in enumerate(track.scan_t_us):
-            s = slice(int(track.scan_bounds[i]), int(track.scan_bounds[i + 1]))
-            q = np.full(len(self.ap), MISSING_DBM)
-            known = [(self.ap[b], r) for b, r in zip(track.bssid[s].tolist(), track.rssi_dbm[s].tolist())
-                     if b in self.ap]  # fmt: skip
-            if not known:
-                continue
-            q[[j for j, _ in known]] = [r for _, r in known]
-            extra = sum(
-                (r - MISSING_DBM) ** 2 for b, r in zip(track.bssid[s], track.rssi_dbm[s]) if b not in self.ap
-            )
-            d = np.sqrt(np.maximum(sq_db - 2 * self.db @ q + q @ q + extra, 0.0))
-            nn = np.argsort(d)[:WKNN_K]
-            w = 1.0 / np.maximum(d[nn], 1e-6)
-            t.append(int(ts))
-            xy.append(w @ self.xy_m[nn] / w.sum())
-            fl.append(
-                int(np.bincount(self.floor[nn] - self.floor.min(), weights=w).argmax() + self.floor.min())
-            )
-        return np.asarray(t, np.int64), np.asarray(xy, float).reshape(-1, 2), np.asarray(fl, np.int64)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -296,6 +89,12 @@ def start_offset_rad(track: Track, start: Start) -> float:
     return _wrap(start.heading_rad - math.atan2(np.sin(psi).sum(), np.cos(psi).sum()))
 
 
+def first_pose_t_us(track: Track, start: Start) -> int:
+    """The first pose's time: the start, but not before the first IMU sample (as the firmware, which
+    emits nothing before its sensors: truth points before them stay unscored for every row)."""
+    return max(int(start.t_us), int(track.imu_t_us[0]))
+
+
 def floors_at(track: Track, t_us: np.ndarray, start: Start, storey_m: float) -> np.ndarray:
     """Start floor + round(barometric height change since the start / storey height)."""
     if len(track.baro_t_us) < 2:
@@ -309,11 +108,21 @@ def _poses(
     track: Track, rows: list[tuple[int, float, float, float, float]], start: Start, storey_m: float
 ) -> Table:
     t, x, y, sig, hd = (np.asarray(c) for c in zip(*rows))
-    return Table({"t_us": t.astype(np.int64), "x_m": x, "y_m": y, "floor": floors_at(track, t, start, storey_m),
-                  "sigma_m": sig, "heading_rad": hd})  # fmt: skip
+    return Table(
+        {
+            "t_us": t.astype(np.int64),
+            "x_m": x,
+            "y_m": y,
+            "floor": floors_at(track, t, start, storey_m),
+            "sigma_m": sig,
+            "heading_rad": hd,
+        }
+    )
 
 
-def run_pdr(track: Track, k: float, start: Start, storey_m: float, fixes: tuple[np.ndarray, np.ndarray] | None = None) -> Table:  # fmt: skip
+def run_pdr(
+    track: Track, k: float, start: Start, storey_m: float, fixes: tuple[np.ndarray, np.ndarray] | None = None
+) -> Table:
     """``reference_pdr`` from ``start``: poses at the start and every step after it.
 
     ``fixes`` (t_us, xy_m) only learn the offset (from the first fix; see the module); None: the offset
@@ -325,7 +134,7 @@ def run_pdr(track: Track, k: float, start: Start, storey_m: float, fixes: tuple[
     offset, learned = (start_offset_rad(track, start), True) if fixes is None else (0.0, False)
     ft, fxy = fixes if fixes is not None else (np.zeros(0, np.int64), np.zeros((0, 2)))
     u = np.zeros(2)  # dead-reckoned displacement since the start, device frame (offset 0) [m]
-    rows = [(start.t_us, start.x_m, start.y_m, 0.0, start.heading_rad)]
+    rows = [(first_pose_t_us(track, start), start.x_m, start.y_m, 0.0, start.heading_rad)]
     j = int(np.searchsorted(ft, start.t_us, side="right"))
     for ts, ln, p in zip(st.tolist(), length.tolist(), psi.tolist()):
         while not learned and j < len(ft) and ft[j] <= ts:  # the first fixes give the offset, once
@@ -382,8 +191,14 @@ class Ekf:
         return "accepted"
 
 
-def run_ekf(track: Track, k: float, start: Start, fixes: tuple[np.ndarray, np.ndarray], storey_m: float,
-            true_start: bool) -> tuple[Table, dict[str, int]]:  # fmt: skip
+def run_ekf(
+    track: Track,
+    k: float,
+    start: Start,
+    fixes: tuple[np.ndarray, np.ndarray],
+    storey_m: float,
+    true_start: bool,
+) -> tuple[Table, dict[str, int]]:
     """``reference_ekf`` from ``start``: poses at the start, every step and every fix after it, and the
     count of fixes accepted, rejected and reset to."""
     if true_start:
@@ -398,14 +213,22 @@ def run_ekf(track: Track, k: float, start: Start, fixes: tuple[np.ndarray, np.nd
     ]
     events += [(int(t), 1, xy) for t, xy in zip(*fixes) if t > start.t_us]
     counts = {"accepted": 0, "rejected": 0, "reset": 0}
-    rows = [(start.t_us, start.x_m, start.y_m, math.sqrt(ekf.P[0, 0] + ekf.P[1, 1]), start.heading_rad)]
+    rows = [
+        (
+            first_pose_t_us(track, start),
+            start.x_m,
+            start.y_m,
+            math.sqrt(ekf.P[0, 0] + ekf.P[1, 1]),
+            start.heading_rad,
+        )
+    ]
     psi = start.heading_rad - ekf.x[2]
     for t, kind, what in sorted(events, key=lambda e: (e[0], e[1])):
         if kind == 0:
             ekf.predict(*what)
             psi = what[1]
         else:
-            counts[ekf.update(what)] += 1
+            counts[ekf.update(np.asarray(what, float))] += 1
         rows.append((t, ekf.x[0], ekf.x[1], math.sqrt(ekf.P[0, 0] + ekf.P[1, 1]), psi + ekf.x[2]))
     return _poses(track, rows, start, storey_m), counts
 
@@ -417,8 +240,9 @@ def storey_of(floor_heights_m: Sequence[float]) -> float:
     return float(np.median(d)) if len(d) else DEFAULT_STOREY_M
 
 
-def run_references(held: Track, training: Sequence[Track], floor_heights_m: Sequence[float],
-                   true_start: bool) -> tuple[dict[str, dict[str, Table]], dict[str, Any]]:  # fmt: skip
+def run_references(
+    held: Track, training: Sequence[Track], floor_heights_m: Sequence[float], true_start: bool
+) -> tuple[dict[str, dict[str, Table]], dict[str, Any]]:
     """Both references on the held-out walk, trained on ``training``: run tag ("fixes", and
     "true_start" when asked) → name → pose Table; and what was learned (K, storey, fix counts)."""
     k = weinberg_k(training)

@@ -91,19 +91,15 @@ LOSS_METRICS = ("ipin_score", "mean")
 def loses_to_reference(
     table: Mapping[str, Mapping[str, Any]], refs: Mapping[str, Mapping[str, Any]]
 ) -> list[dict[str, Any]]:
-    """The schemes whose IPIN score or mean error [m] is worse (higher) than their reference's
-    (:data:`REFERENCE_OF`, else ``reference_ekf``): scheme, reference and the metrics lost with both values."""
+    """The schemes whose IPIN score and mean error [m] are both worse (higher) than their reference's
+    (:data:`REFERENCE_OF`, else ``reference_ekf``): scheme, reference and both metrics with both values."""
     out = []
     for name, row in table.items():
         ref = REFERENCE_OF.get(name, reference.REFERENCE_EKF)
         if ref is None or ref not in refs:
             continue
-        lost = {
-            k: {"scheme": row[k], "reference": refs[ref][k]}
-            for k in LOSS_METRICS
-            if math.isfinite(row[k]) and math.isfinite(refs[ref][k]) and row[k] > refs[ref][k]
-        }
-        if lost:
+        lost = {k: {"scheme": row[k], "reference": refs[ref][k]} for k in LOSS_METRICS}
+        if all(math.isfinite(v["reference"]) and v["scheme"] > v["reference"] for v in lost.values()):
             out.append({"scheme": name, "reference": ref, "lost": lost})
     return out
 
