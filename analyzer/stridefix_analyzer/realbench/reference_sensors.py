@@ -224,30 +224,23 @@ class Fingerprints:
 
     def locate(self, track: Track) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """WkNN fix of every scan of ``track`` sharing an AP with the map: (t_us, xy_m (n, 2), floor)."""
-        t, xy, fl = [], [], []
-        if not len(self.db):
+        n = len(track.scan_t_us)
+        scan = np.repeat(np.arange(n), np.diff(track.scan_bounds))
+        col = np.array([self.ap.get(b, -1) for b in track.bssid.tolist()], np.int64)
+        known = col >= 0
+        heard = np.bincount(scan[known], minlength=n) > 0
+        if not len(self.db) or not heard.any():
             return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros(0, np.int64)
-        sq_db = (self.db**2).sum(axis=1)
-        for i, ts in enumerate(track.scan_t_us):
-            s = slice(int(track.scan_bounds[i]), int(track.scan_bounds[i + 1]))
-            q = np.full(len(self.ap), MISSING_DBM)
-            known = [
-                (self.ap[b], r)
-                for b, r in zip(track.bssid[s].tolist(), track.rssi_dbm[s].tolist())
-                if b in self.ap
-            ]
-            if not known:
-                continue
-            q[[j for j, _ in known]] = [r for _, r in known]
-            extra = sum(
-                (r - MISSING_DBM) ** 2 for b, r in zip(track.bssid[s], track.rssi_dbm[s]) if b not in self.ap
-            )
-            d = np.sqrt(np.maximum(sq_db - 2 * self.db @ q + q @ q + extra, 0.0))
-            nn = np.argsort(d)[:WKNN_K]
-            w = 1.0 / np.maximum(d[nn], 1e-6)
-            t.append(int(ts))
-            xy.append(w @ self.xy_m[nn] / w.sum())
-            fl.append(
-                int(np.bincount(self.floor[nn] - self.floor.min(), weights=w).argmax() + self.floor.min())
-            )
-        return np.asarray(t, np.int64), np.asarray(xy, float).reshape(-1, 2), np.asarray(fl, np.int64)
+        q = np.full((n, len(self.ap)), MISSING_DBM)
+        q[scan[known], col[known]] = track.rssi_dbm[known]
+        # APs of the scan the map never heard: (rssi − missing)² against every fingerprint
+        extra = np.bincount(scan[~known], weights=(track.rssi_dbm[~known] - MISSING_DBM) ** 2, minlength=n)
+        d2 = (self.db**2).sum(axis=1)[None, :] - 2 * q @ self.db.T + ((q**2).sum(axis=1) + extra)[:, None]
+        d = np.sqrt(np.maximum(d2[heard], 0.0))
+        nn = np.argsort(d, axis=1)[:, :WKNN_K]
+        w = 1.0 / np.maximum(np.take_along_axis(d, nn, axis=1), 1e-6)
+        xy = np.einsum("ik,ikj->ij", w, self.xy_m[nn]) / w.sum(axis=1, keepdims=True)
+        lo = int(self.floor.min())
+        votes = np.zeros((len(nn), int(self.floor.max()) - lo + 1))
+        np.add.at(votes, (np.arange(len(nn))[:, None], self.floor[nn] - lo), w)
+        return track.scan_t_us[heard].astype(np.int64), xy, votes.argmax(axis=1).astype(np.int64) + lo
