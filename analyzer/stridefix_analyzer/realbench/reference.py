@@ -7,7 +7,7 @@ starts and truth times as the firmware's schemes. Not schemes: the firmware neve
   from the training walks) along the complementary-filter heading ψ plus one constant device-to-walk
   offset per walk. From the true start (truth position at the first truth point, heading towards the next
   one) the offset = that heading minus the circular mean of ψ over the first :data:`START_STEPS` steps
-  (magnetometer and gyroscope only); from the first fix (the first WkNN fix) the offset = the angle
+  (magnetometer and gyroscope only; the one look-ahead, ≈ 2 s, averages the gait's sway); from the first fix (the first WkNN fix) the offset = the angle
   between the fixes' displacement and the dead-reckoned displacement since that fix, taken once, when
   a fix lies :data:`OFFSET_MIN_SPAN_M` from the first (0 until then; the track since the start turns
   with it). No absolute fix after the start.
@@ -40,7 +40,8 @@ from stridefix_analyzer.realbench.strides import WEINBERG_EXPONENT
 REFERENCE_PDR, REFERENCE_EKF = "reference_pdr", "reference_ekf"
 NAMES = (REFERENCE_PDR, REFERENCE_EKF)
 START_STEPS = 4  # ≈ 2 s of walking: averages the hand-held phone's sway over two strides
-#: fixes this far apart (≈ 3 × the fix σ·√2) fix the device-to-walk offset within ~25° [m]
+#: two fixes (σ 3 m per axis each) this far apart give the walking direction within atan(3·√2/10) ≈ 23°
+#: (1σ) [m]
 OFFSET_MIN_SPAN_M = 10.0
 FIX_SIGMA_M = 3.0
 GATE_CHI2 = 9.21  # χ²(2 dof) at 99 %
@@ -201,9 +202,9 @@ def run_ekf(
 ) -> tuple[Table, dict[str, int]]:
     """``reference_ekf`` from ``start``: poses at the start, every step and every fix after it, and the
     count of fixes accepted, rejected and reset to."""
-    if true_start:
+    if true_start:  # position known; the offset from 4 steps of ψ (5° sway each) and the truth heading
         ekf = Ekf(start, start_offset_rad(track, start), 0.0, 2 * STEP_HEADING_SIGMA_RAD)
-    else:
+    else:  # at the first fix, its σ; the offset unknown
         ekf = Ekf(start, 0.0, FIX_SIGMA_M, START_BIAS_SIGMA_RAD)
     after = track.step_t_us > start.t_us
     length = k * np.maximum(track.step_range_mps2[after], 0.0) ** WEINBERG_EXPONENT
@@ -250,8 +251,8 @@ def run_references(
     ft, fxy, ffl = Fingerprints(training).locate(held)
     info: dict[str, Any] = {"K": k, "storey_m": storey, "wifi_fixes": len(ft)}
     out: dict[str, dict[str, Table]] = {}
-    if not math.isfinite(k) or len(held.step_t_us) == 0:
-        info["error"] = "no Weinberg K or no steps"
+    if not math.isfinite(k):
+        info["error"] = "no Weinberg K: the training walks have no scored segment"
         return out, info
     starts: list[tuple[str, Start | None]] = [
         ("fixes", Start(int(ft[0]), float(fxy[0, 0]), float(fxy[0, 1]), int(ffl[0])) if len(ft) else None)

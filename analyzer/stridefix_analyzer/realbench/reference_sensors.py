@@ -242,5 +242,5 @@ class Fingerprints:
         xy = np.einsum("ik,ikj->ij", w, self.xy_m[nn]) / w.sum(axis=1, keepdims=True)
         lo = int(self.floor.min())
         votes = np.zeros((len(nn), int(self.floor.max()) - lo + 1))
-        np.add.at(votes, (np.arange(len(nn))[:, None], self.floor[nn] - lo), w)
+        np.add.at(votes, (np.arange(len(nn))[:, None], (self.floor[nn] - lo).astype(np.int64)), w)
         return track.scan_t_us[heard].astype(np.int64), xy, votes.argmax(axis=1).astype(np.int64) + lo
