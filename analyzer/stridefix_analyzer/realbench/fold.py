@@ -23,6 +23,8 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.realbench import lsd
+from stridefix_analyzer.realbench.reference import run_references
+from stridefix_analyzer.realbench.reference_sensors import Track
 from stridefix_analyzer.realbench.sitecontent import GroupContent, apply_fields, train_placed
 
 #: 1: with the matcher's map levels averaged over all of a cell's scans (misses at fill), one detection
@@ -62,6 +64,9 @@ class FoldJob:
     #: the group's building content (walls, geo, beacons) and this walk's index in its group
     content: GroupContent | None = None
     content_index: int = -1
+    #: the textbook references' inputs (:mod:`.reference`): the held-out walk's and the training walks'
+    reference_held: Track | None = None
+    reference_training: tuple[Track, ...] = ()
 
 
 def fold_site(
@@ -193,8 +198,41 @@ def run_fold(job: FoldJob) -> dict[str, Any]:
             return out
         out[tag] = score_walk(metrics)
         out.setdefault("fix_sources", {})[tag] = analysis["fix_sources"]
+    if job.reference_held is not None:
+        poses, info = run_references(
+            job.reference_held, job.reference_training, site.floor_height_m, job.true_start
+        )
+        truth = job.reference_held.truth
+        out["references"] = {
+            tag: {n: score_poses(p, truth, heights) for n, p in d.items()} for tag, d in poses.items()
+        }
+        out["fold"]["reference"] = info
     out["run_s"] = time.perf_counter() - t0
     return out
+
+
+def score_poses(pose: Any, truth: Any, heights: Any) -> dict[str, Any]:
+    """One walk of a Python-computed track (a :mod:`.reference`): the same keys and functions as a
+    scheme's row of :func:`score_walk` (the causal match at the truth times, :mod:`..scoring.metrics`)."""
+    import numpy as np
+
+    from stridefix_analyzer.io.logread import Table
+    from stridefix_analyzer.scoring import iso18305
+    from stridefix_analyzer.scoring.metrics import error_stats, ipin_score, match_causal, scored_errors
+
+    cols = {c: truth[c] for c in ("t_us", "x_m", "y_m", "floor")}
+    m = match_causal(pose, Table({**cols, "heading_rad": np.full(len(truth), np.nan)}))
+    err, ferr = scored_errors(m)
+    stats = error_stats(err)
+    return {
+        **{k: stats[k] for k in STATS_KEYS},
+        "unscored": int(np.count_nonzero(~m["scored"])),
+        "floor_hit_rate": float(np.mean(ferr == 0)) if len(ferr) else math.nan,
+        "ipin_score": ipin_score(err, ferr),
+        "iso18305": iso18305.terms(m, heights),
+        "errors_m": err.tolist(),
+        "floor_errors": ferr.tolist(),
+    }
 
 
 def score_walk(metrics: Any) -> dict[str, dict[str, Any]]:

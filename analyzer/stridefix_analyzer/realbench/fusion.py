@@ -13,7 +13,10 @@ of the group only (DESIGN.md, evaluation protocol):
    candidate (:func:`.heading.learn_rotation_deg`) and the floors (:mod:`.floors`);
 3. walk i is replayed on its fold's site (with the walls, geo-reference and beacons of the
    training walks, :mod:`.sitecontent`) with every scheme and scored at its ground-truth times
-   (:mod:`.fold`). ``--true-start`` adds a run labelled truth-initialised.
+   (:mod:`.fold`). ``--true-start`` adds a run labelled truth-initialised. Beside the schemes, two
+   textbook references computed in Python from the same walks, training walks, starts and truth
+   (:mod:`.reference`: ``reference_pdr``, ``reference_ekf``); a scheme that scores worse than its
+   reference is listed in ``loses_to_reference``.
 
 Outputs (:mod:`.summary`): ``results.json``, the HTML report next to it (:mod:`.report`), and the
 per-walk work files under ``OUT/realbench_work/<group>/<walk>`` (site file, stridefixd log,
@@ -322,6 +325,10 @@ def plan_group(run: Run, part: Part, walks: list[dict[str, Any]]) -> tuple[dict[
                 site_fields=tuning.walk_site_fields(choices, j),
                 content=content,
                 content_index=j,
+                reference_held=sub[j].get("reference"),
+                reference_training=tuple(
+                    w["reference"] for jj, w in enumerate(sub) if jj != j and w.get("reference") is not None
+                ),
             )
         )
     return info, jobs

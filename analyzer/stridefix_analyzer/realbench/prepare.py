@@ -4,7 +4,9 @@
 From that replay and the walk's own log: the walk-mode radio-map sums
 (:class:`~stridefix_analyzer.radiomap.build.WalkStats`), the Weinberg segment inputs of
 :mod:`.strides`, the heading-offset sums of every heading candidate (:func:`.heading.rotation_stats`;
-the walk is replayed once per candidate) and the barometric height of each truth floor.
+the walk is replayed once per candidate) and the barometric height of each truth floor. The walk's
+raw sensors, read once more through the data set, give the textbook references their inputs
+(:func:`.reference.track_of`).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 from stridefix_analyzer.realbench.floors import floor_heights_of_walk
 from stridefix_analyzer.realbench.heading import rotation_stats
+from stridefix_analyzer.realbench.reference_sensors import track_of
 from stridefix_analyzer.realbench.walks import cached_import, new_walk
 
 
@@ -55,7 +58,8 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
         :func:`.heading.rotation_stats`), ``floor_heights``, ``floors`` (truth floors),
         ``first_waypoint`` (t_us, x, y, floor), ``import_log``, ``fw_log`` (the site-less replay) and
         ``ble_placed`` (the BLE readings placed on the truth,
-        :func:`~stridefix_analyzer.radiomap.beacons.place_readings`).
+        :func:`~stridefix_analyzer.radiomap.beacons.place_readings`) and ``reference`` (the textbook
+        references' :class:`.reference.Track`, None when the walk cannot be read again).
     """
     from stridefix_analyzer.radiomap.beacons import place_readings
     from stridefix_analyzer.radiomap.build import RadioMapInputError, WalkStats, load_recordings
@@ -132,6 +136,11 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
         else {}
     )
     walk["floors"] = sorted({int(f) for f in truth["floor"]})
+    try:
+        walk["reference"] = track_of(job.dataset.read(trace, **job.read_options))
+    except Exception as exc:  # the references lose this walk only; the schemes keep it
+        walk["reference"] = None
+        walk["warnings"].append(f"no reference track: {type(exc).__name__}: {exc}")
     walk["first_waypoint"] = (
         int(truth["t_us"][0]),
         float(truth["x_m"][0]),

@@ -29,6 +29,7 @@ from stridefix_analyzer import datasets  # noqa: E402
 from stridefix_analyzer.datasets.protocol import DatasetError  # noqa: E402
 from stridefix_analyzer.realbench.summary import (  # noqa: E402
     PDR_TRUE_START_LABEL,
+    loses_text,
     pdr_true_start,
     pdr_true_start_text,
 )
@@ -175,8 +176,12 @@ def _matched(series: Mapping[str, np.ndarray]) -> dict[str, Any]:
     return out
 
 
+_SUMMARY = {"fixes": "summary", "true_start": "summary_true_start"}
+
+
 def _scheme_table(summary: dict, extra: Sequence[tuple[str, dict]] = ()) -> str:
-    """The scheme table of one run; ``extra`` rows (label, row) come last, in bold."""
+    """The scheme table of one run; ``extra`` rows (label, row) come last, in bold; then the textbook
+    references (:mod:`.reference`), labelled as such, and a scheme that loses to one is marked."""
     head = [
         "scheme",
         "n",
@@ -192,10 +197,12 @@ def _scheme_table(summary: dict, extra: Sequence[tuple[str, dict]] = ()) -> str:
         "walks mean > 15 m",
     ]
     rows = []
-    for name, r in [*summary["schemes"].items(), *extra]:
+    losers = {e["scheme"]: e["reference"] for e in summary.get("loses_to_reference", [])}
+    refs = [(f"{n} (textbook reference, not a scheme)", r) for n, r in summary.get("references", {}).items()]
+    for name, r in [*summary["schemes"].items(), *extra, *refs]:
         rows.append(
             [
-                name,
+                name + (f" — loses to {losers[name]}" if name in losers else ""),
                 r["n"],
                 _f(r["mean"]),
                 _f(r["median"]),
@@ -209,7 +216,8 @@ def _scheme_table(summary: dict, extra: Sequence[tuple[str, dict]] = ()) -> str:
                 f"{r['walks_mean_over_15m']}/{r['walks']} ({_f(100 * r['share_walks_mean_over_15m'], 1)} %)",
             ]
         )
-    return _table(head, rows, bold_last=len(extra))
+    table = _table(head, rows, bold_last=len(extra) + len(refs))
+    return table + f"<p><b>{html.escape(loses_text(summary))}</b></p>"
 
 
 def _table(head: Sequence[object], rows: Iterable[Sequence[object]], bold_last: int = 0) -> str:
@@ -284,6 +292,11 @@ def render(doc: dict) -> str:
             series = _matched(dict(np.load(npz)))
             title = f"{r['walk']}: best {best} {means[best]:.1f} m, worst {worst} {means[worst]:.1f} m (mean)"
             parts.append(_img(to_png(plot_walk(series, r["walk"], [best, worst], plan, title)), r["walk"]))
+        ref_cols = [
+            (tag, n)
+            for tag in ("fixes", "true_start")
+            for n in g.get(_SUMMARY[tag], {}).get("references", {})
+        ]
         head = ["walk", "waypoints", "K", "rotation °", "RPs"] + [f"{n} mean" for n in sch]
         if true_pdr is not None:
             head.append(f"{PDR_TRUE_START_LABEL} mean")
@@ -304,7 +317,9 @@ def render(doc: dict) -> str:
                     if true_pdr is not None
                     else []
                 )
+                + [_f((r.get("references") or {}).get(tag, {}).get(n, {}).get("mean")) for tag, n in ref_cols]
             )
+        head += [f"{n} mean" + (" (truth-initialised)" if tag == "true_start" else "") for tag, n in ref_cols]
         parts.append("<h3>Per walk</h3>" + _table(head, trows))
     return (
         f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>StrideFix realbench fusion"

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 
 from stridefix_analyzer import schemes
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.realbench import reference
 from stridefix_analyzer.realbench.fold import FoldJob
 from stridefix_analyzer.realbench.strides import error_stats, spread
 from stridefix_analyzer.realbench.tuning import Axis
@@ -42,31 +43,80 @@ def stats_of(errors: ArrayLike) -> dict[str, Any]:
     return {**error_stats(e), "rmse": float(np.sqrt(np.mean(e**2))) if len(e) else math.nan}
 
 
+def _pooled_row(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """One scheme's (or reference's) walks pooled: sample stats, IPIN score, floor hit rate, walk means."""
+    err = np.concatenate([np.asarray(r["errors_m"], float) for r in rows]) if rows else np.zeros(0)
+    ferr = np.concatenate([np.asarray(r["floor_errors"], float) for r in rows]) if rows else np.zeros(0)
+    means = np.array([r["mean"] for r in rows], float)
+    finite = means[np.isfinite(means)]
+    return {
+        **stats_of(err),
+        "ipin_score": ipin_score(err, ferr),
+        "floor_hit_rate": float(np.mean(ferr == 0)) if len(ferr) else math.nan,
+        "walks": len(rows),
+        "walks_mean_over_15m": int(np.sum(finite > ROBUST_MEAN_M)),
+        "share_walks_mean_over_15m": float(np.mean(finite > ROBUST_MEAN_M)) if len(finite) else math.nan,
+        "walk_mean_median": float(np.median(finite)) if len(finite) else math.nan,
+    }
+
+
 def summarize_group(results: Sequence[Mapping[str, Any]], tag: str = "fixes") -> dict[str, Any]:
     """Per scheme over a group's walks: pooled sample stats, IPIN score, floor hit rate, the
-    per-walk mean spread and the share of walks whose mean error exceeds :data:`ROBUST_MEAN_M`."""
-    table = {}
+    per-walk mean spread and the share of walks whose mean error exceeds :data:`ROBUST_MEAN_M`; the
+    same for the textbook references (``references``) and the schemes that lose to them
+    (``loses_to_reference``, :func:`loses_to_reference`)."""
     names = [n for n in schemes.NAMES if any(n in r.get(tag, {}) for r in results)]
-    for name in names:
-        rows = [r[tag][name] for r in results if name in r.get(tag, {})]
-        err = np.concatenate([np.asarray(r["errors_m"], float) for r in rows]) if rows else np.zeros(0)
-        ferr = np.concatenate([np.asarray(r["floor_errors"], float) for r in rows]) if rows else np.zeros(0)
-        means = np.array([r["mean"] for r in rows], float)
-        finite = means[np.isfinite(means)]
-        table[name] = {
-            **stats_of(err),
-            "ipin_score": ipin_score(err, ferr),
-            "floor_hit_rate": float(np.mean(ferr == 0)) if len(ferr) else math.nan,
-            "walks": len(rows),
-            "walks_mean_over_15m": int(np.sum(finite > ROBUST_MEAN_M)),
-            "share_walks_mean_over_15m": (
-                float(np.mean(finite > ROBUST_MEAN_M)) if len(finite) else math.nan
-            ),
-            "walk_mean_median": float(np.median(finite)) if len(finite) else math.nan,
-        }
+    table = {name: _pooled_row([r[tag][name] for r in results if name in r.get(tag, {})]) for name in names}
+    refs = {}
+    for name in reference.NAMES:
+        rows = [r["references"][tag][name] for r in results if name in r.get("references", {}).get(tag, {})]
+        if rows:
+            refs[name] = _pooled_row(rows)
     w, a = table.get("wifi_only", {}).get("mean"), table.get("adaptive", {}).get("mean")
     red = 100.0 * (w - a) / w if w and a is not None and math.isfinite(w) and w > 0 else math.nan
-    return {"schemes": table, "adaptive_vs_wifi_only_reduction_pct": red}
+    return {
+        "schemes": table,
+        "adaptive_vs_wifi_only_reduction_pct": red,
+        "references": refs,
+        "loses_to_reference": loses_to_reference(table, refs),
+    }
+
+
+#: which reference a scheme is held against: pdr_only against the plain PDR; every scheme that fuses
+#: fixes with steps against the EKF (wifi_only fuses nothing: it has no reference)
+REFERENCE_OF = {schemes.PDR_ONLY: reference.REFERENCE_PDR, schemes.WIFI_ONLY: None}
+LOSS_METRICS = ("ipin_score", "mean")
+
+
+def loses_to_reference(
+    table: Mapping[str, Mapping[str, Any]], refs: Mapping[str, Mapping[str, Any]]
+) -> list[dict[str, Any]]:
+    """The schemes whose IPIN score and mean error [m] are both worse (higher) than their reference's
+    (:data:`REFERENCE_OF`, else ``reference_ekf``): scheme, reference and both metrics with both values."""
+    out = []
+    for name, row in table.items():
+        ref = REFERENCE_OF.get(name, reference.REFERENCE_EKF)
+        if ref is None or ref not in refs:
+            continue
+        lost = {k: {"scheme": row[k], "reference": refs[ref][k]} for k in LOSS_METRICS}
+        if all(math.isfinite(v["reference"]) and v["scheme"] > v["reference"] for v in lost.values()):
+            out.append({"scheme": name, "reference": ref, "lost": lost})
+    return out
+
+
+def loses_text(summary: Mapping[str, Any]) -> str:
+    """One line: which schemes lose to their reference (console and HTML)."""
+    lost = summary.get("loses_to_reference", [])
+    if not summary.get("references"):
+        return "loses to reference: no reference ran"
+    if not lost:
+        return "loses to reference: none"
+    return "LOSES TO REFERENCE: " + "; ".join(
+        f"{e['scheme']} vs {e['reference']} ("
+        + ", ".join(f"{k} {_f(v['scheme'])} > {_f(v['reference'])}" for k, v in e["lost"].items())
+        + ")"
+        for e in lost
+    )
 
 
 def build_doc(
@@ -126,6 +176,7 @@ def build_doc(
             for tag in ("fixes", "true_start"):
                 if tag in r:
                     row[tag] = r[tag]
+            row["references"] = r.get("references", {})
             row["fix_sources"] = r.get("fix_sources", {}).get("fixes", {})
             entry["walk_rows"].append(row)
         per_group.append(entry)
@@ -143,8 +194,10 @@ def strip_samples(doc: Mapping[str, Any]) -> dict[str, Any]:
     out = json.loads(json.dumps(json_ready(doc)))
     for g in out["groups"]:
         for row in g["walk_rows"]:
-            for tag in ("fixes", "true_start"):
-                for s in (row.get(tag) or {}).values():
+            runs = [row.get(tag) or {} for tag in ("fixes", "true_start")]
+            runs += list((row.get("references") or {}).values())
+            for run in runs:
+                for s in run.values():
                     s.pop("errors_m", None)
                     s.pop("floor_errors", None)
     return out
@@ -225,19 +278,24 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
             true_pdr = pdr_true_start(g)
             if key == "summary" and true_pdr is not None:
                 rows.append((PDR_TRUE_START_LABEL, true_pdr))
-            w = max(10, *(len(name) + 1 for name, _ in rows))
+            w = max(10, *(len(name) + 1 for name, _ in rows), *(len(n) + 1 for n in s.get("references", {})))
             lines.append(f"  [{title}]  errors in m at the ground-truth times")
             lines.append(
                 f"  {'scheme':<{w}}{'n':>6}{'mean':>8}{'median':>8}{'p75':>8}{'p90':>8}"
                 f"{'max':>8}{'rmse':>8}{'ipin':>8}{'floor%':>8}{'>15m':>10}"
             )
-            for name, r in rows:
+            refs = list(s.get("references", {}).items())
+            losers = {e["scheme"]: e["reference"] for e in s.get("loses_to_reference", [])}
+            for i, (name, r) in enumerate([*rows, *refs]):
+                if refs and i == len(rows):
+                    lines.append("  -- textbook references, computed in Python (not schemes) --")
                 share = r["share_walks_mean_over_15m"]
                 lines.append(
                     f"  {name:<{w}}{r['n']:>6}{_f(r['mean']):>8}{_f(r['median']):>8}"
                     f"{_f(r['p75']):>8}{_f(r['p90']):>8}{_f(r['max']):>8}{_f(r['rmse']):>8}"
                     f"{_f(r['ipin_score']):>8}{_f(100 * r['floor_hit_rate'], 1):>8}"
                     f"{(_f(100 * share, 1) + '%') if share == share else '-':>10}"
+                    + (f"  loses to {losers[name]}" if name in losers and i < len(s["schemes"]) else "")
                 )
             lines.append(
                 f"  adaptive vs wifi_only: mean error reduced by "
@@ -245,6 +303,7 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
                 f"whose mean error exceeds {ROBUST_MEAN_M:g} m; ipin = p75 of 2-D error + "
                 f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|, Matlab quantile)"
             )
+            lines.append(f"  {loses_text(s)}")
         lines.append(f"  {pdr_true_start_text(doc['format'], g)}")
         if "fix_sources" in g:
             text = format_fix_sources(g["fix_sources"], "pooled over the walks")
