@@ -38,7 +38,7 @@
  * compares them all. Each scheme's pose is sf_estimator_scheme_pose; sf_estimator_pose is the PDR
  * track from the config start (σ grows by estimator_sigma_per_m per metre walked).
  *
- * The multi-scheme controller (sf_controller.h; issue 14), when the site has a context map: every
+ * The multi-scheme controller (sf_controller.h), when the site has a context map: every
  * Wi-Fi, BLE and GNSS reading first goes to its CLS raw; a source the controller's policy keeps off
  * then gives sf_scheme_count audits with reason CONTEXT_OFF and no fix (landmarks are never kept off);
  * after each credited step and each absolute-source input the controller steps on the motion of the
@@ -46,11 +46,13 @@
  * and the latest activity. Its events come out of sf_estimator_next_context, a stairs recalibration
  * with its METHOD_PORT fix offered to every scheme like a landmark; a switch to a context on another
  * floor renumbers the shared floor to the controller's (sf_floor_shift, as the floor vote does). The
- * controller's primary pose is sf_estimator_scheme_pose(sf_scheme_controller). Without a context map
- * nothing of this changes an output.
+ * controller's primary pose is sf_estimator_scheme_pose(sf_scheme_controller): the pose of the scheme
+ * it follows; when it starts to follow another, the old pose minus the new one at that moment is added
+ * and fades with controller_handover_s (exp(−age/τ)), its outer product added to the covariance, so the
+ * primary pose never jumps at a switch. Without a context map nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 15 728 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
+ * Memory: sizeof(sf_estimator_t) = 15 752 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
  * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
  * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
  * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's
@@ -146,6 +148,10 @@ typedef struct {
     uint32_t stride_calibrations;
     /* the multi-scheme controller (issue 14): inactive without a site's context map */
     sf_controller_t controller;
+    /* the primary pose's hand-over when the controller follows another scheme: the old pose minus the
+     * new one at the switch, decaying with controller_handover_s (sf_estimator_scheme_pose) */
+    int64_t handover_t_us; /* INT64_MIN: none */
+    double handover_dx_m, handover_dy_m;
     uint32_t context_off; /* source inputs the controller's policy kept off (REASON_CONTEXT_OFF) */
 } sf_estimator_t;
 _Static_assert(sizeof(sf_estimator_t) <= 16 * 1024, "sf_estimator.h promises at most 16 KiB");

@@ -34,7 +34,18 @@ void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *con
     sf_ctl_motion_t m;
     motion(e, p, t_us, &m);
     const uint32_t switches = c->switches;
+    sf_pose_t before;
+    const bool had = sf_estimator_scheme_pose(e, p, sf_scheme_controller, &before);
+    const int scheme_before = sf_controller_scheme(c);
     const bool queued = sf_controller_update(c, p, &m);
+    sf_pose_t after;
+    if (had && sf_controller_scheme(c) != scheme_before &&
+        sf_estimator_scheme_pose(e, p, sf_controller_scheme(c), &after)) {
+        /* another scheme: the primary pose hands over from where it was, without a jump */
+        e->handover_t_us = m.t_us;
+        e->handover_dx_m = before.x_m - after.x_m;
+        e->handover_dy_m = before.y_m - after.y_m;
+    }
     /* cppcheck-suppress knownConditionTrueFalse ; sf_controller_update counts switches through c */
     if (!queued || c->switches == switches) { /* no event, or none that switched */
         return;

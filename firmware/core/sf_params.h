@@ -283,6 +283,7 @@
     X(controller, enabled,         int32_t, 1,       0,       1,       "",      "1 = the multi-scheme controller runs when the site has a context map (site file v3); 0 = every scheme side by side, every source on") \
     X(controller, init_scheme,     int32_t, sf_scheme_ekf, 0, SF_SCHEME_COUNT - 1, "", "fusion scheme (pose_t.SCHEME_*) the primary pose follows before the CLS identifies a context (INIT) when the site's contexts name more than one scheme (one scheme for all: that one)") \
     X(controller, door_steps,      int32_t, 5,       1,       100,     "steps", "steps since a door transition began after which it ends (the paper's 5)") \
+    X(controller, handover_s,      double,  5.0,     0.0,     600.0,   "s",     "when the primary pose starts to follow another scheme it keeps the old one's position as an offset that decays with this time constant (about six steps), its variance carried with it; 0 = jump") \
     X(controller, elevator_walk_steps, int32_t, 2,   1,       100,     "steps", "walking steps after an elevator ride that say the user walks again (one gait cycle)") \
     X(controller, port_margin_m,   double,  1.0,     0.0,     50.0,    "m",     "a position within a port's radius plus this is near the port (the fused position errs by about a metre there)") \
     X(controller, port_leave_m,    double,  2.0,     0.0,     100.0,   "m",     "beyond radius + margin + this from the port the walker has left it (LEFT_PORT: the old context stays); about three steps") \

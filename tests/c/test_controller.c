@@ -719,6 +719,55 @@ static void test_estimator_gate_and_port_fix(void **state)
     assert_false(has_fix);
 }
 
+/* GIVEN the primary pose following the static scheme in INIT, 4 m east of the ekf, WHEN the CLS
+ * identifies floor 0 (whose scheme is the ekf), THEN the pose does not jump: it starts where it was and
+ * fades into the ekf's with controller.handover_s, the offset in its variance; with 0 it jumps. */
+static void test_scheme_switch_hands_over(void **state)
+{
+    (void)state;
+    static sf_estimator_t est;
+    static sf_fingerprint_workspace_t ws;
+    for (int jump = 0; jump < 2; jump++) {
+        sf_params_t p;
+        sf_params_default(&p);
+        p.init_use_config_pose = 1;
+        p.init_x_m = 5.0;
+        p.init_y_m = 15.0;
+        p.controller_init_scheme = sf_scheme_static; /* the campus's contexts name two schemes */
+        p.controller_handover_s = jump ? 0.0 : 5.0;
+        const sf_site_t site = campus();
+        sf_estimator_init(&est, &p);
+        assert_int_equal(sf_estimator_attach_site(&est, &p, &site, &ws), SF_OK);
+        est.fusion[sf_scheme_static].x_m = 9.0;
+        sf_pose_t pose;
+        assert_true(sf_estimator_scheme_pose(&est, &p, sf_scheme_controller, &pose));
+        assert_true(fabs(pose.x_m - 9.0) < 1e-9);
+        scan_buf_t b;
+        sf_fix_t fix;
+        bool has_fix;
+        sf_fix_audit_t audits[sf_scheme_count];
+        sf_wifi_scan_t scan = floors_scan(&b, 1 * S_US, 1u, 3, -60.0f);
+        (void)sf_estimator_wifi(&est, &p, &scan, &fix, &has_fix, audits);
+        assert_int_equal(sf_controller_scheme(&est.controller), sf_scheme_ekf);
+        assert_true(sf_estimator_scheme_pose(&est, &p, sf_scheme_controller, &pose));
+        sf_pose_t ekf;
+        assert_true(sf_estimator_scheme_pose(&est, &p, sf_scheme_ekf, &ekf));
+        if (jump) {
+            assert_true(fabs(pose.x_m - 5.0) < 1e-9);
+            continue;
+        }
+        assert_true(fabs(pose.x_m - 9.0) < 1e-9); /* no jump */
+        assert_true(fabs(pose.cov_m2[0] - (ekf.cov_m2[0] + 16.0)) < 1e-9);
+        /* one time constant later by the estimator's clock (the IMU's, which this test does not feed)
+         * the offset is 4/e */
+        est.t_us = est.handover_t_us + 5 * S_US;
+        assert_true(sf_estimator_scheme_pose(&est, &p, sf_scheme_controller, &pose));
+        assert_true(sf_estimator_scheme_pose(&est, &p, sf_scheme_ekf, &ekf));
+        assert_true(fabs(pose.x_m - (ekf.x_m + 4.0 * exp(-1.0))) < 1e-9);
+        assert_true(fabs(pose.y_m - ekf.y_m) < 1e-9);
+    }
+}
+
 /* ---- the barometer's floor and the staircase's own steps (our rules, sf_controller.h) -------------- */
 
 /* GIVEN a walker on floor 0 of A who rode the elevator (3–5 s) with controller.floor_from_barometer. */
@@ -907,6 +956,7 @@ int main(void)
         cmocka_unit_test(test_stairs_count_from_the_first_stair),
         cmocka_unit_test(test_lost_outdoors),
         cmocka_unit_test(test_barometer_missed_transition),
+        cmocka_unit_test(test_scheme_switch_hands_over),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
