@@ -79,6 +79,7 @@ demo: build
 
 MSINDOOR ?= ../shared/data/msindoor
 GSD ?= ../shared/data/gsd
+IPIN2023 ?= ../shared/data/ipin2023
 # Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
 	@status=0; \
@@ -105,6 +106,11 @@ bench: build
 			results="$$results out/bench/realbench/$$name-crowd-map/results.json"; \
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
 	done; \
+	if [ -d "$(IPIN2023)" ]; then \
+		$(PY) -m stridefix_analyzer.cli realbench --format gsd "$(IPIN2023)" --true-start --quiet \
+			--stridefixd $(STRIDEFIXD) --out out/bench/realbench/ipin2023-fusion/results.json || status=1; \
+		results="$$results out/bench/realbench/ipin2023-fusion/results.json"; \
+	fi; \
 	if [ -d "$(GSD)" ]; then \
 		$(PY) -m stridefix_analyzer.cli realbench --format gsd "$(GSD)" --true-start --quiet \
 			--stridefixd $(STRIDEFIXD) --out out/bench/realbench/gsd-fusion/results.json || status=1; \

@@ -281,7 +281,7 @@
  * the walk's physics: a step is ~0.7 m, a scan comes every 1-2 s. */
 #define SF_PARAMS_CONTROLLER(X)                                                                        \
     X(controller, enabled,         int32_t, 1,       0,       1,       "",      "1 = the multi-scheme controller runs when the site has a context map (site file v3); 0 = every scheme side by side, every source on") \
-    X(controller, init_scheme,     int32_t, sf_scheme_ekf, 0, SF_SCHEME_COUNT - 1, "", "fusion scheme (pose_t.SCHEME_*) the primary pose follows before the CLS identifies a context (INIT) when the site's contexts name more than one scheme (one scheme for all: that one)") \
+    X(controller, init_scheme,     int32_t, sf_scheme_kalman, 0, SF_SCHEME_COUNT - 1, "", "fusion scheme (pose_t.SCHEME_*) the primary pose follows before the CLS identifies a context (INIT) when the site's contexts name more than one scheme (one scheme for all: that one), and POSE's scheme without a context map; kalman: the best fused scheme measured on real hand-held walks (realbench: ipin2023, gsd, site1/F2)") \
     X(controller, door_steps,      int32_t, 5,       1,       100,     "steps", "steps since a door transition began after which it ends (the paper's 5)") \
     X(controller, handover_s,      double,  5.0,     0.0,     600.0,   "s",     "when the primary pose starts to follow another scheme it keeps the old one's position as an offset that decays with this time constant (about six steps), its variance carried with it; 0 = jump") \
     X(controller, elevator_walk_steps, int32_t, 2,   1,       100,     "steps", "walking steps after an elevator ride that say the user walks again (one gait cycle)") \

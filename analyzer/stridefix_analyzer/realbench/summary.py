@@ -82,6 +82,55 @@ def summarize_group(results: Sequence[Mapping[str, Any]], tag: str = "fixes") ->
     }
 
 
+def primary_scheme(summary: Mapping[str, Any], jobs: Sequence[FoldJob]) -> dict[str, Any]:
+    """The scheme of the product's primary pose (what ``POSE`` carries) in a group's replays: the
+    multi-scheme controller's when it ran, with the fusion scheme it followed in how many folds (the
+    fold site's choice), else the copy of ``controller.init_scheme``'s pose (its ``--set``, else the
+    firmware's default). ``scheme`` names the row of the summary tables."""
+    if schemes.CONTROLLER in summary["schemes"]:
+        follows: dict[str, int] = {}
+        for j in jobs:
+            v = j.variants.get("lsd")
+            if v is not None:
+                follows[v] = follows.get(v, 0) + 1
+        return {"scheme": schemes.CONTROLLER, "follows": follows}
+    init = next(
+        (
+            kv.split("=", 1)[1].strip()
+            for j in jobs
+            for kv in j.param_sets
+            if kv.split("=", 1)[0].strip() == INIT_KEY
+        ),
+        None,
+    )
+    if init is None and jobs:
+        init = jobs[0].firmware.params[INIT_KEY].default
+    name = schemes.scheme_name(int(init)) if init is not None and init.lstrip("-").isdigit() else init
+    return {"scheme": name, "follows": {}}
+
+
+def primary_text(summary: Mapping[str, Any]) -> str:
+    """One line on the primary pose: its row, what it followed, and how far it is from the best
+    fused scheme by IPIN score and mean."""
+    pr = summary["primary"]
+    table = summary["schemes"]
+    follows = ", ".join(f"{v} in {n} folds" for v, n in pr.get("follows", {}).items())
+    text = f"primary pose (POSE): {pr['scheme']}" + (f", following {follows}" if follows else "")
+    row = table.get(pr["scheme"])
+    fused = {
+        n: r for n, r in table.items() if n not in (schemes.CONTROLLER, schemes.PDR_ONLY, schemes.WIFI_ONLY)
+    }
+    if row and fused:
+        for metric in LOSS_METRICS:
+            best = min(fused, key=lambda n: fused[n][metric])
+            text += f"; {metric} {_f(row[metric])} vs best fused {best} {_f(fused[best][metric])}"
+    return text
+
+
+#: the firmware parameter naming the scheme POSE copies without a context map
+INIT_KEY = "controller.init_scheme"
+
+
 #: which reference a scheme is held against: pdr_only against the plain PDR; every scheme that fuses
 #: fixes with steps against the EKF (wifi_only fuses nothing: it has no reference)
 REFERENCE_OF = {schemes.PDR_ONLY: reference.REFERENCE_PDR, schemes.WIFI_ONLY: None}
@@ -135,9 +184,12 @@ def build_doc(
     for label in labels:
         info = group_info[label]
         rs = [r for r in results if r["group"] == label]
+        jobs = [job_of[r["walk"]] for r in rs]
         entry = {**info, "summary": summarize_group([r for r in rs if not r["error"]], "fixes")}
+        entry["summary"]["primary"] = primary_scheme(entry["summary"], jobs)
         if true_start:
             entry["summary_true_start"] = summarize_group([r for r in rs if not r["error"]], "true_start")
+            entry["summary_true_start"]["primary"] = primary_scheme(entry["summary_true_start"], jobs)
         entry["fold_errors"] = [{"walk": r["walk"], "error": r["error"]} for r in rs if r["error"]]
         for tag, key in (("fixes", "fix_sources"), ("true_start", "fix_sources_true_start")):
             if tag == "fixes" or true_start:
@@ -304,6 +356,8 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
                 f"{IPIN_FLOOR_PENALTY_M:g} m x |floor error|, Matlab quantile)"
             )
             lines.append(f"  {loses_text(s)}")
+            if s.get("primary"):
+                lines.append(f"  {primary_text(s)}")
         lines.append(f"  {pdr_true_start_text(doc['format'], g)}")
         if "fix_sources" in g:
             text = format_fix_sources(g["fix_sources"], "pooled over the walks")

@@ -1,4 +1,4 @@
-"""bench real-targets: issue 11's targets read from realbench results files, misses named."""
+"""bench real-targets: the targets read from realbench results files, misses named."""
 
 from __future__ import annotations
 
@@ -120,3 +120,42 @@ def test_wall_time_is_the_fusion_files_total_per_floor(tmp_path):
     fusion.write_text(json.dumps(doc))
     rows, missed = realdata.check(realdata.load_groups([crowd, fusion]))
     assert "realbench site1/F2 realbench fusion wall time [s] <= 60: 229 (bound 60)" in missed
+
+
+def test_primary_every_fused_and_relative_targets():
+    """The primary pose is the row summary.primary names; 'every fused scheme' holds the worst fused
+    scheme (not pdr_only, wifi_only or the controller) to the bound; a bound relative to another row
+    (a scheme or a textbook reference) is that row's value times the factor."""
+    row = lambda ipin, floor=1.0: {"ipin_score": ipin, "floor_hit_rate": floor}  # noqa: E731
+    summary = {
+        "schemes": {
+            "pdr_only": row(12.0, 0.5),
+            "wifi_only": row(7.5, 0.9),
+            "kalman": row(5.0),
+            "ekf": row(6.0, 0.98),
+            "controller": row(5.1),
+        },
+        "references": {"reference_ekf": row(5.2)},
+        "primary": {"scheme": "controller", "follows": {"kalman": 3}},
+    }
+    groups = {realdata.IPIN2023: {"label": realdata.IPIN2023, "summary": summary}}
+    targets = (
+        realdata.Target(
+            realdata.IPIN2023, "first fix", realdata.PRIMARY, "ipin_score", 1.0, relative_to="reference_ekf"
+        ),
+        realdata.Target(
+            realdata.IPIN2023, "first fix", realdata.EVERY_FUSED, "ipin_score", 1.0, relative_to="wifi_only"
+        ),
+        realdata.Target(
+            realdata.IPIN2023, "first fix", realdata.EVERY_FUSED, "floor_hit_rate", 0.99, at_least=True
+        ),
+    )
+    rows, missed = realdata.check(groups, targets)
+    assert [(r["value"], r["bound"], r["met"]) for r in rows] == [
+        (5.1, 5.2, True),
+        (6.0, 7.5, True),
+        (0.98, 0.99, False),
+    ]
+    assert missed == [f"realbench {targets[2].describe()}: 0.98 (bound 0.99)"]
+    assert "every fused scheme floor_hit_rate >= 0.99" in targets[2].describe()
+    assert targets[0].describe().endswith("primary ipin_score <= 1 x reference_ekf")

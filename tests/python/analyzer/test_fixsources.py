@@ -6,7 +6,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-from stridefix import fix_t
+from stridefix import pose_t, fix_t
 from stridefix_analyzer import schemes
 from stridefix_analyzer.realbench import report as rb_report
 from stridefix_analyzer.realbench import summary as rb_summary
@@ -113,7 +113,13 @@ def test_realbench_pools_fix_sources_per_group_and_shows_them():
             {"walk": w, "group": "F2", "error": None, "fixes": {"kalman": row}, "fix_sources": {"fixes": fs}}
         )
     job_of = {
-        r["walk"]: SimpleNamespace(index=i, rotation_learned=True, dir="/nonexistent")
+        r["walk"]: SimpleNamespace(
+            index=i,
+            rotation_learned=True,
+            dir="/nonexistent",
+            variants={},
+            param_sets=[f"controller.init_scheme={pose_t.SCHEME_KALMAN}"],
+        )
         for i, r in enumerate(results)
     }
     walks = [{"waypoint_t_us": [0], "step_t_us": [], "import": {}, "floors": [0]} for _ in results]
@@ -123,6 +129,8 @@ def test_realbench_pools_fix_sources_per_group_and_shows_them():
     g = doc["groups"][0]
     # THEN the group pools them, each walk row keeps its own, the console and HTML show them
     assert g["fix_sources"]["kalman"]["gnss"]["offered"] == 5
+    # without the controller the primary pose is the copy of controller.init_scheme's (its --set here)
+    assert g["summary"]["primary"] == {"scheme": "kalman", "follows": {}}
     assert [r["fix_sources"]["kalman"]["gnss"]["accepted"] for r in g["walk_rows"]] == [2, 3]
     assert "fix_sources_true_start" not in g
     g["constants"] = {k: spread([1.0]) for k in ("K", "rotation_deg", "n_rp", "n_ap")}

@@ -68,12 +68,12 @@ def test_bench_controller_one_seed(stridefixd, cli, tmp_path):
 def _assert_primary_pose_channels(out: Path) -> None:
     """The walk's two logs: with the controller, POSE carries its pose only (scheme 8) and each fusion
     scheme its own POSE_<SCHEME>; with it disabled (the fixed schemes' run), POSE is a copy of one
-    scheme's pose (controller.init_scheme, ekf, or pdr_only before ekf has a position)."""
+    scheme's pose (controller.init_scheme, kalman, or pdr_only before kalman has a position)."""
     (ctl_log,) = out.rglob("campus2-s1/stridefixd.lcmlog")
     fixed_log = ctl_log.parent / "fixed" / "stridefixd.lcmlog"
     for log, primary in (
         (ctl_log, {pose_t.SCHEME_CONTROLLER}),
-        (fixed_log, {pose_t.SCHEME_EKF, pose_t.SCHEME_PDR_ONLY}),
+        (fixed_log, {pose_t.SCHEME_KALMAN, pose_t.SCHEME_PDR_ONLY}),
     ):
         schemes: dict[str, set[int]] = {}
         for e in lcm.EventLog(str(log), "r"):

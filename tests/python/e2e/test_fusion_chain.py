@@ -119,7 +119,7 @@ def test_every_scheme_publishes_pose_after_its_first_fix(walk):
 def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
     """Each fusion scheme's poses on POSE_<SCHEME> (its scheme field agreeing), and POSE the primary
     pose only: without a context map (this site has none) one per output, a copy of
-    controller.init_scheme's pose (ekf), pdr_only's while ekf has none; the POSE record's payload
+    controller.init_scheme's pose (kalman), pdr_only's while kalman has none; the POSE record's payload
     is the one its scheme's channel got just before, at the same log time."""
     last: dict[str, tuple[int, bytes]] = {}
     primary: list[int] = []
@@ -130,7 +130,7 @@ def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
         per_channel[e.channel] += 1
         p = pose_t.decode(e.data)
         if e.channel == "POSE":
-            assert p.scheme in (pose_t.SCHEME_EKF, pose_t.SCHEME_PDR_ONLY)
+            assert p.scheme in (pose_t.SCHEME_KALMAN, pose_t.SCHEME_PDR_ONLY)
             assert last[POSE_SCHEME_CHANNELS[p.scheme]] == (e.timestamp, e.data)
             primary.append(p.scheme)
         else:
@@ -139,7 +139,7 @@ def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
     assert sorted(per_channel) == sorted(POSE_CHANNELS)
     # one primary pose per output: as many as the scheme published most often
     assert per_channel["POSE"] == max(n for ch, n in per_channel.items() if ch != "POSE")
-    assert primary.count(pose_t.SCHEME_EKF) > 0.9 * len(primary)
+    assert primary.count(pose_t.SCHEME_KALMAN) > 0.9 * len(primary)
 
 
 @pytest.mark.parametrize(
@@ -147,8 +147,8 @@ def test_each_scheme_on_its_own_channel_and_the_primary_on_pose(walk):
     [
         # one scheme: its own channel, and POSE its copy (the primary of a one-scheme replay)
         (["--fusion", "kalman"], {"POSE_KALMAN", "POSE"}, pose_t.SCHEME_KALMAN),
-        # --channels picks pose channels one by one: the primary (ekf's copy here) without the rest
-        (["--channels", "POSE"], {"POSE"}, pose_t.SCHEME_EKF),
+        # --channels picks pose channels one by one: the primary (kalman's copy here) without the rest
+        (["--channels", "POSE"], {"POSE"}, pose_t.SCHEME_KALMAN),
         (["--channels", "POSE_PARTICLE"], {"POSE_PARTICLE"}, pose_t.SCHEME_PARTICLE),
     ],
     ids=["fusion-kalman", "channels-POSE", "channels-POSE_PARTICLE"],
