@@ -6,7 +6,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-from stridefix import pose_t, fix_t
+from stridefix import fix_t, pose_t
 from stridefix_analyzer import schemes
 from stridefix_analyzer.realbench import report as rb_report
 from stridefix_analyzer.realbench import summary as rb_summary
