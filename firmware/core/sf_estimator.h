@@ -52,7 +52,7 @@
  * primary pose never jumps at a switch. Without a context map nothing of this changes an output.
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
- * Memory: sizeof(sf_estimator_t) = 15 752 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
+ * Memory: sizeof(sf_estimator_t) = 15 768 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
  * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
  * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
  * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's

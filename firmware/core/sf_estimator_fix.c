@@ -101,8 +101,13 @@ static int wifi_fix(sf_estimator_t *const e, const sf_params_t *const p, const s
                       audits);
     }
     *has_fix = true;
-    sf_source_quality_reference(&e->quality, fix, e->x_m, e->y_m, e->distance_m);
-    return sf_estimator_offer_fix(e, p, fix, true, audits);
+    const int n = sf_estimator_offer_fix(e, p, fix, true, audits);
+    /* the reference for GNSS and BLE: a Wi-Fi fix the kalman scheme took (as for the stride): one it
+     * gated is off the walk, outdoors beyond the radio map or between its reference points */
+    if (audits[sf_scheme_kalman].accepted) {
+        sf_source_quality_reference(&e->quality, fix, e->x_m, e->y_m, e->distance_m);
+    }
+    return n;
 }
 
 /* A GNSS or BLE fix at the accuracy its source delivers on this walk (sf_source_quality.h). */

@@ -69,7 +69,10 @@ double sf_source_quality_judge(sf_source_quality_t *const q, const sf_params_t *
         s->claimed_m2 += w * (fix->accuracy_m * fix->accuracy_m - s->claimed_m2);
         s->square_m2 += w * (dx * dx + dy * dy - s->square_m2);
         const double gap_s = (double)(fix->t_us - s->prev_t_us) * 1e-6;
-        if (s->prev_t_us != INT64_MIN && gap_s >= 0.0 && gap_s <= p->quality_ref_max_age_s) {
+        /* a pair judged against one Wi-Fi fix shares that fix's error: only pairs across a new
+         * reference say how long the source's own error lasts */
+        if (s->prev_t_us != INT64_MIN && gap_s >= 0.0 && gap_s <= p->quality_ref_max_age_s &&
+            s->prev_ref_t_us != q->ref_t_us) {
             s->n_lag++;
             const double wl = 1.0 / fmin((double)s->n_lag, fmax(p->quality_memory_fixes, 1.0));
             s->lag_m2 += wl * (dx * s->prev_dx_m + dy * s->prev_dy_m - s->lag_m2);
@@ -77,6 +80,17 @@ double sf_source_quality_judge(sf_source_quality_t *const q, const sf_params_t *
         s->prev_dx_m = dx;
         s->prev_dy_m = dy;
         s->prev_t_us = fix->t_us;
+        s->prev_ref_t_us = q->ref_t_us;
+    } else if (s->n > 0 && isfinite(fix->accuracy_m)) {
+        /* no reference (outdoors, beyond the radio map): each fix moves the means toward a source as
+         * good as it claims, so what was learnt among the buildings fades where the source is all
+         * there is */
+        const double w = 1.0 / fmax(p->quality_memory_fixes, 1.0);
+        const double claim_m2 = fix->accuracy_m * fix->accuracy_m;
+        s->claimed_m2 += w * (claim_m2 - s->claimed_m2);
+        s->excess_m2 += w * (claim_m2 - s->excess_m2);
+        s->lag_m2 += w * (0.0 - s->lag_m2);
+        s->prev_t_us = INT64_MIN;
     }
     return factor_of(s, p);
 }

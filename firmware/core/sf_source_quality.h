@@ -7,7 +7,8 @@
  * claim it outweighs the radio map and the schemes gate the good Wi-Fi fixes out. The radio map's
  * fixes are the reference: the site measured them (sf_radiomap.h fix model), the others only report.
  *
- * Model. Reference r(t) = the latest Wi-Fi fix z_w + the PDR displacement since it, valid for
+ * Model. Reference r(t) = the latest Wi-Fi fix z_w the kalman scheme accepted (the caller's choice:
+ * one it gated is off the walk, as outdoors beyond the radio map) + the PDR displacement since it, valid for
  * quality_ref_max_age_s after that fix, per axis variance σ_w² (its accuracy²) + fusion_q_step_m2_per_m
  * × the distance walked since (the schemes' own PDR noise). For a fix z_s of source s with claimed
  * accuracy σ_s, d = z_s − r and, were both claims true, E[|d|²]/2 = σ_s² + σ_w² + σ_dr². Per source
@@ -17,16 +18,19 @@
  * Persistence: a source's errors outlast its fix interval (GNSS multipath, a beacon heard across the
  * slab: the same tens of metres for a minute), and the schemes fuse each fix as independent. With the
  * lag-one correlation of consecutive residuals ρ_s = mean(d_k·d_{k−1}) / mean(|d|²), clamped to
- * [0, quality_max_rho] (consecutive: at most quality_ref_max_age_s apart), n fixes carry the
+ * [0, quality_max_rho] (consecutive: at most quality_ref_max_age_s apart, and judged against two
+ * different Wi-Fi fixes, since a pair judged against one shares its error), n fixes carry the
  * information of n(1 − ρ)/(1 + ρ) independent ones (AR(1) errors), so the variance of each is
  * inflated by (1 + ρ)/(1 − ρ). The factor is
  *   k_s = clamp(√(max(e_s / c_s, 1) · (1 + ρ_s)/(1 − ρ_s)), 1, quality_max_factor)
  * once quality_min_fixes comparisons are in (1 before): the fix is offered with accuracy k_s·σ_s. A
  * source is never trusted more than it claims (k ≥ 1), and a walk with no Wi-Fi reference leaves
- * every factor at 1. Wi-Fi itself is not judged here (it is the reference; the schemes' gates and the
+ * every factor at 1. A fix without a fresh reference (outdoors, beyond the radio map) moves the means
+ * by the same weight toward a source as good as it claims (e_s → σ_s², the lag term → 0): where the
+ * source is all there is, what was learnt among the buildings fades over quality_memory_fixes fixes. Wi-Fi itself is not judged here (it is the reference; the schemes' gates and the
  * ekf's correlated-error state judge it).
  *
- * Cost: O(1) per fix (a sqrt). Memory: sizeof(sf_source_quality_t) = 192 B on x86-64 (at most 256 B,
+ * Cost: O(1) per fix (a sqrt). Memory: sizeof(sf_source_quality_t) = 208 B on x86-64 (at most 256 B,
  * checked). No heap, no I/O, no clock. Functions cannot fail; NULL arguments break the contract
  * (SF_ASSERT). */
 #ifndef SF_SOURCE_QUALITY_H
@@ -46,6 +50,7 @@ typedef struct {
     double lag_m2;     /* mean d_k·d_{k−1} of consecutive comparisons */
     double prev_dx_m, prev_dy_m;
     int64_t prev_t_us; /* INT64_MIN: none */
+    int64_t prev_ref_t_us; /* the reference it was judged against */
     uint32_t n;        /* comparisons so far (counter, never decreases) */
     uint32_t n_lag;    /* consecutive pairs so far */
 } sf_source_stats_t;
