@@ -55,8 +55,8 @@ double sf_source_quality_judge(sf_source_quality_t *const q, const sf_params_t *
     if (s == NULL) {
         return 1.0;
     }
-    const double age_s = (double)(fix->t_us - q->ref_t_us) * 1e-6;
-    const bool fresh = q->has_ref && age_s >= 0.0 && age_s <= p->quality_ref_max_age_s;
+    const bool fresh = q->has_ref && fix->t_us >= q->ref_t_us &&
+                       (double)(fix->t_us - q->ref_t_us) * 1e-6 <= p->quality_ref_max_age_s;
     if (fresh && isfinite(fix->x_m) && isfinite(fix->y_m) && isfinite(fix->accuracy_m)) {
         const double dx = fix->x_m - (q->ref_x_m + pdr_x_m - q->ref_pdr_x_m);
         const double dy = fix->y_m - (q->ref_y_m + pdr_y_m - q->ref_pdr_y_m);
@@ -68,11 +68,11 @@ double sf_source_quality_judge(sf_source_quality_t *const q, const sf_params_t *
         s->excess_m2 += w * (excess - s->excess_m2);
         s->claimed_m2 += w * (fix->accuracy_m * fix->accuracy_m - s->claimed_m2);
         s->square_m2 += w * (dx * dx + dy * dy - s->square_m2);
-        const double gap_s = (double)(fix->t_us - s->prev_t_us) * 1e-6;
         /* a pair judged against one Wi-Fi fix shares that fix's error: only pairs across a new
          * reference say how long the source's own error lasts */
-        if (s->prev_t_us != INT64_MIN && gap_s >= 0.0 && gap_s <= p->quality_ref_max_age_s &&
-            s->prev_ref_t_us != q->ref_t_us) {
+        const bool paired = s->prev_t_us != INT64_MIN && fix->t_us >= s->prev_t_us &&
+                            (double)(fix->t_us - s->prev_t_us) * 1e-6 <= p->quality_ref_max_age_s;
+        if (paired && s->prev_ref_t_us != q->ref_t_us) {
             s->n_lag++;
             const double wl = 1.0 / fmin((double)s->n_lag, fmax(p->quality_memory_fixes, 1.0));
             s->lag_m2 += wl * (dx * s->prev_dx_m + dy * s->prev_dy_m - s->lag_m2);
