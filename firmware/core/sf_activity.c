@@ -163,8 +163,15 @@ int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const s
         a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */
         return 0;
     }
+    /* the sway bound is the sway's rate at the fastest step rate (1 / activity_min_step_period_ms);
+     * at a slower cadence the same sway turns proportionally slower (A·2πf/√2) */
+    const int64_t gap_us = ev->t_us - a->last_detection_t_us;
+    const int64_t min_period_us = (int64_t)p->activity_min_step_period_ms * 1000;
+    const double cadence = gap_us > min_period_us && gap_us <= (int64_t)p->steps_max_period_ms * 1000
+                               ? (double)min_period_us / (double)gap_us
+                               : 1.0;
     if (a->rotation_radps > p->activity_max_rotation_radps ||
-        sf_activity_off_axis_radps(a) > p->activity_max_off_axis_radps) {
+        sf_activity_off_axis_radps(a) > p->activity_max_off_axis_radps * cadence) {
         /* turning faster than a walker turns, or about two axes at once: a gesture; the walk starts anew */
         a->rejected_steps++;
         a->turning_steps++;
