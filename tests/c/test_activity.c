@@ -454,6 +454,40 @@ static void test_two_axis_gesture_is_no_walk(void **state)
     assert_int_equal(a.turning_steps, 41);
 }
 
+/* Regression (ipin2023 Trial27 repetition01: 16 "steps" while the walker stood handling the phone in
+ * the 30 s before the walk, moving a truth-initialised start 8 m): detections of a hand that fidgets
+ * come at irregular intervals (0.4, 1.1, 1.4, 0.4, 0.7 s …), and each pair of them started a bout that
+ * the next one confirmed.
+ * GIVEN the default bout (3) and rhythm tolerance (activity_bout_rhythm = 0.35)
+ * WHEN detections come 0.4 s, then 1.1 s, 1.4 s, 0.4 s, 0.7 s, 0.3 s, 0.7 s apart (a moving body, a_v ±1)
+ * THEN none is credited; AND a walk that follows, 0.55 s apart with its second interval 20 % longer
+ * (gait initiation), is credited from its third step on. */
+static void test_arrhythmic_handling_is_no_walk(void **state)
+{
+    (void)state;
+    sf_params_t p;
+    sf_params_default(&p);
+    assert_int_equal(p.activity_bout_steps, 3);
+    assert_true(fabs(p.activity_bout_rhythm - 0.35) < 1e-12);
+    sf_activity_t a;
+    sf_activity_init(&a, &p);
+    int64_t t_us = shake(&a, &p, 0, 2000000, 1.0, 0.2);
+    const int64_t gaps_ms[7] = {400, 1100, 1400, 400, 700, 300, 700};
+    int credited = detect(&a, &p, t_us - 100000);
+    for (int i = 0; i < 7; i++) {
+        t_us = shake(&a, &p, t_us, t_us + gaps_ms[i] * 1000, 1.0, 0.2);
+        credited += detect(&a, &p, t_us - 100000);
+    }
+    assert_int_equal(credited, 0);
+    t_us = shake(&a, &p, t_us, t_us + 3000000, 1.0, 0.2);
+    const int64_t walk_ms[6] = {0, 550, 660, 550, 550, 550};
+    const int want[6] = {0, 0, 3, 1, 1, 1};
+    for (int i = 0; i < 6; i++) {
+        t_us = shake(&a, &p, t_us, t_us + walk_ms[i] * 1000, 1.0, 0.2);
+        assert_int_equal(detect(&a, &p, t_us - 100000), want[i]);
+    }
+}
+
 static void test_deterministic(void **state)
 {
     (void)state;
@@ -475,6 +509,7 @@ int main(void)
         cmocka_unit_test(test_walk_after_gesture),
         cmocka_unit_test(test_handling_is_no_walk),
         cmocka_unit_test(test_two_axis_gesture_is_no_walk),
+        cmocka_unit_test(test_arrhythmic_handling_is_no_walk),
         cmocka_unit_test(test_deterministic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
