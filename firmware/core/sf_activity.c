@@ -163,8 +163,15 @@ int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const s
         a->rejected_steps++; /* a quiet body, or one rising faster than stairs allow (a lift) */
         return 0;
     }
+    /* the sway bound is the sway's rate at the fastest step rate (1 / activity_min_step_period_ms);
+     * at a slower cadence the same sway turns proportionally slower (A·2πf/√2) */
+    const int64_t gap_us = ev->t_us - a->last_detection_t_us;
+    const int64_t min_period_us = (int64_t)p->activity_min_step_period_ms * 1000;
+    const double cadence = gap_us > min_period_us && gap_us <= (int64_t)p->steps_max_period_ms * 1000
+                               ? (double)min_period_us / (double)gap_us
+                               : 1.0;
     if (a->rotation_radps > p->activity_max_rotation_radps ||
-        sf_activity_off_axis_radps(a) > p->activity_max_off_axis_radps) {
+        sf_activity_off_axis_radps(a) > p->activity_max_off_axis_radps * cadence) {
         /* turning faster than a walker turns, or about two axes at once: a gesture; the walk starts anew */
         a->rejected_steps++;
         a->turning_steps++;
@@ -175,8 +182,14 @@ int sf_activity_step(sf_activity_t *const a, const sf_params_t *const p, const s
     const int64_t since_us = ev->t_us - a->last_detection_t_us;
     /* the next step of the same walk comes one gait period later: not sooner than a fast walker's
      * step (activity_min_step_period_ms) while the bout is unconfirmed, not later than steps_max_period_ms */
-    const bool in_bout = since_us <= (int64_t)p->steps_max_period_ms * 1000 &&
-                         (a->held_n == 0 || since_us >= (int64_t)p->activity_min_step_period_ms * 1000);
+    bool in_bout = since_us <= (int64_t)p->steps_max_period_ms * 1000 &&
+                   (a->held_n == 0 || since_us >= (int64_t)p->activity_min_step_period_ms * 1000);
+    if (in_bout && a->held_n >= 2 && p->activity_bout_rhythm > 0.0) {
+        /* a walk keeps its rhythm: the interval to this detection within the tolerance of the held one */
+        const double prev = (double)(a->held_t_us[a->held_n - 1] - a->held_t_us[a->held_n - 2]);
+        const double ratio = (double)since_us / prev;
+        in_bout = ratio <= 1.0 + p->activity_bout_rhythm && ratio * (1.0 + p->activity_bout_rhythm) >= 1.0;
+    }
     a->last_detection_t_us = ev->t_us;
     int credited = 0;
     if (!in_bout) {

@@ -36,7 +36,11 @@
  * errors e (axis × angle) feed the gyro: ω = ω_gyro − b̂ + Kp·e, and b̂ ← b̂ − Ki·e·δt (the integral
  * term). The gravity error uses attitude_mahony_kp on each IMU sample; the magnetometer error is the
  * yaw angle of the horizontal field only (rotation about nav z, mapped into body), so a magnetometer
- * error never tilts the attitude; it uses attitude_mahony_kp_mag at each accepted mag sample. Rest:
+ * error never tilts the attitude; it uses attitude_mahony_kp_mag at each accepted mag sample, and feeds
+ * the bias with its own integral gain attitude_mahony_ki_mag, 0 by default: indoors most of that error
+ * is a disturbance that passed the gates (steel bends the field by 10–40° over metres), and integrating
+ * it taught the bias a drift of its own (ipin2023, 25 hand-held walks, truth-initialised PDR: 7.55 →
+ * 5.90 m mean with it off, the 0.1 of the gravity integral before). Rest:
  * when |ω − b̂| < attitude_rest_gyro_radps and | |a| − g | < attitude_rest_accel_mps2 have both held
  * for attitude_rest_time_s, b̂ also low-passes the raw gyro (time constant attitude_rest_bias_tau_s),
  * much faster than the integral term. Each bias component is bounded by attitude_gyro_bias_max_radps,
@@ -56,9 +60,18 @@
  *     sample (hysteresis: accept again only after the field has been consistent for a while);
  *   - accepted: fused. The first accepted sample sets yaw outright and sets yaw_absolute; until then
  *     yaw starts at 0 (body x towards east) and yaw_absolute is false.
- * References start at attitude_mag_field_ut / attitude_mag_dip_deg and, when attitude_mag_learn_tau_s
- * > 0, follow the accepted samples with that time constant, bounded to configured ± tolerance, so a
- * slow local difference is learned but a disturbance can never walk the reference away.
+ * References start at attitude_mag_field_ut / attitude_mag_dip_deg. Acquisition: the references
+ * follow the *quiet* samples (|ω − b̂| < attitude_mag_acquire_gyro_radps: the dip needs the
+ * accelerometer's tilt, which a waved device does not give; exponential average over 2 s, the first
+ * quiet sample sets them; before it the acquisition's first sample sets them and the next ones are
+ * followed, so a device that never rests still gets its field) until those cover attitude_mag_acquire_s; what they reach is the anchor. When
+ * attitude_mag_learn_tau_s > 0 they then follow the accepted samples with that time constant, bounded
+ * to the anchor ± tolerance, so a slow local difference is learned but a disturbance can never walk
+ * the reference away. A field out of tolerance for attitude_mag_reacquire_s without one sample inside
+ * starts the acquisition again (counted in mag_reacquisitions): steel disturbs over metres, seconds of
+ * walking, so that long is a changed field or sensor calibration — a phone's OS refits its hard iron
+ * during the calibration gestures a walk starts with (51 → 40 µT within a minute on an IPIN 2023 log,
+ * which the first 10 s of acquisition took as the site's field, rejecting every later sample).
  * Time for the mag blend is the interval since the previous mag sample, clamped to [0, 0.2] s.
  *
  * Counters never decrease. Cost (callgrind, x86-64 -O3, `stridefix bench perf`'s sensors walk): ≈ 385
@@ -69,7 +82,7 @@
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
  * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at sf_qexp in sf_quat.h,
  * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory
- * sizeof(sf_attitude_t) = 344 B on x86-64 (316 B on i686; < 400 B, checked). No heap, no I/O, no clock, no
+ * sizeof(sf_attitude_t) = 376 B on x86-64 (< 400 B, checked). No heap, no I/O, no clock, no
  * hidden state: the same inputs give bit-identical outputs. Functions cannot fail (void); NULL arguments are
  * a contract violation (SF_ASSERT). */
 #ifndef SF_ATTITUDE_H
@@ -136,6 +149,11 @@ typedef struct {
     int64_t mag_acquire_start_t_us;
     double mag_anchor_field_ut;
     double mag_anchor_dip_rad;
+    bool mag_acquiring;          /* the references follow the quiet samples */
+    int32_t mag_acquire_n;       /* quiet samples taken by this acquisition */
+    double mag_acquired_s;       /* their time (sum of mag intervals) */
+    int64_t mag_last_ok_t_us;    /* last sample within tolerance (or the acquisition's start) */
+    uint32_t mag_reacquisitions; /* acquisitions restarted by attitude_mag_reacquire_s */
 
     /* health: counters never decrease */
     uint32_t mag_accepted;

@@ -232,17 +232,19 @@ int sf_estimator_imu(sf_estimator_t *const e, const sf_params_t *const p, const 
     if (!sf_steps_update(&e->steps, p, s->t_us, a_v, &ev)) {
         return 0;
     }
-    sf_heading_on_step(&e->heading, p, s->t_us);
     const sf_activity_t *const a = &e->activity;
     const int credited = sf_activity_step(&e->activity, p, &ev);
     if (credited == 0) {
         if (a->held_n > 0 && a->held_t_us[a->held_n - 1] == ev.t_us) {
             e->held_events[a->held_n - 1] = ev; /* a detection of a bout waits for its confirmation */
+            sf_heading_on_step(&e->heading, p, s->t_us);
         } else {
             e->steps_refused++;
+            sf_heading_discard_step(&e->heading, s->t_us); /* a gesture's window teaches no offset */
         }
         return 0;
     }
+    sf_heading_on_step(&e->heading, p, s->t_us);
     SF_ASSERT(credited <= SF_ESTIMATOR_MAX_STEPS);
     for (int i = 0; i < credited - 1; i++) {
         move(e, p, &e->held_events[i], s->t_us, &steps[i]);

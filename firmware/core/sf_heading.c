@@ -163,6 +163,13 @@ void sf_heading_on_step(sf_heading_t *const h, const sf_params_t *const p, const
     }
 }
 
+void sf_heading_discard_step(sf_heading_t *const h, const int64_t t_us)
+{
+    SF_ASSERT(h != NULL);
+    h->windows_discarded++;
+    restart_window(h, t_us);
+}
+
 double sf_heading_offset_rad(const sf_heading_t *const h, const sf_params_t *const p)
 {
     return h->confident && p->heading_learn_offset ? h->offset_rad : sf_wrap_pi(p->heading_mount_offset_deg * DEG);

@@ -35,13 +35,20 @@
  * msindoor walks) the gait-based offset wandered by 26° median over 10 s spans against 9° with the
  * fixed offset, whose constant part the site's map rotation absorbs.
  *
+ * Only detections the activity credits (or holds for a bout) close a window that is used: the estimator
+ * discards the window of a refused one (sf_heading_discard_step: a gesture, handling while standing),
+ * whose acceleration is no gait. The prior heading_mount_offset_deg should be the device's usual
+ * carriage — 0 for a board worn with x forward, 90 for an Android phone held in front (its y axis
+ * along the screen towards the top; the gsd and msindoor data sets set it) — since it is used until
+ * the estimate is confident.
+ *
  * A window counts only if it lasts 0.2–2.0 s and holds ≥ 4 samples (longer: standing between steps,
  * discarded). A sample interval ≤ 0 is skipped; one longer than 0.5 s restarts the vertical filters
  * and the open window (counted in gaps).
  *
  * Cost: O(1) per sample (~40 flops; sf_heading_update adds a sin/cos pair, sf_heading_update_dir
  * none: ≈ 100 instructions), O(1) per step (one atan2, one sqrt); memory
- * sizeof(sf_heading_t) = 312 B on x86-64 (296 B on i686; < 400 B, checked). No heap, I/O, clock or hidden
+ * sizeof(sf_heading_t) = 320 B on x86-64 (< 400 B, checked). No heap, I/O, clock or hidden
  * state: bit-identical outputs for the same inputs. Functions cannot fail (void); NULL arguments break the
  * contract (SF_ASSERT). */
 #ifndef SF_HEADING_H
@@ -88,6 +95,7 @@ typedef struct {
     uint32_t time_errors; /* interval ≤ 0 */
     uint32_t invalid;     /* non-finite input: sample skipped */
     uint32_t windows_rejected;
+    uint32_t windows_discarded; /* sf_heading_discard_step */
     sf_heading_step_audit_t last_step;
 } sf_heading_t;
 _Static_assert(sizeof(sf_heading_t) < 400, "sf_heading.h promises less than 400 B");
@@ -106,6 +114,12 @@ void sf_heading_update_dir(sf_heading_t *h, const sf_params_t *p, int64_t t_us, 
 
 /* A step was detected at t_us: closes the step window, updates the offset estimate. */
 void sf_heading_on_step(sf_heading_t *h, const sf_params_t *p, int64_t t_us);
+
+/* A detection at t_us that is not a step of a walk (the activity refused it: a gesture, handling the
+ * device while standing): closes the step window without using it (counted in windows_discarded).
+ * The calibration gestures a phone's walk begins with otherwise taught the offset a flipped axis
+ * (ipin2023: 170–180° off for the first seconds of the walk). */
+void sf_heading_discard_step(sf_heading_t *h, int64_t t_us);
 
 /* Mounting offset in use (rad, (−π, π]): the estimate when confident, else heading_mount_offset_deg. */
 double sf_heading_offset_rad(const sf_heading_t *h, const sf_params_t *p);

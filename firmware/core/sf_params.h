@@ -60,7 +60,8 @@
     X(attitude, mode,                int32_t, 1,       0,       1,       "",      "0 = complementary (Ramadhan 2016), 1 = Mahony (with gyro bias; the default: better heading in SIL)") \
     X(attitude, tau_s,               double,  0.75,    0.02,    30.0,    "s",     "complementary time constant: alpha = tau/(tau+dt)") \
     X(attitude, mahony_kp,           double,  1.0,     0.0,     20.0,    "1/s",   "Mahony proportional gain on the gravity error") \
-    X(attitude, mahony_ki,           double,  0.1,     0.0,     5.0,     "1/s2",  "Mahony integral gain (gyro bias) on gravity and yaw errors") \
+    X(attitude, mahony_ki,           double,  0.1,     0.0,     5.0,     "1/s2",  "Mahony integral gain (gyro bias) on the gravity error") \
+    X(attitude, mahony_ki_mag,       double,  0.0,     0.0,     5.0,     "1/s2",  "Mahony integral gain (gyro bias) on the magnetometer yaw error; 0: indoors that error is mostly disturbance (steel: 10-40 deg over metres), not bias; the bias is learnt at rest and from gravity") \
     X(attitude, mahony_kp_mag,       double,  1.0,     0.0,     20.0,    "1/s",   "Mahony proportional gain on the magnetometer yaw error") \
     X(attitude, accel_gate_mps2,     double,  2.0,     0.05,    50.0,    "m/s2",  "| |a| - g | above which the accelerometer does not correct tilt") \
     X(attitude, rest_gyro_radps,     double,  0.05,    0.001,   1.0,     "rad/s", "rest: bias-corrected gyro norm below this") \
@@ -75,6 +76,8 @@
     X(attitude, mag_dip_tol_deg,     double,  8.0,     0.1,     360.0,   "deg",   "accepted | dip - expected dip | (>= 180 = off)") \
     X(attitude, mag_settle_s,        double,  1.0,     0.0,     60.0,    "s",     "field consistent this long before use after a rejection") \
     X(attitude, mag_acquire_s,       double,  10.0,    0.0,     600.0,   "s",     "first seconds of magnetometer data: field/dip references follow the data (the site's field, unknown a priori); 0 = use mag_field_ut/mag_dip_deg") \
+    X(attitude, mag_acquire_gyro_radps, double, 1.0,   0.01,    100.0,   "rad/s", "acquisition uses a sample only while |gyro - bias| is below this: the dip needs the accelerometer's tilt, which calibration gestures (3-7 rad/s) spoil; a walk sways at <= 1 rad/s (sf_activity.h)") \
+    X(attitude, mag_reacquire_s,     double,  20.0,    0.0,     3600.0,  "s",     "field/dip out of tolerance this long without a break: acquire the references again (steel disturbs over metres, a few seconds of walking; longer is a changed site field or sensor calibration); 0 = never") \
     X(attitude, mag_learn_tau_s,     double,  60.0,    0.0,     3600.0,  "s",     "learn field/dip from accepted samples (0 = off); bounded to +-tol") \
     X(heading,  map_rotation_deg,    double,  0.0,     -360.0,  360.0,   "deg",   "map heading = ENU heading - rotation (set by the site file)") \
     X(heading,  mount_offset_deg,    double,  0.0,     -180.0,  180.0,   "deg",   "walking direction minus device yaw, until estimated") \
@@ -128,9 +131,10 @@
     X(activity, still_time_ms,     int32_t, 2000,    100,     60000,   "ms",    "no step for this long (and quiet) is still") \
     X(activity, step_window_ms,    int32_t, 2500,    500,     10000,   "ms",    "steps counted over this window for the step rate") \
     X(activity, min_steps,         int32_t, 2,       1,       8,       "steps", "steps in the window needed to be walking") \
-    X(activity, bout_steps,        int32_t, 2,       2,       8,       "steps", "detections held before a walk is credited: 2 = one gait cycle (4, two cycles, was worse on msindoor site1/F2)") \
+    X(activity, bout_steps,        int32_t, 3,       2,       8,       "steps", "detections held before a walk is credited: 3 = a gait cycle and the next step. A hand-held phone handled while standing (picked up, turned, the calibration figure-eights) makes detections in pairs, which one cycle (2) credited (ipin2023 truth-initialised PDR mean: 2: 6.79 m, 3: 6.32, 4: 5.68); 4 lost real short walks on msindoor (site1/F2 first-fix controller 4.32 -> 4.64 m)") \
+    X(activity, bout_rhythm,       double,  0.35,    0.0,     10.0,    "",      "a held bout continues only when the interval to a detection is within 1/(1+r) .. (1+r) of the held interval before it: steady walking varies 2-4 % step to step (Hausdorff 2005), gait initiation more; handling a phone while standing is arrhythmic; 0 = off") \
     X(activity, max_rotation_radps, double, 3.14159, 0.1,     100.0,   "rad/s", "mean |gyro| above which detections are gestures, not steps: a U-turn takes a walker at least one stride (1 s)") \
-    X(activity, max_off_axis_radps, double, 1.0,     0.1,     100.0,   "rad/s", "RMS gyro rate about the second principal axis above which detections are gestures: a walker turns about one axis at a time, the others only sway (5 deg at 2.5 Hz: 0.97 rad/s)") \
+    X(activity, max_off_axis_radps, double, 1.0,     0.1,     100.0,   "rad/s", "RMS gyro rate about the second principal axis above which detections are gestures: a walker turns about one axis at a time, the others only sway (5 deg at 2.5 Hz: 0.97 rad/s); at a slower cadence f the bound is this x f / 2.5 Hz, the same 5 deg sway") \
     X(activity, stairs_vspeed_mps, double,  0.15,    0.01,    5.0,     "m/s",   "|baro vertical speed| beyond this while stepping is stairs") \
     X(activity, elevator_vspeed_mps, double, 0.30,   0.01,    10.0,    "m/s",   "|baro vertical speed| beyond this without steps is an elevator") \
     X(floor,  height_m,            double,  3.5,     1.0,     20.0,    "m",     "uniform floor-to-floor height (until a site file gives a table)") \

@@ -5,7 +5,7 @@ Two things are learned from the training walks of a fold, both from the same sum
 
 * the map rotation: circular mean of (STEP heading − truth direction) over straight segments
   (:func:`learn_rotation_deg`);
-* the heading variant (gait-learned or fixed mounting offset, normal or wide magnetometer gate): the
+* the heading variant (gait-learned or fixed mounting offset, :data:`HEADING_VARIANTS`): the
   one whose headings agree best with the truth directions once the rotation is taken out
   (:func:`choose_heading_variant`; the heading axis of :mod:`.tuning`).
 """

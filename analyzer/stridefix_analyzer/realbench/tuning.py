@@ -5,8 +5,9 @@ Candidates are ``stridefixd --set KEY=VALUE`` lists (the first is the firmware d
 sees the prepared walks of one group and returns the candidate of every walk's fold, chosen from the
 *other* walks only (DESIGN.md, evaluation protocol):
 
-* ``heading`` (:class:`TruthAgreement`): gait-learned or fixed mounting offset × normal or wide
-  magnetometer gate; the one whose STEP headings agree best with the other walks' truth directions
+* ``heading`` (:class:`TruthAgreement`): gait-learned or fixed mounting offset (the wide magnetometer
+  gate is no candidate since the attitude acquires its references from quiet samples); the one whose
+  STEP headings agree best with the other walks' truth directions
   (:func:`.heading.choose_heading_variant`). A hand-held phone is not a body-worn board.
 * ``matcher`` (:class:`InnerCV`, :mod:`.select`): scans averaged (1 or 2) × WkNN representation (dBm
   or "powed"), by cross-validation inside the training walks on the Wi-Fi fix error.
