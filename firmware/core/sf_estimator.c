@@ -297,28 +297,37 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->scheme = sf_scheme_pdr_only;
 }
 
+bool sf_estimator_followed_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
+                                sf_pose_t *const pose)
+{
+    if (!sf_estimator_scheme_pose(e, p, scheme, pose)) {
+        return false;
+    }
+    if (e->handover_t_us != INT64_MIN && p->controller_handover_s > 0.0) {
+        /* the old scheme's position fades into the new one's; its offset stays in the variance */
+        const double age_s = (double)(pose->t_us - e->handover_t_us) * 1e-6;
+        const double w = age_s > 0.0 ? exp(-age_s / p->controller_handover_s) : 1.0;
+        const double dx = w * e->handover_dx_m, dy = w * e->handover_dy_m;
+        pose->x_m += dx;
+        pose->y_m += dy;
+        pose->cov_m2[0] += dx * dx;
+        pose->cov_m2[1] += dx * dy;
+        pose->cov_m2[2] += dy * dy;
+        pose->sigma_m = sqrt(0.5 * (pose->cov_m2[0] + pose->cov_m2[2]));
+    }
+    return true;
+}
+
 bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
                               sf_pose_t *const pose)
 {
     if (scheme == sf_scheme_controller) {
         const sf_controller_t *const c = &e->controller;
-        if (!sf_controller_active(c) || !sf_estimator_scheme_pose(e, p, sf_controller_scheme(c), pose)) {
+        if (!sf_controller_active(c) || !sf_estimator_followed_pose(e, p, sf_controller_scheme(c), pose)) {
             return false;
         }
         pose->scheme = sf_scheme_controller;
         pose->floor = sf_controller_pose_floor(c, p, sf_floor_current(&e->floor));
-        if (e->handover_t_us != INT64_MIN && p->controller_handover_s > 0.0) {
-            /* the old scheme's position fades into the new one's; its offset stays in the variance */
-            const double age_s = (double)(pose->t_us - e->handover_t_us) * 1e-6;
-            const double w = age_s > 0.0 ? exp(-age_s / p->controller_handover_s) : 1.0;
-            const double dx = w * e->handover_dx_m, dy = w * e->handover_dy_m;
-            pose->x_m += dx;
-            pose->y_m += dy;
-            pose->cov_m2[0] += dx * dx;
-            pose->cov_m2[1] += dx * dy;
-            pose->cov_m2[2] += dy * dy;
-            pose->sigma_m = sqrt(0.5 * (pose->cov_m2[0] + pose->cov_m2[2]));
-        }
         return true;
     }
     if (scheme < 0 || scheme >= sf_scheme_count) {

@@ -28,23 +28,30 @@ static void motion(const sf_estimator_t *const e, const sf_params_t *const p, co
                            .activity = sf_activity_current(&e->activity)};
 }
 
+/* The controller now follows another scheme than `from`: the primary pose hands over from where it
+ * was (the old scheme's pose with its own fading offset; an update leaves the schemes' poses as they
+ * are), without a jump. */
+static void hand_over(sf_estimator_t *const e, const sf_params_t *const p, const int from, const int64_t t_us)
+{
+    sf_pose_t was, now;
+    if (sf_controller_active(&e->controller) && sf_estimator_followed_pose(e, p, from, &was) &&
+        sf_estimator_scheme_pose(e, p, sf_controller_scheme(&e->controller), &now)) {
+        e->handover_t_us = t_us;
+        e->handover_dx_m = was.x_m - now.x_m;
+        e->handover_dy_m = was.y_m - now.y_m;
+    }
+}
+
 void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us)
 {
     sf_controller_t *const c = &e->controller;
     sf_ctl_motion_t m;
     motion(e, p, t_us, &m);
     const uint32_t switches = c->switches;
-    sf_pose_t before;
-    const bool had = sf_estimator_scheme_pose(e, p, sf_scheme_controller, &before);
     const int scheme_before = sf_controller_scheme(c);
     const bool queued = sf_controller_update(c, p, &m);
-    sf_pose_t after;
-    if (had && sf_controller_scheme(c) != scheme_before &&
-        sf_estimator_scheme_pose(e, p, sf_controller_scheme(c), &after)) {
-        /* another scheme: the primary pose hands over from where it was, without a jump */
-        e->handover_t_us = m.t_us;
-        e->handover_dx_m = before.x_m - after.x_m;
-        e->handover_dy_m = before.y_m - after.y_m;
+    if (sf_controller_scheme(c) != scheme_before) {
+        hand_over(e, p, scheme_before, m.t_us);
     }
     /* cppcheck-suppress knownConditionTrueFalse ; sf_controller_update counts switches through c */
     if (!queued || c->switches == switches) { /* no event, or none that switched */

@@ -153,10 +153,12 @@ static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf
     sf_fix_t vote = {.t_us = scan->t_us, .method = sf_fix_ble};
     const sf_context_map_t *const map = &e->site->contexts;
     const bool by_cdd = map->n_contexts > 0 && sf_cls_uses(map, sf_cls_all(map), sf_fix_ble);
-    const bool votes = by_cdd ? sf_cls_ble_floor(map, scan, &vote.floor) == SF_OK
-                              : p->ble_floor_vote_range_m > 0.0 &&
-                                    sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK;
-    if (e->floor_vote_active && votes) {
+    const bool votes =
+        e->floor_vote_active &&
+        (by_cdd ? sf_cls_ble_floor(map, scan, &vote.floor) == SF_OK
+                : p->ble_floor_vote_range_m > 0.0 &&
+                      sf_ble_nearest(&e->site->beacons, scan, p->ble_floor_vote_range_m, &vote) == SF_OK);
+    if (votes) {
         vote.n_ap_used = (int16_t)p->fingerprint_accuracy_ref_aps; /* a full-weight vote (sf_floor_vote.h) */
         vote_floor(e, p, &vote);
         e->ble_floor_votes++;

@@ -17,6 +17,10 @@ int sf_estimator_offer_fix(sf_estimator_t *e, const sf_params_t *p, const sf_fix
 int sf_estimator_refuse(sf_estimator_t *e, int64_t t_us, int8_t method, int16_t n_used, int8_t reason,
                         sf_fix_audit_t audits[sf_scheme_count]);
 
+/* The pose of a scheme the controller follows, with the fading hand-over offset of the last switch
+ * added (sf_estimator.h); false when the scheme has no pose. */
+bool sf_estimator_followed_pose(const sf_estimator_t *e, const sf_params_t *p, int scheme, sf_pose_t *pose);
+
 /* The controller steps on the motion of the scheme it follows at time t_us (after a credited step or
  * a source input); a switch to another floor renumbers the shared floor. */
 void sf_estimator_run_controller(sf_estimator_t *e, const sf_params_t *p, int64_t t_us);
