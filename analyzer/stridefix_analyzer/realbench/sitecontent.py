@@ -79,7 +79,6 @@ class GroupContent:
         """site_t fields of the fold without walk ``held`` (index into the group's walks; several for
         an inner cross-validation's site) and the fold's record (walls, openings, beacons, seconds
         spent)."""
-        out = {held} if isinstance(held, int) else set(held)
         t0 = time.perf_counter()
         fields: dict[str, Any] = {}
         rec: dict[str, Any] = {}
@@ -90,8 +89,8 @@ class GroupContent:
         if self.geo is not None:
             fields.update(self.geo)
         if self.placed:
-            train = [p for k, p in enumerate(self.placed) if k not in out]
-            ble = placed_beacons(merge_placed(train), dict(self.table) if self.table else None)  # type: ignore[arg-type]
+            train = train_placed(self, held) or merge_placed([])
+            ble = placed_beacons(train, dict(self.table) if self.table else None)  # type: ignore[arg-type]
             fields.update(ble["fields"])
             rec.update(beacons=len(ble["fields"].get("beacon_id", [])), ble_model=ble["report"].get("model"))
         rec["content_s"] = time.perf_counter() - t0
