@@ -86,3 +86,9 @@ CONTROLLER: str = scheme_name(pose_t.SCHEME_CONTROLLER)
 
 WIFI_ONLY: str = scheme_name(pose_t.SCHEME_WIFI_ONLY)
 """The Wi-Fi baseline's name (it follows Wi-Fi fixes only: the other sources are not its fixes)."""
+
+
+def is_fused(name: str) -> bool:
+    """Whether the scheme ``name`` fuses steps with fixes: every scheme but the two baselines
+    (``pdr_only`` takes no fix, ``wifi_only`` no step) and the controller, which follows one."""
+    return name not in (PDR_ONLY, WIFI_ONLY, CONTROLLER)

@@ -19,6 +19,8 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+from stridefix_analyzer.schemes import is_fused
+
 
 @dataclasses.dataclass(frozen=True)
 class Target:
@@ -89,8 +91,6 @@ TARGETS: tuple[Target, ...] = (
 )
 #: what the controller is compared with: the fusion schemes, not itself
 _NOT_FIXED = ("controller",)
-#: not fused schemes: the two Wi-Fi-only baselines' halves and the primary that copies one of them
-_NOT_FUSED = ("controller", "pdr_only", "wifi_only")
 
 #: the start mode of the crowd-map targets: the value is the crowd-built map's, the bound a factor of the
 #: truth-built map's (``realbench crowd-map``, first fix)
@@ -144,7 +144,7 @@ def _resolve(group: dict[str, Any], t: Target) -> list[str]:
         name = (summary.get("primary") or {}).get("scheme")
         return [name] if name else []
     if t.scheme == EVERY_FUSED:
-        return [n for n in (summary.get("schemes") or {}) if n not in _NOT_FUSED]
+        return [n for n in (summary.get("schemes") or {}) if is_fused(n)]
     return [t.scheme]
 
 

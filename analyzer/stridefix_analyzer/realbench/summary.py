@@ -117,9 +117,7 @@ def primary_text(summary: Mapping[str, Any]) -> str:
     follows = ", ".join(f"{v} in {n} folds" for v, n in pr.get("follows", {}).items())
     text = f"primary pose (POSE): {pr['scheme']}" + (f", following {follows}" if follows else "")
     row = table.get(pr["scheme"])
-    fused = {
-        n: r for n, r in table.items() if n not in (schemes.CONTROLLER, schemes.PDR_ONLY, schemes.WIFI_ONLY)
-    }
+    fused = {n: r for n, r in table.items() if schemes.is_fused(n)}
     if row and fused:
         for metric in LOSS_METRICS:
             best = min(fused, key=lambda n: fused[n][metric])
