@@ -90,7 +90,7 @@ class GroupContent:
             fields.update(self.geo)
         if self.placed:
             train = train_placed(self, held) or merge_placed([])
-            ble = placed_beacons(train, dict(self.table) if self.table else None)  # type: ignore[arg-type]
+            ble = placed_beacons(train, dict(self.table) if self.table else None)
             fields.update(ble["fields"])
             rec.update(beacons=len(ble["fields"].get("beacon_id", [])), ble_model=ble["report"].get("model"))
         rec["content_s"] = time.perf_counter() - t0
