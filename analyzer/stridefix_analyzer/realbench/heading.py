@@ -29,6 +29,19 @@ RotationSums = dict[str, Any]
 """``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments``, ``segments`` of one walk (:func:`rotation_stats`)."""
 
 
+def is_straight(
+    segment_m: float, heading_rad: np.ndarray, min_segment_m: float, min_steps: int, min_resultant: float
+) -> bool:
+    """Whether a segment between two waypoints ``segment_m`` apart was walked straight: at least
+    ``min_segment_m`` long, with ``min_steps`` or more steps whose unit headings (``heading_rad``,
+    finite) have a resultant length of at least ``min_resultant``."""
+    return bool(
+        segment_m >= min_segment_m
+        and len(heading_rad) >= min_steps
+        and np.hypot(np.cos(heading_rad).mean(), np.sin(heading_rad).mean()) >= min_resultant
+    )
+
+
 def rotation_stats(
     step_t_us: ArrayLike,
     step_heading_rad: ArrayLike,
@@ -60,12 +73,12 @@ def rotation_stats(
         seg_start_m = walked_m
         walked_m += float(np.hypot(*(wp[k + 1] - wp[k])))
         d = wp[k + 1] - wp[k]
-        if not (np.hypot(*d) >= min_segment_m) or wp_t_us[k + 1] <= wp_t_us[k]:
+        if wp_t_us[k + 1] <= wp_t_us[k]:
             continue
         i0, i1 = np.searchsorted(step_t_us, [wp_t_us[k], wp_t_us[k + 1]], side="right")
         hs = h[i0:i1]
         hs = hs[np.isfinite(hs)]
-        if len(hs) < min_steps or np.hypot(np.cos(hs).mean(), np.sin(hs).mean()) < min_resultant:
+        if not is_straight(float(np.hypot(*d)), hs, min_segment_m, min_steps, min_resultant):
             continue
         off = hs - math.atan2(d[1], d[0])
         out["sum_cos"] += float(np.cos(off).sum())

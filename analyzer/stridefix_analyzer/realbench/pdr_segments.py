@@ -31,6 +31,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from stridefix_analyzer.realbench.heading import is_straight
+from stridefix_analyzer.scoring.metrics import wrap_pi
+
 #: a segment shorter than this [m] has no usable direction (waypoint spacing in the IPIN logs: ~5–20 m)
 MIN_SEGMENT_M = 3.0
 #: straight: at least this many steps, their unit headings' resultant length at least this
@@ -51,10 +54,6 @@ SEGMENT_KEYS = (
     "heading_err_rad",
     "dist_ratio",
 )
-
-
-def _wrap(a: ArrayLike) -> np.ndarray:
-    return np.asarray((np.asarray(a, float) + math.pi) % (2 * math.pi) - math.pi)
 
 
 def segment_table(
@@ -87,15 +86,11 @@ def segment_table(
         true_m = float(np.hypot(*d))
         out["k"][k], out["t0_us"][k], out["t1_us"][k] = k, wt[k], wt[k + 1]
         out["true_m"][k], out["n_steps"][k], out["pdr_m"][k] = true_m, len(hs), float(ls.sum())
-        straight = (
-            true_m >= min_segment_m
-            and len(hs) >= min_steps
-            and math.hypot(float(np.cos(hs).mean()), float(np.sin(hs).mean())) >= min_resultant
-        )
+        straight = is_straight(true_m, hs, min_segment_m, min_steps, min_resultant)
         out["straight"][k] = straight
         if straight:
             dx, dy = float((ls * np.cos(hs)).sum()), float((ls * np.sin(hs)).sum())
-            out["heading_err_rad"][k] = float(_wrap(math.atan2(dy, dx) - math.atan2(d[1], d[0])))
+            out["heading_err_rad"][k] = float(wrap_pi(math.atan2(dy, dx) - math.atan2(d[1], d[0])))
             out["dist_ratio"][k] = float(ls.sum()) / true_m
     return out
 

@@ -36,6 +36,7 @@ from stridefix_analyzer.io.logread import Table
 from stridefix_analyzer.realbench.floors import DEFAULT_STOREY_M
 from stridefix_analyzer.realbench.reference_sensors import Fingerprints, Track, weinberg_k
 from stridefix_analyzer.realbench.strides import WEINBERG_EXPONENT
+from stridefix_analyzer.scoring.metrics import wrap_pi
 
 REFERENCE_PDR, REFERENCE_EKF = "reference_pdr", "reference_ekf"
 NAMES = (REFERENCE_PDR, REFERENCE_EKF)
@@ -63,10 +64,6 @@ class Start:
     heading_rad: float = math.nan
 
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2 * math.pi) - math.pi
-
-
 def _angle(dx: float, dy: float) -> float:
     """Heading [rad, clockwise from +y] of the vector (dx, dy)."""
     return math.atan2(dx, dy)
@@ -87,7 +84,7 @@ def start_offset_rad(track: Track, start: Start) -> float:
     psi = track.step_heading_rad[track.step_t_us > start.t_us][:START_STEPS]
     if not math.isfinite(start.heading_rad) or not len(psi):
         return 0.0
-    return _wrap(start.heading_rad - math.atan2(np.sin(psi).sum(), np.cos(psi).sum()))
+    return float(wrap_pi(start.heading_rad - math.atan2(np.sin(psi).sum(), np.cos(psi).sum())))
 
 
 def first_pose_t_us(track: Track, start: Start) -> int:
@@ -141,7 +138,7 @@ def run_pdr(
         while not learned and j < len(ft) and ft[j] <= ts:  # the first fixes give the offset, once
             d = fxy[j] - (start.x_m, start.y_m)
             if math.hypot(*d) >= OFFSET_MIN_SPAN_M and math.hypot(*u) > 0:
-                offset, learned = _wrap(_angle(*d) - _angle(*u)), True
+                offset, learned = float(wrap_pi(_angle(*d) - _angle(*u))), True
             j += 1
         u += (ln * math.sin(p), ln * math.cos(p))
         c, s = math.cos(offset), math.sin(offset)

@@ -118,7 +118,7 @@ def match_causal(pose: Table, truth: Table) -> Table:
     )
 
 
-def wrap_pi(angle_rad: np.ndarray) -> np.ndarray:
+def wrap_pi(angle_rad: ArrayLike) -> np.ndarray:
     """Angles wrapped to (−π, π] [rad]; NaN stays NaN."""
     a = np.asarray(angle_rad, dtype=np.float64)
     return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
