@@ -92,21 +92,14 @@ def _lowpass1(x: np.ndarray, dt_s: np.ndarray, tau_s: float) -> np.ndarray:
 
 
 def _butter2_filtfilt(x: np.ndarray, fs_hz: float, fc_hz: float) -> np.ndarray:
-    """2nd-order Butterworth low-pass (bilinear transform), run forward then backward (zero phase)."""
-    k = math.tan(math.pi * min(fc_hz, 0.45 * fs_hz) / fs_hz)
-    n = 1.0 / (1.0 + math.sqrt(2.0) * k + k * k)
-    b0, b1, b2 = k * k * n, 2 * k * k * n, k * k * n
-    a1, a2 = 2.0 * (k * k - 1.0) * n, (1.0 - math.sqrt(2.0) * k + k * k) * n
+    """2nd-order Butterworth low-pass (scipy.signal.butter: bilinear transform), run forward then
+    backward (zero phase), each pass started at rest on its first sample."""
+    from scipy import signal
 
-    def one(v: list[float]) -> list[float]:
-        out, x1, x2, y1, y2 = [], v[0], v[0], v[0], v[0]
-        for xi in v:
-            yi = b0 * xi + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2
-            out.append(yi)
-            x2, x1, y2, y1 = x1, xi, y1, yi
-        return out
-
-    return np.asarray(one(one(x.tolist())[::-1])[::-1])
+    b, a = signal.butter(2, min(fc_hz, 0.45 * fs_hz), fs=fs_hz)
+    zi = signal.lfilter_zi(b, a)
+    forward = signal.lfilter(b, a, x, zi=zi * x[0])[0]
+    return np.asarray(signal.lfilter(b, a, forward[::-1], zi=zi * forward[-1])[0][::-1])
 
 
 def device_heading(
