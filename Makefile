@@ -6,6 +6,8 @@ VENV ?= .venv
 CMAKE_BUILD_TYPE ?= RelWithDebInfo
 JOBS ?= 2
 PY := $(VENV)/bin/python
+# the lab (benchmarks, real-data benches, the papers' experiments): stridefix-lab
+LAB := $(PY) -m stridefix_lab.cli
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
@@ -83,49 +85,47 @@ IPIN2023 ?= ../shared/data/ipin2023
 # Every bench runs even when one misses its target; the goal fails at the end if any did.
 bench: build
 	@status=0; \
-	for b in sil-pdr aadr2015 office-wifi particle-cost perf sources controller crowd-scale; do \
-		$(PY) -m stridefix_analyzer.cli bench $$b --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
-	done; \
+	$(LAB) bench all --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
 	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \
 	if [ -d "$(MSINDOOR)" ]; then \
-		$(PY) -m stridefix_analyzer.cli crowd experiment --msindoor $(MSINDOOR) --check-targets \
+		$(LAB) crowd experiment --msindoor $(MSINDOOR) --check-targets \
 			--stridefixd $(STRIDEFIXD) --out out/bench/crowd || status=1; \
 	fi; \
 	results=""; \
 	for floor in $(MSINDOOR)/site1/F2 $(MSINDOOR)/site2/F3; do \
 		if [ -d "$$floor" ]; then \
 			name=$$(basename $$(dirname $$floor))-$$(basename $$floor); \
-			$(PY) -m stridefix_analyzer.cli realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
+			$(LAB) realbench pdr-distance --floor "$$floor" --stridefixd $(STRIDEFIXD) \
 				--out out/bench/realbench/$$name || status=1; \
-			$(PY) -m stridefix_analyzer.cli realbench --format msindoor "$$floor" --true-start --quiet \
+			$(LAB) realbench --format msindoor "$$floor" --true-start --quiet \
 				--stridefixd $(STRIDEFIXD) --out out/bench/realbench/$$name-fusion/results.json || status=1; \
 			results="$$results out/bench/realbench/$$name-fusion/results.json"; \
-			$(PY) -m stridefix_analyzer.cli realbench crowd-map --format msindoor "$$floor" --quiet \
+			$(LAB) realbench crowd-map --format msindoor "$$floor" --quiet \
 				--stridefixd $(STRIDEFIXD) --cache out/bench/realbench/$$name-fusion/cache \
 				--out out/bench/realbench/$$name-crowd-map/results.json || status=1; \
 			results="$$results out/bench/realbench/$$name-crowd-map/results.json"; \
 		else echo "bench: $$floor not found, real-data PDR check skipped"; fi; \
 	done; \
 	if [ -d "$(IPIN2023)" ]; then \
-		$(PY) -m stridefix_analyzer.cli realbench --format gsd "$(IPIN2023)" --true-start --quiet \
+		$(LAB) realbench --format gsd "$(IPIN2023)" --true-start --quiet \
 			--stridefixd $(STRIDEFIXD) --out out/bench/realbench/ipin2023-fusion/results.json || status=1; \
 		results="$$results out/bench/realbench/ipin2023-fusion/results.json"; \
 	fi; \
 	if [ -d "$(GSD)" ]; then \
-		$(PY) -m stridefix_analyzer.cli realbench --format gsd "$(GSD)" --true-start --quiet \
+		$(LAB) realbench --format gsd "$(GSD)" --true-start --quiet \
 			--stridefixd $(STRIDEFIXD) --out out/bench/realbench/gsd-fusion/results.json || status=1; \
 		results="$$results out/bench/realbench/gsd-fusion/results.json"; \
 	fi; \
-	$(PY) -m stridefix_analyzer.cli bench real-targets --stridefixd $(STRIDEFIXD) --results $$results || status=1; \
+	$(LAB) bench real-targets --stridefixd $(STRIDEFIXD) --results $$results || status=1; \
 	if [ $$status -ne 0 ]; then echo "bench: FAILED: a target was missed or a bench failed (TARGET MISSED lines above)"; fi; \
 	exit $$status
 
 # Issue 12: bus and board faults (exit 1 when a fault is not recovered) and the 8-hour soak; not in make test.
 reliability: build
-	$(PY) -m stridefix_analyzer.cli bench reliability --stridefixd $(STRIDEFIXD) --out out/bench
+	$(LAB) bench reliability --stridefixd $(STRIDEFIXD) --out out/bench
 
 soak: build
-	$(PY) -m stridefix_analyzer.cli bench soak --stridefixd $(STRIDEFIXD) --out out/bench
+	$(LAB) bench soak --stridefixd $(STRIDEFIXD) --out out/bench
 
 # Quality gates (CI runs them next to make test). check-static reads the generated CAN and LCM headers,
 # so it needs the build; the others are separate build trees with their own compiler, flags or target.

@@ -1,177 +1,46 @@
-"""The `stridefix` console script: one sub-command per job.
+"""The `stridefix` console script: one sub-command per job a user does on their own walks.
 
-Each sub-command lives in the module that does the work and contributes two functions:
-``add_parser(subparsers)`` (declares its arguments and help) and ``run(args) -> int`` (the exit status).
-A sub-command may also rewrite its own argument list before parsing (e.g. to supply a default
-sub-sub-command): :data:`ARGV_REWRITES` names that hook as ``"module:function"``, ``function(argv) ->
-argv``, applied only when that sub-command is the one given. This module registers and dispatches
-and nothing else; nothing imports from it.
-Exit status: the one contract of :mod:`stridefix_analyzer.exits` (0 ok, 1 failed while running, 2 bad
-usage or unreadable input, 3 nothing valid in the input), stated in every sub-command's ``--help``.
-Global options, before the sub-command: ``-q``/``-v`` (:mod:`stridefix_analyzer.console`: what the
-long-running commands print on stderr) and ``--version`` (the analyzer's and the stridefixd's it runs).
-Every ``--help`` goes through :mod:`stridefix_analyzer.helptext` (no docstring markup).
+Simulate a walk, import a data set, analyze and report a log, compare two runs, score a competition
+submission, build a radio map (from a survey or from crowdsourced walks), watch a walk live, inspect
+the channels. The machinery (registry, lazy import, global options, exit-status help) is
+:mod:`stridefix_analyzer.cliapp`; this module registers and dispatches and nothing else; nothing
+imports from it. Benchmarks and the papers' experiments are the lab's console script,
+``stridefix-lab`` (:mod:`stridefix_lab.cli`).
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import os
 import sys
-from collections.abc import Callable
 
-from stridefix_analyzer import __version__, console
-from stridefix_analyzer.exits import EXIT_FAILURE, HELP
-from stridefix_analyzer.helptext import plain_parser
+from stridefix_analyzer.cliapp import CommandLine, split_global
 
 # sub-command name -> module providing add_parser() and run()
 SUBCOMMANDS = {
     "sim": "stridefix_sim.cli",
+    "import": "stridefix_analyzer.datasets.cli",
     "analyze": "stridefix_analyzer.scoring.analyze",
     "report": "stridefix_analyzer.scoring.report",
-    "bench": "stridefix_analyzer.bench.cli",
-    "import": "stridefix_analyzer.datasets.cli",
-    "realbench": "stridefix_analyzer.realbench.cli",
-    "radiomap": "stridefix_analyzer.radiomap.cli",
-    "crowd": "stridefix_analyzer.crowd.cli",
     "compare": "stridefix_analyzer.scoring.compare",
     "score": "stridefix_analyzer.scoring.ipin_cli",
+    "radiomap": "stridefix_analyzer.radiomap.cli",
+    "crowd": "stridefix_analyzer.crowd.cli",
     "live": "stridefix_analyzer.live.server",
     "spy": "stridefix_analyzer.spy",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing
-ARGV_REWRITES = {
-    # `realbench --format ...` = `realbench fusion ...`
-    "realbench": "stridefix_analyzer.realbench.cli:with_default_bench",
-}
+ARGV_REWRITES: dict[str, str] = {}
 
-
-def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The ``stridefix`` parser with every sub-command, or with sub-command ``only`` alone.
-
-    ``only`` is how :func:`main` runs one sub-command: importing every sub-command's module (SciPy,
-    Matplotlib, the crowd and bench layers) took 1-3 s of each ``stridefix analyze`` on the shared
-    2-core machine, more than the analysis of a 1-hour walk, and the others' parsers are never used
-    once the first word names a sub-command."""
-    parser = argparse.ArgumentParser(
-        prog="stridefix",
-        description="StrideFix tools: simulate a walk, analyze LCM logs, render reports.",
-        epilog=HELP,
-    )
-    talk = parser.add_mutually_exclusive_group()
-    talk.add_argument(
-        *GLOBAL_QUIET,
-        dest="verbosity",
-        action="store_const",
-        const=console.QUIET,
-        default=console.NORMAL,
-        help="nothing on stderr but errors (no progress)",
-    )
-    talk.add_argument(
-        *GLOBAL_VERBOSE,
-        dest="verbosity",
-        action="store_const",
-        const=console.VERBOSE,
-        help="a line per step of the long-running commands instead of one progress bar",
-    )
-    parser.add_argument(
-        "--version",
-        action=_VersionAction,
-        help="the analyzer's version and that of the stridefixd it runs (--stridefixd's default)",
-    )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name, module_name in SUBCOMMANDS.items():
-        if only is not None and name != only:
-            continue
-        try:
-            module = importlib.import_module(module_name)
-        except ImportError as exc:
-            # One broken sub-command must not take the others down: it reports itself when used.
-            p = sub.add_parser(name, help=f"(unavailable: {exc})")
-            p.set_defaults(_run=_unavailable(name, exc))
-            continue
-        p = module.add_parser(sub)
-        _add_exit_help(p)
-        p.set_defaults(_run=module.run)
-    plain_parser(parser)
-    return parser
-
-
-GLOBAL_QUIET = ("-q", "--quiet")
-GLOBAL_VERBOSE = ("-v", "--verbose")
-
-
-def version_text() -> str:
-    """``stridefix --version``: this package's version, then the stridefixd that commands run by default
-    (its own ``--version`` line and path) or where it was looked for."""
-    from stridefix_analyzer.firmware import Firmware
-
-    fw = Firmware()
-    if fw.path.is_file() and os.access(fw.path, os.X_OK):
-        found = f"{fw.version()} at {fw.path}"
-    else:
-        found = f"stridefixd not found at {fw.path} (set $STRIDEFIXD, or put stridefixd on PATH)"
-    return f"stridefix {__version__} (analyzer)\n{found}"
-
-
-class _VersionAction(argparse.Action):
-    def __init__(self, option_strings: list[str], dest: str, **kwargs: object) -> None:
-        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help=kwargs.get("help"))  # type: ignore[arg-type]
-
-    def __call__(self, parser: argparse.ArgumentParser, *_: object) -> None:
-        print(version_text())
-        parser.exit()
-
-
-def _add_exit_help(parser: argparse.ArgumentParser) -> None:
-    """The exit-status paragraph at the end of ``parser``'s help and of its sub-commands' (if any)."""
-    parser.epilog = HELP if not parser.epilog else f"{parser.epilog}\n\n{HELP}"
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for child in set(action.choices.values()):
-                _add_exit_help(child)
-
-
-def _unavailable(name: str, exc: ImportError) -> Callable[[argparse.Namespace], int]:
-    def run(_args: argparse.Namespace) -> int:
-        print(f"stridefix {name}: unavailable: {exc}", file=sys.stderr)
-        return EXIT_FAILURE
-
-    return run
-
-
-def rewrite_argv(argv: list[str]) -> list[str]:
-    """``argv`` after the :data:`ARGV_REWRITES` hook of its sub-command (unchanged without one, or
-    when the hook's module does not import: the sub-command then reports itself)."""
-    ref = ARGV_REWRITES.get(argv[0]) if argv else None
-    if ref is None:
-        return argv
-    module_name, function = ref.split(":")
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError:
-        return argv
-    return list(getattr(module, function)(argv))
-
-
-def split_global(argv: list[str]) -> tuple[list[str], list[str]]:
-    """``argv`` as (the global -q/-v before the sub-command, the rest)."""
-    n = 0
-    while n < len(argv) and argv[n] in (*GLOBAL_QUIET, *GLOBAL_VERBOSE):
-        n += 1
-    return argv[:n], argv[n:]
-
-
-def main(argv: list[str] | None = None) -> int:
-    front, rest = split_global(sys.argv[1:] if argv is None else list(argv))
-    rest = rewrite_argv(rest)
-    chosen = rest[0] if rest and rest[0] in SUBCOMMANDS else None  # else: top-level help or a usage error
-    args = build_parser(chosen).parse_args([*front, *rest])
-    console.set_level(args.verbosity)
-    return int(args._run(args) or 0)
-
+APP = CommandLine(
+    prog="stridefix",
+    description="StrideFix tools: simulate a walk, analyze LCM logs, render reports.",
+    subcommands=SUBCOMMANDS,
+    argv_rewrites=ARGV_REWRITES,
+)
+build_parser = APP.build_parser
+rewrite_argv = APP.rewrite_argv
+main = APP.main
+__all__ = ["APP", "ARGV_REWRITES", "SUBCOMMANDS", "build_parser", "main", "rewrite_argv", "split_global"]
 
 if __name__ == "__main__":
     sys.exit(main())

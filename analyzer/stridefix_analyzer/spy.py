@@ -25,7 +25,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK
+from stridefix_common.exits import EXIT_FAILURE, EXIT_OK
 
 REPO = Path(__file__).resolve().parents[2]
 #: the build's Java types (lcmtypes/CMakeLists.txt); ``$STRIDEFIX_LCMTYPES_JAR`` overrides it

@@ -18,7 +18,7 @@ power; each beacon keeps its own. A world without a geo-reference gets the defau
 ``DIR/building.toml``.
 
 A world with building outlines (world_parts.py, e.g. ``campus2``) adds the context map of
-docs/building.md (constructed as the analyzer's ``BuildingOutline`` and ``PortExtra``): one
+docs/building.md (constructed as :mod:`stridefix_common.building`'s ``BuildingOutline`` and ``PortExtra``): one
 ``[[building]]`` per outline (its rectangle's corners counter-clockwise, its floors); each wall on the
 floors of the building that holds it; and each port's extras — its name (``<building>-stairs``,
 ``<building>-elevator``, the door's name), its building, ``outdoor = true`` for a door to the outside,
@@ -34,14 +34,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from stridefix_analyzer.radiomap.building import BuildingOutline, PortExtra, port_extra_lines
+from stridefix_common.building import FORMAT, BuildingOutline, PortExtra, port_extra_lines
 
 from .scenario_sources import SOURCE_DEFAULTS
 from .world import World
 from .world_parts import building_of
 from .world_sources import GeoRef
 
-FORMAT = "stridefix-building 1"
 DOOR_MARGIN_M = 0.5  # a door's port reaches this far beyond the door's half width
 
 

@@ -1,6 +1,6 @@
 """``stridefix sim``: run one software-in-the-loop scenario and write the board's CAN log plus truth.
 
-Exit status (:mod:`stridefix_analyzer.exits`, the contract of every ``stridefix`` command): 0 success,
+Exit status (:mod:`stridefix_common.exits`, the contract of every ``stridefix`` command): 0 success,
 1 the simulation failed or its output could not be written, 2 bad usage or unreadable input (scenario
 file missing, bad TOML, unknown key, value out of range).
 """
@@ -12,7 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE
+from stridefix_common.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE
 
 from .pipeline import CANDUMP_SUFFIXES, candump_path, simulate, write_outputs
 from .scenario import BUILTIN, ScenarioError, resolve_scenario

@@ -23,11 +23,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from stridefix_common.physics import AP_HEIGHT_M
 
 from .walker import Walk
 from .world import World
-
-AP_HEIGHT_M = 2.8
 
 
 @dataclass

@@ -5,8 +5,8 @@ Geo-reference (``GeoRef``): the map frame's origin on WGS-84 (latitude, longitud
 floor-0 walking surface) and its rotation: the map frame is the local east-north frame turned
 counter-clockwise by ``rotation_deg``, so a map vector (x, y) is east-north
 ``(x·cos θ − y·sin θ, x·sin θ + y·cos θ)``. Latitude/longitude come from the local tangent plane with the
-WGS-84 radii of curvature at the origin, the inverse of the analyzer's
-:func:`stridefix_analyzer.datasets.gsd_convert.project` (the firmware's sf_geo uses the same plane). The
+WGS-84 radii of curvature at the origin (:func:`stridefix_common.geodesy.unproject`, the inverse of
+the analyzer's projection; the firmware's sf_geo uses the same plane). The
 simulator has no magnetic declination, so a world's geo rotation equals its ``map_rotation_deg``.
 
 Beacons (``Beacon``): a BLE advertiser at (x, y) on a floor, ``z_m`` above that floor's surface, with
@@ -23,7 +23,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from stridefix_analyzer.datasets.gsd_convert import WGS84_A, WGS84_E2
+from stridefix_common.geodesy import unproject
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,6 @@ class GeoRef:
     origin_lon_deg: float = 8.5417
     origin_alt_m: float = 408.0
     rotation_deg: float = 20.0
-
-    def _radii(self) -> tuple[float, float]:
-        """(prime-vertical radius N, meridian radius M) at the origin [m]."""
-        phi0 = math.radians(self.origin_lat_deg)
-        w = 1.0 - WGS84_E2 * math.sin(phi0) ** 2
-        return WGS84_A / math.sqrt(w), WGS84_A * (1.0 - WGS84_E2) / w**1.5
 
     def map_to_en(self, x_m, y_m) -> tuple[np.ndarray, np.ndarray]:
         th = math.radians(self.rotation_deg)
@@ -51,11 +45,7 @@ class GeoRef:
 
     def en_to_latlon(self, e_m, n_m) -> tuple[np.ndarray, np.ndarray]:
         """Local east/north metres → (lat, lon) [deg] on the origin's tangent plane."""
-        n_rad, m_rad = self._radii()
-        phi0 = math.radians(self.origin_lat_deg)
-        lat = self.origin_lat_deg + np.degrees(np.asarray(n_m, float) / m_rad)
-        lon = self.origin_lon_deg + np.degrees(np.asarray(e_m, float) / (n_rad * math.cos(phi0)))
-        return lat, lon
+        return unproject(e_m, n_m, self.origin_lat_deg, self.origin_lon_deg)
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@
  * a Wi-Fi-like fix (σ 3 m) every 4th step, through the scheme's own calls (sf_fusion_step_on_floor,
  * sf_fusion_fix). callgrind counts the instructions inside those calls (--toggle-collect); the bench
  * divides by the number of calls. With "ekf" after STEPS the ekf scheme walks the same steps and fixes
- * instead (`stridefix bench perf`'s per-update figures). Prints the plan's figures; exit 0, 2 on bad
+ * instead (`stridefix-lab bench perf`'s per-update figures). Prints the plan's figures; exit 0, 2 on bad
  * usage. Usage: sf_particle_cost [STEPS [particle|ekf]] */
 #include <math.h>
 #include <stdbool.h>

@@ -1,4 +1,5 @@
-"""Fixtures shared by every Python test folder: the built stridefixd and the `stridefix` console script."""
+"""Fixtures shared by every Python test folder: the built stridefixd, the `stridefix` console script and
+the lab's `stridefix-lab`."""
 
 from __future__ import annotations
 
@@ -24,6 +25,12 @@ def stridefixd() -> Path:
 def run_cli(*args: str, **kwargs) -> subprocess.CompletedProcess:
     """Runs the `stridefix` console script of this venv."""
     exe = Path(sys.executable).with_name("stridefix")
+    return subprocess.run([str(exe), *args], capture_output=True, text=True, **kwargs)
+
+
+def run_lab(*args: str, **kwargs) -> subprocess.CompletedProcess:
+    """Runs the lab's `stridefix-lab` console script of this venv."""
+    exe = Path(sys.executable).with_name("stridefix-lab")
     return subprocess.run([str(exe), *args], capture_output=True, text=True, **kwargs)
 
 
@@ -61,3 +68,9 @@ def assert_reads_alike():
 def cli():
     """The `stridefix` console script, as a function of its arguments."""
     return run_cli
+
+
+@pytest.fixture(scope="session")
+def lab():
+    """The lab's `stridefix-lab` console script, as a function of its arguments."""
+    return run_lab

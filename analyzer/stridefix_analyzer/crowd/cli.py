@@ -3,22 +3,19 @@
 ``fit``        dissimilarity → distance model g(d) = max(X1, X2 + X3·d) from walks with ground truth:
                every scan pair on a floor (positions interpolated on the truth), exact streaming
                binning, bounded least squares on the bins → ``model.json`` + ``model_fit.png``.
-``models``     every candidate dissimilarity → distance model (feature × form × n* strata, the thesis's
-               as the reference row) fitted on K−1 folds of walks and scored on the held-out one
-               (R², RMSE, rank correlation); the best by held-out R² → ``models.json`` + ``models.png``
-               (:mod:`.select_model`).
 ``solve``      2-D positions of the points of a set of walks from anchors (a subset of the truth
                points) and range rows from PDR and/or the Wi-Fi model → ``solve.json``,
                ``positions.csv``, ``solve.png``; error at the non-anchor truth points.
 ``radiomap``   a site file built from the graph-solved positions (anchors every K-th truth point + the
                walk's steps, :mod:`.graph_run`) instead of the truth (the walk-mode builder of
                ``stridefix radiomap``); ``--truth-site`` also writes the truth-built one.
-``experiment`` the thesis's table in SIL (``--sil``) or on msindoor walks (``--msindoor DIR``), see
-               :mod:`.experiment`.
+
+The model search over candidate forms (``stridefix-lab crowd models``) and the thesis's experiment
+(``stridefix-lab crowd experiment``) are the lab's: :mod:`stridefix_lab.crowd`.
 
 Logs: an argument ``a.lcmlog,b.lcmlog`` is one walk (e.g. ``stridefixd.lcmlog,truth.lcmlog`` of a SIL
 run, or the firmware's replay log with the imported msindoor log); see :mod:`.walks`. This module
-only declares the actions; the work: :mod:`.fit`, :mod:`.positions`, :mod:`.sites`, :mod:`.experiment`
+only declares the actions; the work: :mod:`.fit`, :mod:`.positions`, :mod:`.sites`
 on top of :mod:`.model` (dissimilarity, binning, fit, filter), :mod:`.walks` (loading),
 :mod:`.solve` (problem, solvers, errors), :mod:`.plots`.
 """
@@ -30,48 +27,35 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from stridefix_analyzer.crowd import experiment
+from stridefix_common.exits import input_error_status
+
 from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd.fit import run_fit
 from stridefix_analyzer.crowd.graph_solve import SOLVERS as GRAPH_SOLVERS
 from stridefix_analyzer.crowd.positions import run_solve
-from stridefix_analyzer.crowd.select_model import DEFAULT_FOLDS, run_models
 from stridefix_analyzer.crowd.sites import run_radiomap
 from stridefix_analyzer.crowd.solve import RANGES, SOLVERS
-from stridefix_analyzer.crowd.walks import BANDS, DEFAULT_BAND, CrowdInputError
-from stridefix_analyzer.exits import input_error_status
+from stridefix_analyzer.crowd.walks import CrowdInputError, add_walk_arguments
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.parallel import add_jobs_argument, add_scheduler_argument
 
 # action -> its command (experiment returns its own exit status)
 ACTIONS: dict[str, Callable[[argparse.Namespace], Any]] = {
     "fit": run_fit,
-    "models": run_models,
     "solve": run_solve,
     "radiomap": run_radiomap,
 }
 
 
 def _common(p, solve_opts: bool) -> None:
-    p.add_argument(
-        "logs",
-        nargs="+",
-        metavar="LOG",
-        help="walks: 'a.lcmlog,b.lcmlog' = one walk (firmware log + truth log)",
-    )
-    p.add_argument(
-        "--band",
-        choices=BANDS,
-        default=DEFAULT_BAND,
-        help=f"APs used: 2.4 GHz only as the thesis, or all (default {DEFAULT_BAND})",
-    )
+    add_walk_arguments(p)
     if not solve_opts:
         return
     p.add_argument(
         "--model",
         default=None,
         metavar="model.json",
-        help="pair model from `crowd models` or `crowd fit` (needed for --ranges wifi/both/hybrid; "
+        help="pair model from `crowd fit` or `stridefix-lab crowd models` (needed for --ranges wifi/both/hybrid; "
         "with graph it adds Wi-Fi loop closures)",
     )
     p.add_argument(
@@ -128,7 +112,7 @@ def _common(p, solve_opts: bool) -> None:
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "crowd",
-        help="crowdsourced Wi-Fi model (Kannan 2024): fit, solve, radio map, experiment",
+        help="crowdsourced Wi-Fi model (Kannan 2024): fit, solve, radio map",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -169,19 +153,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default="float64",
         help="arithmetic of the pair blocks (float32: ~2x faster at fleet scale) (default float64)",
     )
-    mo = sub.add_parser("models", help="candidate models chosen by held-out fit → models.json + plot")
-    _common(mo, False)
-    mo.add_argument("--out", required=True, metavar="DIR")
-    mo.add_argument(
-        "--folds", type=int, default=DEFAULT_FOLDS, help=f"folds by walk (default {DEFAULT_FOLDS})"
-    )
-    mo.add_argument(
-        "--candidates",
-        nargs="+",
-        default=None,
-        metavar="FORM/FEATURE[@n*]",
-        help="only these candidates (default all), e.g. thesis/common_sum isotonic/cosine@n*",
-    )
     s = sub.add_parser("solve", help="positions of the walks' points from anchors + ranges")
     _common(s, True)
     s.add_argument("--out", required=True, metavar="DIR")
@@ -210,16 +181,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     )
     r.add_argument("--cell-size-m", type=float, default=2.0, help="walk-mode grid cell [m]")
     r.add_argument("--map-rotation-deg", type=float, default=0.0)
-    e = sub.add_parser("experiment", help="the thesis's table: --sil or --msindoor DIR")
-    experiment.add_arguments(e)
     return p
 
 
 def run(args: argparse.Namespace) -> int:
     prog = f"stridefix crowd {args.crowd_command}"
     try:
-        if args.crowd_command == "experiment":
-            return experiment.run_experiment(args)
         ACTIONS[args.crowd_command](args)
     except (LogReadError, CrowdInputError) as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)

@@ -37,6 +37,22 @@ DEFAULT_BAND = "2.4"
 DEFAULT_BORROW_S = 2.0
 
 
+def add_walk_arguments(p) -> None:
+    """The arguments every crowd command takes: the walks (``LOG``) and the Wi-Fi band."""
+    p.add_argument(
+        "logs",
+        nargs="+",
+        metavar="LOG",
+        help="walks: 'a.lcmlog,b.lcmlog' = one walk (firmware log + truth log)",
+    )
+    p.add_argument(
+        "--band",
+        choices=BANDS,
+        default=DEFAULT_BAND,
+        help=f"APs used: 2.4 GHz only as the thesis, or all (default {DEFAULT_BAND})",
+    )
+
+
 class CrowdInputError(Exception):
     """The logs cannot be used (no WIFI, no TRUTH, no STEP where needed). The message says why."""
 

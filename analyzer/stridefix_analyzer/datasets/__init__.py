@@ -2,7 +2,7 @@
 
 Every module of this package that defines ``DATASET`` (an instance of
 :class:`~.protocol.Dataset`) is a data set: :func:`get` and :func:`names` find it without a list to
-edit, so ``stridefix import``, ``stridefix realbench --format`` and crowd's walks pick a new set up
+edit, so ``stridefix import``, ``stridefix-lab realbench --format`` and crowd's walks pick a new set up
 from its module alone. :func:`register` adds one from elsewhere (a plug-in, a test).
 """
 

@@ -6,7 +6,7 @@ every format shares, then the set's own options (:meth:`~.protocol.Dataset.add_a
 ``--json``. Every format writes either one log per input into a directory (``--out DIR``:
 ``DIR/<input-stem>.lcmlog``) or, for a single input, one named file (``-o/--output FILE``):
 :func:`add_output_arguments`, :func:`output_paths`.
-Exit status (:mod:`stridefix_analyzer.exits`): 0 every input imported, 1 an output could not be
+Exit status (:mod:`stridefix_common.exits`): 0 every input imported, 1 an output could not be
 written, 2 bad usage or a missing/unreadable input, 3 an input held no valid sensor record (nothing
 written for it); with several inputs the worst of theirs.
 """
@@ -22,10 +22,11 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from stridefix_common.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, input_error_status, worst
+
 from stridefix_analyzer import console, datasets
 from stridefix_analyzer.datasets.lines import MalformedLineWarning
 from stridefix_analyzer.datasets.protocol import Dataset, DatasetReadError
-from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, input_error_status, worst
 
 
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:

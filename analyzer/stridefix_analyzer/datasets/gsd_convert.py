@@ -19,7 +19,7 @@ kept, the calibration minute included; the truth starts at the first POSI.
   into windows of :data:`~.rawwalk.BLE_WINDOW_S` (:func:`~.rawwalk.ble_scans`: the app logs one
   record per advertisement, with no scan grouping of its own).
 * ``truth``: POSI latitude/longitude → local metres, x east and y north, by a local tangent plane about
-  an origin (:func:`project`); floor = the floor id. The building ids go into ``meta``.
+  an origin (:func:`stridefix_common.geodesy.project`); floor = the floor id. The building ids go into ``meta``.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from stridefix_common.geodesy import project
 
 from stridefix_analyzer.datasets.gsd_parse import INERTIAL, GsdRecords
 from stridefix_analyzer.datasets.rawwalk import RawWalk, ble_scans, dedupe_sorted, gyro_at, wifi_scans
@@ -36,34 +37,6 @@ from stridefix_analyzer.io.logread import Table
 WIFI_GROUP_S = 0.010
 #: The sensor → app clock offset is the median over the inertial samples of the first S seconds.
 CLOCK_ALIGN_S = 10.0
-#: WGS-84 semi-major axis [m] and first eccentricity squared.
-WGS84_A = 6378137.0
-WGS84_E2 = 6.69437999014e-3
-
-
-def project(
-    lat_deg: np.ndarray | list[float],
-    lon_deg: np.ndarray | list[float],
-    origin_lat_deg: float,
-    origin_lon_deg: float,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Latitude/longitude [deg] → local metres (x east, y north) about the origin.
-
-    A local tangent plane with the WGS-84 radii of curvature at the origin's latitude φ0:
-    ``x = N(φ0)·cos φ0·(λ − λ0)``, ``y = M(φ0)·(φ − φ0)`` (angles in radians), with the
-    prime-vertical radius ``N = a / sqrt(1 − e²·sin²φ0)`` and the meridian radius
-    ``M = a·(1 − e²) / (1 − e²·sin²φ0)^1.5``.
-    Over a building (< 1 km) it differs from a full ENU conversion by millimetres.
-    """
-    phi0 = math.radians(origin_lat_deg)
-    w = 1.0 - WGS84_E2 * math.sin(phi0) ** 2
-    n = WGS84_A / math.sqrt(w)
-    m = WGS84_A * (1.0 - WGS84_E2) / w**1.5
-    lat = np.asarray(lat_deg, dtype=np.float64)
-    lon = np.asarray(lon_deg, dtype=np.float64)
-    x = n * math.cos(phi0) * np.radians(lon - origin_lon_deg)
-    y = m * np.radians(lat - origin_lat_deg)
-    return x, y
 
 
 def parse_origin(text: str) -> tuple[float, float]:

@@ -30,10 +30,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, ClassVar
 
+from stridefix_common.exits import NothingValid
+
 from stridefix_analyzer.datasets.lcmwrite import write_lcmlog
 from stridefix_analyzer.datasets.lines import not_text_hint
 from stridefix_analyzer.datasets.rawwalk import RawWalk
-from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import Table
 
 PathLike = str | os.PathLike[str]
@@ -55,7 +56,7 @@ class DatasetReadError(DatasetError):
 class NothingValidError(DatasetReadError, NothingValid):
     """A walk's file was read but held not one valid sensor record (empty, binary, UTF-16, a header
     only): nothing is written, ``stridefix import`` exits
-    :data:`~stridefix_analyzer.exits.EXIT_NOTHING_VALID`. The message names the file, what was read,
+    :data:`~stridefix_common.exits.EXIT_NOTHING_VALID`. The message names the file, what was read,
     and the first malformed line."""
 
 

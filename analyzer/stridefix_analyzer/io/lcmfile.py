@@ -12,8 +12,7 @@ from collections.abc import Callable
 from typing import Any, BinaryIO
 
 import lcm
-
-from stridefix_analyzer.exits import NothingValid
+from stridefix_common.exits import NothingValid
 
 
 class LogReadError(Exception):

@@ -20,18 +20,22 @@ from typing import Any
 
 import numpy as np
 import tomllib
+from stridefix_common.building import (
+    FORMAT,
+    PORT_EXTRA_KEYS,
+    PORT_KIND_CODES,
+    BuildingOutline,
+    PortExtra,
+    port_extra_lines,
+)
+from stridefix_common.geodesy import project
 
-from stridefix_analyzer.datasets.gsd_convert import project
 from stridefix_analyzer.datasets.rawwalk import bssid_to_int
 from stridefix_analyzer.radiomap.building_contexts import (
-    PORT_EXTRA_KEYS,
-    BuildingOutline,
     ContextSpec,
-    PortExtra,
     context_tables_toml,
     parse_context_tables,
     parse_port_extra,
-    port_extra_lines,
 )
 
 __all__ = [
@@ -44,9 +48,6 @@ __all__ = [
     "merge_building",
     "read_building",
 ]
-
-FORMAT = "stridefix-building 1"
-PORT_KIND_CODES = {"door": 1, "stairs": 2, "elevator": 3}
 
 
 class BuildingError(ValueError):

@@ -9,11 +9,17 @@ floors), the ``[[port]]`` extras (name, building, outdoor, steps, ends, links) a
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from typing import Any
 
 from stridefix import pose_t
+from stridefix_common.building import (
+    PORT_EXTRA_KEYS,
+    BuildingOutline,
+    PortExtra,
+    toml_point,
+    toml_string,
+)
 
 from stridefix_analyzer.schemes import NAMES as SCHEME_NAMES
 
@@ -22,30 +28,6 @@ CONTEXT_KIND_NAMES = ("outdoor", "building", "floor")
 METHOD_NAMES = ("wifi", "ble", "gnss")
 #: The fusion schemes a context may use (every pose_t scheme but the controller itself).
 FUSION_SCHEMES = tuple(SCHEME_NAMES[: pose_t.SCHEME_CONTROLLER])
-PORT_EXTRA_KEYS = {"name", "building", "outdoor", "steps", "ends", "links"}
-
-
-@dataclasses.dataclass
-class BuildingOutline:
-    """A building: unique name, outline polygon (map frame [m], ≥ 3 vertices, closed implicitly) and
-    its floor indices."""
-
-    name: str
-    outline: list[tuple[float, float]]
-    floors: list[int]
-
-
-@dataclasses.dataclass
-class PortExtra:
-    """The controller's extras of one ``Building.ports`` row (same order)."""
-
-    name: str = ""  # unique when given; links refer to it
-    building: str | None = None  # BuildingOutline.name, None: an outdoor port
-    outdoor: bool = False  # leads outdoors (a door with an outdoor neighbour)
-    steps: int = 0  # stairs: steps end to end (> 0); others 0
-    end_lo: tuple[float, float] | None = None  # stairs: endpoint on the lowest floor (None: centre)
-    end_hi: tuple[float, float] | None = None  # stairs: endpoint on the highest floor
-    links: list[str] = dataclasses.field(default_factory=list)  # names of reachable ports
 
 
 @dataclasses.dataclass
@@ -227,41 +209,17 @@ def parse_context_tables(
     return buildings, extras, _contexts(path, doc, buildings, error)
 
 
-def _pt(p: tuple[float, float]) -> str:
-    return f"[{p[0]!r}, {p[1]!r}]"
-
-
-def _s(v: str) -> str:
-    return json.dumps(v, ensure_ascii=False)  # a TOML basic string
-
-
-def port_extra_lines(e: PortExtra, centre: tuple[float, float]) -> list[str]:
-    """The ``[[port]]`` lines of one port's extras (``outdoor`` always, so the extras round-trip; a
-    missing stairs endpoint beside a given one is written as the port's ``centre``)."""
-    out = [f"name = {_s(e.name)}"] if e.name else []
-    if e.building is not None:
-        out.append(f"building = {_s(e.building)}")
-    out.append(f"outdoor = {'true' if e.outdoor else 'false'}")
-    if e.steps:
-        out.append(f"steps = {e.steps}")
-    if e.end_lo is not None or e.end_hi is not None:
-        out.append(f"ends = [{_pt(e.end_lo or centre)}, {_pt(e.end_hi or centre)}]")
-    if e.links:
-        out.append("links = [" + ", ".join(_s(n) for n in e.links) + "]")
-    return out
-
-
 def context_tables_toml(buildings: list[BuildingOutline], contexts: list[ContextSpec]) -> list[str]:
     """The ``[[building]]`` and ``[[context]]`` lines (port extras: :func:`port_extra_lines`)."""
     out: list[str] = []
     for b in buildings:
-        out += ["", "[[building]]", f"name = {_s(b.name)}"]
-        out.append("outline = [" + ", ".join(_pt(p) for p in b.outline) + "]")
+        out += ["", "[[building]]", f"name = {toml_string(b.name)}"]
+        out.append("outline = [" + ", ".join(toml_point(p) for p in b.outline) + "]")
         out.append("floors = [" + ", ".join(str(f) for f in b.floors) + "]")
     for c in contexts:
         out += ["", "[[context]]", f'kind = "{c.kind}"']
         if c.building is not None:
-            out.append(f"building = {_s(c.building)}")
+            out.append(f"building = {toml_string(c.building)}")
         if c.floor is not None:
             out.append(f"floor = {c.floor}")
         if c.scheme is not None:

@@ -1,37 +1,29 @@
 """``stridefix radiomap build|show``: the command line of the radio-map builder.
 
-``build`` reads the logs (:mod:`.recordings`; one task per argument on ``--scheduler``, see
-:mod:`stridefix_analyzer.parallel`), builds the site (:func:`~.build.build_site`) and writes it; ``show`` checks a site file and prints its summary (and a PNG, :mod:`.show`).
+``build`` declares the options of :class:`~.make.SiteOptions` and calls :func:`~.make.make_site` (the
+logs read on ``--scheduler``, the site built and written); ``show`` checks a site file and prints its
+summary (and a PNG, :mod:`.show`). This module only declares and dispatches.
 """
 
 from __future__ import annotations
 
 import argparse
-import os
+import dataclasses
 import sys
 
-import numpy as np
-from stridefix import site_t
+from stridefix_common.exits import input_error_status
 
-from stridefix_analyzer.exits import input_error_status
-from stridefix_analyzer.io.logread import LogReadError
-from stridefix_analyzer.io.sitefile import SiteFileError, read_site, write_site
+from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.parallel import (
-    SchedulerError,
-    WorkerFiles,
     add_jobs_argument,
     add_scheduler_argument,
-    is_remote,
-    task_runner,
 )
 from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
-from stridefix_analyzer.radiomap.build import MODES, build_site
-from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
-from stridefix_analyzer.radiomap.contexts import ContextMapError, build_context_map, context_map_summary
-from stridefix_analyzer.radiomap.floorplan import FloorPlanError
+from stridefix_analyzer.radiomap.build import MODES
+from stridefix_analyzer.radiomap.contexts import context_map_summary
 from stridefix_analyzer.radiomap.grid import DEFAULT_CELL_SIZE_M
+from stridefix_analyzer.radiomap.make import INPUT_ERRORS, SiteOptions, make_site
 from stridefix_analyzer.radiomap.placement import DEFAULT_SCAN_DURATION_MS, DEFAULT_STATIC_TOL_M
-from stridefix_analyzer.radiomap.recordings import RadioMapInputError, arg_files, load_recordings
 from stridefix_analyzer.radiomap.show import format_summary, plot_site
 
 
@@ -40,29 +32,6 @@ def _float_list(text: str) -> list[float]:
         return [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list of numbers") from None
-
-
-def read_beacon_table(path: str, origin: tuple[float, float]) -> dict[str, tuple[float, float, int]]:
-    """A beacon table CSV (bleID, Lat, Lon, floor) → name → (x, y, floor) in the frame about origin."""
-    import csv
-
-    from stridefix_analyzer.datasets.gsd_convert import project
-
-    try:
-        with open(path, encoding="utf-8", newline="") as f:
-            rows = list(csv.DictReader(f))
-        out = {}
-        i = 0
-        for i, r in enumerate(rows):  # noqa: B007 - i names the row in the message
-            x, y = project([float(r["Lat"])], [float(r["Lon"])], *origin)
-            out[r["bleID"]] = (float(x[0]), float(y[0]), int(r["floor"]))
-    except OSError as exc:
-        raise RadioMapInputError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    except (KeyError, ValueError) as exc:
-        raise RadioMapInputError(
-            f"{path}: row {i + 2}: bad field {exc} (needs bleID,Lat,Lon,floor)"
-        ) from None
-    return out
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -208,86 +177,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def add_floor_plan(site: site_t, recordings: list, args: argparse.Namespace) -> dict:
-    """Walls and geo-reference of ``--floor-plan`` written into ``site``; returns the plan report."""
-    from stridefix_analyzer.io.sitefile import set_counts
-    from stridefix_analyzer.radiomap.floorplan import load_plan, site_plan
-
-    plan = load_plan(args.floor_plan, args.floor_info)
-    xy = [np.column_stack([r.truth["x_m"], r.truth["y_m"]]) for r in recordings]
-    floors = [np.asarray(r.truth["floor"], np.int64) for r in recordings]
-    seen = sorted({int(f) for fl in floors for f in fl})
-    floor = args.plan_floor
-    if floor is None:
-        if len(seen) != 1:
-            raise RadioMapInputError(f"--floor-plan: the walks are on floors {seen}: give --plan-floor N")
-        floor = seen[0]
-    on = [fl == floor for fl in floors]
-    fields, report = site_plan(
-        plan,
-        [p[m] for p, m in zip(xy, on)],
-        [f[m] for f, m in zip(floors, on)],
-        floor,
-        min_room_area_m2=args.min_room_area_m2,
-    )
-    for k, v in fields.items():
-        setattr(site, k, v)
-    set_counts(site)
-    site.source = f"{site.source}; floor plan {os.path.basename(args.floor_plan)}"
-    return report
-
-
-def run_build(args: argparse.Namespace) -> tuple[site_t, dict]:
-    """Build and write the site of ``args`` (the ``build`` options); return (site, summary)."""
-    if args.origin_deg is not None and len(args.origin_deg) != 2:
-        raise RadioMapInputError("--origin-deg needs LAT,LON")
-    table = None
-    if getattr(args, "beacon_table", None):
-        if args.origin_deg is None:
-            raise RadioMapInputError("--beacon-table needs --origin-deg LAT,LON (the frame's origin)")
-        table = read_beacon_table(args.beacon_table, tuple(args.origin_deg))
-    logs, scheduler = list(args.logs), getattr(args, "scheduler", None)
-    if is_remote(scheduler):  # a remote worker's working folder is not ours
-        logs = [",".join(os.path.abspath(f) for f in arg_files(a)) for a in logs]
-    files = WorkerFiles(read=[f for a in logs for f in arg_files(a)])
-    with task_runner(scheduler, getattr(args, "workers", 2), files) as runner:
-        recordings = load_recordings(logs, runner)
-    name = args.name or os.path.splitext(os.path.basename(args.out))[0]
-    site, summary = build_site(
-        recordings,
-        mode=args.mode,
-        cell_size_m=args.cell_size_m,
-        min_count=args.min_count,
-        name=name,
-        map_rotation_deg=args.map_rotation_deg,
-        floor_height_m=args.floor_height_m,
-        floor_heights_m=args.floor_heights_m,
-        lowest_floor=args.lowest_floor,
-        origin_deg=tuple(args.origin_deg) if args.origin_deg else None,
-        scan_duration_ms=args.scan_duration_ms,
-        static_tol_m=args.static_tol_m,
-        beacon_table=table,
-    )
-    if getattr(args, "floor_plan", None):
-        summary["floor_plan"] = add_floor_plan(site, recordings, args)
-    if getattr(args, "building", None):
-        building = read_building(args.building)
-        summary["building"] = merge_building(site, building, os.path.basename(args.building))
-        if building.buildings:
-            from stridefix_analyzer.radiomap.beacons import place_readings
-
-            summary["context_map"] = build_context_map(site, building, place_readings(recordings))
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    summary["bytes"] = write_site(args.out, site)
-    return site, summary
-
-
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix radiomap``; returns the exit status."""
     prog = f"stridefix radiomap {args.radiomap_command}"
     try:
         if args.radiomap_command == "build":
-            _, summary = run_build(args)
+            _, summary = make_site(
+                args.logs,
+                args.out,
+                SiteOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(SiteOptions)}),
+                scheduler=args.scheduler,
+                workers=args.workers,
+            )
             print(format_summary(summary))
             print(f"wrote {args.out} ({summary['bytes']} bytes)")
         else:
@@ -299,15 +200,7 @@ def run(args: argparse.Namespace) -> int:
             if args.png:
                 plot_site(site, args.png)
                 print(f"wrote {args.png}")
-    except (
-        LogReadError,
-        RadioMapInputError,
-        SiteFileError,
-        BuildingError,
-        FloorPlanError,
-        ContextMapError,
-        SchedulerError,
-    ) as exc:
+    except INPUT_ERRORS as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
     return 0

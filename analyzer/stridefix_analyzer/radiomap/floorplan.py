@@ -136,7 +136,7 @@ def read_geojson_plan(
 def geo_reference(plan: GeoFloorPlan) -> dict[str, Any]:
     """site_t geo fields of the plan's frame (origin = its (0, 0), rotation 0: x east, y north) and
     ``scale`` = map metres per tangent-plane metre along x and y (1 = the frame is true metres)."""
-    from stridefix_analyzer.datasets.gsd_convert import project
+    from stridefix_common.geodesy import project
 
     ex, ny = project([plan.lat_max_deg], [plan.lon_max_deg], plan.lat_min_deg, plan.lon_min_deg)
     return {

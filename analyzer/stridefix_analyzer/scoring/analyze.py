@@ -16,7 +16,7 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
-Exit status (:mod:`stridefix_analyzer.exits`): 0 success; 1 nothing could be scored (every truth
+Exit status (:mod:`stridefix_common.exits`): 0 success; 1 nothing could be scored (every truth
 sample precedes the first POSE); 2 missing or unreadable input, or no TRUTH / no POSE in the logs;
 3 nothing valid in them (not an LCM log, or neither TRUTH nor POSE in any).
 """
@@ -31,8 +31,8 @@ import warnings
 from typing import Any
 
 import numpy as np
+from stridefix_common.exits import input_error_status
 
-from stridefix_analyzer.exits import input_error_status
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,

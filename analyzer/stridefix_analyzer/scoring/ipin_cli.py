@@ -8,7 +8,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from stridefix_analyzer.exits import EXIT_FAILURE, EXIT_OK, input_error_status, worst
+from stridefix_common.exits import EXIT_FAILURE, EXIT_OK, input_error_status, worst
+
 from stridefix_analyzer.io.jsonio import write_json
 from stridefix_analyzer.scoring.ipin_eval import (
     MATCH_SLACK_S,

@@ -33,9 +33,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from stridefix_common.exits import NothingValid
+from stridefix_common.geodesy import project
 
-from stridefix_analyzer.datasets.gsd_convert import project
-from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M, ipin_score, matlab_quantile
 
 #: rows at the top of an estimate file that the organisers' scorer skips

@@ -22,9 +22,9 @@ import dataclasses
 
 import numpy as np
 from numpy.typing import ArrayLike
+from stridefix_common.exits import NothingValid
 
 from stridefix_analyzer import schemes as registry
-from stridefix_analyzer.exits import NothingValid
 from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 from stridefix_analyzer.scoring import iso18305
@@ -48,7 +48,7 @@ class MetricsInputError(ValueError):
 
 class NothingToScoreError(MetricsInputError, NothingValid):
     """The logs hold neither TRUTH nor POSE: nothing valid for scoring in them (``stridefix analyze``
-    exits :data:`~stridefix_analyzer.exits.EXIT_NOTHING_VALID`)."""
+    exits :data:`~stridefix_common.exits.EXIT_NOTHING_VALID`)."""
 
 
 def scheme_code(name: str | int) -> int:

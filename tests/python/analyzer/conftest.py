@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from stridefix import config_t, health_t, pose_t, step_t, truth_t
 from stridefix_analyzer import cli
-from stridefix_analyzer.bench import perf
+from stridefix_lab.bench import perf
 
 
 def make_truth(t_us, x_m, y_m, floor=0, step_count=-1, heading_rad=float("nan")):

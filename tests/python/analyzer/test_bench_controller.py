@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import context_t
-from stridefix_analyzer.bench import controller
-from stridefix_analyzer.bench import controller_score as cs
+from stridefix_lab.bench import controller
+from stridefix_lab.bench import controller_score as cs
 
 #: two buildings: A a 30 × 20 m box at the origin, B an L-shaped hexagon east of it [m]
 A = cs.Outline("A", np.array([[0, 0], [30, 0], [30, 20], [0, 20]], float))

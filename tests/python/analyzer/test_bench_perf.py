@@ -1,12 +1,12 @@
-"""``stridefix bench perf`` (bench/perf.py) and its harness ``sf_core_cost`` (tests/perf/core_cost.c):
+"""``stridefix-lab bench perf`` (bench/perf.py) and its harness ``sf_core_cost`` (tests/perf/core_cost.c):
 the harness drives the real core calls (steps come out of the walk, every fix lands near its scan),
 callgrind's count is read per call, and the budgets are judged from the figures, not hard-coded."""
 
 from __future__ import annotations
 
 import pytest
-from stridefix_analyzer.bench import perf
 from stridefix_analyzer.firmware import Firmware
+from stridefix_lab.bench import perf
 
 
 def test_sensor_walk_runs_the_pdr_at_the_board_rates(harness):

@@ -1,4 +1,4 @@
-"""``stridefix bench perf``'s scikit-learn peer on a real map (bench/perf_knn_real.py): the harness
+"""``stridefix-lab bench perf``'s scikit-learn peer on a real map (bench/perf_knn_real.py): the harness
 ``sf_site_match`` loads a site file with the board's loader, matches each query scan alone and dumps the
 levels it compares, so sklearn on that dump reproduces the C matcher wherever both consider the same RPs.
 A small grid site stands in for the msindoor floor (the whole floor is bench perf's, ~30 s)."""
@@ -9,8 +9,8 @@ import math
 
 import numpy as np
 import pytest
-from stridefix_analyzer.bench import perf_knn_real, perf_peers
 from stridefix_analyzer.io.sitefile import new_site, write_site
+from stridefix_lab.bench import perf_knn_real, perf_peers
 
 
 def _grid_site(path):

@@ -1,4 +1,4 @@
-"""``stridefix bench perf``'s Python peers (bench/perf_peers.py) on small inputs: Madgwick and Fusion run
+"""``stridefix-lab bench perf``'s Python peers (bench/perf_peers.py) on small inputs: Madgwick and Fusion run
 on the harness's samples and agree on the yaw, and scikit-learn's KNN reads the harness's own map and
 scans so that it reproduces the C matcher's exact (full-visit) WkNN fixes."""
 
@@ -8,7 +8,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from stridefix_analyzer.bench import perf_peers
+from stridefix_lab.bench import perf_peers
 
 
 def test_madgwick_and_fusion_run_per_sample_and_agree_on_the_yaw(harness, tmp_path):

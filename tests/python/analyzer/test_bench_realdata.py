@@ -6,7 +6,7 @@ import json
 import math
 
 import pytest
-from stridefix_analyzer.bench import realdata
+from stridefix_lab.bench import realdata
 
 
 def _doc(label: str, ekf_mean: float, floor_hit: float) -> dict:

@@ -1,4 +1,4 @@
-"""``stridefix bench reliability`` and ``bench soak``: the harness machinery on short walks through the
+"""``stridefix-lab bench reliability`` and ``bench soak``: the harness machinery on short walks through the
 real stridefixd (what the firmware survives is the bench's output, not asserted here), and the
 recovery rule on made-up rows."""
 
@@ -8,9 +8,9 @@ import argparse
 import json
 
 import pytest
-from stridefix_analyzer.bench import cli as bench_cli
-from stridefix_analyzer.bench import reliability, soak
 from stridefix_analyzer.firmware import Firmware
+from stridefix_lab.bench import cli as bench_cli
+from stridefix_lab.bench import reliability, soak
 
 CASES = [
     ("clean", "-", {}),

@@ -4,7 +4,7 @@ targets' MET/MISSED (a missing particle scheme is a miss, not a pass)."""
 from __future__ import annotations
 
 import numpy as np
-from stridefix_analyzer.bench.sources import GNSS_FRACTION_MIN, crossings, targets, walls_of
+from stridefix_lab.bench.sources import GNSS_FRACTION_MIN, crossings, targets, walls_of
 from stridefix_sim.building import write_building
 from stridefix_sim.worlds import load_world
 

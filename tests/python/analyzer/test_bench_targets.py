@@ -1,4 +1,4 @@
-"""Exit status of `stridefix bench`: 1 with a TARGET MISSED line per miss, 0 when every target is met.
+"""Exit status of `stridefix-lab bench`: 1 with a TARGET MISSED line per miss, 0 when every target is met.
 
 On synthetic results only (a full benchmark takes minutes): the miss lines of each bench's JSON
 document, and the command's exit status with the benchmark itself replaced.
@@ -7,12 +7,13 @@ document, and the command's exit status with the benchmark itself replaced.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 
 import pytest
-from stridefix_analyzer.bench import cli as bench_cli
-from stridefix_analyzer.bench import fusion, sil_pdr
 from stridefix_analyzer.firmware import Firmware
+from stridefix_lab.bench import cli as bench_cli
+from stridefix_lab.bench import fusion, sil_pdr
 
 
 def _row(scenario="default", seed=1, step_error_pct=0.5, floor_hit_rate=1.0, final_error_pct=1.0):
@@ -102,7 +103,9 @@ def fake_firmware(tmp_path):
 
 @pytest.mark.parametrize("missed, status", [([], 0), (["x = 2 (target <= 1)"], 1)])
 def test_bench_command_exit_status(monkeypatch, tmp_path, fake_firmware, capsys, missed, status):
-    monkeypatch.setitem(bench_cli.BENCHES, "sil-pdr", (lambda args, fw, seeds, out: list(missed), "1"))
+    found = bench_cli.benches()
+    found["sil-pdr"] = dataclasses.replace(found["sil-pdr"], run=lambda args, fw, seeds, out: list(missed))
+    monkeypatch.setattr(bench_cli, "benches", lambda: found)
     parser = argparse.ArgumentParser()
     bench_cli.add_parser(parser.add_subparsers())
     args = parser.parse_args(["bench", "sil-pdr", "--stridefixd", str(fake_firmware), "--out", str(tmp_path)])

@@ -6,17 +6,19 @@ import subprocess
 import sys
 
 from stridefix_analyzer import cli
+from stridefix_lab import cli as lab_cli
 
 
 def test_every_rewrite_hook_belongs_to_a_registered_sub_command():
-    assert set(cli.ARGV_REWRITES) <= set(cli.SUBCOMMANDS)
-    assert all(ref.count(":") == 1 for ref in cli.ARGV_REWRITES.values())
+    for app in (cli, lab_cli):
+        assert set(app.ARGV_REWRITES) <= set(app.SUBCOMMANDS)
+        assert all(ref.count(":") == 1 for ref in app.ARGV_REWRITES.values())
 
 
 def test_realbench_format_runs_the_fusion_bench_through_the_hook():
-    # `stridefix realbench --format gsd DIR` means `stridefix realbench fusion --format gsd DIR`
-    assert cli.rewrite_argv(["realbench", "--format", "gsd", "d"])[:2] == ["realbench", "fusion"]
-    assert cli.rewrite_argv(["realbench", "pdr-distance", "--floor", "x"])[1] == "pdr-distance"
+    # `stridefix-lab realbench --format gsd DIR` means `stridefix-lab realbench fusion --format gsd DIR`
+    assert lab_cli.rewrite_argv(["realbench", "--format", "gsd", "d"])[:2] == ["realbench", "fusion"]
+    assert lab_cli.rewrite_argv(["realbench", "pdr-distance", "--floor", "x"])[1] == "pdr-distance"
 
 
 def test_other_sub_commands_pass_unchanged(monkeypatch):

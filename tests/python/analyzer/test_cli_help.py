@@ -1,6 +1,6 @@
-"""What `stridefix ... --help` shows and the options the commands share (issue 17 item 6).
+"""What `stridefix ... --help` and `stridefix-lab ... --help` show and the options the commands share.
 
-GIVEN every parser of the `stridefix` tree (each sub-command and sub-sub-command), WHEN its help is
+GIVEN every parser of the `stridefix` and `stridefix-lab` trees (each sub-command and sub-sub-command), WHEN its help is
 formatted, THEN it carries no docstring markup and no empty default; and an option several commands
 take (--max-wifi-age-s, --jobs/--workers) has one default on all of them, the shared constant's.
 """
@@ -15,6 +15,7 @@ from stridefix_analyzer import cli
 from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S
 from stridefix_analyzer.helptext import plain
 from stridefix_analyzer.parallel import DEFAULT_JOBS
+from stridefix_lab import cli as lab_cli
 
 MARKUP = re.compile(r"``|:(?:py:)?(?:func|mod|class|meth|data|attr|exc|obj|ref):`")
 EMPTY_DEFAULT = re.compile(r"\(default: (?:None|False|\[\])\)")
@@ -34,6 +35,7 @@ def _parsers() -> list[tuple[str, argparse.ArgumentParser]]:
                     walk(child, f"{path} {name}")
 
     walk(cli.build_parser(), "stridefix")
+    walk(lab_cli.build_parser(), "stridefix-lab")
     return out
 
 
@@ -41,9 +43,10 @@ PARSERS = _parsers()
 
 
 def test_the_tree_has_every_sub_command():
-    names = {path.split()[1] for path, _ in PARSERS if " " in path}
-    assert names == set(cli.SUBCOMMANDS)
-    assert len(PARSERS) >= 20  # bench, crowd, import, radiomap and realbench have their own
+    for prog, subcommands in (("stridefix", cli.SUBCOMMANDS), ("stridefix-lab", lab_cli.SUBCOMMANDS)):
+        names = {path.split()[1] for path, _ in PARSERS if path.startswith(f"{prog} ")}
+        assert names == set(subcommands), prog
+    assert len(PARSERS) >= 30  # bench (one per bench), crowd, import, radiomap and realbench have their own
 
 
 @pytest.mark.parametrize("path,parser", PARSERS, ids=[p for p, _ in PARSERS])
@@ -55,12 +58,11 @@ def test_help_has_no_markup_and_no_empty_default(path, parser):
 
 def test_plain_removes_roles_and_literals():
     assert (
-        plain("``stridefix bench``: see :func:`~a.b.run` and :mod:`.fusion`")
-        == "stridefix bench: see run and fusion"
+        plain("``stridefix-lab bench``: see :func:`~a.b.run` and :mod:`.fusion`")
+        == "stridefix-lab bench: see run and fusion"
     )
     assert (
-        plain(":data:`stridefix_analyzer.exits.HELP` and :class:`x.Y`")
-        == "stridefix_analyzer.exits.HELP and x.Y"
+        plain(":data:`stridefix_common.exits.HELP` and :class:`x.Y`") == "stridefix_common.exits.HELP and x.Y"
     )
 
 
@@ -75,8 +77,10 @@ def _defaults(option: str) -> dict[str, object]:
 
 def test_max_wifi_age_has_one_default():
     found = _defaults("--max-wifi-age-s")
-    assert {"stridefix import msindoor", "stridefix import gsd", "stridefix realbench fusion"} <= set(found)
-    assert "stridefix realbench pdr-distance" in found  # had 3 s while the importers had 2
+    assert {"stridefix import msindoor", "stridefix import gsd", "stridefix-lab realbench fusion"} <= set(
+        found
+    )
+    assert "stridefix-lab realbench pdr-distance" in found  # had 3 s while the importers had 2
     assert set(found.values()) == {DEFAULT_MAX_WIFI_AGE_S}
 
 

@@ -1,12 +1,16 @@
-"""Package layout of stridefix_analyzer and stridefix_sim, checked on the source with ``ast``.
+"""Package layout of stridefix_common, stridefix_sim, stridefix_analyzer and stridefix_lab, checked on
+the source with ``ast``.
 
 (a) No import circle among their modules: every circle so far came from a CLI module hosting helpers
     that the modules below it imported back (bench.sil_pdr <-> bench.fusion, crowd.cli <->
     crowd.experiment). Function-level imports count; imports under ``if TYPE_CHECKING:`` do not
     (annotations only, never run).
 (b) No module over :data:`MAX_LINES` lines, and no firmware C source or header either.
-(c) CLI modules only register commands: nothing imports ``stridefix_analyzer.cli`` or any ``*.cli``
-    module, except the top-level ``stridefix_analyzer.cli`` (which loads them by name).
+(c) CLI modules only register commands: nothing imports a ``*.cli`` module (the console scripts
+    ``stridefix_analyzer.cli`` and ``stridefix_lab.cli`` load them by name).
+(d) The packages import in one direction: common ← sim, common ← analyzer ← lab, sim ← lab. The
+    product (common, sim, analyzer) never imports the lab, the simulator and the analyzer never
+    import each other, and the common package imports none of them.
 """
 
 from __future__ import annotations
@@ -16,11 +20,20 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[3]
 ROOTS = {
-    "stridefix_analyzer": REPO / "analyzer" / "stridefix_analyzer",
+    "stridefix_common": REPO / "common" / "stridefix_common",
     "stridefix_sim": REPO / "hil-sim" / "stridefix_sim",
+    "stridefix_analyzer": REPO / "analyzer" / "stridefix_analyzer",
+    "stridefix_lab": REPO / "lab" / "stridefix_lab",
+}
+#: package → the packages it may import (besides itself)
+MAY_IMPORT = {
+    "stridefix_common": set(),
+    "stridefix_sim": {"stridefix_common"},
+    "stridefix_analyzer": {"stridefix_common"},
+    "stridefix_lab": {"stridefix_common", "stridefix_analyzer", "stridefix_sim"},
 }
 MAX_LINES = 500
-TOP_CLI = "stridefix_analyzer.cli"
+TOP_CLIS = {"stridefix_analyzer.cli", "stridefix_lab.cli"}
 
 
 def _modules() -> dict[str, Path]:
@@ -123,7 +136,7 @@ def _cycles(graph: dict[str, set[str]]) -> list[tuple[str, ...]]:
 def test_the_graph_sees_function_level_imports():
     # the parser must see a lazy import: crowd.cli imports experiment at module level, and the top
     # CLI's sub-commands are loaded by name (no import edge)
-    assert "stridefix_analyzer.scoring.analyze" in GRAPH["stridefix_analyzer.bench.sil_pdr"]
+    assert "stridefix_analyzer.scoring.analyze" in GRAPH["stridefix_lab.bench.sil_pdr"]
     assert "stridefix_analyzer.io.tum" in GRAPH["stridefix_analyzer.scoring.analyze"]  # inside run()
     assert "stridefix_analyzer.scoring.metrics" not in GRAPH["stridefix_analyzer.io.tum"]  # TYPE_CHECKING
 
@@ -147,27 +160,42 @@ def test_no_firmware_source_over_max_lines():
     assert long == []
 
 
-def test_cli_modules_are_imported_only_by_the_top_cli():
-    bad = {
+def test_cli_modules_are_imported_by_nobody():
+    bad = {(m, dep) for m, deps in GRAPH.items() for dep in deps if dep in TOP_CLIS or dep.endswith(".cli")}
+    assert sorted(bad) == []
+
+
+def test_packages_import_in_one_direction():
+    wrong = sorted(
         (m, dep)
         for m, deps in GRAPH.items()
-        if m != TOP_CLI
         for dep in deps
-        if dep == TOP_CLI or dep.endswith(".cli")
-    }
-    assert sorted(bad) == []
+        if dep.split(".")[0] != m.split(".")[0] and dep.split(".")[0] not in MAY_IMPORT[m.split(".")[0]]
+    )
+    assert wrong == []
+
+
+def test_the_direction_check_sees_every_package():
+    # each package's modules are in the graph, and the lab does import the product
+    assert {m.split(".")[0] for m in MODULES} == set(ROOTS)
+    assert any(d.startswith("stridefix_analyzer.") for d in GRAPH["stridefix_lab.bench.sil_pdr"])
+
+
+def test_the_product_holds_no_benchmark():
+    # the lab's packages have no namesake left in the product
+    assert not any(
+        m.startswith(("stridefix_analyzer.bench", "stridefix_analyzer.realbench")) for m in MODULES
+    )
 
 
 # The analyzer's packages in data-flow order (docs/ARCHITECTURE.md): a module imports only from its own
 # package or from one above it in this list.
 LAYERS = (
-    "exits",
     "console",
     "helptext",
     "schemes",
     "firmware",
     "spy",
-    "stages",
     "parallel",
     "io",
     "datasets",
@@ -175,8 +203,7 @@ LAYERS = (
     "scoring",
     "live",
     "crowd",
-    "realbench",
-    "bench",
+    "cliapp",
     "cli",
 )
 

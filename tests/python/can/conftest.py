@@ -11,8 +11,8 @@ import cantools
 import lcm
 import pytest
 from stridefix import health_t
-from stridefix_analyzer.exits import EXIT_OK
 from stridefix_analyzer.firmware import Firmware
+from stridefix_common.exits import EXIT_OK
 from stridefix_sim.board import DBC_PATH
 from stridefix_sim.pipeline import SimResult, simulate, write_outputs
 from stridefix_sim.scenario import default_scenario

@@ -14,7 +14,7 @@ import can
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer.exits import EXIT_OK
+from stridefix_common.exits import EXIT_OK
 from stridefix_sim import cli as sim_cli
 
 LINE_RE = re.compile(r"^\((\d+)\.(\d{6})\) can0 ([0-9A-F]{3})#([0-9A-F]*)$")

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from stridefix_analyzer.realbench.crowdfolds import choose
+from stridefix_lab.realbench.crowdfolds import choose
 
 
 def _sims(rng, spread_rad: dict[str, float], n: int = 12) -> list[dict]:

@@ -1,5 +1,5 @@
 """The map nobody surveyed: `stridefix crowd radiomap` (graph-solved positions → site) and
-`stridefix realbench crowd-map` (the fold sites of realbench fusion, truth-built vs crowd-built).
+`stridefix-lab realbench crowd-map` (the fold sites of realbench fusion, truth-built vs crowd-built).
 
 GIVEN three short SIL walkers (conftest ``sil_walks``) WHEN their radio map is built from positions solved
 on the graph from every 4th truth point and their steps THEN it is a valid site whose reference points lie
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from stridefix_analyzer.io.sitefile import read_site
-from stridefix_analyzer.realbench.heading import HEADING_VARIANTS
+from stridefix_lab.realbench.heading import HEADING_VARIANTS
 
 MSINDOOR_F2 = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "msindoor" / "site1" / "F2"
 
@@ -42,7 +42,7 @@ def test_crowd_radiomap_site_near_the_truth_site(sil_walks, cli, tmp_path):
 
 
 @pytest.fixture(scope="module")
-def crowd_map_small(request, tmp_path_factory, cli) -> dict:
+def crowd_map_small(request, tmp_path_factory, cli, lab) -> dict:
     """GIVEN realbench crowd-map and realbench fusion on the first 4 walks of site1/F2."""
     if not MSINDOOR_F2.is_dir():
         pytest.skip(
@@ -52,8 +52,8 @@ def crowd_map_small(request, tmp_path_factory, cli) -> dict:
     out = tmp_path_factory.mktemp("crowd_map")
     common = ["--format", "msindoor", str(MSINDOOR_F2), "--limit", "4", "--stridefixd", str(stridefixd)]
     common += ["--cache", str(out / "cache")]
-    proc = cli("realbench", "crowd-map", *common, "--out", str(out / "crowd" / "results.json"))
-    fusion = cli(
+    proc = lab("realbench", "crowd-map", *common, "--out", str(out / "crowd" / "results.json"))
+    fusion = lab(
         "realbench", *common, "--quiet", "--no-report", "--out", str(out / "fusion" / "results.json")
     )
     assert fusion.returncode == 0, fusion.stderr

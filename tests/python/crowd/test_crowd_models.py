@@ -14,9 +14,9 @@ import pytest
 from numpy.testing import assert_allclose
 from stridefix_analyzer.crowd import model as cm
 from stridefix_analyzer.crowd import models as mm
-from stridefix_analyzer.crowd import select_model as sm
 from stridefix_analyzer.crowd.features import FEATURES, features, iter_feature_blocks, pair_loop_features
 from stridefix_analyzer.crowd.walks import Walk
+from stridefix_lab.crowd import select_model as sm
 
 
 def _walks_from_scans(R: np.ndarray, xy: np.ndarray, per_walk: int) -> list[Walk]:
@@ -269,8 +269,8 @@ def test_thesis_distance_model_is_a_pair_model(random_scans):
 # --- CLI -------------------------------------------------------------------------------------------
 
 
-def test_crowd_models_cli_on_sil_walks(sil_walks, cli, tmp_path):
-    proc = cli("crowd", "models", *sil_walks, "--folds", "3", "--out", str(tmp_path))
+def test_crowd_models_cli_on_sil_walks(sil_walks, cli, tmp_path, lab):
+    proc = lab("crowd", "models", *sil_walks, "--folds", "3", "--out", str(tmp_path))
     assert proc.returncode == 0, proc.stderr
     doc = json.loads((tmp_path / "models.json").read_text())
     names = [r["name"] for r in doc["rows"]]

@@ -6,13 +6,13 @@ import json
 
 import numpy as np
 import pytest
-from stridefix_analyzer.bench import crowd_scale
 from stridefix_analyzer.crowd import blocks as cbk
 from stridefix_analyzer.crowd.fit import fit_walks
-from stridefix_analyzer.crowd.fleet import FleetSpec, make_fleet
-from stridefix_analyzer.crowd.scale_solve import solve_walks_grouped, walk_groups
 from stridefix_analyzer.crowd.walks import CrowdInputError, pool_scans
 from stridefix_analyzer.parallel import dask_client, run_tasks
+from stridefix_lab.bench import crowd_scale
+from stridefix_lab.crowd.fleet import FleetSpec, make_fleet
+from stridefix_lab.crowd.scale_solve import solve_walks_grouped, walk_groups
 
 
 @pytest.fixture(scope="module")

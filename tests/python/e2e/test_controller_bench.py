@@ -1,4 +1,4 @@
-"""End to end, ``stridefix bench controller --seeds 1``: the campus2 survey, the site with its context
+"""End to end, ``stridefix-lab bench controller --seeds 1``: the campus2 survey, the site with its context
 map, one walk replayed through the real stridefixd with the controller and without, scored.
 
 GIVEN the whole chain (the simulator's campus2 world, ``radiomap build --building`` writing the context
@@ -10,37 +10,15 @@ with a verdict. Skipped, with the piece named, while a branch of issue 14 is not
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import lcm
-import pytest
 from stridefix import pose_t
-from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.channels import POSE_CHANNELS, POSE_SCHEME_CHANNELS
-from stridefix_sim.scenario import BUILTIN
 
 
-def _missing(stridefixd: Path) -> str | None:
-    if "campus2" not in BUILTIN or "campus2_survey" not in BUILTIN:
-        return "the simulator has no campus2 / campus2_survey scenario (branch ctl-sim)"
-    exe = Path(sys.executable).with_name("stridefix")
-    help_text = subprocess.run(
-        [str(exe), "radiomap", "build", "--help"], capture_output=True, text=True
-    ).stdout
-    if "--building" not in help_text:
-        return "radiomap build takes no --building (branch ctl-site)"
-    if "controller.enabled" not in Firmware(stridefixd).params:
-        return "stridefixd has no controller (controller.enabled; branch ctl-core)"
-    return None
-
-
-def test_bench_controller_one_seed(stridefixd, cli, tmp_path):
-    why = _missing(stridefixd)
-    if why:
-        pytest.skip(why)
-    proc = cli("bench", "controller", "--seeds", "1", "--stridefixd", str(stridefixd), "--out", str(tmp_path))
+def test_bench_controller_one_seed(stridefixd, cli, tmp_path, lab):
+    proc = lab("bench", "controller", "--seeds", "1", "--stridefixd", str(stridefixd), "--out", str(tmp_path))
     assert proc.returncode in (0, 1), proc.stderr  # 1: a target missed, still a complete run
     doc = json.loads((tmp_path / "controller.json").read_text())
     table = doc["table"]

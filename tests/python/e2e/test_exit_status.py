@@ -12,7 +12,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from stridefix_analyzer import exits
+from stridefix_common import exits
 
 
 def _run(stridefixd: Path, *args: str) -> subprocess.CompletedProcess:

@@ -7,8 +7,8 @@ full-length table; this is its regression test.)"""
 from __future__ import annotations
 
 import pytest
-from stridefix_analyzer.bench import reliability
 from stridefix_analyzer.firmware import Firmware
+from stridefix_lab.bench import reliability
 
 CASES = [
     ("clean", "-", {}),

@@ -27,7 +27,7 @@ from stridefix_analyzer.scoring.fixsources import fix_source_counts
 def campus_walk(tmp_path_factory, stridefixd):
     """The campus (walls, Wi-Fi, BLE, GNSS, landmarks) surveyed into a site, then a 2-minute walk
     replayed with it: a log with every scheme's POSE and FIX records of every source."""
-    from stridefix_analyzer.bench import fusion, sources
+    from stridefix_lab.bench import fusion, sources
 
     out = tmp_path_factory.mktemp("live")
     fw = Firmware(stridefixd)

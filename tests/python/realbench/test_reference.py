@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from stridefix_analyzer.datasets.rawwalk import RawWalk
 from stridefix_analyzer.io.logread import Table
-from stridefix_analyzer.realbench import reference as ref
-from stridefix_analyzer.realbench import reference_sensors as sensors
 from stridefix_analyzer.scoring.metrics import wrap_pi
+from stridefix_lab.realbench import reference as ref
+from stridefix_lab.realbench import reference_sensors as sensors
 
 GSD = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "gsd"
 
@@ -134,14 +134,14 @@ def test_ekf_prediction_follows_heading_plus_bias():
 
 
 @pytest.fixture(scope="module")
-def gsd_results(tmp_path_factory, cli, stridefixd) -> dict:
-    """GIVEN `stridefix realbench fusion --format gsd <gsd> --limit 3 --true-start` (3 real walks)."""
+def gsd_results(tmp_path_factory, cli, stridefixd, lab) -> dict:
+    """GIVEN `stridefix-lab realbench fusion --format gsd <gsd> --limit 3 --true-start` (3 real walks)."""
     if not GSD.is_dir() or not list(GSD.glob("*.txt")):
         pytest.skip(
             f"real GetSensorData logs not found at {GSD} (needs ../shared/data beside the repository)"
         )
     out = tmp_path_factory.mktemp("realbench_reference") / "results.json"
-    proc = cli(
+    proc = lab(
         "realbench", "fusion", "--format", "gsd", str(GSD), "--limit", "3", "--true-start",
         "--stridefixd", str(stridefixd), "--out", str(out), "--quiet",
     )  # fmt: skip

@@ -64,14 +64,14 @@ def real_trace() -> Path:
 
 
 @pytest.fixture(scope="session")
-def realbench_small(request, tmp_path_factory, cli) -> dict:
-    """GIVEN `stridefix realbench pdr-distance --limit 4` run on site1/F2: its output and JSON."""
+def realbench_small(request, tmp_path_factory, cli, lab) -> dict:
+    """GIVEN `stridefix-lab realbench pdr-distance --limit 4` run on site1/F2: its output and JSON."""
     floor = MSINDOOR / "site1" / "F2"
     if not floor.is_dir():
         pytest.skip(f"real msindoor data not found at {floor} (needs ../shared/data beside the repository)")
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench")
-    proc = cli(
+    proc = lab(
         "realbench",
         "pdr-distance",
         "--floor",
@@ -159,8 +159,8 @@ def real_gsd() -> Path:
 
 
 @pytest.fixture(scope="session")
-def realbench_fusion_small(request, tmp_path_factory, cli) -> dict:
-    """GIVEN `stridefix realbench --format msindoor site1/F2 --limit 5 --out results.json` (the
+def realbench_fusion_small(request, tmp_path_factory, cli, lab) -> dict:
+    """GIVEN `stridefix-lab realbench --format msindoor site1/F2 --limit 5 --out results.json` (the
     leave-one-walk-out fusion benchmark on 5 real walks): its process, results and folders."""
     floor = MSINDOOR / "site1" / "F2"
     if not floor.is_dir():
@@ -168,7 +168,7 @@ def realbench_fusion_small(request, tmp_path_factory, cli) -> dict:
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench_fusion")
     results = out / "results.json"
-    proc = cli(
+    proc = lab(
         "realbench",
         "--format",
         "msindoor",

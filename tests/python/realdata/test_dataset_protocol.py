@@ -29,8 +29,8 @@ from stridefix_analyzer.datasets.protocol import (
 from stridefix_analyzer.datasets.rawwalk import RawWalk, finite, wifi_table
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import Table, read_logs
-from stridefix_analyzer.realbench import walks as rb_walks
-from stridefix_analyzer.realbench.prepare import PrepareJob, prepare
+from stridefix_lab.realbench import walks as rb_walks
+from stridefix_lab.realbench.prepare import PrepareJob, prepare
 
 from .conftest import GSD, MSINDOOR
 

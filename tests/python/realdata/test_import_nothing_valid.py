@@ -12,11 +12,11 @@ import argparse
 import os
 
 import pytest
-from stridefix_analyzer import exits
 from stridefix_analyzer.datasets import cli as import_cli
 from stridefix_analyzer.datasets import gsd, msindoor
 from stridefix_analyzer.datasets.lcmwrite import write_lcmlog
 from stridefix_analyzer.datasets.protocol import NothingValidError
+from stridefix_common import exits
 
 
 def _run_import(*argv: str) -> int:

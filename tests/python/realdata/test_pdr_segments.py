@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer.realbench.pdr_segments import format_table, segment_table, walk_summary
+from stridefix_lab.realbench.pdr_segments import format_table, segment_table, walk_summary
 
 
 @pytest.fixture

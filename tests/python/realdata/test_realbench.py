@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer.realbench import pdr_distance as rb
-from stridefix_analyzer.realbench import strides
+from stridefix_lab.realbench import pdr_distance as rb
+from stridefix_lab.realbench import strides
 
 # --- calibration and segments on synthetic data ---------------------------------------------------
 
@@ -135,11 +135,11 @@ def test_realbench_small_run(realbench_small):
             assert w["K"] == pytest.approx(expect, rel=1e-12)
 
 
-def test_realbench_reuses_cached_imports(realbench_small, cli, stridefixd):
+def test_realbench_reuses_cached_imports(realbench_small, cli, stridefixd, lab):
     out = realbench_small["out"]
     before = {p.name: p.stat().st_mtime_ns for p in (out / "cache").glob("*.lcmlog")}
     assert len(before) == 4
-    proc = cli(
+    proc = lab(
         "realbench",
         "pdr-distance",
         "--floor",
@@ -157,8 +157,8 @@ def test_realbench_reuses_cached_imports(realbench_small, cli, stridefixd):
     assert after == before
 
 
-def test_realbench_missing_floor_is_usage_error(cli, tmp_path):
-    proc = cli("realbench", "pdr-distance", "--floor", str(tmp_path / "nowhere"))
+def test_realbench_missing_floor_is_usage_error(cli, tmp_path, lab):
+    proc = lab("realbench", "pdr-distance", "--floor", str(tmp_path / "nowhere"))
     assert proc.returncode == 2
     assert "nowhere: no such directory" in proc.stderr
 

@@ -18,9 +18,9 @@ from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
 from stridefix_analyzer.radiomap import floorplan as fp
 from stridefix_analyzer.radiomap.beacons import MIN_RANGE_M
-from stridefix_analyzer.realbench import fold as rfold
-from stridefix_analyzer.realbench import sitecontent as sc
-from stridefix_analyzer.realbench.walks import RealbenchError
+from stridefix_lab.realbench import fold as rfold
+from stridefix_lab.realbench import sitecontent as sc
+from stridefix_lab.realbench.walks import RealbenchError
 
 BEACON = 0xBEAC20230001
 ONLY_HELD = 0xBEAC20230002  # heard by walk 0 only
@@ -200,7 +200,7 @@ def test_realbench_switches(flags, expected, monkeypatch):
         seen["content"] = cfg.content
         raise RealbenchError("stop here")
 
-    monkeypatch.setattr("stridefix_analyzer.realbench.cli.run_fusion", fake_run_fusion)
+    monkeypatch.setattr("stridefix_lab.realbench.cli.run_fusion", fake_run_fusion)
     args = build_parser().parse_args(
         ["realbench", "fusion", "--format", "gsd", "x", "--out", "r.json", *flags]
     )

@@ -8,7 +8,7 @@ import json
 
 import pytest
 from stridefix_analyzer.parallel import dask_client
-from stridefix_analyzer.realbench.summary import untimed
+from stridefix_lab.realbench.summary import untimed
 
 from .conftest import MSINDOOR
 
@@ -21,8 +21,8 @@ def scheduler_address():
 
 
 @pytest.fixture(scope="module")
-def serial_and_dask(request, tmp_path_factory, cli, scheduler_address) -> dict:
-    """GIVEN `stridefix realbench --format msindoor site1/F2 --limit 6` with --scheduler serial, then
+def serial_and_dask(request, tmp_path_factory, cli, scheduler_address, lab) -> dict:
+    """GIVEN `stridefix-lab realbench --format msindoor site1/F2 --limit 6` with --scheduler serial, then
     --scheduler local --workers 2, then --scheduler tcp://… (a LocalCluster's scheduler started here),
     into the same folder (same paths in every document)."""
     floor = MSINDOOR / "site1" / "F2"
@@ -36,7 +36,7 @@ def serial_and_dask(request, tmp_path_factory, cli, scheduler_address) -> dict:
         ("dask", ["--scheduler", "local", "--workers", "2"]),
         ("address", ["--scheduler", scheduler_address]),
     ):
-        proc = cli(
+        proc = lab(
             "realbench",
             "--format",
             "msindoor",

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from stridefix_analyzer.realbench import fixmodel, priors
+from stridefix_lab.realbench import fixmodel, priors
 
 
 def _ar_walk(

@@ -1,4 +1,4 @@
-"""`stridefix realbench --format ...`: the fusion schemes on real walks, leave one walk out.
+"""`stridefix-lab realbench --format ...`: the fusion schemes on real walks, leave one walk out.
 
 Synthetic checks of the fold machinery (sufficient-statistics maps, rotation and floor-height
 learning), then a small real run (5 msindoor walks) checked for sanity, leakage, determinism, and
@@ -20,9 +20,9 @@ from stridefix_analyzer import datasets, schemes
 from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
-from stridefix_analyzer.realbench import cli as rbcli
-from stridefix_analyzer.realbench import floors, heading
-from stridefix_analyzer.realbench import fold as rfold
+from stridefix_lab.realbench import cli as rbcli
+from stridefix_lab.realbench import floors, heading
+from stridefix_lab.realbench import fold as rfold
 
 SCHEMES = schemes.NAMES
 MSINDOOR_SETS = datasets.get("msindoor").firmware_sets
@@ -385,7 +385,7 @@ def test_inner_cv_replay_mode_scores_as_the_stage_replays_did(realbench_fusion_s
     GIVEN a real walk on its fold's site, WHEN replayed the three ways, THEN the fix residuals and the
     adaptive POSE errors are bit-identical and the filtered log holds FIX and POSE only."""
     from stridefix_analyzer.firmware import Firmware
-    from stridefix_analyzer.realbench import select as rs
+    from stridefix_lab.realbench import select as rs
 
     r = realbench_fusion_small
     row = r["doc"]["groups"][0]["walk_rows"][1]

@@ -1,5 +1,5 @@
 """realbench's per-fold matcher choice by cross-validation inside the training walks
-(``stridefix_analyzer.realbench.select``, the rows of ``realbench.tuning``): the fix-error arithmetic, the user's override, and a real
+(``stridefix_lab.realbench.select``, the rows of ``realbench.tuning``): the fix-error arithmetic, the user's override, and a real
 run on 8 msindoor walks checked for the choice rule and for leakage of the held-out block."""
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ import pytest
 from numpy.testing import assert_allclose
 from stridefix import fix_t, pose_t
 from stridefix_analyzer.io.sitefile import read_site
-from stridefix_analyzer.realbench import select as rs
-from stridefix_analyzer.realbench import tuning
+from stridefix_lab.realbench import select as rs
+from stridefix_lab.realbench import tuning
 
 from .conftest import MSINDOOR
 
@@ -124,15 +124,15 @@ def test_no_block_is_scored_with_a_map_or_walk_of_its_own(tmp_path):
 
 
 @pytest.fixture(scope="module")
-def realbench_eight(request, tmp_path_factory, cli) -> dict:
-    """GIVEN `stridefix realbench --format msindoor site1/F2 --limit 8` (enough walks for a choice)."""
+def realbench_eight(request, tmp_path_factory, cli, lab) -> dict:
+    """GIVEN `stridefix-lab realbench --format msindoor site1/F2 --limit 8` (enough walks for a choice)."""
     floor = MSINDOOR / "site1" / "F2"
     if not floor.is_dir():
         pytest.skip(f"real msindoor data not found at {floor}")
     stridefixd = request.getfixturevalue("stridefixd")
     out = tmp_path_factory.mktemp("realbench_select")
     results = out / "results.json"
-    proc = cli(
+    proc = lab(
         "realbench",
         "--format",
         "msindoor",

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from stridefix_analyzer.datasets.gsd_convert import project
+from stridefix_common.geodesy import project
 from stridefix_sim.ble import simulate_ble
 from stridefix_sim.board import load_dbc
 from stridefix_sim.gnss import MODE_DOOR, MODE_OUTDOOR, gauss_markov, simulate_gnss

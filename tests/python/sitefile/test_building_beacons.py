@@ -9,10 +9,10 @@ import pathlib
 import numpy as np
 import pytest
 from stridefix import ble_scan_t
-from stridefix_analyzer.datasets.gsd_convert import project
 from stridefix_analyzer.io import sitefile
 from stridefix_analyzer.radiomap import beacons as B
 from stridefix_analyzer.radiomap.building import BuildingError, building_toml, merge_building, read_building
+from stridefix_common.geodesy import project
 
 EXAMPLE = pathlib.Path(__file__).resolve().parents[3] / "docs" / "examples" / "building.toml"
 

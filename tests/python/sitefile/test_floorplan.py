@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from stridefix_analyzer.datasets.gsd_convert import project
 from stridefix_analyzer.radiomap import floorplan as fp
+from stridefix_common.geodesy import project
 
 F2 = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "msindoor" / "site1" / "F2"
 LON0, LAT0 = 120.0, 30.0
