@@ -78,7 +78,7 @@ def is_remote(scheduler: str | None) -> bool:
     return bool(scheduler) and "://" in str(scheduler)
 
 
-#: Worker processes of every command's ``--jobs``/``--workers`` (issue 17: realbench pdr-distance took
+#: Worker processes of every command's ``--jobs``/``--workers`` (realbench pdr-distance took
 #: the CPU count, the others 2): the development machine's 2 cores; a bigger one says -j N.
 DEFAULT_JOBS = 2
 

@@ -1,5 +1,5 @@
 """The ``campus2`` world: two buildings joined by an outdoor path, for the multi-scheme controller
-(issue 14; Jäger, Süß, Becker §III: contexts outdoor / building / floor, ports door / stairs / elevator).
+(Jäger, Süß, Becker §III: contexts outdoor / building / floor, ports door / stairs / elevator).
 
 A new world rather than an extension of ``campus``: the existing worlds' walks, surveys and radio maps
 stay as they are. The world has one plan for every floor (world.py); the outlines (world_parts.py) say

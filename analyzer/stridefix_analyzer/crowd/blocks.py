@@ -9,7 +9,7 @@ and at float64 the same bins as the serial loop always gave (``0 + x`` is exact)
 use it: the task's per-pair work is ``bin_block``'s (:func:`.model._block` for the dissimilarity, the
 true distance from the positions), the runner is :func:`stridefix_analyzer.parallel.run_tasks`.
 
-Scale (issue 15): the full pair set of 100 000 scans is ~10⁹–5·10⁹ pairs; blocks are computed in
+Scale: the full pair set of 100 000 scans is ~10⁹–5·10⁹ pairs; blocks are computed in
 ``dtype`` (float32 halves the memory traffic of the matrix products; RSS are whole dBm, so V, V² and
 their products are integers, exact in float32 up to 2²⁴). When all pairs are too many, ``pair_fraction``
 f < 1 fits on an **unbiased random subsample of scan pairs**: the scans of each group are put in a

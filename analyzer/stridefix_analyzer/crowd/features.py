@@ -1,6 +1,6 @@
 """Per-pair fingerprint features for the dissimilarity → distance models, computed blockwise.
 
-Issue 15 item 1: on both msindoor floors the thesis's ``common_sum`` (Kannan 2024, Eq. 4; see
+On both msindoor floors the thesis's ``common_sum`` (Kannan 2024, Eq. 4; see
 :mod:`.model`) degenerates, so the candidates of :mod:`.models` try other features of a scan pair.
 Every feature comes from the same matrix products as :func:`.model._block` (V = RSS + 100 dB, 0 where
 not heard; M the heard mask; Q = V²), so a block of B_a × B_b pairs costs O(B_a·B_b·m) and memory

@@ -85,9 +85,9 @@ class UnknownDatasetError(DatasetError):
     """No data set of that name is registered."""
 
 
-#: Default age beyond which a Wi-Fi entry counts as cached [s] (issue 5: "more than ~2 s older than
+#: Default age beyond which a Wi-Fi entry counts as cached [s] ("more than ~2 s older than
 #: its scan is a cached entry"): every data set's, and so every command's ``--max-wifi-age-s`` (import,
-#: realbench fusion and pdr-distance; issue 17: pdr-distance had 3).
+#: realbench fusion and pdr-distance; pdr-distance once had 3).
 DEFAULT_MAX_WIFI_AGE_S = 2.0
 
 

@@ -1,6 +1,6 @@
 """The building description ``building.toml`` (docs/building.md): geo-reference, BLE model, walls,
 ports and beacons of a user's own building, merged into a site file by ``stridefix radiomap build
---building FILE``; since issue 14 also the context map's tables ([[building]], the [[port]] extras,
+--building FILE``; also the context map's tables ([[building]], the [[port]] extras,
 [[context]]: :mod:`.building_contexts`, built into the site by :mod:`.contexts`).
 
 :func:`read_building` parses and checks it (tomllib); every error names the file, the entry

@@ -1,5 +1,5 @@
 """``stridefix-lab bench controller``: the multi-scheme controller against every fixed scheme on the SIL
-``campus2`` walks (issue 14; Jäger, Süß, Becker §III-B/C): outdoors → building A's door → stairs →
+``campus2`` walks (Jäger, Süß, Becker §III-B/C): outdoors → building A's door → stairs →
 floor 1 → elevator → floor 2 → elevator → out → the path → building B's door.
 
 The campus is surveyed once (``campus2_survey``, its own seed), the survey replayed through
@@ -18,7 +18,7 @@ Per seed and pooled over the seeds (figures in :mod:`.controller_score`):
   every radio on the whole walk: the baseline run's HEALTH, or the walk's span);
 * the controller's CONTEXT events per rule, and a timeline PNG per seed (truth vs controller).
 
-Targets (issue 14), each in the JSON's ``targets`` with its value and met: controller mean error ≤
+Targets, each in the JSON's ``targets`` with its value and met: controller mean error ≤
 the best fixed scheme's in every context; ≥ 20 % below the best single fixed scheme over the whole
 walk; floor hit ≥ 99 %; every transition detected within 5 s; no false switch.
 """
@@ -55,7 +55,7 @@ SCENARIO, SURVEY = "campus2", "campus2_survey"
 CONTROLLER = schemes.scheme_name(pose_t.SCHEME_CONTROLLER)
 #: the baseline replay: the fixed schemes alone
 BASELINE_SETS = ("controller.enabled=0",)
-#: issue 14's targets
+#: the targets
 WHOLE_REDUCTION_MIN = 0.20  # controller ≥ 20 % below the best single fixed scheme over the whole walk
 FLOOR_HIT_MIN = 0.99
 WHOLE = "whole walk"
@@ -195,7 +195,7 @@ def targets(
     switches: Sequence[dict[str, Any]],
     n_seeds: int,
 ) -> list[dict[str, Any]]:
-    """Issue 14's campus targets, each with its value and met (a missing controller misses all)."""
+    """The campus targets, each with its value and met (a missing controller misses all)."""
     rows = []
     fixed = [n for n in table if n != CONTROLLER]
     contexts = sorted({c for n in table for c in table[n]["contexts"]} - {WHOLE})

@@ -1,5 +1,5 @@
 """The figures of ``stridefix-lab bench controller`` that need no firmware: true contexts, transition
-latencies, false switches, per-context errors (issue 14; Jäger, Süß, Becker §III-C).
+latencies, false switches, per-context errors (Jäger, Süß, Becker §III-C).
 
 Contexts are named by keys: ``"outdoor"``, ``"<building>/<floor>"`` (a floor context, e.g. ``"A/1"``)
 and ``"<building>"`` (a building context: the building on any floor). The truth's context at a sample

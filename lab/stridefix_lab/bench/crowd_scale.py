@@ -1,6 +1,6 @@
 """``stridefix-lab bench crowd-scale``: the crowd fit and solve at fleet scale, serial and on Dask.
 
-Issue 15, item 4: fit and solve for 100 000 scans / 500 walks within a few minutes on 2 cores. A
+The target: fit and solve for 100 000 scans / 500 walks within a few minutes on 2 cores. A
 synthetic fleet (:mod:`stridefix_lab.crowd.fleet`: log-distance radio, piecewise-straight walks,
 biased dead reckoning, waypoints every ~10 s) is generated in this process; then
 

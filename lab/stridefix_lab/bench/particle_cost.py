@@ -1,6 +1,6 @@
 """``stridefix-lab bench particle-cost``: the particle scheme's instructions per step under callgrind.
 
-Issue 13's cost target: at most 1 million instructions per PDR step at 1 000 particles on a floor plan
+The cost target: at most 1 million instructions per PDR step at 1 000 particles on a floor plan
 of 5 000 wall segments. The harness ``tests/perf/particle_cost.c`` (built as ``sf_particle_cost`` next
 to ``stridefixd``'s build tree) builds such a floor, seeds the cloud and walks; callgrind counts the
 instructions inside the scheme's step call (``--toggle-collect=sf_fusion_step_on_floor``) and, in a

@@ -1,4 +1,4 @@
-"""``stridefix-lab bench perf``: the estimator core's cost and the logger's speed against issue 16's budgets.
+"""``stridefix-lab bench perf``: the estimator core's cost and the logger's speed against the unit's budgets.
 
 Each figure says how it was measured:
 
@@ -69,7 +69,7 @@ WIFI_SCANS = 50
 WIFI_HEARD_DBM = (-70.0, -80.0, -85.0, -88.0)
 REPLAY_SECONDS = 3600
 
-#: issue 16's budgets: (key, figure, comparison, bound)
+#: the unit's budgets: (key, figure, comparison, bound)
 BUDGETS = (
     ("imu_all_ir", "all core work per IMU sample [instructions]", "<=", 1200),
     ("attitude_vs_fusion", "attitude filter / x-io Fusion's update, per IMU sample", "<=", 1.5),

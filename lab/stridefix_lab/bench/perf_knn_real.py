@@ -1,4 +1,4 @@
-"""``stridefix-lab bench perf``'s scikit-learn peer on a real floor (issue 16): the radio map of a real
+"""``stridefix-lab bench perf``'s scikit-learn peer on a real floor: the radio map of a real
 msindoor floor, the held-out walks' scans, our matcher and ``KNeighborsRegressor`` side by side.
 
 The floor's walks (sorted by name) are imported once (realbench's importer and cache,

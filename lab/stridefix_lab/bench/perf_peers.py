@@ -1,4 +1,4 @@
-"""``stridefix-lab bench perf``'s Python peers (issue 16): the ``ahrs`` package's Madgwick and scikit-learn's KNN.
+"""``stridefix-lab bench perf``'s Python peers: the ``ahrs`` package's Madgwick and scikit-learn's KNN.
 
 Both run in Python, so callgrind instruction counts would compare an interpreter with a C function;
 these rows are wall times on this machine (informative, no budget), with what each one covers:
@@ -14,7 +14,7 @@ these rows are wall times on this machine (informative, no budget), with what ea
   of the wrapped yaw difference [deg] between the two after :data:`SETTLE_S` s (Fusion's start-up
   ramp). The harness's field is constant in the body frame while the gyro turns, so the yaw is a tug
   of war between gyro and magnetometer: the agreement says how alike the two weigh them, not accuracy.
-  **Ours against Fusion** (issue 16's "heading agrees with Fusion"): with ``ours_yaw`` (the lines of
+  **Ours against Fusion** (the budget "heading agrees with Fusion"): with ``ours_yaw`` (the lines of
   ``sf_core_cost yaw``, our attitude's device yaw after each IMU sample of the same walk, its MAG
   sample included) the RMS, max and mean of the wrapped difference ours − Fusion after
   :data:`SETTLE_S`; Fusion runs in its default NWU frame (yaw 0 with body x north), ours in ENU (yaw 0

@@ -1,5 +1,5 @@
 """``stridefix-lab bench reliability`` (``make reliability``): the default SIL walk with each bus and board
-fault (issue 12 item 2), replayed through the real ``stridefixd``, next to the same walk clean.
+fault, replayed through the real ``stridefixd``, next to the same walk clean.
 
 Each case of :data:`CASES` is one row: a fault kind, its rate (or time), and the scenario keys that
 inject it (the simulator's ``[faults]`` table and ``can`` keys; ``stridefix_sim/faults.py``). Every

@@ -1,5 +1,5 @@
 """``stridefix-lab bench scale``: realbench and ``radiomap build`` on one msindoor floor, serially and on
-Dask (issue 16 item 4: fleets of walks as tasks on a cluster).
+Dask (fleets of walks as tasks on a cluster).
 
 Each run is its own ``stridefix`` process (so a Dask run's wall time includes its LocalCluster's start):
 

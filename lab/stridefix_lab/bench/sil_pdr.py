@@ -1,4 +1,4 @@
-"""``stridefix-lab bench sil-pdr``: the PDR targets of issue 3 on SIL walks.
+"""``stridefix-lab bench sil-pdr``: the PDR targets on SIL walks.
 
 For each scenario and seed, simulate the walk, replay it through the real
 ``stridefixd`` binary in PDR-only mode, and score the log with the evaluation protocol of DESIGN.md.
@@ -47,7 +47,7 @@ DEFAULT_SCENARIOS = ["default", "pace_slow", "pace_normal", "pace_fast"]
 #: how every row started: the replay has no site, so pdr_only starts at the config pose, the truth
 START = f"{schemes.PDR_ONLY}, truth-initialised (the simulator's init_truth.ini)"
 
-# Issue 3's targets on the default scenarios.
+# The targets on the default scenarios.
 TARGETS = {"step_error_pct_abs_max": 1.0, "floor_hit_rate_min": 0.99, "final_error_pct_max": 2.0}
 
 
@@ -136,7 +136,7 @@ def run_one(
 
 
 def meets_targets(row: dict[str, Any]) -> dict[str, bool | None]:
-    """Which of issue 3's targets one run meets."""
+    """Which of the targets one run meets."""
 
     def ok(value: float | None, test: Callable[[float], bool]) -> bool | None:
         return None if value is None or not np.isfinite(value) else bool(test(value))

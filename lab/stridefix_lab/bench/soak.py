@@ -1,5 +1,5 @@
-"""``stridefix-lab bench soak`` (``make soak``): an 8-hour SIL walk with faults through ``stridefixd``
-(issue 12 item 6): peak RSS at 1 h and at 8 h of input, and every event accounted for.
+"""``stridefix-lab bench soak`` (``make soak``): an 8-hour SIL walk with faults through ``stridefixd``:
+peak RSS at 1 h and at 8 h of input, and every event accounted for.
 
 The walk (:func:`soak_scenario`) is laps of the floor-0 loop for ``hours`` with faults sprinkled in:
 board resets, payload corruption, duplicates, loss bursts, a silence window and rare implausible

@@ -1,4 +1,4 @@
-"""Issue 15's targets for ``crowd experiment --msindoor``: on each floor, the graph's solved positions
+"""The targets of ``crowd experiment --msindoor``: on each floor, the graph's solved positions
 ≥ 20 % better (mean error at the non-anchor waypoints) than interpolating the anchors in time."""
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A synthetic crowd fleet: many walkers on a few floors, as :class:`.walks.Walk` objects (no LCM logs).
 
-For the scale bench and tests of the crowd fit and solve (issue 15, item 4); fully vectorised numpy,
+For the scale bench and tests of the crowd fit and solve; fully vectorised numpy,
 so 100 000 scans / 500 walks take seconds.
 
 Radio: the simulator's log-distance model (``hil-sim/stridefix_sim/radio.py``, its constants from

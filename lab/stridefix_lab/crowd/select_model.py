@@ -1,4 +1,4 @@
-"""Held-out choice of the dissimilarity → distance model per site (issue 15 item 1).
+"""Held-out choice of the dissimilarity → distance model per site.
 
 The walks of a site (floor set) are split into K folds BY WALK (sorted by name, walk k → fold k mod K:
 deterministic and independent of the argument order). Every candidate of :mod:`.models` is fitted on

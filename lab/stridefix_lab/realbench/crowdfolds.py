@@ -2,7 +2,7 @@
 its training walks' anchors only.
 
 A crowd map has no truth, but every walk carries anchors (every K-th waypoint here), and the fleet of
-training walks together says more than one walk alone (issue 15; the fleet priors of
+training walks together says more than one walk alone (the fleet priors of
 :mod:`..crowd.graph`). Per fold (test walk left out), from the training walks' anchors:
 
 * **the heading variant** (:data:`.heading.HEADING_VARIANTS`: learned or fixed mounting offset, mag

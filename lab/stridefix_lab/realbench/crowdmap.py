@@ -1,6 +1,6 @@
 """``stridefix-lab realbench crowd-map``: the fix error on a radio map nobody surveyed, next to the surveyed one.
 
-Issue 15, item 3 (Kannan 2024, §4-5: a radio map from crowd walks with anchors every 4th waypoint).
+The crowd-built map (Kannan 2024, §4-5: a radio map from crowd walks with anchors every 4th waypoint).
 The walks, groups and folds are those of ``realbench fusion`` (:mod:`.fusion`: leave one walk out per
 floor) and so are its phases 1-2 (:func:`.fusion.prepare_walks`, :func:`.fusion.plan_group`). Each
 fold then gets two sites from its training walks:

@@ -1,7 +1,7 @@
 """The site's Wi-Fi fix-error model for the ``ekf`` scheme, measured on training walks the map never saw.
 
 The matcher's ``accuracy_m`` is the spread of its neighbours, a shape rather than a calibrated σ
-(issue 11: fixes whose real error is 5–6 m report 1.5–3 m). The ``ekf`` scheme takes its R as
+(fixes whose real error is 5–6 m report 1.5–3 m). The ``ekf`` scheme takes its R as
 ``accuracy_m² · M`` (``firmware/core/sf_ekf.h``); this module measures M against the truth:
 
 * the walks of a group are dealt into blocks and replayed with ``--fusion wifi_only`` on maps without

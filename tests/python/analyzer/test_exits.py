@@ -11,7 +11,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from stridefix_analyzer import cli, exits
+from stridefix_analyzer import cli
+from stridefix_common import exits
 
 REPO = Path(__file__).resolve().parents[3]
 PAIRS = {
