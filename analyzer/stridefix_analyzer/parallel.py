@@ -43,10 +43,10 @@ SCHEDULER_HELP = (
     "serial (this process), processes (a pool of --workers local processes), local (a Dask "
     "LocalCluster of --workers processes) or a Dask scheduler address tcp://HOST:PORT"
 )
-#: what a worker that lacks the files is told to provide (README section)
+#: what a worker that lacks the files is told to provide (docs/scale-out.md)
 NEEDS = (
     "Dask workers need the same stridefix package, stridefixd build, input data and output folder at the "
-    "same paths as this machine (README: Scale out on a Dask cluster)"
+    "same paths as this machine (docs/scale-out.md)"
 )
 
 #: Keep BLAS single-threaded in the worker processes (one task per core).

@@ -1,7 +1,7 @@
 """The exit-status contract of every ``stridefix`` command, the same as ``stridefixd``'s.
 
 The C side is ``SF_EXIT_*`` in firmware/app/sf_options.h; tests/python/analyzer/test_exits.py keeps the
-two equal. README "Exit status" has the table. A command over several inputs exits with the worst
+two equal. docs/reliability.md has the table. A command over several inputs exits with the worst
 status of its inputs (:func:`worst`): a failure before an unreadable input before one with nothing valid.
 """
 

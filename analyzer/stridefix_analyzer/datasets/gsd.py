@@ -1,6 +1,6 @@
 """GetSensorData logfiles (the IPIN competition Track 3 format: real Android phone walks) as a data set.
 
-Layout: ``../shared/data/gsd/*.txt`` (one walk per logfile; format in that folder's README and in each
+Layout: ``gsd/*.txt``, docs/datasets.md (one walk per logfile; format in that folder's README and in each
 file's ``%`` header) with ``BLE_Locations.csv`` (the building's beacons) beside them. Walks group per
 folder, all read about one origin (the first POSI of the folder's first log) so they share one frame,
 and are split by the building of their ground truth once read. One logfile becomes one raw-sensor LCM

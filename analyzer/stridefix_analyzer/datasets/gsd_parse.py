@@ -1,7 +1,7 @@
 """Parsing of one GetSensorData logfile (IPIN competition Track 3 format) into its raw records.
 
 The text side only: ``;``-separated records after ``%`` header lines (format in
-``../shared/data/gsd/README.md`` and in each file's header). :func:`parse_log` keeps, per record type,
+the data set's README and in each file's header). :func:`parse_log` keeps, per record type,
 the numbers the conversion (:mod:`.gsd_convert`) needs, in file order and on the file's own clocks;
 nothing is aligned, grouped or projected here.
 

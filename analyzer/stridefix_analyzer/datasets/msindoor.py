@@ -1,6 +1,6 @@
 """The Microsoft Indoor Location Competition 2.0 traces (real Android phone walks) as a data set.
 
-Layout: ``../shared/data/msindoor/<site>/<floor>/path_data_files/*.txt`` (one walk per trace; format
+Layout: ``msindoor/<site>/<floor>/path_data_files/*.txt``, docs/datasets.md (one walk per trace; format
 in that folder's README), with the floor's ``floor_info.json`` (extent in metres), ``floor_image.png``
 and ``geojson_map.json`` beside ``path_data_files``. Walks group per floor folder: each floor is its
 own map. No beacon table (beacon positions are learnt by ``stridefix radiomap build``). One trace becomes one raw-sensor LCM log (:mod:`.msindoor_parse` reads it):

@@ -1,6 +1,6 @@
 """Parsing of one Microsoft Indoor Location Competition 2.0 trace into a :class:`~.rawwalk.RawWalk`.
 
-The file format is in ``../shared/data/msindoor/README.md``: tab-separated ``unix-ms  TYPE_...  values``
+The file format is in the data set's own README (docs/datasets.md): tab-separated ``unix-ms  TYPE_...  values``
 lines after ``#`` header lines. What becomes of each record (:mod:`.msindoor` has the table):
 
 * TYPE_ACCELEROMETER → ``imu`` (m/s²), with TYPE_GYROSCOPE (rad/s) interpolated linearly to the
