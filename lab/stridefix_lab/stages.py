@@ -30,6 +30,11 @@ def stridefix_exe() -> str:
     return str(Path(sys.executable).with_name("stridefix"))
 
 
+def lab_exe() -> str:
+    """The lab's ``stridefix-lab`` console script of this interpreter's environment."""
+    return str(Path(sys.executable).with_name("stridefix-lab"))
+
+
 def run_stage(
     cmd: list[str], what: str, error: type[Exception] = StageError, tail: int = 2000
 ) -> subprocess.CompletedProcess[str]:

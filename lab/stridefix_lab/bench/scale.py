@@ -1,7 +1,7 @@
 """``stridefix-lab bench scale``: realbench and ``radiomap build`` on one msindoor floor, serially and on
 Dask (fleets of walks as tasks on a cluster).
 
-Each run is its own ``stridefix`` process (so a Dask run's wall time includes its LocalCluster's start):
+Each run is its own process (``stridefix-lab realbench``, ``stridefix radiomap build``: what is timed is the command a user runs) (so a Dask run's wall time includes its LocalCluster's start):
 
 * ``realbench --format msindoor FLOOR --true-start`` (as ``make bench`` runs it) with ``--scheduler
   serial``, ``processes`` (2 forked processes, realbench's default), ``local --workers 1`` and
@@ -30,7 +30,7 @@ from stridefix_analyzer.firmware import Firmware
 
 from stridefix_lab.bench.registry import Bench
 from stridefix_lab.realbench.summary import untimed
-from stridefix_lab.stages import run_stage, stridefix_exe
+from stridefix_lab.stages import lab_exe, run_stage, stridefix_exe
 
 DEFAULT_FLOOR = Path("..") / "shared" / "data" / "msindoor" / "site2" / "F3"
 #: name → --scheduler options
@@ -60,7 +60,7 @@ def run_scale(
     t0 = time.perf_counter()
     work = out / "scale"
     results, cache = work / "realbench" / "results.json", work / "cache"
-    base = [stridefix_exe(), "realbench", "--format", "msindoor", str(floor), "--true-start", "--quiet"]
+    base = [lab_exe(), "realbench", "--format", "msindoor", str(floor), "--true-start", "--quiet"]
     base += ["--no-report", "--stridefixd", str(stridefixd), "--cache", str(cache), "--out", str(results)]
     warm_s = None
     if not any(cache.rglob("*.lcmlog")):
