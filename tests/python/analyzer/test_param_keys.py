@@ -1,4 +1,4 @@
-"""Every firmware parameter key the analyzer spells (tuning candidates, benchmark overrides) is a key
+"""Every firmware parameter key the analyzer and the lab spell (tuning candidates, benchmark overrides) is a key
 of the firmware's own table (`stridefixd --print-config --json`): renaming a parameter in
 firmware/core/sf_params.h fails here, not halfway through a benchmark."""
 
@@ -9,17 +9,19 @@ from pathlib import Path
 
 from stridefix_analyzer.firmware import Firmware
 
-ANALYZER = Path(__file__).resolve().parents[3] / "analyzer" / "stridefix_analyzer"
+REPO = Path(__file__).resolve().parents[3]
+#: the packages that spell keys: the analyzer and the lab
+ROOTS = (REPO / "analyzer" / "stridefix_analyzer", REPO / "lab" / "stridefix_lab")
 # a string literal (or f-string) that starts with section.name= : a --set override
 _SET_LITERAL = re.compile(r"""f?["']([a-z][a-z0-9_]*\.[a-z][a-z0-9_]*)=""")
 
 
 def _spelled_keys() -> dict[str, list[str]]:
     keys: dict[str, list[str]] = {}
-    for path in sorted(ANALYZER.rglob("*.py")):
+    for path in sorted(p for root in ROOTS for p in root.rglob("*.py")):
         for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
             for key in _SET_LITERAL.findall(line):
-                keys.setdefault(key, []).append(f"{path.relative_to(ANALYZER)}:{n}")
+                keys.setdefault(key, []).append(f"{path.relative_to(REPO)}:{n}")
     return keys
 
 

@@ -84,7 +84,7 @@ def test_defaults_ini_is_print_config(prefix):
 def test_one_version_everywhere(prefix, stridefixd):
     """VERSION = stridefixd's = the analyzer's = `stridefix --version`'s = the pkg-config file's."""
     from stridefix_analyzer import __version__
-    from stridefix_analyzer.cli import version_text
+    from stridefix_analyzer.cliapp import version_text
 
     assert __version__ == VERSION
     lines = version_text().splitlines()

@@ -26,7 +26,12 @@ def test_wheel_runs_with_the_installed_stridefixd(prefix, python_site, tmp_path)
     src.mkdir()
     for rel in ("pyproject.toml", "VERSION"):
         shutil.copy2(REPO / rel, src / rel)
-    for pkg in ("analyzer/stridefix_analyzer", "hil-sim/stridefix_sim"):
+    for pkg in (
+        "common/stridefix_common",
+        "analyzer/stridefix_analyzer",
+        "hil-sim/stridefix_sim",
+        "lab/stridefix_lab",
+    ):
         shutil.copytree(REPO / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__"))
     pip = [sys.executable, "-m", "pip", "--disable-pip-version-check", "-q"]
     wheels = tmp_path / "wheels"
@@ -52,7 +57,7 @@ def test_wheel_runs_with_the_installed_stridefixd(prefix, python_site, tmp_path)
     env["PYTHONPATH"] = f"{target}{os.pathsep}{python_site}"
     env["PATH"] = f"{prefix / 'bin'}{os.pathsep}/usr/bin{os.pathsep}/bin"
     code = (
-        "import json, stridefix_analyzer, stridefix; from stridefix_analyzer.cli import version_text; "
+        "import json, stridefix_analyzer, stridefix; from stridefix_analyzer.cliapp import version_text; "
         "print(json.dumps([stridefix_analyzer.__file__, stridefix.__file__, version_text()]))"
     )
     proc = subprocess.run(

@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix_analyzer import datasets
-from stridefix_analyzer.cli import build_parser
 from stridefix_analyzer.cli import main as stridefix_main
 from stridefix_analyzer.datasets.protocol import (
     Dataset,
@@ -29,6 +28,7 @@ from stridefix_analyzer.datasets.protocol import (
 from stridefix_analyzer.datasets.rawwalk import RawWalk, finite, wifi_table
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import Table, read_logs
+from stridefix_lab.cli import build_parser
 from stridefix_lab.realbench import walks as rb_walks
 from stridefix_lab.realbench.prepare import PrepareJob, prepare
 

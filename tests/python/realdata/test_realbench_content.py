@@ -13,11 +13,11 @@ import pytest
 from numpy.testing import assert_allclose
 from stridefix import truth_t, wifi_scan_t
 from stridefix_analyzer import datasets
-from stridefix_analyzer.cli import build_parser
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
 from stridefix_analyzer.radiomap import floorplan as fp
 from stridefix_analyzer.radiomap.beacons import MIN_RANGE_M
+from stridefix_lab.cli import build_parser
 from stridefix_lab.realbench import fold as rfold
 from stridefix_lab.realbench import sitecontent as sc
 from stridefix_lab.realbench.walks import RealbenchError
