@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from stridefix_analyzer.io.results import read_realbench_results
 from stridefix_analyzer.realbench.summary import untimed
 from stridefix_analyzer.stages import run_stage, stridefix_exe
 
@@ -76,7 +77,7 @@ def run_scale(
     for name, opts in runs.items():
         load = os.getloadavg()[0]
         wall_s = _timed([*base, *opts], f"realbench {name}")
-        res = json.loads(results.read_text())
+        res = read_realbench_results(results)
         first = first or untimed(res)
         realbench[name] = {
             "wall_s": wall_s,
