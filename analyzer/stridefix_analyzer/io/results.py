@@ -1,29 +1,18 @@
 """The result files of the analyzer, typed: realbench's ``results.json`` and analyze's ``metrics.json``.
 
-Every result file says what it is in its ``kind`` key (the first key), the convention of the crowd
-models file (``stridefix.crowd.models/v1``):
+Every result file says what it is in its first key, ``kind`` (the convention of the crowd models
+file, ``stridefix.crowd.models/v1``): :data:`REALBENCH_RESULTS_KIND` (``realbench [fusion]``,
+:class:`RealbenchResults`), :data:`CROWD_MAP_RESULTS_KIND` (``realbench crowd-map``,
+:class:`CrowdMapResults`: the fusion file's frame, but groups that pair a truth-built and a
+crowd-built map instead of listing schemes) and :data:`ANALYZE_METRICS_KIND` (``analyze``'s
+metrics.json, also per walk in realbench's work folders: :class:`AnalyzeMetrics`).
 
-- :data:`REALBENCH_RESULTS_KIND`: ``stridefix realbench [fusion] --out results.json``
-  (:class:`RealbenchResults`);
-- :data:`CROWD_MAP_RESULTS_KIND`: ``stridefix realbench crowd-map --out results.json``
-  (:class:`CrowdMapResults`). It shares the fusion file's frame (``benchmark``, ``format``,
-  ``params``, ``stridefixd``, ``groups`` with ``label``, ``walks``, ``ran``, ``failed``,
-  ``walk_rows``, ``run_s``) but its groups pair two maps instead of listing schemes;
-- :data:`ANALYZE_METRICS_KIND`: ``stridefix analyze``'s ``metrics.json`` (:class:`AnalyzeMetrics`),
-  also the per-walk ``metrics.json`` of realbench's work folders.
-
-The types are :class:`typing.TypedDict`: a document read is the JSON object itself, so the files
-are exactly what the writers wrote. Numbers that were not finite are ``null`` in the files
-(:func:`~stridefix_analyzer.io.jsonio.json_ready`), hence the ``float | None``. Blobs whose shape
-belongs to another module (a fold's constants, the site content, ISO/IEC 18305 terms, HEALTH and
-CONFIG) stay ``dict[str, Any]``.
-
-Writers go through :func:`write_realbench_results`, :func:`write_crowd_map_results` and
-:func:`write_analyze_metrics` (which stamp the kind); readers through :func:`read_realbench_results`,
-:func:`read_crowd_map_results`, :func:`read_analyze_metrics` or, for a file that may be any of the
-three, :func:`read_any_results`. A file whose kind is another one is refused with a
-:class:`ResultsFileError` that names the file, its kind and the one expected; a file without
-``kind`` (written before the kinds) is read as version 1 of the kind its shape says.
+TypedDicts, so a document read is the JSON object itself; non-finite numbers are ``null`` in the
+files (:func:`~stridefix_analyzer.io.jsonio.json_ready`), hence ``float | None``; blobs shaped by
+other modules (fold constants, site content, ISO/IEC 18305 terms, HEALTH, CONFIG) stay dicts.
+Writers stamp the kind (``write_*``); readers (``read_*``, :func:`read_any_results` for any of the
+three) refuse another kind with a :class:`ResultsFileError` naming the file, its kind and the one
+expected, and read a file without ``kind`` (written before the kinds) as v1 of the kind its shape says.
 """
 
 from __future__ import annotations
@@ -32,16 +21,13 @@ import dataclasses
 import json
 import os
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any, NotRequired, TypedDict, cast
 
 from stridefix_analyzer.io.jsonio import json_ready
 
-#: ``kind`` of realbench fusion's results.json
+#: the ``kind`` of realbench fusion's results.json, of realbench crowd-map's, of analyze's metrics.json
 REALBENCH_RESULTS_KIND = "stridefix.realbench.results/v1"
-#: ``kind`` of realbench crowd-map's results.json
 CROWD_MAP_RESULTS_KIND = "stridefix.realbench.crowd-map/v1"
-#: ``kind`` of analyze's metrics.json
 ANALYZE_METRICS_KIND = "stridefix.analyze.metrics/v1"
 #: the ``benchmark`` of a crowd-map results.json (what tells a file without ``kind`` apart)
 CROWD_MAP_BENCHMARK = "crowd-map"
@@ -61,8 +47,7 @@ class ResultsFileError(ValueError):
 
 
 class ErrorStats(TypedDict):
-    """Position error statistics [m] of the scored samples (``null`` when none was scored)."""
-
+    # Position error statistics [m] of the scored samples (``null`` when none was scored).
     n: int
     mean: float | None
     median: float | None
@@ -73,9 +58,7 @@ class ErrorStats(TypedDict):
     rmse: float | None
 
 
-class MethodCounts(TypedDict):
-    """FIX records of one scheme and one method (Wi-Fi, GNSS, BLE, landmark)."""
-
+class MethodCounts(TypedDict):  # FIX records of one scheme and one method (Wi-Fi, GNSS, BLE, landmark).
     offered: int
     accepted: int
     rejected: int
@@ -86,16 +69,12 @@ class MethodCounts(TypedDict):
 FixSourceCounts = dict[str, dict[str, MethodCounts]]
 
 
-class FirmwareInfo(TypedDict):
-    """The stridefixd a realbench run replayed with."""
-
+class FirmwareInfo(TypedDict):  # the stridefixd a realbench run replayed with.
     path: str
     version: str | None
 
 
-class WalkFailure(TypedDict):
-    """A walk that could not be prepared or scored, and why."""
-
+class WalkFailure(TypedDict):  # a walk that could not be prepared or scored, and why.
     walk: str
     error: str | None
 
@@ -104,8 +83,7 @@ class WalkFailure(TypedDict):
 
 
 class WalkScore(ErrorStats):
-    """One scheme (or textbook reference) on one walk (``walk_rows[].fixes[scheme]``)."""
-
+    # One scheme (or textbook reference) on one walk (``walk_rows[].fixes[scheme]``).
     unscored: int
     floor_hit_rate: float | None
     ipin_score: float | None
@@ -113,8 +91,7 @@ class WalkScore(ErrorStats):
 
 
 class PooledRow(ErrorStats):
-    """One scheme (or reference) pooled over a group's walks (``summary.schemes[scheme]``)."""
-
+    # One scheme (or reference) pooled over a group's walks (``summary.schemes[scheme]``).
     ipin_score: float | None
     floor_hit_rate: float | None
     walks: int
@@ -123,31 +100,25 @@ class PooledRow(ErrorStats):
     walk_mean_median: float | None
 
 
-class LostMetric(TypedDict):
-    """A metric a scheme loses on: its value and its reference's."""
-
+class LostMetric(TypedDict):  # a metric a scheme loses on: its value and its reference's.
     scheme: float | None
     reference: float | None
 
 
-class Loss(TypedDict):
-    """A scheme worse than its textbook reference on every metric of ``lost``."""
-
+class Loss(TypedDict):  # a scheme worse than its textbook reference on every metric of ``lost``.
     scheme: str
     reference: str
     lost: dict[str, LostMetric]
 
 
 class PrimaryPose(TypedDict):
-    """The scheme POSE carried in a group and, for the controller, what it followed in how many folds."""
-
+    # The scheme POSE carried in a group and, for the controller, what it followed in how many folds.
     scheme: str | None
     follows: dict[str, int]
 
 
 class GroupSummary(TypedDict):
-    """A group's schemes and references pooled over its walks (``summary``, ``summary_true_start``)."""
-
+    # A group's schemes and references pooled over its walks (``summary``, ``summary_true_start``).
     schemes: dict[str, PooledRow]
     adaptive_vs_wifi_only_reduction_pct: float | None
     references: dict[str, PooledRow]
@@ -155,9 +126,7 @@ class GroupSummary(TypedDict):
     primary: PrimaryPose
 
 
-class Spread(TypedDict):
-    """A fold constant over a group's folds."""
-
+class Spread(TypedDict):  # a fold constant over a group's folds.
     n: int
     mean: float | None
     std: float | None
@@ -166,9 +135,8 @@ class Spread(TypedDict):
 
 
 class FoldConstants(TypedDict):
-    """The constants learnt per fold, spread over a group. The file also holds, per tuning axis,
-    ``<axis>_variant``: variant → number of folds (names not known here)."""
-
+    # The constants learnt per fold, spread over a group. The file also holds, per tuning axis,
+    # ``<axis>_variant``: variant → number of folds (names not known here).
     K: Spread
     rotation_deg: Spread
     n_rp: Spread
@@ -176,8 +144,7 @@ class FoldConstants(TypedDict):
 
 
 class WalkRow(TypedDict):
-    """One walk of a group: its fold's constants and per scheme its scores (per start mode)."""
-
+    # One walk of a group: its fold's constants and per scheme its scores (per start mode).
     walk: str
     error: str | None
     fold: dict[str, Any] | None
@@ -195,9 +162,8 @@ class WalkRow(TypedDict):
 
 
 class FusionGroup(TypedDict):
-    """One group (a floor, a building) of a fusion run. The file also holds the tuning rows' record
-    of how they chose (e.g. ``heading_variant_all_walks``; names not known here)."""
-
+    # One group (a floor, a building) of a fusion run. The file also holds the tuning rows' record
+    # of how they chose (e.g. ``heading_variant_all_walks``; names not known here).
     label: str
     walks: int
     ran: int
@@ -215,8 +181,7 @@ class FusionGroup(TypedDict):
 
 
 class RealbenchParams(TypedDict):
-    """How a fusion run was set up (``jobs`` and ``scheduler`` say how it ran, not what it gave)."""
-
+    # How a fusion run was set up (``jobs`` and ``scheduler`` say how it ran, not what it gave).
     cell_size_m: float
     min_count: int
     firmware_sets: list[str]
@@ -231,9 +196,7 @@ class RealbenchParams(TypedDict):
     site_content: dict[str, Any]
 
 
-class FusionRunTimes(TypedDict):
-    """Wall-clock seconds of a fusion run's phases."""
-
+class FusionRunTimes(TypedDict):  # wall-clock seconds of a fusion run's phases.
     prepare: float
     folds: float
     total: float
@@ -257,16 +220,13 @@ class RealbenchResults(TypedDict):
 # --- realbench crowd-map: results.json ------------------------------------------------------------
 
 
-class PositionError(TypedDict):
-    """Mean position error [m] of the crowd positions over ``n`` waypoints."""
-
+class PositionError(TypedDict):  # mean position error [m] of the crowd positions over ``n`` waypoints.
     n: int
     mean_m: float | None
 
 
 class CrowdMapSummary(TypedDict):
-    """A group's walks scored on both maps, pooled as realbench fusion pools them."""
-
+    # A group's walks scored on both maps, pooled as realbench fusion pools them.
     truth_map: dict[str, PooledRow]
     crowd_map: dict[str, PooledRow]
     #: scheme → crowd map's mean / truth map's mean
@@ -276,8 +236,7 @@ class CrowdMapSummary(TypedDict):
 
 
 class CrowdMapWalkRow(TypedDict):
-    """One walk replayed on the truth-built and on the crowd-built map of its fold."""
-
+    # One walk replayed on the truth-built and on the crowd-built map of its fold.
     walk: str
     error: str | None
     truth_map: dict[str, ErrorStats]
@@ -289,9 +248,7 @@ class CrowdMapWalkRow(TypedDict):
     ratio: dict[str, float | None]
 
 
-class CrowdMapGroup(TypedDict):
-    """One group of a crowd-map run."""
-
+class CrowdMapGroup(TypedDict):  # one group of a crowd-map run.
     label: str
     walks: int | None
     ran: int | None
@@ -305,9 +262,7 @@ class CrowdMapGroup(TypedDict):
     walk_rows: list[CrowdMapWalkRow]
 
 
-class CrowdMapRunTimes(TypedDict):
-    """Wall-clock seconds of a crowd-map run's phases."""
-
+class CrowdMapRunTimes(TypedDict):  # wall-clock seconds of a crowd-map run's phases.
     prepare_plan: float
     crowd_solve: float
     folds: float
@@ -336,22 +291,18 @@ class CrowdMapResults(TypedDict):
 
 
 class PositionErrorStats(ErrorStats):
-    """A scheme's position error statistics [m], and the non-finite errors left out."""
-
+    # A scheme's position error statistics [m], and the non-finite errors left out.
     nonfinite: int
 
 
-class HeadingError(TypedDict):
-    """Heading error [deg] at the scored samples."""
-
+class HeadingError(TypedDict):  # heading error [deg] at the scored samples.
     n: int
     rms_deg: float | None
     mean_abs_deg: float | None
 
 
 class StepCounts(TypedDict):
-    """Steps detected against the truth's (``truth``, ``error`` null without truth steps)."""
-
+    # Steps detected against the truth's (``truth``, ``error`` null without truth steps).
     detected: int
     step_messages: int
     truth: int | None
@@ -359,9 +310,7 @@ class StepCounts(TypedDict):
     error_pct: float | None
 
 
-class SchemeMetrics(TypedDict):
-    """One POSE scheme scored against TRUTH (``per_scheme[scheme]``)."""
-
+class SchemeMetrics(TypedDict):  # one POSE scheme scored against TRUTH (``per_scheme[scheme]``).
     n_pose: int
     position_error_m: PositionErrorStats
     unscored: int
@@ -411,53 +360,29 @@ class AnalyzeMetrics(TypedDict):
 # --- writing --------------------------------------------------------------------------------------
 
 
-def _stamped(kind: str, doc: Mapping[str, Any]) -> dict[str, Any]:
-    """``doc`` as JSON values with ``kind`` as its first key (a ``kind`` already in it is replaced)."""
-    return {"kind": kind, **{k: v for k, v in json_ready(dict(doc)).items() if k != "kind"}}
-
-
-def realbench_results(doc: Mapping[str, Any]) -> RealbenchResults:
-    """A fusion run's document as the typed, stamped results.json content (JSON values)."""
-    return cast(RealbenchResults, _stamped(REALBENCH_RESULTS_KIND, doc))
-
-
-def crowd_map_results(doc: Mapping[str, Any]) -> CrowdMapResults:
-    """A crowd-map run's document as the typed, stamped results.json content (JSON values)."""
-    return cast(CrowdMapResults, _stamped(CROWD_MAP_RESULTS_KIND, doc))
-
-
-def analyze_metrics(doc: Mapping[str, Any]) -> AnalyzeMetrics:
-    """An analyze summary as the typed, stamped metrics.json content (JSON values)."""
-    return cast(AnalyzeMetrics, _stamped(ANALYZE_METRICS_KIND, doc))
-
-
-def _write(path: str | os.PathLike[str], doc: Mapping[str, Any], indent: int) -> Path:
-    out = Path(path)
-    with open(out, "w", encoding="utf-8") as f:
-        json.dump(doc, f, indent=indent, allow_nan=False)
+def _write(path: str | os.PathLike[str], kind: str, doc: Mapping[str, Any], indent: int) -> dict[str, Any]:
+    """Write ``doc`` as JSON values with ``kind`` as its first key (replacing a ``kind`` in it); return
+    what was written."""
+    out = {"kind": kind, **{k: v for k, v in json_ready(dict(doc)).items() if k != "kind"}}
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(out, f, indent=indent, allow_nan=False)
         f.write("\n")
     return out
 
 
 def write_realbench_results(path: str | os.PathLike[str], doc: Mapping[str, Any]) -> RealbenchResults:
-    """Write a fusion run's results.json (stamped with :data:`REALBENCH_RESULTS_KIND`); return what was written."""
-    typed = realbench_results(doc)
-    _write(path, typed, indent=1)
-    return typed
+    """Write a fusion run's results.json, stamped :data:`REALBENCH_RESULTS_KIND`; return what was written."""
+    return cast(RealbenchResults, _write(path, REALBENCH_RESULTS_KIND, doc, indent=1))
 
 
 def write_crowd_map_results(path: str | os.PathLike[str], doc: Mapping[str, Any]) -> CrowdMapResults:
-    """Write a crowd-map run's results.json (stamped with :data:`CROWD_MAP_RESULTS_KIND`); return what was written."""
-    typed = crowd_map_results(doc)
-    _write(path, typed, indent=1)
-    return typed
+    """Write a crowd-map run's results.json, stamped :data:`CROWD_MAP_RESULTS_KIND`."""
+    return cast(CrowdMapResults, _write(path, CROWD_MAP_RESULTS_KIND, doc, indent=1))
 
 
 def write_analyze_metrics(path: str | os.PathLike[str], doc: Mapping[str, Any]) -> AnalyzeMetrics:
-    """Write analyze's metrics.json (stamped with :data:`ANALYZE_METRICS_KIND`); return what was written."""
-    typed = analyze_metrics(doc)
-    _write(path, typed, indent=2)
-    return typed
+    """Write analyze's metrics.json, stamped :data:`ANALYZE_METRICS_KIND`."""
+    return cast(AnalyzeMetrics, _write(path, ANALYZE_METRICS_KIND, doc, indent=2))
 
 
 # --- reading --------------------------------------------------------------------------------------
@@ -486,9 +411,8 @@ def kind_of(doc: Mapping[str, Any]) -> str | None:
     if kind is not None:
         return str(kind)
     if isinstance(doc.get("groups"), list):
-        return (
-            CROWD_MAP_RESULTS_KIND if doc.get("benchmark") == CROWD_MAP_BENCHMARK else REALBENCH_RESULTS_KIND
-        )
+        crowd = doc.get("benchmark") == CROWD_MAP_BENCHMARK
+        return CROWD_MAP_RESULTS_KIND if crowd else REALBENCH_RESULTS_KIND
     if isinstance(doc.get("per_scheme"), dict):
         return ANALYZE_METRICS_KIND
     return None
@@ -506,14 +430,11 @@ def _checked(path: str | os.PathLike[str], doc: dict[str, Any], expected: str) -
     """``doc`` when it is of kind ``expected`` (or has no kind and that shape); else the error."""
     name = os.fspath(path)
     kind = kind_of(doc)
-    if "kind" not in doc and kind is None:
-        raise ResultsFileError(
-            f"{name}: no 'kind' and not the shape of {_WHAT[expected]}; expected kind {expected!r}"
-        )
     if kind != expected:
+        got = f"kind {kind!r}" if "kind" in doc else f"no 'kind', shaped as {kind!r}"
+        got = "no 'kind' and not the shape of a result file" if kind is None else got
         what = f" ({_WHAT[kind]})" if kind in _WHAT else ""
-        how = "kind" if "kind" in doc else "no 'kind', shaped as"
-        raise ResultsFileError(f"{name}: {how} {kind!r}{what}; expected {expected!r} ({_WHAT[expected]})")
+        raise ResultsFileError(f"{name}: {got}{what}; expected {expected!r} ({_WHAT[expected]})")
     missing = [k for k in _REQUIRED[expected] if k not in doc]
     if missing:
         raise ResultsFileError(f"{name}: {_WHAT[expected]} without {', '.join(missing)}")
