@@ -24,7 +24,6 @@ sample precedes the first POSE); 2 missing or unreadable input, or no TRUTH / no
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import warnings
@@ -41,6 +40,7 @@ from stridefix_analyzer.io.logread import (
     LogTruncatedWarning,
     read_logs,
 )
+from stridefix_analyzer.io.results import write_analyze_metrics
 from stridefix_analyzer.schemes import NAMES
 from stridefix_analyzer.scoring import floor_height, iso18305
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
@@ -158,9 +158,7 @@ def write_outputs(out_dir: str, summary: dict, metrics: Metrics, site: Any = Non
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, METRICS_FILE)
     npz_path = os.path.join(out_dir, SERIES_FILE)
-    with open(json_path, "w", encoding="utf-8") as f:
-        json.dump(summary, f, indent=2, allow_nan=False)
-        f.write("\n")
+    write_analyze_metrics(json_path, summary)
     series: dict[str, Any] = metrics.series()
     if site is not None:
         for col in ("x0_m", "y0_m", "x1_m", "y1_m"):

@@ -20,9 +20,12 @@ import json
 import math
 import os
 import sys
-from typing import Any
+from collections.abc import Mapping
+from typing import Any, cast
 
 import numpy as np
+
+from stridefix_analyzer.io.results import ResultsFileError, read_any_results
 
 #: statistics a walk row offers: realbench walk rows and analyze's per_scheme position_error_m
 METRICS = ("mean", "median", "p75", "p90", "p95", "max", "rmse", "ipin_score", "floor_hit_rate")
@@ -38,34 +41,36 @@ class CompareInputError(ValueError):
 def load_run(path: str) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
     """(group, walk) → scheme → statistic of one run file (module docstring)."""
     try:
-        with open(path, encoding="utf-8") as f:
-            doc = json.load(f)
-    except OSError as exc:
-        raise CompareInputError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    except ValueError as exc:
-        raise CompareInputError(f"{path}: not JSON: {exc}") from exc
+        run = read_any_results(path)
+    except ResultsFileError as exc:
+        raise CompareInputError(str(exc)) from exc
     walks: dict[tuple[str, str], dict[str, dict[str, float]]] = {}
-    if isinstance(doc, dict) and "groups" in doc:
-        for g in doc["groups"]:
-            group = str(g.get("label") or g.get("group") or "?")
+    if run.realbench is not None:
+        for g in run.realbench["groups"]:
+            group = str(g.get("label") or cast(Mapping[str, Any], g).get("group") or "?")
             for row in g.get("walk_rows", []):
-                if row.get("error") or not row.get("fixes"):
+                fixes = row.get("fixes")
+                if row.get("error") or not fixes:
                     continue
                 walks[(group, str(row["walk"]))] = {
-                    name: {k: _num(s.get(k)) for k in METRICS} for name, s in row["fixes"].items()
+                    name: {k: _num(cast(Mapping[str, Any], s).get(k)) for k in METRICS}
+                    for name, s in fixes.items()
                 }
-    elif isinstance(doc, dict) and "per_scheme" in doc:
-        walks[("walk", str(doc.get("label") or os.path.basename(os.path.dirname(os.path.abspath(path)))))] = {
+    elif run.metrics is not None:
+        m = run.metrics
+        walks[("walk", str(m.get("label") or os.path.basename(os.path.dirname(os.path.abspath(path)))))] = {
             name: {
-                **{k: _num(s["position_error_m"].get(k)) for k in METRICS if k in s["position_error_m"]},
+                **{k: _num(e.get(k)) for k in METRICS if k in e},
                 "ipin_score": _num(s.get("ipin_score")),
                 "floor_hit_rate": _num(s.get("floor_hit_rate")),
             }
-            for name, s in doc["per_scheme"].items()
+            for name, s in m["per_scheme"].items()
+            for e in [cast(Mapping[str, Any], s["position_error_m"])]
         }
     else:
         raise CompareInputError(
-            f"{path}: neither a realbench results.json (groups) nor a metrics.json (per_scheme)"
+            f"{path}: {run.kind}: a crowd-map file has no per-scheme walk rows; compare realbench fusion "
+            "results.json or analyze metrics.json files"
         )
     if not walks:
         raise CompareInputError(f"{path}: no scored walk in it")

@@ -12,12 +12,12 @@ from __future__ import annotations
 import argparse
 import base64
 import html
-import json
 import os
 import sys
 
 import numpy as np
 
+from stridefix_analyzer.io.results import AnalyzeMetrics, ResultsFileError, read_analyze_metrics
 from stridefix_analyzer.scoring import plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
 from stridefix_analyzer.scoring.config_table import config_html
@@ -34,7 +34,7 @@ class ReportInputError(Exception):
 _STAT_COLS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
 
 
-def load_analysis(directory: str) -> tuple[dict, dict]:
+def load_analysis(directory: str) -> tuple[AnalyzeMetrics, dict]:
     """Load (metrics.json as dict, analysis.npz as dict of arrays) from ``directory``.
 
     Raises
@@ -50,10 +50,9 @@ def load_analysis(directory: str) -> tuple[dict, dict]:
     if missing:
         raise ReportInputError(f"missing {', '.join(missing)} (run `stridefix analyze` first)")
     try:
-        with open(json_path, encoding="utf-8") as f:
-            summary = json.load(f)
-    except (OSError, ValueError) as exc:
-        raise ReportInputError(f"{json_path}: cannot read as JSON ({exc})") from exc
+        summary = read_analyze_metrics(json_path)
+    except ResultsFileError as exc:
+        raise ReportInputError(str(exc)) from exc
     try:
         with np.load(npz_path) as z:
             series = {k: z[k] for k in z.files}
@@ -96,7 +95,7 @@ def _kv_table(rows: list[tuple[str, object]], header=("item", "value")) -> str:
     )
 
 
-def _scheme_table(summary: dict) -> str:
+def _scheme_table(summary: AnalyzeMetrics) -> str:
     head = (
         "<tr><th class='k'>scheme</th><th>POSE msgs</th>"
         + "".join(f"<th>{c}{'' if c == 'n' else ' [m]'}</th>" for c in _STAT_COLS)
@@ -134,7 +133,7 @@ _ISO_COLS = (
 )
 
 
-def _iso18305_table(summary: dict) -> str:
+def _iso18305_table(summary: AnalyzeMetrics) -> str:
     head = (
         "<tr><th class='k'>scheme</th>"
         + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in _ISO_COLS)
@@ -152,7 +151,7 @@ def _iso18305_table(summary: dict) -> str:
     return f"<table>{head}{''.join(rows)}</table>"
 
 
-def _steps_table(summary: dict) -> str:
+def _steps_table(summary: AnalyzeMetrics) -> str:
     head = (
         "<tr><th class='k'>scheme</th><th>detected</th><th>truth</th><th>error</th>"
         "<th>error %</th><th>STEP msgs</th></tr>"
@@ -184,7 +183,7 @@ def _iso_overview(t: dict | None) -> str | None:
     )
 
 
-def render_html(summary: dict, series: dict, title: str = "StrideFix walk report") -> str:
+def render_html(summary: AnalyzeMetrics, series: dict, title: str = "StrideFix walk report") -> str:
     """The complete report page for one analysis, as an HTML string."""
     figs = plots.render_all(series)
     e = summary["position_error_m"]

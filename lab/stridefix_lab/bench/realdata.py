@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.results import read_any_results
 from stridefix_analyzer.schemes import is_fused
 
 from stridefix_lab.bench.registry import Bench
@@ -184,18 +185,21 @@ def load_groups(paths: Iterable[str | Path]) -> dict[str, dict[str, Any]]:
     groups: dict[str, dict[str, Any]] = {}
     for path in paths:
         try:
-            doc = json.loads(Path(path).read_text())
-            for g in doc["groups"]:
-                old = groups.get(g["label"], {})
-                if doc.get("benchmark") == "crowd-map":
-                    groups[g["label"]] = {**old, "crowd_map": g}
-                else:
-                    total = (doc.get("run_s") or {}).get("total")
+            run = read_any_results(path)
+            if run.crowd_map is not None:
+                for c in run.crowd_map["groups"]:
+                    groups[c["label"]] = {**groups.get(c["label"], {}), "crowd_map": c}
+            elif run.realbench is not None:
+                total = (run.realbench.get("run_s") or {}).get("total")
+                for g in run.realbench["groups"]:
+                    old = groups.get(g["label"], {})
                     groups[g["label"]] = {
                         **g,
                         **({"crowd_map": old["crowd_map"]} if "crowd_map" in old else {}),
                         **({"run_s_total": float(total)} if total is not None else {}),
                     }
+            else:
+                raise ValueError(f"kind {run.kind!r}")
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise ResultsError(f"{path}: not a realbench results file ({exc})") from exc
     return groups

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from stridefix_analyzer.firmware import Firmware
+from stridefix_analyzer.io.results import read_realbench_results
 
 from stridefix_lab.bench.registry import Bench
 from stridefix_lab.realbench.summary import untimed
@@ -80,7 +81,7 @@ def run_scale(
     for name, opts in runs.items():
         load = os.getloadavg()[0]
         wall_s = _timed([*base, *opts], f"realbench {name}")
-        res = json.loads(results.read_text())
+        res = read_realbench_results(results)
         first = first or untimed(res)
         realbench[name] = {
             "wall_s": wall_s,

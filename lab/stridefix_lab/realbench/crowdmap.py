@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import collections
 import dataclasses
-import json
 import math
 import os
 import sys
@@ -36,7 +35,7 @@ from typing import Any, TextIO
 
 from stridefix_analyzer.console import Progress
 from stridefix_analyzer.datasets.protocol import WalkGroup
-from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.io.results import write_crowd_map_results
 from stridefix_analyzer.radiomap.build import WalkStats
 
 from stridefix_lab.realbench.crowdfolds import Choice, CrowdJob, choice_doc, fold_stats, solve_folds
@@ -150,9 +149,7 @@ def _run_crowd_map(
         "folds": time.perf_counter() - t_crowd,
         "total": time.perf_counter() - t_start,
     }
-    with open(cfg.out_json, "w", encoding="utf-8") as f:
-        json.dump(json_ready(doc), f, indent=1, allow_nan=False)
-        f.write("\n")
+    write_crowd_map_results(cfg.out_json, doc)
     run.stream.close()
     if cfg.quiet:
         stream.close()

@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import json
 import math
 import os
 import sys
@@ -46,7 +45,7 @@ import numpy as np
 from stridefix_analyzer.console import Progress
 from stridefix_analyzer.datasets.protocol import Dataset, WalkGroup
 from stridefix_analyzer.firmware import Firmware
-from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.io.results import write_realbench_results
 from stridefix_analyzer.parallel import TaskRunner, WorkerFiles, is_remote, task_runner
 from stridefix_analyzer.radiomap.build import WalkStats
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
@@ -156,9 +155,7 @@ def _run_fusion(run: Run, groups: list[WalkGroup], t_start: float) -> dict[str, 
         write_report(doc, html)
         doc["report"] = str(html)
     doc["run_s"]["total"] = time.perf_counter() - t_start
-    with open(cfg.out_json, "w", encoding="utf-8") as f:
-        json.dump(json_ready(strip_samples(doc)), f, indent=1, allow_nan=False)
-        f.write("\n")
+    write_realbench_results(cfg.out_json, strip_samples(doc))
     if cfg.quiet:
         stream.close()
     return doc

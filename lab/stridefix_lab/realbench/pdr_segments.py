@@ -149,12 +149,11 @@ def realbench_table(
     at the truth times). The STEP stream comes from the replay log in the walk's work folder, the
     truth from its imported log in the import cache (``cache``, default: ``cache`` beside the result,
     as ``realbench fusion`` makes it)."""
-    import json
-
     from stridefix_analyzer.io.logread import read_table
+    from stridefix_analyzer.io.results import read_realbench_results, walk_scores
 
     path = Path(results_json)
-    doc = json.loads(path.read_text())
+    doc = read_realbench_results(path)
     cache_dir = Path(cache) if cache is not None else path.parent / "cache"
     rows = []
     for group in doc["groups"]:
@@ -172,7 +171,8 @@ def realbench_table(
             args = (steps["t_us"], steps["heading_rad"], steps["length_m"])
             wp_xy = np.column_stack([truth["x_m"], truth["y_m"]])
             seg = segment_table(*args, truth["t_us"], wp_xy)
-            row = {"walk": w["walk"], "pdr_mean_m": w[tag].get("pdr_only", {}).get("mean", math.nan)}
+            pdr = walk_scores(w, tag).get("pdr_only")
+            row = {"walk": w["walk"], "pdr_mean_m": pdr.get("mean", math.nan) if pdr else math.nan}
             row.update(walk_summary(seg, *args, truth["t_us"]))
             rows.append(row)
     return rows

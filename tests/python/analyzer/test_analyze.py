@@ -1,16 +1,16 @@
 """analyze sub-command: outputs, exit statuses."""
 
-import json
-
 import numpy as np
 from numpy.testing import assert_allclose
+from stridefix_analyzer.io.results import ANALYZE_METRICS_KIND, read_analyze_metrics
 
 
 def test_analyze_writes_metrics_and_series(walk_logs, tmp_path, cli_main, capsys):
     fw, sim = walk_logs
     out = tmp_path / "an"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
-    m = json.loads((out / "metrics.json").read_text())
+    m = read_analyze_metrics(out / "metrics.json")
+    assert next(iter(m)) == "kind" and m["kind"] == ANALYZE_METRICS_KIND
     for key in (
         "inputs",
         "position_error_m",
@@ -48,7 +48,7 @@ def test_analyze_scheme_option(walk_logs, tmp_path, cli_main):
     fw, sim = walk_logs
     out = tmp_path / "pdr"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out), "--scheme", "pdr_only"]) == 0
-    m = json.loads((out / "metrics.json").read_text())
+    m = read_analyze_metrics(out / "metrics.json")
     assert m["primary_scheme"] == "pdr_only"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out), "--scheme", "kalman"]) == 2
 
@@ -73,7 +73,7 @@ def test_no_pose_exits_2(msg, write_log, tmp_path, cli_main, capsys):
 def test_nothing_scored_exits_1(msg, write_log, tmp_path, cli_main):
     path = write_log("late.lcmlog", [("TRUTH", msg.truth(0, 0, 0)), ("POSE", msg.pose(5, 0, 0))])
     assert cli_main(["analyze", str(path), "--out", str(tmp_path / "o")]) == 1
-    m = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    m = read_analyze_metrics(tmp_path / "o" / "metrics.json")
     assert m["position_error_m"]["n"] == 0 and m["position_error_m"]["mean"] is None
 
 
@@ -83,7 +83,7 @@ def test_analyze_json_and_console_carry_the_ipin_score(walk_logs, tmp_path, cli_
     fw, sim = walk_logs
     out = tmp_path / "ipin"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
-    m = json.loads((out / "metrics.json").read_text())
+    m = read_analyze_metrics(out / "metrics.json")
     assert_allclose(m["per_scheme"]["adaptive"]["ipin_score"], np.hypot(0.1, 1.0), rtol=1e-9)
     assert_allclose(m["per_scheme"]["pdr_only"]["ipin_score"], 1.9, rtol=1e-9)
     assert m["ipin_score"] == m["per_scheme"][m["primary_scheme"]]["ipin_score"]

@@ -3,10 +3,9 @@ the console line, the report's event table, and the controller's pose as the pri
 
 from __future__ import annotations
 
-import json
-
 from numpy.testing import assert_allclose
 from stridefix import context_t, pose_t
+from stridefix_analyzer.io.results import read_analyze_metrics
 from stridefix_analyzer.scoring.context import context_summary, format_context_line, rule_name
 
 S = 1_000_000
@@ -77,7 +76,7 @@ def test_analyze_writes_context_and_controller_is_primary(
     assert (
         "context: 3 events, 2 switches (cls_unlimited 1, door 1); last context building 0 floor 0" in console
     )
-    doc = json.loads((out / "metrics.json").read_text())
+    doc = read_analyze_metrics(out / "metrics.json")
     assert doc["primary_scheme"] == "controller"
     assert_allclose(doc["position_error_m"]["mean"], 0.5)
     assert doc["context"]["switches_by_rule"] == {"cls_unlimited": 1, "door": 1}
@@ -94,7 +93,7 @@ def test_analyze_without_context_has_null_section(walk_logs, tmp_path, cli_main,
     out = tmp_path / "an"
     assert cli_main(["analyze", str(fw), str(sim), "--out", str(out)]) == 0
     assert "context: no CONTEXT message" in capsys.readouterr().out
-    doc = json.loads((out / "metrics.json").read_text())
+    doc = read_analyze_metrics(out / "metrics.json")
     assert doc["context"] is None and doc["primary_scheme"] == "adaptive"
     assert cli_main(["report", str(out)]) == 0
     assert "no CONTEXT message in the logs" in (out / "report.html").read_text()

@@ -15,6 +15,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from stridefix_analyzer.io.results import (
+    CROWD_MAP_RESULTS_KIND,
+    read_crowd_map_results,
+    read_realbench_results,
+)
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_lab.realbench.heading import HEADING_VARIANTS
 
@@ -59,8 +64,8 @@ def crowd_map_small(request, tmp_path_factory, cli, lab) -> dict:
     assert fusion.returncode == 0, fusion.stderr
     return {
         "proc": proc,
-        "doc": json.loads((out / "crowd" / "results.json").read_text()),
-        "fusion": json.loads((out / "fusion" / "results.json").read_text()),
+        "doc": read_crowd_map_results(out / "crowd" / "results.json"),
+        "fusion": read_realbench_results(out / "fusion" / "results.json"),
     }
 
 
@@ -68,6 +73,7 @@ def test_crowd_map_scores_both_maps(crowd_map_small):
     proc, doc = crowd_map_small["proc"], crowd_map_small["doc"]
     assert proc.returncode == 0, proc.stderr
     assert doc["benchmark"] == "crowd-map" and doc["anchors"] == "every:4"
+    assert doc["kind"] == CROWD_MAP_RESULTS_KIND
     (g,) = doc["groups"]
     assert g["label"] == "site1/F2" and g["paired"] == 4 and len(g["walk_rows"]) == 4
     for row in g["walk_rows"]:

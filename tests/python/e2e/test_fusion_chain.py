@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from stridefix import fix_t, pose_t, wifi_scan_t
 from stridefix_analyzer.io.channels import POSE_CHANNELS, POSE_SCHEME_CHANNELS
+from stridefix_analyzer.io.results import read_analyze_metrics
 from stridefix_analyzer.schemes import FUSION_SCHEMES as SCHEMES  # the controller judges no fix
 
 SCHEME_IDS = [s.id for s in SCHEMES]  # every fusion scheme of pose_t.lcm
@@ -183,7 +184,7 @@ def test_fusion_beats_wifi_alone_at_the_reference_points(walk, cli, tmp_path):
         str(tmp_path),
     )
     assert proc.returncode == 0, proc.stderr
-    per = json.loads((tmp_path / "metrics.json").read_text())["per_scheme"]
+    per = read_analyze_metrics(tmp_path / "metrics.json")["per_scheme"]
     n = {k: v["position_error_m"]["n"] for k, v in per.items()}
     assert n["kalman"] == 14  # the track's 14 reference points
     mean = {k: v["position_error_m"]["mean"] for k, v in per.items()}

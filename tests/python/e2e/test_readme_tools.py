@@ -4,7 +4,6 @@ trip replays the same walk, evo's APE is our 3-D error)."""
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import shutil
@@ -12,6 +11,7 @@ import subprocess
 
 import lcm
 import pytest
+from stridefix_analyzer.io.results import read_analyze_metrics
 
 from ..conftest import REPO
 
@@ -49,7 +49,7 @@ def test_readme_tools_block_runs(tmp_path, stridefixd):
     # the ASC round trip replays the same walk: the same POSE payloads (host times move, see the CAN section)
     pose = [d for c, d in events("run.lcmlog") if c.startswith("POSE")]
     assert pose and pose == [d for c, d in events("back.lcmlog") if c.startswith("POSE")]
-    metrics = json.loads((tmp_path / "an" / "metrics.json").read_text())
+    metrics = read_analyze_metrics(tmp_path / "an" / "metrics.json")
     ape_mean = float(re.search(r"^\s+mean\s+([0-9.]+)", out, re.M).group(1))
     assert ape_mean == pytest.approx(metrics["iso18305"]["vertical"]["mean_3d_error_m"], abs=1e-5)
     assert (tmp_path / "csv" / "pdr_only_matched.csv").is_file()

@@ -15,6 +15,7 @@ from pathlib import Path
 import lcm
 import pytest
 from stridefix import health_t
+from stridefix_analyzer.io.results import read_analyze_metrics
 
 
 def run_stridefixd(stridefixd: Path, walk_dir: Path, log: Path, candump: Path | None = None, stdin=None):
@@ -127,7 +128,7 @@ def test_analyzer_scores_the_log(replay, default_walk, tmp_path, cli):
         "analyze", str(replay["log"]), str(default_walk["dir"] / "truth.lcmlog"), "--out", str(tmp_path)
     )
     assert proc.returncode == 0, proc.stderr
-    metrics = json.loads((tmp_path / "metrics.json").read_text())
+    metrics = read_analyze_metrics(tmp_path / "metrics.json")
     err = metrics["position_error_m"]
     assert err["n"] > 100
     assert 0.0 <= err["median"] <= err["p95"] <= err["max"]

@@ -6,7 +6,6 @@ records per scheme and per source; the raw-sensor log replayed (lcmlog:) gives t
 
 from __future__ import annotations
 
-import json
 import math
 import subprocess
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 from stridefix import fix_t, truth_t
 from stridefix_analyzer.io.logread import read_logs
+from stridefix_analyzer.io.results import read_analyze_metrics
 from stridefix_analyzer.io.sitefile import new_site, write_site
 from stridefix_analyzer.schemes import FUSION_SCHEMES
 
@@ -207,7 +207,7 @@ def test_analyze_counts_fixes_per_source(sources_run, cli):
     proc = cli("analyze", str(d / "run.lcmlog"), str(truth), "--out", str(d / "analyze"))
     assert proc.returncode == 0, proc.stderr
     assert "fix sources (FIX records per scheme and source)" in proc.stdout
-    doc = json.loads((d / "analyze" / "metrics.json").read_text())
+    doc = read_analyze_metrics(d / "analyze" / "metrics.json")
     fs = doc["fix_sources"]
     for s, name in enumerate(NAMES):
         lm = fs[name]["landmark"]

@@ -4,7 +4,6 @@ real run whose results.json carries both reference rows."""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import numpy as np
 import pytest
 from stridefix_analyzer.datasets.rawwalk import RawWalk
 from stridefix_analyzer.io.logread import Table
+from stridefix_analyzer.io.results import REALBENCH_RESULTS_KIND, read_realbench_results
 from stridefix_analyzer.scoring.metrics import wrap_pi
 from stridefix_lab.realbench import reference as ref
 from stridefix_lab.realbench import reference_sensors as sensors
@@ -146,10 +146,11 @@ def gsd_results(tmp_path_factory, cli, stridefixd, lab) -> dict:
         "--stridefixd", str(stridefixd), "--out", str(out), "--quiet",
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-2000:]
-    return dict(json.loads(out.read_text()))
+    return dict(read_realbench_results(out))
 
 
 def test_real_run_has_both_reference_rows_with_the_schemes_keys(gsd_results):
+    assert gsd_results["kind"] == REALBENCH_RESULTS_KIND
     g = gsd_results["groups"][0]
     for key in ("summary", "summary_true_start"):
         refs = g[key]["references"]

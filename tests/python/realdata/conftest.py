@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
+from stridefix_analyzer.io.results import read_realbench_results
 
 REPO = Path(__file__).resolve().parents[3]
 MSINDOOR = REPO.parent / "shared" / "data" / "msindoor"
@@ -181,7 +181,7 @@ def realbench_fusion_small(request, tmp_path_factory, cli, lab) -> dict:
         str(results),
         "--quiet",
     )
-    doc = json.loads(results.read_text()) if results.is_file() else None
+    doc = read_realbench_results(results) if results.is_file() else None
     return {
         "proc": proc,
         "out": out,

@@ -4,9 +4,8 @@ timers and the record of how the run was scheduled."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
+from stridefix_analyzer.io.results import read_realbench_results
 from stridefix_analyzer.parallel import dask_client
 from stridefix_lab.realbench.summary import untimed
 
@@ -52,7 +51,7 @@ def serial_and_dask(request, tmp_path_factory, cli, scheduler_address, lab) -> d
             *opts,
         )
         assert proc.returncode == 0, proc.stderr[-2000:]
-        docs[name] = json.loads(out.read_text())
+        docs[name] = read_realbench_results(out)
     return docs
 
 

@@ -4,13 +4,12 @@ run on 8 msindoor walks checked for the choice rule and for leakage of the held-
 
 from __future__ import annotations
 
-import json
-
 import lcm
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from stridefix import fix_t, pose_t
+from stridefix_analyzer.io.results import read_realbench_results
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_lab.realbench import select as rs
 from stridefix_lab.realbench import tuning
@@ -147,7 +146,7 @@ def realbench_eight(request, tmp_path_factory, cli, lab) -> dict:
         "--quiet",
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
-    return {"doc": json.loads(results.read_text()), "out": out}
+    return {"doc": read_realbench_results(results), "out": out}
 
 
 def test_each_block_takes_the_candidate_with_the_lowest_pooled_error(realbench_eight):
