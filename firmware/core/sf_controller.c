@@ -311,18 +311,6 @@ static bool lost_outdoors(sf_controller_t *const c, const sf_params_t *const p, 
     return true;
 }
 
-/* The building has a stairs or elevator port (a floor change there is the port rules' to see). */
-bool sf_controller_has_vertical_port(const sf_controller_t *const c, const int32_t building)
-{
-    const sf_ports_t *const ports = &c->site->ports;
-    for (int32_t q = 0; q < ports->n_ports; q++) {
-        if (ports->kind[q] != sf_port_door && c->site->contexts.port_building[q] == building) {
-            return true;
-        }
-    }
-    return false;
-}
-
 /* IN_CONTEXT near no port: a barometric floor of the same building held away from the context's floor
  * for controller.floor_disagree_s means a stairs or elevator transition the position missed (rule
  * BAROMETER); the floor context of that floor follows. */

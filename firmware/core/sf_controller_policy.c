@@ -1,6 +1,8 @@
 /* sf_controller_policy.c — what the multi-scheme controller says to the rest of the estimator: the
  * rules' words, the scheme the primary pose follows, its floor, and the sources kept on (Jäger et al.
- * Table I and the GPS policy of §III-C; sf_controller.h). The state machine is sf_controller.c. */
+ * Table I and the GPS policy of §III-C; sf_controller.h). The state machine is sf_controller.c.
+ * A leaf of it: pure queries on a const sf_controller_t and its site, O(1) but for the port scans
+ * (O(ports)); no state of its own and no call into sf_controller.c, which calls these. */
 #include "sf_controller.h"
 
 const char *sf_controller_rule_text(const int rule)
@@ -18,7 +20,6 @@ const char *sf_controller_rule_text(const int rule)
     }
 }
 
-
 /* ---- policy -------------------------------------------------------------------------------------- */
 
 bool sf_controller_active(const sf_controller_t *const c)
@@ -34,6 +35,18 @@ int sf_controller_scheme(const sf_controller_t *const c)
 int16_t sf_controller_floor(const sf_controller_t *const c)
 {
     return c->floor;
+}
+
+/* The building has a stairs or elevator port (a floor change there is the port rules' to see). */
+bool sf_controller_has_vertical_port(const sf_controller_t *const c, const int32_t building)
+{
+    const sf_ports_t *const ports = &c->site->ports;
+    for (int32_t q = 0; q < ports->n_ports; q++) {
+        if (ports->kind[q] != sf_port_door && c->site->contexts.port_building[q] == building) {
+            return true;
+        }
+    }
+    return false;
 }
 
 int16_t sf_controller_pose_floor(const sf_controller_t *const c, const sf_params_t *const p, const int16_t baro_floor)
