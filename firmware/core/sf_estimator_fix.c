@@ -78,7 +78,7 @@ static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const 
         (void)sf_fusion_fix_on_floor(&e->fusion[s], p, fix, floor, between, &audits[s]);
     }
     /* the stride is calibrated on fixes whose error does not grow with the building: Wi-Fi (as since
-     * issue 4) and landmarks; GNSS and BLE fixes err by metres over a few metres of walk */
+     * the first absolute fixes) and landmarks; GNSS and BLE fixes err by metres over a few metres of walk */
     if (audits[sf_scheme_kalman].accepted && (fix->method == sf_fix_wifi || fix->method == sf_fix_landmark)) {
         calibrate_stride(e, p, fix);
     }

@@ -1,4 +1,4 @@
-/* core_cost.c — the estimator core's cost harness (issue 16), measured under callgrind by `stridefix bench
+/* core_cost.c — the estimator core's cost harness (against its cost budget), measured under callgrind by `stridefix bench
  * perf` (analyzer/stridefix_analyzer/bench/perf.py), which counts the instructions inside one core call
  * (--toggle-collect) and divides by the calls this harness reports.
  *
