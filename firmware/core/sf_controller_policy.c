@@ -3,6 +3,7 @@
  * Table I and the GPS policy of §III-C; sf_controller.h). The state machine is sf_controller.c.
  * A leaf of it: pure queries on a const sf_controller_t and its site, O(1) but for the port scans
  * (O(ports)); no state of its own and no call into sf_controller.c, which calls these. */
+#include "sf_assert.h"
 #include "sf_controller.h"
 
 const char *sf_controller_rule_text(const int rule)
@@ -29,6 +30,7 @@ bool sf_controller_active(const sf_controller_t *const c)
 
 int sf_controller_scheme(const sf_controller_t *const c)
 {
+    SF_ASSERT(!c->active || c->context < c->site->contexts.n_contexts);
     return c->active && c->context >= 0 ? c->site->contexts.scheme[c->context] : c->init_scheme;
 }
 
@@ -51,6 +53,7 @@ bool sf_controller_has_vertical_port(const sf_controller_t *const c, const int32
 
 int16_t sf_controller_pose_floor(const sf_controller_t *const c, const sf_params_t *const p, const int16_t baro_floor)
 {
+    SF_ASSERT(c->state != sf_ctl_transition || (c->port >= 0 && c->port < c->site->ports.n_ports));
     if (c->state == sf_ctl_transition && p->controller_floor_from_barometer &&
         c->site->ports.kind[c->port] != sf_port_door && sf_port_joins(&c->site->ports, c->port, baro_floor)) {
         return baro_floor; /* on the staircase or in the cab the floor changes before the context does */
@@ -69,6 +72,8 @@ bool sf_controller_source_on(const sf_controller_t *const c, const int method)
     if (!c->active || method == sf_fix_landmark || method == sf_fix_port) {
         return true;
     }
+    SF_ASSERT(c->site != NULL && c->context < c->site->contexts.n_contexts);
+    SF_ASSERT(c->state != sf_ctl_in_context || c->context >= 0);
     const sf_context_map_t *const m = &c->site->contexts;
     if (c->state == sf_ctl_init) {
         return method == sf_fix_gnss || sf_cls_uses(m, c->cls.candidates, method); /* Table I: all on */
