@@ -6,7 +6,6 @@
 
 #include "board.h"
 #include "sf_board_ble.h"
-#include "sf_board_scan.h"
 #include "sf_error.h"
 
 #define DEG_TO_RAD (3.14159265358979323846 / 180.0)
@@ -48,31 +47,13 @@ int sf_board_rx_flush(sf_board_rx_t *const rx, sf_rx_event_t *const ev)
     return rc;
 }
 
-int32_t sf_wifi_channel_to_mhz(const unsigned channel)
-{
-    if (channel >= 1 && channel <= 13) {
-        return 2407 + 5 * (int32_t)channel;
-    }
-    if (channel == 14) {
-        return 2484;
-    }
-    if (channel >= 32 && channel <= 177) {
-        return 5000 + 5 * (int32_t)channel;
-    }
-    return 0;
-}
-
 /* A new epoch (the board restarted): what was in flight belongs to the old boot. */
 static void on_new_epoch(sf_board_rx_t *const rx)
 {
     memset(rx->accel, 0, sizeof rx->accel);
     memset(rx->gyro, 0, sizeof rx->gyro);
-    if (rx->scan_open && rx->scan_timed) {
-        rx->counters.wifi_incomplete++;
-    }
-    rx->scan_open = false;
+    sf_board_scan_on_new_epoch(&rx->scan, &rx->counters);
     rx->gnss_info_valid = false;
-    rx->last_scan_valid = false;
 }
 
 /* Gives a sample its time; counts gaps and sync, duplicate, late and corrupt-seq problems. */
@@ -161,9 +142,9 @@ static int on_imu_half(sf_board_rx_t *const rx, const bool is_accel, const sf_im
     return 0;
 }
 
-/* A full board time carried by a frame (scan start, GNSS fix), unwrapped (sf_board_clock_carried);
- * a corrupt one is counted as a decode error. */
-int sf_board_rx_carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
+/* The full board time a GNSS_INFO carries, unwrapped (sf_board_clock_carried); a corrupt one is
+ * counted as a decode error. */
+static int carried_time(sf_board_rx_t *const rx, const uint32_t time_ms, int64_t *const t_ms)
 {
     const int rc = sf_board_clock_carried(&rx->clock, time_ms, rx->host_t_us, t_ms);
     if (rc == SF_ENOTSYNC) {
@@ -246,7 +227,7 @@ static int on_wifi_scan_begin(sf_board_rx_t *const rx, const sf_can_frame_t *con
 {
     struct board_wifi_scan_begin_t m;
     (void)board_wifi_scan_begin_unpack(&m, f->data, f->dlc);
-    return sf_board_scan_begin(rx, &m, ev);
+    return sf_board_scan_begin(&rx->scan, &rx->counters, &rx->clock, rx->host_t_us, &m, ev);
 }
 
 static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -254,14 +235,14 @@ static int on_wifi_ap(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf
     (void)ev;
     struct board_wifi_ap_t m;
     (void)board_wifi_ap_unpack(&m, f->data, f->dlc);
-    return sf_board_scan_ap(rx, &m);
+    return sf_board_scan_ap(&rx->scan, &rx->counters, &m);
 }
 
 static int on_wifi_scan_end(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
 {
     struct board_wifi_scan_end_t m;
     (void)board_wifi_scan_end_unpack(&m, f->data, f->dlc);
-    return sf_board_scan_end(rx, &m, ev);
+    return sf_board_scan_end(&rx->scan, &rx->counters, &m, ev);
 }
 
 static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, sf_rx_event_t *const ev)
@@ -270,7 +251,7 @@ static int on_gnss_info(sf_board_rx_t *const rx, const sf_can_frame_t *const f, 
     struct board_gnss_info_t m;
     (void)board_gnss_info_unpack(&m, f->data, f->dlc);
     int64_t t_ms;
-    const int rc = sf_board_rx_carried_time(rx, m.time_ms, &t_ms);
+    const int rc = carried_time(rx, m.time_ms, &t_ms);
     if (rc != SF_OK) {
         return rc;
     }

@@ -22,7 +22,7 @@
  * are counted in sf_rx_counters_t and skipped: the return code says which counter moved, so the
  * caller can print a message naming the line.
  *
- * Memory: sizeof(sf_board_rx_t) = 5552 B on x86-64 (one Wi-Fi scan and one BLE window in progress;
+ * Memory: sizeof(sf_board_rx_t) = 5544 B on x86-64 (one Wi-Fi scan and one BLE window in progress;
  * asserted ≤ 5.5 KiB); no heap. */
 #ifndef SF_BOARD_RX_H
 #define SF_BOARD_RX_H
@@ -30,13 +30,14 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_board_scan.h"
 #include "sf_board_time.h"
 #include "sf_can_frame.h"
 #include "sf_params.h"
 #include "sf_rx_event.h"
 
-/* Counters never decrease. */
-typedef struct {
+/* Counters never decrease. (Tagged: sf_board_scan.h counts into it by a pointer.) */
+typedef struct sf_rx_counters {
     uint64_t frames;          /* frames offered */
     uint64_t frames_ok;       /* decoded and used */
     uint64_t unknown_id;      /* id not in the DBC, extended or remote frames */
@@ -92,17 +93,7 @@ typedef struct {
     sf_imu_half_t accel[SF_IMU_HALVES]; /* halves waiting for their partner */
     sf_imu_half_t gyro[SF_IMU_HALVES];
     int64_t host_t_us;    /* host receive time of the latest frame */
-    bool scan_open;       /* between SCAN_BEGIN and SCAN_END */
-    bool scan_repeat;     /* frames of a repeated scan are being dropped */
-    uint32_t scan_time_ms; /* SCAN_BEGIN time of the open scan, as sent */
-    bool last_scan_valid; /* the last closed scan, to recognise a repeat */
-    uint8_t last_scan_raw_id;
-    uint32_t last_scan_time_ms;
-    bool scan_timed;      /* the open scan has a board time */
-    uint8_t scan_raw_id;
-    bool scan_id_started;
-    int64_t scan_id;      /* unwrapped id of the open scan */
-    sf_rx_wifi_t scan;
+    sf_board_scan_t scan; /* the Wi-Fi scan in reassembly (sf_board_scan.h) */
     bool gnss_info_valid;
     int64_t gnss_t_ms;
     double gnss_alt_m;
@@ -140,8 +131,5 @@ void sf_rx_count_sample(sf_rx_counters_t *counters, sf_rx_kind_t kind);
 
 /* The length board.dbc declares for a standard frame id [bytes]; 0 for an id not in board.dbc. */
 unsigned sf_board_rx_dbc_length(uint32_t id);
-
-/* Wi-Fi channel → centre frequency [MHz]; 0 when the channel is not a 2.4 or 5 GHz channel. */
-int32_t sf_wifi_channel_to_mhz(unsigned channel);
 
 #endif

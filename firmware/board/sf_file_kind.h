@@ -1,4 +1,5 @@
-/* sf_file_kind.h — refuse what is not a file where a file is expected (issue 12 item 4).
+/* sf_file_kind.h — refuse what is not a file where a file is expected (a device or a directory given
+ * as an input, a config or a site file).
  *
  * A config, a site file, a candump or an LCM log read from /dev/zero never ends, and a directory
  * "opens" and then fails obscurely: each path is checked by stat() before it is opened. Regular files

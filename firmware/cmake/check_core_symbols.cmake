@@ -1,5 +1,6 @@
-# The core's "no heap, no I/O, no clock" rule checked on the object code (issue 16): every symbol the
-# core library needs from outside itself (nm -u) is an sf_* function of the core, or on the allowlist
+# The core's "no heap, no I/O, no clock" rule checked on the object code (a source review misses a
+# call a macro or a library hides): every symbol the core library needs from outside itself (nm -u)
+# is an sf_* function of the core, or on the allowlist
 # below (libm, the mem*/str* functions that never allocate, compiler runtime helpers). A heap call
 # hidden in libc (qsort may malloc), printf, a file or a clock fails the build's tests.
 #   cmake -DNM=<nm> -DLIB=<libsf_core.a> -P check_core_symbols.cmake

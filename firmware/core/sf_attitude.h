@@ -78,7 +78,7 @@
  * instructions per sf_attitude_update_imu_finite (sf_attitude_update_imu's finiteness check ≈ 22
  * more) and ≈ 500 per sf_attitude_update_mag (the dip's asin ≈ 75, the yaw correction's rotation
  * ≈ 80), ≈ 636 per IMU sample with MAG at 50 Hz, where x-io Fusion's FusionAhrsUpdate (in float)
- * takes 331 (× 1.9; issue 16 asks ≤ 1.5×, ≈ 500).
+ * takes 331 (× 1.9; the cost budget asks ≤ 1.5×, ≈ 500).
  * No sincos and mostly no atan2: rotation steps below 0.25 rad and tilt/yaw errors below 11.4° are
  * series, and sf_attitude_yaw_rad's atan2 is replaced by one (error bounds at sf_qexp in sf_quat.h,
  * sf_atan2_half and sf_atan2 in sf_math.h); libm keeps a few sqrt per call and the dip's asin. Memory

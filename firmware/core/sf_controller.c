@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 
 void sf_controller_init(sf_controller_t *const c, const sf_params_t *const p)
@@ -102,6 +103,7 @@ void sf_controller_activity(sf_controller_t *const c, const int64_t t_us, const 
 
 static void push(sf_controller_t *const c, const sf_context_event_t *const ev)
 {
+    SF_ASSERT(c->ev_n >= 0 && c->ev_n <= SF_CONTROLLER_EVENTS && c->ev_head >= 0 && c->ev_head < SF_CONTROLLER_EVENTS);
     if (c->ev_n == SF_CONTROLLER_EVENTS) { /* full: the oldest goes */
         c->ev_head = (c->ev_head + 1) % SF_CONTROLLER_EVENTS;
         c->ev_n--;
@@ -113,6 +115,8 @@ static void push(sf_controller_t *const c, const sf_context_event_t *const ev)
 
 bool sf_controller_next_event(sf_controller_t *const c, sf_context_event_t *const ev)
 {
+    SF_ASSERT(c != NULL && ev != NULL);
+    SF_ASSERT(c->ev_n >= 0 && c->ev_n <= SF_CONTROLLER_EVENTS && c->ev_head >= 0 && c->ev_head < SF_CONTROLLER_EVENTS);
     if (c->ev_n == 0) {
         return false;
     }
@@ -179,11 +183,13 @@ static void emit(sf_controller_t *const c, const sf_ctl_motion_t *const m, const
 /* The floor of context ctx, or the estimator's in a building context. */
 static int16_t floor_of(const sf_controller_t *const c, const int16_t ctx, const int16_t motion_floor)
 {
+    SF_ASSERT(ctx >= 0 && ctx < c->site->contexts.n_contexts);
     return c->site->contexts.kind[ctx] == sf_context_building ? motion_floor : c->site->contexts.floor[ctx];
 }
 
 static double port_distance_m(const sf_controller_t *const c, const int32_t q, const double x_m, const double y_m)
 {
+    SF_ASSERT(q >= 0 && q < c->site->ports.n_ports);
     return hypot(x_m - (double)c->site->ports.x_m[q], y_m - (double)c->site->ports.y_m[q]);
 }
 
@@ -209,6 +215,7 @@ static int16_t near_port(const sf_controller_t *const c, const sf_params_t *cons
 
 static void begin_transition(sf_controller_t *const c, const sf_ctl_motion_t *const m, const int16_t q)
 {
+    SF_ASSERT(q >= 0 && q < c->site->ports.n_ports); /* near_port's, or the port just left */
     c->state = sf_ctl_transition;
     c->port = q;
     c->steps_at_start = m->step_count;
@@ -231,6 +238,7 @@ static void end_transition(sf_controller_t *const c, const sf_params_t *const p,
     const int16_t prev = c->context;
     const int16_t from_floor = c->floor;
     const int32_t q = c->port;
+    SF_ASSERT(c->state == sf_ctl_transition && q >= 0 && q < c->site->ports.n_ports);
     c->context = to;
     c->floor = floor_of(c, to, m->floor);
     c->state = sf_ctl_in_context;
@@ -294,6 +302,7 @@ static int16_t gnss_outdoor(const sf_controller_t *const c, const int64_t since_
  * unlimited CLS (rule LOST). */
 static bool lost_outdoors(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
+    SF_ASSERT(c->state == sf_ctl_in_context && c->context >= 0 && c->context < c->site->contexts.n_contexts);
     if (p->controller_context_lost_s <= 0.0 || c->site->contexts.kind[c->context] != sf_context_outdoor) {
         return false;
     }
@@ -311,23 +320,12 @@ static bool lost_outdoors(sf_controller_t *const c, const sf_params_t *const p, 
     return true;
 }
 
-/* The building has a stairs or elevator port (a floor change there is the port rules' to see). */
-bool sf_controller_has_vertical_port(const sf_controller_t *const c, const int32_t building)
-{
-    const sf_ports_t *const ports = &c->site->ports;
-    for (int32_t q = 0; q < ports->n_ports; q++) {
-        if (ports->kind[q] != sf_port_door && c->site->contexts.port_building[q] == building) {
-            return true;
-        }
-    }
-    return false;
-}
-
 /* IN_CONTEXT near no port: a barometric floor of the same building held away from the context's floor
  * for controller.floor_disagree_s means a stairs or elevator transition the position missed (rule
  * BAROMETER); the floor context of that floor follows. */
 static void missed_transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
+    SF_ASSERT(c->state == sf_ctl_in_context && c->context >= 0 && c->context < c->site->contexts.n_contexts);
     const sf_context_map_t *const map = &c->site->contexts;
     const int16_t to = map->kind[c->context] == sf_context_floor && m->floor != c->floor
                            ? sf_cls_context_of(map, map->building[c->context], m->floor)
@@ -355,6 +353,7 @@ static void missed_transition(sf_controller_t *const c, const sf_params_t *const
 static void transition(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
     const int32_t q = c->port;
+    SF_ASSERT(c->state == sf_ctl_transition && q >= 0 && q < c->site->ports.n_ports);
     const int kind = c->site->ports.kind[q];
     const int32_t steps = m->step_count - c->steps_at_start;
     const int32_t stair_steps = m->step_count - steps_from(c);
@@ -421,6 +420,8 @@ static void account_radios(sf_controller_t *const c, const int64_t t_us)
 
 bool sf_controller_update(sf_controller_t *const c, const sf_params_t *const p, const sf_ctl_motion_t *const m)
 {
+    SF_ASSERT(c != NULL && p != NULL && m != NULL);
+    SF_ASSERT(!c->active || c->site != NULL); /* sf_controller_attach turns it on only with a map */
     account_radios(c, m->t_us);
     if (!c->active) {
         return false;

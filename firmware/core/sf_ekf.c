@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
 #include "sf_math.h"
 
 enum { n = SF_EKF_N, ix = 0, iy = 1, ib = 2, is = 3, icx = 4, icy = 5 };
@@ -106,6 +107,7 @@ static void set_model(sf_ekf_t *const e, const sf_params_t *const p, const doubl
 
 void sf_ekf_start(sf_ekf_t *const e, const sf_params_t *const p)
 {
+    SF_ASSERT(e != NULL && p != NULL);
     *e = (sf_ekf_t){.heading_bias_rad = 0.0, .stride_scale = 1.0};
     e->P[ib][ib] = p->ekf_init_bias_sigma_rad * p->ekf_init_bias_sigma_rad;
     e->P[is][is] = p->ekf_init_scale_sigma * p->ekf_init_scale_sigma;
@@ -130,6 +132,7 @@ void sf_ekf_use_site_model(sf_ekf_t *const e, const sf_params_t *const p, const 
 
 void sf_ekf_restart_at_fix(sf_ekf_t *const e, const double r_white_m2[3])
 {
+    SF_ASSERT(e != NULL && r_white_m2 != NULL);
     clear_position_and_bias(e);
     const double c2 = c_var(e);
     e->P[ix][ix] = r_white_m2[0] + c2;
@@ -142,6 +145,8 @@ void sf_ekf_restart_at_fix(sf_ekf_t *const e, const double r_white_m2[3])
 
 void sf_ekf_restart_known(sf_ekf_t *const e, const double pos_cov_m2[3])
 {
+    /* the caller's σ² (sf_fusion_init_at refuses a σ that is not finite and ≥ 0) */
+    SF_ASSERT(e != NULL && pos_cov_m2 != NULL && pos_cov_m2[0] >= 0.0 && pos_cov_m2[2] >= 0.0);
     clear_position_and_bias(e);
     const double c2 = c_var(e);
     e->P[ix][ix] = pos_cov_m2[0];
@@ -153,6 +158,8 @@ void sf_ekf_restart_known(sf_ekf_t *const e, const double pos_cov_m2[3])
 void sf_ekf_step(sf_ekf_t *const e, const sf_params_t *const p, const double length_m, const double heading_rad,
                  double d_m[2])
 {
+    SF_ASSERT(e != NULL && p != NULL && d_m != NULL);
+    SF_ASSERT(isfinite(length_m) && length_m >= 0.0); /* sf_fusion counts and skips any other step */
     const double s = e->stride_scale, theta = heading_rad + e->heading_bias_rad;
     const double c = cos(theta), sn = sin(theta), sl = s * length_m;
     d_m[0] = sl * c;
@@ -188,6 +195,7 @@ void sf_ekf_step(sf_ekf_t *const e, const sf_params_t *const p, const double len
 
 void sf_ekf_time(sf_ekf_t *const e, const sf_params_t *const p, const double dt_s)
 {
+    SF_ASSERT(e != NULL && p != NULL);
     if (dt_s > 0.0) {
         e->P[ix][ix] += p->fusion_q_time_m2_per_s * dt_s;
         e->P[iy][iy] += p->fusion_q_time_m2_per_s * dt_s;
@@ -201,6 +209,8 @@ static double kappa(const bool correlated)
 
 void sf_ekf_fix_total(const sf_ekf_t *const e, const double accuracy_m, double total_m2[3])
 {
+    /* only a usable fix gets here: sf_fusion refuses one whose accuracy is not finite and ≥ 0 */
+    SF_ASSERT(e != NULL && total_m2 != NULL && isfinite(accuracy_m) && accuracy_m >= 0.0);
     const double a2 = accuracy_m * accuracy_m;
     for (int i = 0; i < 3; i++) {
         total_m2[i] = e->fix_floor_m2[i] + a2 * e->fix_model[i];
@@ -210,6 +220,7 @@ void sf_ekf_fix_total(const sf_ekf_t *const e, const double accuracy_m, double t
 void sf_ekf_fix_r(const sf_ekf_t *const e, const sf_params_t *const p, const double accuracy_m,
                   double r_white_m2[3])
 {
+    SF_ASSERT(p != NULL && r_white_m2 != NULL);
     const double c2 = c_var(e);
     double total[3];
     sf_ekf_fix_total(e, accuracy_m, total);
@@ -240,6 +251,7 @@ static void hph(const sf_ekf_t *const e, const double k, double m[3])
 double sf_ekf_nis(const sf_ekf_t *const e, const bool correlated, const double nu_m[2], const double r_white_m2[3],
                   double s_m2[3])
 {
+    SF_ASSERT(e != NULL && nu_m != NULL && r_white_m2 != NULL && s_m2 != NULL);
     hph(e, kappa(correlated), s_m2);
     for (int i = 0; i < 3; i++) {
         s_m2[i] += r_white_m2[i];
@@ -280,6 +292,7 @@ void sf_ekf_learn_fix_model(sf_ekf_t *const e, const sf_params_t *const p, const
 double sf_ekf_update(sf_ekf_t *const e, const sf_params_t *const p, const bool correlated, const double nu_m[2],
                      const double r_white_m2[3], double dpos_m[2])
 {
+    SF_ASSERT(p != NULL && dpos_m != NULL); /* e, nu_m, r_white_m2: sf_ekf_nis's */
     const double k = kappa(correlated);
     double s_m2[3];
     (void)sf_ekf_nis(e, correlated, nu_m, r_white_m2, s_m2);

@@ -1,4 +1,5 @@
-/* sf_estimator.c — composition of the PDR modules (see sf_estimator.h). */
+/* sf_estimator.c — composition of the PDR modules and the multi-scheme controller's step (see
+ * sf_estimator.h); the absolute fixes are sf_estimator_fix.c, which calls the step here. */
 #include "sf_estimator.h"
 
 #include <math.h>
@@ -297,8 +298,10 @@ void sf_estimator_pose(const sf_estimator_t *const e, sf_pose_t *const pose)
     pose->scheme = sf_scheme_pdr_only;
 }
 
-bool sf_estimator_followed_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
-                                sf_pose_t *const pose)
+/* The pose of a scheme the controller follows, with the fading hand-over offset of the last switch
+ * added (sf_estimator.h); false when the scheme has no pose. */
+static bool followed_pose(const sf_estimator_t *const e, const sf_params_t *const p, const int scheme,
+                          sf_pose_t *const pose)
 {
     if (!sf_estimator_scheme_pose(e, p, scheme, pose)) {
         return false;
@@ -323,7 +326,7 @@ bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *
 {
     if (scheme == sf_scheme_controller) {
         const sf_controller_t *const c = &e->controller;
-        if (!sf_controller_active(c) || !sf_estimator_followed_pose(e, p, sf_controller_scheme(c), pose)) {
+        if (!sf_controller_active(c) || !followed_pose(e, p, sf_controller_scheme(c), pose)) {
             return false;
         }
         pose->scheme = sf_scheme_controller;
@@ -335,6 +338,74 @@ bool sf_estimator_scheme_pose(const sf_estimator_t *const e, const sf_params_t *
     }
     sf_estimator_pose(e, pose);
     return sf_fusion_pose(&e->fusion[scheme], p, e->t_us, sf_floor_current(&e->floor), pose);
+}
+
+/* ---- the multi-scheme controller: the motion it sees, the hand-over, the shared floor on a switch ---- */
+
+/* The controller's view of the walk: the pose of the scheme it follows; without one, the PDR track
+ * when the schemes started at the config pose (no site, or truth-initialised).
+ * DEVIATION: sf_controller.h says "or the PDR track's"; with a site and schemes that start at their
+ * first fix the PDR track's frame is the config start, which says nothing about ports, so it is not a
+ * position then. */
+static void motion(const sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us,
+                   sf_ctl_motion_t *const m)
+{
+    sf_pose_t pose;
+    bool has = sf_estimator_scheme_pose(e, p, sf_controller_scheme(&e->controller), &pose);
+    if (!has && (e->site == NULL || p->init_use_config_pose != 0)) {
+        sf_estimator_pose(e, &pose);
+        has = true;
+    }
+    *m = (sf_ctl_motion_t){.t_us = t_us > e->t_us ? t_us : e->t_us,
+                           .has_position = has,
+                           .x_m = has ? pose.x_m : 0.0,
+                           .y_m = has ? pose.y_m : 0.0,
+                           .floor = sf_floor_current(&e->floor),
+                           .step_count = e->step_count,
+                           .activity = sf_activity_current(&e->activity)};
+}
+
+/* The controller now follows another scheme than `from`: the primary pose hands over from where it
+ * was (the old scheme's pose with its own fading offset; an update leaves the schemes' poses as they
+ * are), without a jump. */
+static void hand_over(sf_estimator_t *const e, const sf_params_t *const p, const int from, const int64_t t_us)
+{
+    sf_pose_t was, now;
+    if (sf_controller_active(&e->controller) && followed_pose(e, p, from, &was) &&
+        sf_estimator_scheme_pose(e, p, sf_controller_scheme(&e->controller), &now)) {
+        e->handover_t_us = t_us;
+        e->handover_dx_m = was.x_m - now.x_m;
+        e->handover_dy_m = was.y_m - now.y_m;
+    }
+}
+
+void sf_estimator_run_controller(sf_estimator_t *const e, const sf_params_t *const p, const int64_t t_us)
+{
+    sf_controller_t *const c = &e->controller;
+    sf_ctl_motion_t m;
+    motion(e, p, t_us, &m);
+    const uint32_t switches = c->switches;
+    const int scheme_before = sf_controller_scheme(c);
+    const bool queued = sf_controller_update(c, p, &m);
+    if (sf_controller_scheme(c) != scheme_before) {
+        hand_over(e, p, scheme_before, m.t_us);
+    }
+    /* cppcheck-suppress knownConditionTrueFalse ; sf_controller_update counts switches through c */
+    if (!queued || c->switches == switches) { /* no event, or none that switched */
+        return;
+    }
+    const bool vertical = c->last_rule == sf_ctl_rule_stairs || c->last_rule == sf_ctl_rule_elevator;
+    const bool counting = e->floor.started && !sf_floor_settled(&e->floor, p); /* a barometer mid-climb */
+    if (c->last_rule == sf_ctl_rule_barometer || (vertical && (c->last_by_baro || counting))) {
+        return; /* the barometer's own floor, or one still counting the climb: a shift would count it twice */
+    }
+    /* a switch to a context on another floor: every scheme's floor follows the controller's (the body
+     * stays where it is, its floor number changes, as when the floor vote renumbers) */
+    const int32_t shift = (int32_t)c->floor - (int32_t)sf_floor_current(&e->floor); /* the context's floor */
+    sf_floor_shift(&e->floor, shift, false);
+    if (e->floor_vote_active) { /* the start-floor vote renumbers with it (sf_floor_vote.h) */
+        sf_floor_vote_renumber(&e->floor_vote, shift);
+    }
 }
 
 void sf_estimator_status(const sf_estimator_t *const e, sf_estimator_status_t *const status)

@@ -53,7 +53,7 @@
  *
  * No heap, no I/O, no clock, no hidden state: the same inputs give bit-identical outputs.
  * Memory: sizeof(sf_estimator_t) = 15 768 B on x86-64 (i686 not rechecked), at most 16 KiB (checked, the
- * issue 16 budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
+ * cost budget for the core's state without the radio map): the eight schemes are 4 224 B of it (each
  * carries the ekf's 408 B filter), the fingerprint's scan ring 3 568 B (sf_fingerprint_t: the last
  * scans' readings of map APs in a shared pool; the matcher's query scratch is in the caller's
  * workspace, sf_fingerprint.h), the step detector 2 464 B, the controller 1 480 B (sf_controller.h);
@@ -65,7 +65,7 @@
  * sample gates ≈ 115, the heading filter ≈ 105 and the yaw's direction ≈ 35; the walking direction's
  * atan2 only when it is read: a step, a POSE), ≈ 935 per sf_estimator_mag (the attitude's
  * magnetometer fusion ≈ 500, sf_magcal ≈ 315), ≈ 410 per sf_estimator_baro (sf_floor ≈ 275):
- * ≈ 1 875 per IMU sample at 100/50/20 Hz, all core work (issue 16 asks ≤ 1 200); a Wi-Fi fix is
+ * ≈ 1 875 per IMU sample at 100/50/20 Hz, all core work (the cost budget asks ≤ 1 200); a Wi-Fi fix is
  * sf_fingerprint.h's, a particle step
  * sf_particle.h's. */
 #ifndef SF_ESTIMATOR_H
@@ -129,7 +129,7 @@ typedef struct {
     sf_gap_bridge_t gap;
     uint32_t samples_refused[4]; /* by sf_gate_verdict_t (index 0 unused) */
     sf_step_event_t held_events[SF_ACTIVITY_BOUT_MAX]; /* the held detections of a bout (sf_activity.h) */
-    /* absolute fixes (issue 4): the site and the matcher's workspace are the caller's */
+    /* absolute fixes: the site and the matcher's workspace are the caller's */
     const sf_site_t *site;          /* NULL: no site, no Wi-Fi fixes */
     sf_fingerprint_workspace_t *ws; /* prepared for site->radiomap */
     sf_fingerprint_t fingerprint;
@@ -146,7 +146,7 @@ typedef struct {
     double calib_pdr_x_m, calib_pdr_y_m;   /* the PDR track at the anchor */
     double calib_distance_m;               /* distance walked at the anchor */
     uint32_t stride_calibrations;
-    /* the multi-scheme controller (issue 14): inactive without a site's context map */
+    /* the multi-scheme controller: inactive without a site's context map */
     sf_controller_t controller;
     /* the primary pose's hand-over when the controller follows another scheme: the old pose minus the
      * new one at the switch, decaying with controller_handover_s (sf_estimator_scheme_pose) */

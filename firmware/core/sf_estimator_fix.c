@@ -1,9 +1,18 @@
 /* sf_estimator_fix.c — the estimator's absolute fixes (see sf_estimator.h): a Wi-Fi scan matched on
  * the radio map (sf_fingerprint), a GNSS fix through the geo-reference (sf_geo), a BLE scan ranged to
- * the site's beacons (sf_ble), a landmark as it is; each fix then votes on the floor and is offered to
- * every scheme (sf_fusion), and a Kalman-accepted Wi-Fi or landmark fix recalibrates the stride.
- * Around each: the controller's CLS gets the raw reading first, its policy may keep the source off
- * (CONTEXT_OFF audits; never a landmark), and the controller steps after it (sf_estimator_context.c). */
+ * the site's beacons (sf_ble), a landmark as it is, and the staircase endpoint of a controller event;
+ * each fix then votes on the floor and is offered to every scheme (sf_fusion), and a Kalman-accepted
+ * Wi-Fi or landmark fix recalibrates the stride. Around each: the controller's CLS gets the raw reading
+ * first, its policy may keep the source off (CONTEXT_OFF audits; never a landmark), and the controller
+ * steps after it (sf_estimator_run_controller, sf_estimator.c).
+ *
+ * DEVIATION: not a leaf. sf_estimator is one module over one state, sf_estimator_t, whose fix inputs
+ * (here) and sample inputs (sf_estimator.c) are both public entry points; it is split in two files only
+ * for the 500-line cap. A fix reads and moves most of that state (the floor and its vote, every scheme,
+ * the stride calibration, the source quality, the controller), so it cannot have a small state of its
+ * own, and every input ends with the controller's step, which the IMU path takes too. What is kept:
+ * the calls go one way, from this file into sf_estimator.c (that one function, four call sites), never
+ * back; sf_estimator.c calls nothing here. */
 #include <math.h>
 
 #include "sf_ble.h"
@@ -51,8 +60,8 @@ static void vote_floor(sf_estimator_t *const e, const sf_params_t *const p, cons
 }
 
 /* Every scheme judges the fix (one audit each); the floor vote first when the fix knows its floor. */
-int sf_estimator_offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix,
-                           const bool votes, sf_fix_audit_t audits[sf_scheme_count])
+static int offer_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_fix_t *const fix, const bool votes,
+                     sf_fix_audit_t audits[sf_scheme_count])
 {
     if (votes) { /* the fix votes before the schemes see it */
         vote_floor(e, p, fix);
@@ -69,7 +78,7 @@ int sf_estimator_offer_fix(sf_estimator_t *const e, const sf_params_t *const p, 
         (void)sf_fusion_fix_on_floor(&e->fusion[s], p, fix, floor, between, &audits[s]);
     }
     /* the stride is calibrated on fixes whose error does not grow with the building: Wi-Fi (as since
-     * issue 4) and landmarks; GNSS and BLE fixes err by metres over a few metres of walk */
+     * the first absolute fixes) and landmarks; GNSS and BLE fixes err by metres over a few metres of walk */
     if (audits[sf_scheme_kalman].accepted && (fix->method == sf_fix_wifi || fix->method == sf_fix_landmark)) {
         calibrate_stride(e, p, fix);
     }
@@ -77,8 +86,8 @@ int sf_estimator_offer_fix(sf_estimator_t *const e, const sf_params_t *const p, 
 }
 
 /* No fix from this input: each scheme records the refusal, nothing moves. */
-int sf_estimator_refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t method, const int16_t n_used,
-                        const int8_t reason, sf_fix_audit_t audits[sf_scheme_count])
+static int refuse(sf_estimator_t *const e, const int64_t t_us, const int8_t method, const int16_t n_used,
+                  const int8_t reason, sf_fix_audit_t audits[sf_scheme_count])
 {
     const sf_fix_t none = {.t_us = t_us, .method = method, .floor = sf_floor_current(&e->floor), .n_ap_used = n_used};
     for (int s = 0; s < sf_scheme_count; s++) {
@@ -97,11 +106,11 @@ static int wifi_fix(sf_estimator_t *const e, const sf_params_t *const p, const s
     const int16_t baro_floor = sf_floor_current(&e->floor);
     const int rc = sf_fingerprint_match(&e->fingerprint, p, &e->site->radiomap, e->ws, scan, baro_floor, true, fix);
     if (rc != SF_OK) {
-        return sf_estimator_refuse(e, scan->t_us, sf_fix_wifi, (int16_t)e->fingerprint.audit.n_used, sf_fix_reason_too_few_aps,
+        return refuse(e, scan->t_us, sf_fix_wifi, (int16_t)e->fingerprint.audit.n_used, sf_fix_reason_too_few_aps,
                       audits);
     }
     *has_fix = true;
-    const int n = sf_estimator_offer_fix(e, p, fix, true, audits);
+    const int n = offer_fix(e, p, fix, true, audits);
     /* the reference for GNSS and BLE: a Wi-Fi fix the kalman scheme took (as for the stride): one it
      * gated is off the walk, outdoors beyond the radio map or between its reference points */
     if (audits[sf_scheme_kalman].accepted) {
@@ -130,14 +139,14 @@ static int gnss_fix(sf_estimator_t *const e, const sf_params_t *const p, const s
     if (!(isfinite(acc_m) && acc_m >= 0.0 && acc_m <= p->gnss_max_accuracy_m) ||
         sf_geo_to_map(&e->site->geo, gnss->lat_deg, gnss->lon_deg, &x_m, &y_m) != SF_OK) {
         e->gnss_refused++;
-        return sf_estimator_refuse(e, gnss->t_us, sf_fix_gnss, 0, sf_fix_reason_inaccurate, audits);
+        return refuse(e, gnss->t_us, sf_fix_gnss, 0, sf_fix_reason_inaccurate, audits);
     }
     /* a GNSS fix knows no floor: it is on the caller's, and does not vote */
     *fix = (sf_fix_t){.t_us = gnss->t_us, .method = sf_fix_gnss, .x_m = x_m, .y_m = y_m,
                       .floor = sf_floor_current(&e->floor), .accuracy_m = fmax(acc_m, p->gnss_min_accuracy_m)};
     judge_source(e, p, fix);
     *has_fix = true;
-    return sf_estimator_offer_fix(e, p, fix, false, audits);
+    return offer_fix(e, p, fix, false, audits);
 }
 
 static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_ble_scan_t *const scan,
@@ -165,11 +174,11 @@ static int ble_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf
     }
     int32_t n_used = 0;
     if (sf_ble_fix(&e->ble, p, &e->site->beacons, scan, sf_floor_current(&e->floor), fix, &n_used) != SF_OK) {
-        return sf_estimator_refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
+        return refuse(e, scan->t_us, sf_fix_ble, (int16_t)n_used, sf_fix_reason_too_few_aps, audits);
     }
     judge_source(e, p, fix);
     *has_fix = true;
-    return sf_estimator_offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
+    return offer_fix(e, p, fix, false, audits); /* on the caller's floor by construction: no vote */
 }
 
 static int landmark_fix(sf_estimator_t *const e, const sf_params_t *const p, const sf_landmark_t *const lm,
@@ -178,13 +187,25 @@ static int landmark_fix(sf_estimator_t *const e, const sf_params_t *const p, con
     *has_fix = false;
     if (!(isfinite(lm->x_m) && isfinite(lm->y_m) && isfinite(lm->accuracy_m) && lm->accuracy_m >= 0.0)) {
         e->landmarks_refused++;
-        return sf_estimator_refuse(e, lm->t_us, sf_fix_landmark, 0, sf_fix_reason_inaccurate, audits);
+        return refuse(e, lm->t_us, sf_fix_landmark, 0, sf_fix_reason_inaccurate, audits);
     }
     /* a landmark needs no site: its position is in the map frame already */
     *fix = (sf_fix_t){.t_us = lm->t_us, .method = sf_fix_landmark, .x_m = lm->x_m, .y_m = lm->y_m,
                       .floor = lm->floor, .accuracy_m = lm->accuracy_m};
     *has_fix = true;
-    return sf_estimator_offer_fix(e, p, fix, true, audits);
+    return offer_fix(e, p, fix, true, audits);
+}
+
+/* Whether the controller keeps this source off now; if so, *n = the CONTEXT_OFF audits written. */
+static bool context_off(sf_estimator_t *const e, const sf_params_t *const p, const int8_t method, const int64_t t_us,
+                        sf_fix_audit_t audits[sf_scheme_count], int *const n)
+{
+    if (!p->controller_gate_sources || sf_controller_source_on(&e->controller, method)) {
+        return false;
+    }
+    e->context_off++;
+    *n = refuse(e, t_us, method, 0, sf_fix_reason_context_off, audits);
+    return true;
 }
 
 /* ---- the public inputs: CLS first, the controller's gate, the fix, the controller's step ---------- */
@@ -195,7 +216,7 @@ int sf_estimator_wifi(sf_estimator_t *const e, const sf_params_t *const p, const
     *has_fix = false;
     sf_controller_wifi(&e->controller, p, scan);
     int n;
-    if (!sf_estimator_context_off(e, p, sf_fix_wifi, scan->t_us, audits, &n)) {
+    if (!context_off(e, p, sf_fix_wifi, scan->t_us, audits, &n)) {
         n = wifi_fix(e, p, scan, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, scan->t_us);
@@ -209,7 +230,7 @@ int sf_estimator_gnss(sf_estimator_t *const e, const sf_params_t *const p, const
     e->gnss_offered++;
     sf_controller_gnss(&e->controller, p, gnss->t_us, gnss->accuracy_m);
     int n;
-    if (!sf_estimator_context_off(e, p, sf_fix_gnss, gnss->t_us, audits, &n)) {
+    if (!context_off(e, p, sf_fix_gnss, gnss->t_us, audits, &n)) {
         n = gnss_fix(e, p, gnss, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, gnss->t_us);
@@ -222,7 +243,7 @@ int sf_estimator_ble(sf_estimator_t *const e, const sf_params_t *const p, const 
     *has_fix = false;
     sf_controller_ble(&e->controller, p, scan);
     int n;
-    if (!sf_estimator_context_off(e, p, sf_fix_ble, scan->t_us, audits, &n)) {
+    if (!context_off(e, p, sf_fix_ble, scan->t_us, audits, &n)) {
         n = ble_fix(e, p, scan, fix, has_fix, audits);
     }
     sf_estimator_run_controller(e, p, scan->t_us);
@@ -236,4 +257,22 @@ int sf_estimator_landmark(sf_estimator_t *const e, const sf_params_t *const p, c
     const int n = landmark_fix(e, p, lm, fix, has_fix, audits); /* a landmark overrides everything: never off */
     sf_estimator_run_controller(e, p, lm->t_us);
     return n;
+}
+
+bool sf_estimator_next_context(sf_estimator_t *const e, const sf_params_t *const p, sf_context_event_t *const ev,
+                               sf_fix_t *const fix, bool *const has_fix, sf_fix_audit_t audits[sf_scheme_count],
+                               int *const n_audits)
+{
+    *has_fix = false;
+    *n_audits = 0;
+    if (!sf_controller_next_event(&e->controller, ev)) {
+        return false;
+    }
+    if (ev->recalibrated) { /* the staircase's endpoint on the new floor: a known position */
+        *fix = (sf_fix_t){.t_us = ev->t_us, .method = sf_fix_port, .x_m = ev->recal_x_m, .y_m = ev->recal_y_m,
+                          .floor = ev->floor, .accuracy_m = p->controller_recal_sigma_m};
+        *has_fix = true;
+        *n_audits = offer_fix(e, p, fix, true, audits);
+    }
+    return true;
 }

@@ -71,35 +71,16 @@ static double entry_g(const sf_radiomap_t *const map, const int32_t i, const sf_
                : -1.0;
 }
 
-/* The pre-selection's arrays: every entry's g AP-major and RP-major (a counting sort by RP that
- * keeps the APs ascending within an RP, as the AP-major visit meets them), and an empty query. */
-static void prepare_preselect(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
-                              const sf_params_t *const p)
+/* The prepared AP-major levels the full visit reads (entry_g of every entry) and an empty query; the
+ * pre-selection builds its RP-major copy from them (sf_fp_preselect_prepare). */
+static void prepare_levels(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map,
+                           const sf_params_t *const p)
 {
-    int32_t *const cursor = ws->touched; /* scratch, zeroed again below */
-    for (int32_t r = 0; r < map->n_rp; r++) {
-        cursor[r] = 0;
-    }
-    for (int32_t i = 0; i < map->n_entries; i++) {
-        cursor[map->entry_rp[i]]++;
-    }
-    ws->rp_entry_first[0] = 0;
-    for (int32_t r = 0; r < map->n_rp; r++) {
-        ws->rp_entry_first[r + 1] = ws->rp_entry_first[r] + cursor[r];
-        cursor[r] = ws->rp_entry_first[r];
-    }
     for (int32_t a = 0; a < map->n_ap; a++) {
         ws->ap_query_w[a] = 0.0;
         for (int32_t i = map->ap_first[a]; i < map->ap_first[a + 1]; i++) {
-            const int32_t j = cursor[map->entry_rp[i]]++;
-            const double g = entry_g(map, i, p);
-            ws->rp_entry_ap[j] = a;
-            ws->rp_entry_level_db[j] = g < 0.0 ? 0.0 : g;
-            ws->entry_level_db[i] = g;
+            ws->entry_level_db[i] = entry_g(map, i, p);
         }
-    }
-    for (int32_t r = 0; r < map->n_rp; r++) {
-        cursor[r] = 0;
     }
 }
 
@@ -149,7 +130,8 @@ int sf_fingerprint_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiom
         ws->rp_miss_loglik[r] += log(1.0 - detection(map, i, p_min)) - log_not_p;
     }
     if (all_pre) {
-        prepare_preselect(ws, map, p);
+        prepare_levels(ws, map, p);
+        sf_fp_preselect_prepare(ws, map);
     }
     ws->map_n_ap = map->n_ap;
     ws->map_n_rp = map->n_rp;
@@ -181,27 +163,6 @@ static void touch(sf_fingerprint_workspace_t *const ws, int32_t *const n_touched
     }
     ws->n_common[r]++;
     ws->acc[r] += term;
-}
-
-void sf_fp_insert_best(sf_fp_ranked_t *const best, int32_t *const n_best, const int32_t k, const double key,
-                       const int32_t rp)
-{
-    SF_ASSERT(k >= 1 && k <= SF_FINGERPRINT_K_MAX && *n_best >= 0 && *n_best <= k);
-    int32_t pos = *n_best;
-    while (pos > 0 && (key < best[pos - 1].key || (key == best[pos - 1].key && rp < best[pos - 1].rp))) {
-        pos--;
-    }
-    if (pos >= k) {
-        return;
-    }
-    const int32_t last = *n_best < k ? *n_best : k - 1;
-    for (int32_t i = last; i > pos; i--) {
-        best[i] = best[i - 1];
-    }
-    best[pos] = (sf_fp_ranked_t){key, rp};
-    if (*n_best < k) {
-        (*n_best)++;
-    }
 }
 
 /* Every entry of every used AP: accumulates the per-RP partial sums (touched RPs in ws->touched),

@@ -1,11 +1,13 @@
 /* sf_fingerprint_internal.h — what sf_fingerprint.c, its query (sf_fingerprint_query.c) and its
- * pre-selection (sf_fingerprint_preselect.c) share. Not part of the core's API. */
+ * pre-selection (sf_fingerprint_preselect.c) share. Not part of the core's API. The query and the
+ * pre-selection are leaves: sf_fingerprint.c calls them, they call nothing of sf_fingerprint.c. */
 #ifndef SF_FINGERPRINT_INTERNAL_H
 #define SF_FINGERPRINT_INTERNAL_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "sf_assert.h"
 #include "sf_fingerprint.h"
 
 typedef struct {
@@ -20,8 +22,34 @@ int32_t sf_fp_store_scan(sf_fingerprint_t *fp, const sf_params_t *p, const sf_ra
 /* Builds ws->query_* (map APs ascending, mean levels) from the last scans; fills the audit's counts. */
 void sf_fp_build_query(sf_fingerprint_t *fp, sf_fingerprint_workspace_t *ws, const sf_params_t *p);
 
-/* Inserts (key, rp) into best[0 .. *n_best), kept sorted by key then RP index, at most k long. */
-void sf_fp_insert_best(sf_fp_ranked_t *best, int32_t *n_best, int32_t k, double key, int32_t rp);
+/* Inserts (key, rp) into best[0 .. *n_best), kept sorted by key then RP index, at most k long: the k-best
+ * list that both the full visit (sf_fingerprint.c) and the pre-selection fill, kept here so that
+ * neither calls into the other's file. O(k). */
+static inline void sf_fp_insert_best(sf_fp_ranked_t *const best, int32_t *const n_best, const int32_t k,
+                                     const double key, const int32_t rp)
+{
+    SF_ASSERT(k >= 1 && k <= SF_FINGERPRINT_K_MAX && *n_best >= 0 && *n_best <= k);
+    int32_t pos = *n_best;
+    while (pos > 0 && (key < best[pos - 1].key || (key == best[pos - 1].key && rp < best[pos - 1].rp))) {
+        pos--;
+    }
+    if (pos >= k) {
+        return;
+    }
+    const int32_t last = *n_best < k ? *n_best : k - 1;
+    for (int32_t i = last; i > pos; i--) {
+        best[i] = best[i - 1];
+    }
+    best[pos] = (sf_fp_ranked_t){key, rp};
+    if (*n_best < k) {
+        (*n_best)++;
+    }
+}
+
+/* The pre-selection's RP-major copy of the prepared levels (sf_fingerprint_preselect.c): ws->entry_level_db
+ * (AP-major, −1 censored) counting-sorted by RP, the APs ascending within an RP as the AP-major visit
+ * meets them, censored entries 0. ws->touched is its scratch and is left zero. O(n_rp + n_entries). */
+void sf_fp_preselect_prepare(sf_fingerprint_workspace_t *ws, const sf_radiomap_t *map);
 
 /* WkNN fill mode with the pre-selection's arrays and fingerprint_preselect_aps > 0: the k best of the
  * pre-selected candidates (sf_fingerprint_preselect.c). ws->ap_query_w holds the query; scan_sum =

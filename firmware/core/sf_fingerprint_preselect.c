@@ -15,7 +15,9 @@
  * visit whose strongest APs look unlike the scan's is then missed — the approximation the cost budget
  * buys. Fewer than k reached: undecided (the caller
  * visits everything), as it does on a walk-built map (fewer than fingerprint_preselect_min_scans scans
- * per RP) and where the pre-selection would not halve the entries visited. */
+ * per RP) and where the pre-selection would not halve the entries visited.
+ * A leaf of sf_fingerprint.c: its state is the workspace's RP-major arrays, which it builds
+ * (sf_fp_preselect_prepare) from the prepared AP-major levels and reads; it calls nothing there. */
 #include <math.h>
 
 #include "sf_assert.h"
@@ -120,6 +122,33 @@ static void heap_replace_top(sf_fp_ranked_t *const h, const int32_t n, const sf_
     }
     if (n > 0) {
         h[i] = e;
+    }
+}
+
+void sf_fp_preselect_prepare(sf_fingerprint_workspace_t *const ws, const sf_radiomap_t *const map)
+{
+    int32_t *const cursor = ws->touched; /* scratch, zeroed again below */
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        cursor[r] = 0;
+    }
+    for (int32_t i = 0; i < map->n_entries; i++) {
+        cursor[map->entry_rp[i]]++;
+    }
+    ws->rp_entry_first[0] = 0;
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        ws->rp_entry_first[r + 1] = ws->rp_entry_first[r] + cursor[r];
+        cursor[r] = ws->rp_entry_first[r];
+    }
+    for (int32_t a = 0; a < map->n_ap; a++) {
+        for (int32_t i = map->ap_first[a]; i < map->ap_first[a + 1]; i++) {
+            const int32_t j = cursor[map->entry_rp[i]]++;
+            const double g = ws->entry_level_db[i];
+            ws->rp_entry_ap[j] = a;
+            ws->rp_entry_level_db[j] = g < 0.0 ? 0.0 : g;
+        }
+    }
+    for (int32_t r = 0; r < map->n_rp; r++) {
+        cursor[r] = 0;
     }
 }
 

@@ -29,7 +29,7 @@
  *   - pinned (truth-initialised runs, init_use_config_pose: the start floor is given): only the proof
  *     and the spurious-change rule move s;
  *   - renumbered from outside (the multi-scheme controller identified a floor context and moved the
- *     barometric floor there, sf_estimator_context.c): s moves with it, d and the scores stay. Without
+ *     barometric floor there, sf_estimator.c): s moves with it, d and the scores stay. Without
  *     this the vote would read the renumbering as a climb (d ± the shift) and refuse, as infeasible,
  *     every later fix on the floor the walker is really on; with it those fixes vote on as before and
  *     move s back when they lead by the margin.

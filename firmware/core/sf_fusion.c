@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 #include "sf_fusion_internal.h"
 
@@ -228,6 +229,7 @@ void sf_fusion_step(sf_fusion_t *const f, const sf_params_t *const p, const int6
 void sf_fusion_step_on_floor(sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us, const double dx_m,
                              const double dy_m, const double length_m, const int16_t baro_floor)
 {
+    SF_ASSERT(f != NULL && p != NULL);
     if (!predicts(f)) {
         return; /* wifi_only ignores steps */
     }
@@ -264,6 +266,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
                            const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
     /* baro_floor: the particle scheme's floors; the others are on the caller's floor (Floors) */
+    SF_ASSERT(f != NULL && p != NULL && fix != NULL && audit != NULL);
     audit_begin(audit, f, fix);
     f->fixes++;
     if (!fix_usable(fix)) {
@@ -377,6 +380,7 @@ int sf_fusion_fix_on_floor(sf_fusion_t *const f, const sf_params_t *const p, con
 bool sf_fusion_pose(const sf_fusion_t *const f, const sf_params_t *const p, const int64_t t_us,
                     const int16_t baro_floor, sf_pose_t *const pose)
 {
+    SF_ASSERT(f != NULL && p != NULL && pose != NULL);
     pose->scheme = f->scheme;
     pose->ess = 0.0;
     if (f->initialised && is_particle(f) && sf_fusion_particle_pose(f, pose)) {
@@ -425,6 +429,7 @@ void sf_fusion_set_fix_model(sf_fusion_t *const f, const sf_params_t *const p, c
 
 void sf_fusion_set_cloud(sf_fusion_t *const f, const sf_params_t *const p, sf_particle_t *const cloud)
 {
+    SF_ASSERT(f != NULL && p != NULL);
     if (!is_particle(f)) {
         return;
     }

@@ -3,6 +3,7 @@
  * sf_fusion_fix: floors, innovate, judge, apply, record. */
 #include <math.h>
 
+#include "sf_assert.h"
 #include "sf_fusion_internal.h"
 
 /* The fix's 1σ per axis. A Wi-Fi matcher's accuracy is a shape, not a σ (sf_ekf.h: on site2/F3 the
@@ -26,6 +27,7 @@ static double fix_sigma_m(const sf_fusion_t *const f, const sf_params_t *const p
 static void mirror(sf_fusion_t *const f, sf_particle_summary_t *const s, const bool jump)
 {
     sf_particle_t *const c = f->cloud;
+    SF_ASSERT(c != NULL && c->seeded); /* a seeded cloud is mirrored, never a missing one */
     sf_particle_summary(c, s);
     double x = s->x_m, y = s->y_m;
     if (!jump && c->walls != NULL && f->floor_offset == (int32_t)s->floor &&
@@ -78,6 +80,7 @@ void sf_fusion_particle_fix(sf_fusion_t *const f, const sf_params_t *const p, co
                             const int16_t baro_floor, const bool between_floors, sf_fix_audit_t *const audit)
 {
     sf_particle_t *const c = f->cloud;
+    SF_ASSERT(f->fixes > 0 && isfinite(fix->accuracy_m)); /* sf_fusion_fix_on_floor counted and checked it */
     const double sigma_m = fix_sigma_m(f, p, fix), r_m2 = sigma_m * sigma_m;
     sf_particle_summary_t s;
     if (c == NULL) {

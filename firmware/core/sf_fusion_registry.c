@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 #include "sf_fusion_internal.h"
 #include "sf_math.h"
@@ -70,6 +71,7 @@ static const char *const scheme_names[] = {
 
 const sf_scheme_row_t *sf_fusion_row(const int scheme)
 {
+    SF_ASSERT(scheme >= 0 && scheme < sf_scheme_count); /* sf_fusion_init refuses any other */
     return &scheme_rows[scheme];
 }
 

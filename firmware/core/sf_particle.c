@@ -4,6 +4,7 @@
 
 #include <math.h>
 
+#include "sf_assert.h"
 #include "sf_error.h"
 #include "sf_math.h"
 
@@ -34,6 +35,7 @@ void sf_particle_set_map(sf_particle_t *const c, const sf_wall_grid_t *const wal
 void sf_particle_seed(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
                       const double sigma_m, const int16_t floor, const bool keep_gait)
 {
+    SF_ASSERT(c != NULL && p != NULL && c->n >= 1 && c->n <= c->capacity); /* sf_particle_init's */
     const double w = 1.0 / (double)c->n;
     const bool keep = keep_gait && c->seeded;
     for (int32_t i = 0; i < c->n; i++) {
@@ -83,6 +85,7 @@ static bool has_floor_ports(const sf_ports_t *const ports)
 static void floor_transition(sf_particle_t *const c, const int32_t i, const int16_t baro_floor, const bool anywhere,
                              const double x0_m, const double y0_m)
 {
+    SF_ASSERT(i >= 0 && i < c->n);
     if (c->floor[i] == baro_floor || baro_floor == FLOOR_KEEP) {
         return;
     }
@@ -131,6 +134,7 @@ static bool normalise(sf_particle_t *const c)
 void sf_particle_resample(sf_particle_t *const c)
 {
     const int32_t n = c->n;
+    SF_ASSERT(n >= 1 && n <= c->capacity);
     /* counts per particle (systematic: u_k = (u + k) / n), kept in the weights' place */
     int32_t last_alive = 0;
     for (int32_t i = 0; i < n; i++) {
@@ -155,6 +159,7 @@ void sf_particle_resample(sf_particle_t *const c)
         for (int32_t m = (int32_t)c->p[i].w; m > 1; m--) {
             while (c->p[free_slot].w != 0.0) {
                 free_slot++;
+                SF_ASSERT(free_slot < n); /* as many slots drawn 0 times as extra draws */
             }
             c->p[free_slot] = c->p[i];
             c->p[free_slot].w = 1.0; /* now taken */
@@ -178,6 +183,8 @@ static void resample_if_needed(sf_particle_t *const c, const sf_params_t *const 
 void sf_particle_step(sf_particle_t *const c, const sf_params_t *const p, const double length_m,
                       const double heading_rad, const int16_t baro_floor)
 {
+    SF_ASSERT(c != NULL && p != NULL);
+    SF_ASSERT(isfinite(length_m) && length_m >= 0.0); /* sf_fusion counts and skips any other step */
     if (!c->seeded) {
         return;
     }
@@ -233,6 +240,7 @@ void sf_particle_step(sf_particle_t *const c, const sf_params_t *const p, const 
 
 double sf_particle_evidence(const sf_particle_t *const c, const double x_m, const double y_m, const double sigma_m)
 {
+    SF_ASSERT(c != NULL && sigma_m > 0.0); /* the fix's σ is floored at fusion.var_min_m2 > 0 */
     const double k = -0.5 / (sigma_m * sigma_m);
     double e = 0.0;
     for (int32_t i = 0; i < c->n; i++) {
@@ -245,6 +253,8 @@ double sf_particle_evidence(const sf_particle_t *const c, const double x_m, cons
 double sf_particle_update(sf_particle_t *const c, const sf_params_t *const p, const double x_m, const double y_m,
                           const double sigma_m, double *const ess_after)
 {
+    SF_ASSERT(c != NULL && p != NULL && ess_after != NULL && sigma_m > 0.0);
+    SF_ASSERT(p->particle_outlier_share > 0.0); /* its range: the sum below stays > 0 */
     const double k = -0.5 / (sigma_m * sigma_m), eps = p->particle_outlier_share;
     double sum = 0.0;
     for (int32_t i = 0; i < c->n; i++) {
@@ -356,6 +366,7 @@ void sf_particle_inject(sf_particle_t *const c, const double x_m, const double y
                         const int16_t floor, const double share)
 {
     const int32_t k = share > 0.0 && share < 1.0 ? (int32_t)lround(1.0 / share) : 1;
+    SF_ASSERT(c->n >= 1 && k >= 1);
     const double w = 1.0 / (double)c->n;
     for (int32_t i = 0; i < c->n; i += k) { /* every k-th: a strided, not a weight-ordered, choice */
         sf_particle_state_t *const q = &c->p[i];

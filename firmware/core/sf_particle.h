@@ -1,6 +1,6 @@
-/* sf_particle.h — the `particle` scheme's math: a map-aware particle filter over PDR steps (issue 13
- * item 4). The control around it (start, floor, gate, recovery, audit) is sf_fusion's
- * (sf_fusion_particle.c); this module is the cloud.
+/* sf_particle.h — the `particle` scheme's math: a map-aware particle filter over PDR steps. The control
+ * around it (start, floor, gate, recovery, audit) is sf_fusion's (sf_fusion_particle.c); this module
+ * is the cloud.
  *
  * State per particle: position (x, y) [m, map frame], floor (int16), heading bias b [rad] added to the
  * PDR walking direction, stride scale s multiplying the PDR step length, weight w. Weights are linear

@@ -148,7 +148,7 @@ static void test_parse_garbage_is_syntax_error(void **state)
 }
 
 /* asc2log writes a direction flag after every frame ("R" received, "T" sent: can-utils' asc2log
- * output, issue 17); each line is the frame of the line without it, whichever entry reads it (the
+ * output, which must replay like candump -L); each line is the frame of the line without it, whichever entry reads it (the
  * replay-shaped line takes sf_candump_parse_line's fast path). */
 static void test_parse_direction_flag_is_the_same_frame(void **state)
 {

@@ -1,6 +1,6 @@
 /* test_candump_model.c — the table-driven candump -L parser (sf_candump_parse) against a dumb
  * reference model: the straightforward parser it replaced (one range test per character class),
- * kept here verbatim but for two additions of issue 17 in its own style (marked): CAN FD lines
+ * kept here verbatim but for two additions in its own style (marked, for asc2log output): CAN FD lines
  * (SF_ENOTCLASSIC with the header) and asc2log's direction flag. Seeded mutations of valid lines —
  * every byte value at every place, digits dropped and doubled, blanks, line ends, NULs — must give
  * the same verdict and, when valid (or FD), the same frame; a rejected line leaves *frame untouched
@@ -112,7 +112,7 @@ static int reference_parse(const char *line, sf_can_frame_t *const frame)
     if (*p == 'R') {
         f.remote = true;
         p++;
-    } else if (*p == '#') { /* issue 17: CAN FD, "##", a flags digit, a valid FD length of bytes */
+    } else if (*p == '#') { /* added: CAN FD, "##", a flags digit, a valid FD length of bytes */
         p++;
         if (ref_hex_value(*p) < 0) {
             return SF_ESYNTAX;
@@ -143,7 +143,7 @@ static int reference_parse(const char *line, sf_can_frame_t *const frame)
         }
         f.dlc = (uint8_t)n;
     }
-    if (ref_is_space(*p)) { /* issue 17: blanks, then perhaps a direction flag */
+    if (ref_is_space(*p)) { /* added: blanks, then perhaps a direction flag */
         while (ref_is_space(*p)) {
             p++;
         }

@@ -205,7 +205,7 @@ static void test_set(void **state)
     assert_true(strlen(err) > 0);
 }
 
-/* Regression (issue 12): a --set longer than 255 characters was cut short silently; the value is
+/* Regression (input hardening): a --set longer than 255 characters was cut short silently; the value is
  * now read in place (no limit) and an over-long key is refused. */
 static void test_set_is_never_cut_short(void **state)
 {
@@ -226,7 +226,7 @@ static void test_set_is_never_cut_short(void **state)
     assert_non_null(strstr(err, "characters"));
 }
 
-/* Regression (issue 12): a line longer than inih's INI_MAX_LINE was split, and the error named a
+/* Regression (input hardening): a line longer than inih's INI_MAX_LINE was split, and the error named a
  * later line and a key made of the line's tail. It is now refused with its own line number. */
 static void test_over_long_line_names_its_line(void **state)
 {
@@ -260,7 +260,7 @@ static void test_nul_byte_is_refused(void **state)
     assert_non_null(strstr(err, ":2: a NUL byte"));
 }
 
-/* Regression (issue 12): --config /dev/zero hung in inih, --config DIR was accepted. */
+/* Regression (input hardening): --config /dev/zero hung in inih, --config DIR was accepted. */
 static void test_device_and_directory_are_refused(void **state)
 {
     (void)state;

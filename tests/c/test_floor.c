@@ -322,7 +322,7 @@ static void test_bad_samples_gaps_backwards(void **state)
     assert_int_equal(sf_floor_current(&f), 1);
 }
 
-/* A dog-leg stair (issue 11, SIL tour): the landing sits at exactly half a storey, where the truth
+/* A dog-leg stair (SIL tour): the landing sits at exactly half a storey, where the truth
  * already counts the upper floor. Climbing, the mid-height is enough, so the change commits on the
  * landing (confirm_ms after arriving), not a flight later; and the landing is no floor, so nothing is
  * re-referenced there (a re-reference would put floor 1 at 1.75 m and make the second flight floor 2).

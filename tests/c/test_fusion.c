@@ -507,12 +507,12 @@ static void test_uninitialised_until_first_fix(void **state)
         } else {
             assert_true(pose.x_m == 10.0 && pose.y_m == -4.0 && pose.sigma_m == 2.5);
         }
-        assert_int_equal(pose.floor, s == sf_scheme_wifi_only ? 1 : 2); /* the caller's (issue 11) */
+        assert_int_equal(pose.floor, s == sf_scheme_wifi_only ? 1 : 2); /* the caller's floor */
         assert_int_equal(f[s].initialisations, 1);
     }
 }
 
-/* Floors (issue 11): every predicting scheme is on the caller's floor, whatever its fixes say; a fix on
+/* Floors: every predicting scheme is on the caller's floor, whatever its fixes say; a fix on
  * another floor is judged on the gate alone (its floor voted already, sf_floor_vote.h); between floors
  * every fix is refused FLOOR_MISMATCH without counting toward a recovery. */
 static void test_floors(void **state)

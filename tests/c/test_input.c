@@ -276,7 +276,8 @@ static void test_describe_names_file_and_line(void **state)
     unlink(candump);
 }
 
-/* The candump in path as can-utils' asc2log writes it (issue 17), into out: a direction flag after
+/* The candump in path as can-utils' asc2log writes it (logs converted from
+ * Vector ASC files must replay too), into out: a direction flag after
  * every frame (" R", every third " T") and, after every fifth line, a CAN FD line of the same time
  * (12 bytes; extended id every other one). Returns the number of FD lines. */
 static int write_asc2log(const char *const path, const char *const out)
@@ -352,7 +353,7 @@ static bool stdin_open(void)
     return fcntl(0, F_GETFD) != -1;
 }
 
-/* Regression (issue 10): `stridefixd --replay` closed file descriptor 0 at exit, because it always
+/* Regression: `stridefixd --replay` closed file descriptor 0 at exit, because it always
  * closed the CAN input, which on a replay had never been opened (zeroed: fd 0). With stdin closed,
  * the next file the process opens becomes fd 0. Replaying, and closing a never-opened CAN input, must
  * both leave stdin open. */
@@ -402,7 +403,7 @@ static void test_missing_inputs_fail_with_a_message(void **state)
     assert_int_equal(sf_input_open(&in, "", err, sizeof err), SF_EINVAL);
 }
 
-/* Regression (issue 12): --input /dev/zero hung and a directory was accepted. Devices and
+/* Regression (input hardening): --input /dev/zero hung and a directory was accepted. Devices and
  * directories are refused for candump and LCM inputs alike; a FIFO (a stream, as stdin) is not. */
 static void test_devices_and_directories_are_refused(void **state)
 {
@@ -429,7 +430,7 @@ static void test_devices_and_directories_are_refused(void **state)
     unlink(fifo);
 }
 
-/* Regression (issue 12): a PNG given as a candump was 508 bad lines and exit 0. An input without one
+/* Regression (input hardening): a PNG given as a candump was 508 bad lines and exit 0. An input without one
  * valid frame says so; one valid frame among bad lines is enough. */
 static void test_nothing_valid_is_told(void **state)
 {

@@ -1,5 +1,5 @@
 /* test_lcm_input.c — the raw-sensor replay (sf_lcm_input.h) on hostile logs, built byte by byte in
- * memory: issue 12 found that a WIFI event declaring 2^29 readings overflowed the heap in the
+ * memory: an input-hardening review found that a WIFI event declaring 2^29 readings overflowed the heap in the
  * generated decode (SIGSEGV), a negative count asked for a huge allocation and an event header
  * claiming 1.9 GB made liblcm map 1.9 GB and then end the replay silently with status 0. Each case
  * checks the code, the counters, the message (event number, offset, field) and that the good events

@@ -1,5 +1,5 @@
-/* core_cost.c — the estimator core's cost harness (issue 16), measured under callgrind by `stridefix-lab bench
- * perf` (analyzer/stridefix_analyzer/bench/perf.py), which counts the instructions inside one core call
+/* core_cost.c — the estimator core's cost harness (against its cost budget), measured under callgrind by `stridefix-lab bench
+ * perf` (lab/stridefix_lab/bench/perf.py), which counts the instructions inside one core call
  * (--toggle-collect) and divides by the calls this harness reports.
  *
  *   core_cost sensors SECONDS   a walk of SECONDS through the core's sensor calls at the board's rates:

@@ -1,4 +1,4 @@
-/* particle_cost.c — the particle scheme's cost harness (issue 13: ≤ 1 million instructions per step at
+/* particle_cost.c — the particle scheme's cost harness (its budget: ≤ 1 million instructions per step at
  * 1 000 particles on a floor plan of 5 000 segments). Builds a 200 m × 100 m floor of 5 m rooms (every
  * room wall split by a 1 m door) plus furniture segments up to 5 000 walls, indexes it, seeds the cloud
  * in a room and walks STEPS steps (a walker bouncing off the walls, PDR heading 5° off with noise) with
