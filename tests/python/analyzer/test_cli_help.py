@@ -1,4 +1,4 @@
-"""What `stridefix ... --help` shows and the options the commands share (issue 17 item 6).
+"""What `stridefix ... --help` shows and the options the commands share.
 
 GIVEN every parser of the `stridefix` tree (each sub-command and sub-sub-command), WHEN its help is
 formatted, THEN it carries no docstring markup and no empty default; and an option several commands
