@@ -48,7 +48,7 @@ build: deps
 	@$(call configure,$(BUILD),-DCMAKE_BUILD_TYPE=$(CMAKE_BUILD_TYPE))
 	@cmake --build $(BUILD) -j $(JOBS)
 
-# What goes where: cmake/install.cmake (README "Install on a logger").
+# What goes where: cmake/install.cmake (docs/deployment.md "Install on a logger").
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
@@ -120,7 +120,7 @@ bench: build
 	if [ $$status -ne 0 ]; then echo "bench: FAILED: a target was missed or a bench failed (TARGET MISSED lines above)"; fi; \
 	exit $$status
 
-# Issue 12: bus and board faults (exit 1 when a fault is not recovered) and the 8-hour soak; not in make test.
+# Bus and board faults (exit 1 when a fault is not recovered) and the 8-hour soak; not in make test.
 reliability: build
 	$(LAB) bench reliability --stridefixd $(STRIDEFIXD) --out out/bench
 
@@ -148,7 +148,7 @@ check-asan: deps
 	@cmake --build build-asan -j $(JOBS)
 	cd build-asan && ctest --output-on-failure
 
-# The unit's processor (issue 16): the estimator core, the CAN codec and the core tests cross-compiled
+# The unit's processor: the estimator core, the CAN codec and the core tests cross-compiled
 # for 32-bit ARM (Debian armhf, cmake/toolchain-armhf.cmake; SF_CORE_ONLY leaves out what needs LCM,
 # inih or Ceres), the tests run by ctest under qemu-arm, then the core's size against its text budget
 # (tools/core_size.sh, written to build-arm/core_size.json).
@@ -162,7 +162,7 @@ check-arm: deps
 	cd $(ARM_BUILD) && ctest --output-on-failure
 	@tools/core_size.sh $(ARM_SIZE) $(ARM_BUILD)/firmware/libsf_core.a $(ARM_BUILD)/core_size.json $(CORE_TEXT_BUDGET_B)
 
-# libFuzzer (README "Fuzzing"): clang with ASan+UBSan, SF_ASSERT live, -O1. Each harness starts from
+# libFuzzer (docs/reliability.md "Fuzzing"): clang with ASan+UBSan, SF_ASSERT live, -O1. Each harness starts from
 # tests/fuzz/corpus/<h> and crashers/<h> (read only) and grows build-fuzz/corpus/<h>; a finding is
 # written to build-fuzz/artifacts/<h>/ and fails the goal (keep it in tests/fuzz/crashers/<h>/).
 FUZZ_HARNESSES ?= candump board_rx lcm_input site config

@@ -4,7 +4,7 @@
 #  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
 #     re-installed only when requirements.txt or pyproject.toml changed.
 #  3. A .pth file so the venv imports what the build generates (development; an installed logger gets the
-#     LCM types from `cmake --install`, README "Install on a logger"): the LCM Python bindings and the native
+#     LCM types from `cmake --install`, docs/deployment.md "Install on a logger"): the LCM Python bindings and the native
 #     solver module (stridefix_native, with its scipy reference beside it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,7 +24,7 @@ DEBS+=(valgrind)
 # no browser download).
 DEBS+=(chromium)
 # can-utils: log2asc and asc2log, candump and canplayer (tests/python/can: the Vector ASC round trip,
-# whose asc2log writes the direction flags the candump parser reads; README "CAN tools").
+# whose asc2log writes the direction flags the candump parser reads; docs/deployment.md "CAN tools").
 DEBS+=(can-utils)
 # lcm-spy and the Java types (lcmtypes/CMakeLists.txt builds build/lcmtypes/java/stridefix_lcmtypes.jar
 # when a JDK and lcm.jar are found; `stridefix spy` / make spy start lcm.spy.Spy from lcm.jar):

@@ -57,7 +57,7 @@ def test_bad_file_is_named(tmp_path):
 
 
 def test_controller_bound_is_relative_to_the_best_fixed_scheme(tmp_path):
-    """Issue 14: the controller's mean within 2 % of the best fusion scheme of the same group."""
+    """The controller target: the controller's mean within 2 % of the best fusion scheme of the same group."""
     doc = _doc("site1/F2", 3.0, 1.0)
     schemes = doc["groups"][0]["summary"]["schemes"]
     schemes["kalman"] = {"mean": 2.9}
@@ -75,7 +75,7 @@ def test_controller_bound_is_relative_to_the_best_fixed_scheme(tmp_path):
 
 
 def test_crowd_map_bound_is_relative_to_the_truth_map(tmp_path):
-    """Issue 15: the crowd-built map's Wi-Fi fix error within 15 % of the truth-built map's, read from
+    """The crowd-map target: the crowd-built map's Wi-Fi fix error within 15 % of the truth-built map's, read from
     a crowd-map results file beside (not instead of) the fusion results of the same group."""
 
     def crowd_doc(truth: float, crowd: float) -> dict:
@@ -101,7 +101,7 @@ def test_crowd_map_bound_is_relative_to_the_truth_map(tmp_path):
 
 
 def test_wall_time_is_the_fusion_files_total_per_floor(tmp_path):
-    """Issue 16: realbench <= 60 s per msindoor floor, read from the fusion file's run_s.total (a
+    """The speed budget: realbench <= 60 s per msindoor floor, read from the fusion file's run_s.total (a
     crowd-map file of the same group does not replace it); a file without it is not run."""
     doc = _doc("site1/F2", 3.2, 1.0)
     doc["run_s"] = {"prepare": 5.0, "folds": 40.0, "total": 47.5}

@@ -30,7 +30,7 @@ def test_other_sub_commands_pass_unchanged(monkeypatch):
 
 def test_running_one_sub_command_builds_only_its_parser():
     # stridefix analyze of a 1-hour walk spent 1-3 s importing every sub-command's module (SciPy,
-    # Matplotlib, the crowd and bench layers) before reading a byte; issue 16 budgets the whole run
+    # Matplotlib, the crowd and bench layers) before reading a byte; the cost budget holds the whole run
     # at 3 s. A fresh interpreter, so that modules other tests imported do not count.
     script = (
         "import sys\n"

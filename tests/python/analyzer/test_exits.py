@@ -1,4 +1,4 @@
-"""The exit-status contract (issue 12): one table for stridefixd and every `stridefix` command.
+"""The exit-status contract: one table for stridefixd and every `stridefix` command.
 
 The codes are defined once per language, SF_EXIT_* in firmware/app/sf_options.h and
 stridefix_analyzer/exits.py; this test keeps them equal, and checks that both `--help` texts state
@@ -61,7 +61,7 @@ def test_worst_status_of_several_inputs():
 
 
 def test_analyze_of_junk_or_empty_logs_is_nothing_valid(write_log, tmp_path, cli_main, capsys):
-    """Regression (issue 12): a PNG given as a log exited 2 like a missing file; two logs without one
+    """Regression: a PNG given as a log exited 2 like a missing file; two logs without one
     event exited 2 as if one channel were missing. Both hold nothing valid: 3."""
     png = tmp_path / "photo.png"
     png.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)

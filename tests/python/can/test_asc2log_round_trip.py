@@ -1,4 +1,4 @@
-"""can-utils' log2asc and asc2log (issue 17): the simulator's candump log converted to Vector ASC and
+"""can-utils' log2asc and asc2log (interoperability with the CAN tools): the simulator's candump log converted to Vector ASC and
 back. asc2log writes a direction flag (" R") after every frame, which the firmware's candump parser
 reads; the replay of the round trip is the replay of the original. can-utils is a Debian package
 (tools/deps.sh installs it); without it these tests are skipped.

@@ -1,4 +1,4 @@
-"""firmware/board.dbc's attributes (issue 17): a cycle time on every periodic message, equal to what
+"""firmware/board.dbc's attributes (what CAN tools read from it): a cycle time on every periodic message, equal to what
 the simulator sends (the firmware's decoder seeds its IMU, MAG and BARO periods from the same
 attribute: cantools generates BOARD_*_CYCLE_TIME_MS); event-driven messages marked as such; a value
 table on every flag signal."""

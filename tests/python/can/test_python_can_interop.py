@@ -1,4 +1,4 @@
-"""The simulator's CAN log read by python-can and decoded by cantools (issue 17): ``stridefix sim
+"""The simulator's CAN log read by python-can and decoded by cantools (interoperability): ``stridefix sim
 --candump-suffix .log`` writes board.log, which ``can.LogReader`` reads (it picks its candump -L
 reader by the ``.log`` suffix and refuses ``.candump``); every frame decodes against
 firmware/board.dbc to what the simulator sent, at the DBC's cycle times; stridefixd replays the same

@@ -4,8 +4,8 @@ map, one walk replayed through the real stridefixd with the controller and witho
 GIVEN the whole chain (the simulator's campus2 world, ``radiomap build --building`` writing the context
 map, the firmware's controller) WHEN the bench runs one seed THEN controller.json has the controller's
 and the fixed schemes' errors per true context, a latency per transition of the walk, the switches
-judged, the radios' on-times, the per-rule CONTEXT counts, a timeline PNG, and every issue-14 target
-with a verdict. Skipped, with the piece named, while a branch of issue 14 is not merged yet."""
+judged, the radios' on-times, the per-rule CONTEXT counts, a timeline PNG, and every controller target
+with a verdict. Skipped, with the piece named, while a piece of the controller is missing."""
 
 from __future__ import annotations
 

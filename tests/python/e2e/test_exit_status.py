@@ -1,6 +1,6 @@
-"""stridefixd's exit-status contract and its option/config edge cases (issue 12, item 4).
+"""stridefixd's exit-status contract and its option/config edge cases.
 
-Each test is a regression of a row of issue 12's table: a PNG as candump was 508 lines, 0 ok, exit 0;
+Each test is a regression of a row of the exit-status table: a PNG as candump was 508 lines, 0 ok, exit 0;
 `--config /dev/zero` and `--input /dev/zero` hung; `--config DIR` was accepted; `--set` over 255
 characters was cut short silently; `--max-messages abc` was accepted; a config line longer than inih's
 limit was split and the error named a later line and a wrong key."""

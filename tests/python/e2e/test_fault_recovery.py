@@ -1,4 +1,4 @@
-"""The firmware survives bus and board faults (issue 12 item 2), end to end: a 90 s SIL walk from the
+"""The firmware survives bus and board faults, end to end: a 90 s SIL walk from the
 simulator's fault injector through the real stridefixd, without a site (PDR alone, so nothing can hide a
 lost step). Each fault costs only the frames it touches: steps and PDR error stay with the clean run's,
 the walk carries on to its end, and the fault's own HEALTH counter moves. (`make reliability` is the

@@ -1,4 +1,4 @@
-"""stridefixd --replay on hostile raw-sensor logs (issue 12): a WIFI event declaring 2^29 readings died
+"""stridefixd --replay on hostile raw-sensor logs: a WIFI event declaring 2^29 readings died
 with SIGSEGV in the generated LCM decode, and an event header claiming 1.9 GB made liblcm map 1.9 GB and
 then end the replay silently with status 0.
 

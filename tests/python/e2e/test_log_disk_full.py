@@ -1,4 +1,4 @@
-"""Disk full (issue 12 item 1), for real: a 2 MB tmpfs in the test's own mount namespace.
+"""Disk full, for real: a 2 MB tmpfs in the test's own mount namespace.
 
 Regression: on a full disk the summary said 78,942 events written and 1,226 dropped while the file
 held 23,317, and the error gave no reason. GIVEN 25,000 frames of the default walk, WHEN the log's

@@ -1,4 +1,4 @@
-"""The log file's lifecycle (issue 12 item 1): NAME.part renamed on a clean close, never an existing
+"""The log file's lifecycle: NAME.part renamed on a clean close, never an existing
 file or a symlink overwritten, unique default names, rotation (size, SIGHUP) with CONFIG heading every
 file, SIGTERM/SIGINT as a clean end, the fsync interval honoured after SIGKILL.
 
@@ -51,7 +51,7 @@ def test_log_is_renamed_from_part_on_clean_close(stridefixd, candump, tmp_path, 
 
 
 def test_existing_log_is_never_overwritten_without_force(stridefixd, candump, tmp_path):
-    # Regression (issue 12): an existing --log was overwritten silently.
+    # Regression: an existing --log was overwritten silently.
     log = tmp_path / "walk.lcmlog"
     log.write_text("precious")
     proc = run(stridefixd, "-i", str(candump), "-l", str(log), "-q")
@@ -63,7 +63,7 @@ def test_existing_log_is_never_overwritten_without_force(stridefixd, candump, tm
 
 @pytest.mark.parametrize("force", [False, True], ids=["plain", "force"])
 def test_symlink_at_the_part_name_is_never_followed(stridefixd, candump, tmp_path, force):
-    # Regression (issue 12): a symlink planted at the predictable name overwrote another file.
+    # Regression: a symlink planted at the predictable name overwrote another file.
     victim = tmp_path / "victim"
     victim.write_text("precious")
     (tmp_path / "walk.lcmlog.part").symlink_to(victim)
@@ -76,7 +76,7 @@ def test_symlink_at_the_part_name_is_never_followed(stridefixd, candump, tmp_pat
 
 
 def test_two_daemons_started_together_get_different_default_names(stridefixd, candump, tmp_path):
-    # Regression (issue 12): two daemons started in one second shared a file.
+    # Regression: two daemons started in one second shared a file.
     cmd = [str(stridefixd), "-i", str(candump), "-d", str(tmp_path), "-q"]
     procs = [subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True) for _ in range(3)]
     assert all(p.wait(timeout=120) == 0 for p in procs)
@@ -153,7 +153,7 @@ def wait_for(predicate, timeout_s: float = 20.0) -> None:
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
 def test_stop_signal_closes_the_log_and_exits_0(stridefixd, candump, tmp_path, log_detail, sig):
-    # Regression (issue 12): no handler, so no final flush, no last HEALTH, no summary.
+    # Regression: no handler, so no final flush, no last HEALTH, no summary.
     log = tmp_path / "walk.lcmlog"
     proc = start_on_stdin(stridefixd, log)
     lines = candump.read_text().splitlines(keepends=True)[:3000]

@@ -1,4 +1,4 @@
-"""Least privilege (issue 12 item 5): a live bus (socketcan:) is refused as root unless --allow-root;
+"""Least privilege: a live bus (socketcan:) is refused as root unless --allow-root;
 file replays run as any user.
 
 GIVEN this machine (root, no AF_CAN), WHEN stridefixd is asked for socketcan:vcan0, THEN as root it

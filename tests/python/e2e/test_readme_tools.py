@@ -1,4 +1,4 @@
-"""README "Use it with your tools": the block of commands runs as it stands, and each tool's output
+"""docs/tools.md "The whole round, in one block": the block of commands runs as it stands, and each tool's output
 says it did its job (lcm-logplayer's copy is the log, python-can reads every frame, the ASC round
 trip replays the same walk, evo's APE is our 3-D error)."""
 
@@ -20,9 +20,9 @@ TOOLS = ("lcm-logplayer", "log2asc", "asc2log")
 
 
 def _block() -> str:
-    text = (REPO / "README.md").read_text(encoding="utf-8")
+    text = (REPO / "docs" / "tools.md").read_text(encoding="utf-8")
     m = re.search(re.escape(MARK) + r"\n```sh\n(.*?)\n```", text, re.S)
-    assert m, "README: the tools block and its marker"
+    assert m, "docs/tools.md: the tools block and its marker"
     return m.group(1)
 
 

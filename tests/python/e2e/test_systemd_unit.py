@@ -1,5 +1,5 @@
-"""The shipped systemd unit (issue 12 item 5): it verifies cleanly with systemd-analyze, keeps the
-hardening the README promises, and scores as low exposure in `systemd-analyze security`.
+"""The shipped systemd unit (least privilege): it verifies cleanly with systemd-analyze, keeps the
+hardening docs/deployment.md promises, and scores as low exposure in `systemd-analyze security`.
 
 GIVEN tools/systemd/stridefixd.service with ExecStart pointed at the built binary (verify checks that
 the command exists), WHEN systemd-analyze reads it, THEN it reports nothing about the file.
@@ -18,7 +18,7 @@ UNIT = Path(__file__).resolve().parents[3] / "tools" / "systemd" / "stridefixd.s
 INSTALLED_BINARY = "/usr/local/bin/stridefixd"
 MAX_EXPOSURE = 2.0  # systemd's scale: 0 safest .. 10; "OK" is below 4
 
-# The hardening the README's service section promises: key -> value.
+# The hardening docs/deployment.md's service section promises: key -> value.
 REQUIRED = {
     "DynamicUser": "yes",
     "StateDirectory": "stridefixd",

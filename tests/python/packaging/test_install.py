@@ -1,4 +1,4 @@
-"""`cmake --install` (issue 17 item 6): what a logger and a user of the core library get.
+"""`cmake --install` : what a logger and a user of the core library get.
 
 GIVEN the test build (STRIDEFIXD's build directory) installed into a scratch prefix P, THEN P holds the
 daemon, the core library with its public headers and pkg-config file, the DBC, the LCM definitions and

@@ -1,4 +1,4 @@
-"""Regression (issue 12): `stridefix import gsd` of an empty, random or UTF-16 file said "1/1
+"""Regression: `stridefix import gsd` of an empty, random or UTF-16 file said "1/1
 imported", wrote an empty log and exited 0; `import msindoor` of a header-only file the same.
 
 GIVEN a file without one valid sensor record, WHEN it is imported, THEN a NothingValidError names the

@@ -191,7 +191,7 @@ def test_real_trace(real_trace, tmp_path):
 
 
 def test_default_wifi_age_limit_is_2_s(tmp_path):
-    # issue 5: an entry last seen more than ~2 s before its scan is cached and dropped (was 3 s)
+    # an entry last seen more than ~2 s before its scan is a cached result: dropped
     assert msindoor.DATASET.defaults.max_wifi_age_s == 2.0
     path = tmp_path / "ages.txt"
     path.write_text(

@@ -1,4 +1,4 @@
-"""`stridefix -q` and `-v` before a long-running command (issue 17 item 6): -q leaves only warnings and
+"""`stridefix -q` and `-v` before a long-running command: -q leaves only warnings and
 errors on stderr, and no verbosity changes a result.
 
 GIVEN the handmade msindoor trace (four malformed lines), WHEN `stridefix [-q|-v] import msindoor` runs,

@@ -182,7 +182,7 @@ def test_fold_on_a_multi_floor_site_replays_once(synthetic_walks, tmp_path):
     )  # fmt: skip
     # WHEN the fold runs
     out = rfold.run_fold(job)
-    # THEN the firmware replays the walk once, deciding its start floor itself (issue 11: no first
+    # THEN the firmware replays the walk once, deciding its start floor itself (no first
     # pass feeding init.floor), and the fold record has no such field
     assert out["fold"]["n_floors"] == 2
     assert len(fw.calls) == 1 and not any(s.startswith("init.floor") for s in fw.calls[0])

@@ -1,4 +1,4 @@
-"""End to end, the campus2 walk through the real firmware (issue 14): GIVEN ``stridefix sim --scenario
+"""End to end, the campus2 walk through the real firmware (the multi-scheme controller's SIL campus): GIVEN ``stridefix sim --scenario
 campus2`` (seed 1), WHEN stridefixd replays its candump with the true start pose, THEN every IMU sample,
 GNSS fix, BLE advertisement window and landmark read the simulator sent is in the LCM log without a
 decode error, the step count is within 3 % of the truth, the PDR pose's barometric floor follows the

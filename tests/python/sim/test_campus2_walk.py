@@ -1,4 +1,4 @@
-"""The campus2 walk and survey (issue 14): GIVEN the built-in ``campus2`` scenario, THEN the walk crosses
+"""The campus2 walk and survey (the multi-scheme controller's SIL campus): GIVEN the built-in ``campus2`` scenario, THEN the walk crosses
 no wall, its truth visits outdoor → A floor 0 → 1 → 2 → 0 → outdoor → B floor 0 in that order, the
 summary's transitions are exactly the truth's outline and floor changes (door: the crossing sample;
 stairs: the end of the last flight, after the floor changed on the landing; elevator: the end of the

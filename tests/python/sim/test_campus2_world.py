@@ -1,4 +1,4 @@
-"""The campus2 world (issue 14: the multi-scheme controller's SIL campus): its geometry is consistent
+"""The campus2 world (the multi-scheme controller's SIL campus): its geometry is consistent
 — doors in their outline's exterior wall, the staircase and the elevator inside A, Wi-Fi only in A
 (every floor), BLE only in B, an outdoor path of 50-80 m outside both footprints — and its building
 description carries the context map (outlines, per-building wall floors, port extras and links)."""

@@ -1,4 +1,4 @@
-"""The sources beyond Wi-Fi (issue 13): BLE path loss, the GNSS error process, landmark events at the
+"""The sources beyond Wi-Fi: BLE path loss, the GNSS error process, landmark events at the
 doors, their CAN frames, and the campus world's route (walls, outdoor stretch)."""
 
 from __future__ import annotations
