@@ -263,7 +263,7 @@
  * to a data set; realbench tunes them (the lead's). SF_PARTICLE_MAX is the compile-time capacity. */
 #define SF_PARTICLE_MAX 2048
 #define SF_PARAMS_PARTICLE(X)                                                                          \
-    X(particle, count,             int32_t, 1000,    1,       SF_PARTICLE_MAX, "",  "particles in the cloud (issue 13: about 1 000; at most SF_PARTICLE_MAX; the board allocates this many)") \
+    X(particle, count,             int32_t, 1000,    1,       SF_PARTICLE_MAX, "",  "particles in the cloud (about 1 000 within the per-step cost budget; at most SF_PARTICLE_MAX; the board allocates this many)") \
     X(particle, seed,              int32_t, 1,       0,       2147483647, "",      "seed of the cloud's generator (PCG32): the same seed gives a bit-identical replay") \
     X(particle, length_sigma,      double,  0.08,    0.0,     1.0,     "",      "step-length noise per step, relative (Weinberg's model scatters 5-10 % step to step)") \
     X(particle, heading_sigma_rad, double,  0.05,    0.0,     1.0,     "rad",   "walking-direction noise per step (a few degrees of body sway and gyro noise per step)") \

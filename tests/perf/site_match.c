@@ -1,5 +1,5 @@
 /* site_match.c — the Wi-Fi matcher on a real site file, for the scikit-learn peer on a real floor
- * (the cost budget; analyzer/stridefix_analyzer/bench/perf_peers.py, measure_knn_peer_real).
+ * (the cost budget; lab/stridefix_lab/bench/perf_peers.py, measure_knn_peer_real).
  *
  *   site_match SITE QUERIES DUMP [full]
  *
