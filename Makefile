@@ -86,7 +86,6 @@ IPIN2023 ?= ../shared/data/ipin2023
 bench: build
 	@status=0; \
 	$(LAB) bench all --stridefixd $(STRIDEFIXD) --out out/bench || status=1; \
-	$(PY) -m stridefix_native_reference --n 5000 --out out/bench/native_solver.json || status=1; \
 	if [ -d "$(MSINDOOR)" ]; then \
 		$(LAB) crowd experiment --msindoor $(MSINDOOR) --check-targets \
 			--stridefixd $(STRIDEFIXD) --out out/bench/crowd || status=1; \

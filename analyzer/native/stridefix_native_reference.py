@@ -7,11 +7,9 @@ Same problem as ``analyzer/native/sf_coord_solver.h``: unknown 2-D points p_i (m
 * cost ``1/2 sum |anchor r|^2 + 1/2 sum rho(range r^2)``, rho = none | huber | cauchy on range rows only,
 
 the same default start and the same Jacobian convention at ``|p_I - p_J| = 0`` (p_J east of p_I), solved by
-``scipy.optimize.least_squares(method="trf")``. It exists to cross-check the Ceres solver and to time it;
-it is not meant to be fast. Also here: a synthetic walk problem (:func:`make_problem`) and
-:func:`benchmark` (Ceres vs scipy on the same problem), runnable as::
-
-    python -m stridefix_native_reference --n 5000 --seed 0 [--tol 1e-6] [--out out/bench/native_solver.json]
+``scipy.optimize.least_squares(method="trf")``. It exists to cross-check the Ceres solver and to time it
+(``stridefix-lab bench native-solver``); it is not meant to be fast. Also here: a synthetic walk
+problem (:func:`make_problem`).
 
 Built into ``build/analyzer/native/`` beside ``stridefix_native`` (CMake copies it), so one path entry
 imports both. Reference: Kannan (2024), MSc thesis, Tampere University, section 4.
@@ -19,9 +17,6 @@ imports both. Reference: Kannan (2024), MSc thesis, Tampere University, section 
 
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 import time
 
 import numpy as np
@@ -240,82 +235,3 @@ def make_problem(
         "ranges_m": ranges_m,
         "xy_gt": xy_gt,
     }
-
-
-def benchmark(n=5000, seed=0, tol=1e-6, max_iterations=1000):
-    """Ceres (stridefix_native) vs scipy (this module, sparse Jacobian, LSMR) on the same
-    :func:`make_problem` walk (anchors every 4th point), same start (the default one), same tolerances
-    (``tol`` for function, gradient and parameter). Times are wall seconds around each call (the problem
-    is built beforehand). Returns a dict of numbers: ``max_diff_m`` is the largest coordinate difference
-    between the two solutions, ``*_rmse_m`` the error against the truth.
-
-    On a walk the minimum is flat (a free point's cross-track position on a straight stretch is only
-    second-order observable), so both solvers crawl near the end and may stop metres apart at nearly
-    equal cost; compare ``ceres_cost`` with ``scipy_cost`` as well as ``max_diff_m``."""
-    import stridefix_native  # the built module; see analyzer/native/CMakeLists.txt
-
-    pb = make_problem(n=n, seed=seed)
-    xy_gt = pb.pop("xy_gt")
-    tols = {
-        "function_tolerance": tol,
-        "gradient_tolerance": tol,
-        "parameter_tolerance": tol,
-        "max_iterations": max_iterations,
-    }
-    t0 = time.perf_counter()
-    ceres = stridefix_native.solve_coordinates(**pb, **tols)
-    t_ceres = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    ref = solve_coordinates_ref(**pb, use_sparse=True, **tols)
-    t_scipy = time.perf_counter() - t0
-
-    def rmse(xy):
-        return float(np.sqrt(np.mean(np.sum((xy - xy_gt) ** 2, axis=1))))
-
-    return {
-        "n_points": n,
-        "seed": seed,
-        "n_anchors": int(pb["anchors_idx"].size),
-        "n_pairs": int(pb["ranges_m"].size),
-        "ceres_s": t_ceres,
-        "scipy_s": t_scipy,
-        "speedup": t_scipy / t_ceres,
-        "ceres_iterations": ceres["iterations"],
-        "scipy_iterations": ref["iterations"],
-        "ceres_converged": ceres["converged"],
-        "scipy_converged": ref["converged"],
-        "initial_cost": ceres["initial_cost"],
-        "ceres_cost": ceres["cost"],
-        "scipy_cost": ref["cost"],
-        "max_diff_m": float(np.max(np.abs(ceres["xy"] - ref["xy"]))),
-        "ceres_rmse_m": rmse(ceres["xy"]),
-        "scipy_rmse_m": rmse(ref["xy"]),
-        "init_rmse_m": rmse(default_init(n, pb["anchors_idx"], pb["anchors_xy"])),
-    }
-
-
-def main(argv=None):
-    ap = argparse.ArgumentParser(
-        prog="python -m stridefix_native_reference",
-        description="Time the Ceres coordinate solver against scipy least_squares.",
-    )
-    ap.add_argument("--n", type=int, default=5000, help="points in the synthetic walk (default 5000)")
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--tol", type=float, default=1e-6, help="function/gradient/parameter tolerance")
-    ap.add_argument("--max-iterations", type=int, default=1000)
-    ap.add_argument("--out", help="also write the result as JSON to this file")
-    args = ap.parse_args(argv)
-    result = benchmark(n=args.n, seed=args.seed, tol=args.tol, max_iterations=args.max_iterations)
-    text = json.dumps(result, indent=2)
-    print(text)
-    if args.out:
-        import pathlib
-
-        path = pathlib.Path(args.out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text + "\n")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
