@@ -4,7 +4,7 @@ Three levels: :data:`QUIET` (``-q``: nothing but errors), :data:`NORMAL` (a line
 updating progress bar per phase on a terminal) and :data:`VERBOSE` (``-v``: also a line per step of a
 phase, with its note, elapsed time and ETA). The level is process-wide: :func:`stridefix_analyzer.cli.main`
 sets it once from the global options, before the sub-command runs; worker processes never print.
-Results (stdout, files) never depend on it.
+Files never depend on it; a command's tables on stdout go through :func:`show`, which ``-q`` silences.
 """
 
 from __future__ import annotations
@@ -37,6 +37,12 @@ def say(msg: str, stream: TextIO | None = None) -> None:
     """A phase's line on stderr (or ``stream``), unless quiet."""
     if _level >= NORMAL:
         print(msg, file=stream or sys.stderr, flush=True)
+
+
+def show(text: str) -> None:
+    """A result table or line on stdout, unless quiet (``-q``: nothing but errors)."""
+    if _level >= NORMAL:
+        print(text, flush=True)
 
 
 def _is_tty(stream: TextIO) -> bool:

@@ -33,7 +33,9 @@ Poses: a log of today has each fusion scheme's poses on ``POSE_<SCHEME>`` and th
 log from before the split has every scheme's poses on ``POSE``. Both read into one ``POSE`` table,
 the same rows either way: in a file with a ``POSE_<SCHEME>`` channel, the ``POSE`` messages of a
 fusion scheme are copies of that scheme's own and are left out (``decode`` of any pose channel
-decodes them all). ``LogData.messages`` counts each channel under its own name.
+decodes them all). ``LogData.messages`` counts each channel under its own name, and
+``LogData.pose_channel_scheme`` keeps which scheme the POSE channel carried last, copies included:
+the firmware's primary (:mod:`stridefix_analyzer.scoring.primary`).
 
 Reading: an intact file (one unbroken chain of records) is indexed with numpy (:mod:`.lcmindex`),
 only the channels asked for are decoded, and the fixed-layout ones all at once (:mod:`.lcmdecode`);
@@ -161,6 +163,10 @@ class LogData:
         ``version`` and ``dbc_sha256`` from ``CONFIG``.
     warnings : list of str
         Human-readable notes (truncation, decode errors, config conflicts).
+    pose_channel_scheme : int or None
+        The scheme (pose_t.SCHEME_*) of the last message on the ``POSE`` channel itself, by ``t_us``,
+        in a file that also has ``POSE_<SCHEME>`` channels: the primary pose the firmware chose
+        (module docstring); None without such a file (an older log carries every scheme on POSE).
     """
 
     inputs: list[dict[str, Any]] = dataclasses.field(default_factory=list)
@@ -173,6 +179,7 @@ class LogData:
     config: dict[str, str] = dataclasses.field(default_factory=dict)
     versions: dict[str, str] = dataclasses.field(default_factory=dict)
     warnings: list[str] = dataclasses.field(default_factory=list)
+    pose_channel_scheme: int | None = None
 
     def table(self, channel: str) -> Table | None:
         """The channel's Table, or None when the logs had no decodable message on it."""
@@ -328,6 +335,15 @@ class _Collector:
                 copy[rows] = pose["scheme"][rows] != _SCHEME_CONTROLLER
         return copy
 
+    def pose_channel_scheme(self, pose: Table) -> int | None:
+        """The scheme of the latest message on the POSE channel of a file with per-scheme channels."""
+        rows = [r for f in self.pose_files if f.per_scheme for r in f.primary_rows]
+        if not rows:
+            return None
+        at = np.asarray(rows, dtype=np.int64)
+        last = at[np.argsort(pose["t_us"][at], kind="stable")[-1]]  # equal times: the later row
+        return int(pose["scheme"][last])
+
     def finish(self) -> LogData:
         d = self.data
         for channel in _TABLES:
@@ -336,6 +352,7 @@ class _Collector:
                 continue
             table = Table(columns)
             if channel == POSE:
+                d.pose_channel_scheme = self.pose_channel_scheme(table)
                 table = table.rows(~self.copies(table))
             if channel == "WIFI":
                 # sort scans by time and renumber the AP rows' scan_row to match

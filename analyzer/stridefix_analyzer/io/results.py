@@ -1,18 +1,14 @@
 """The result files of the analyzer, typed: realbench's ``results.json`` and analyze's ``metrics.json``.
 
-Every result file says what it is in its first key, ``kind`` (the convention of the crowd models
-file, ``stridefix.crowd.models/v1``): :data:`REALBENCH_RESULTS_KIND` (``realbench [fusion]``,
-:class:`RealbenchResults`), :data:`CROWD_MAP_RESULTS_KIND` (``realbench crowd-map``,
-:class:`CrowdMapResults`: the fusion file's frame, but groups that pair a truth-built and a
-crowd-built map instead of listing schemes) and :data:`ANALYZE_METRICS_KIND` (``analyze``'s
-metrics.json, also per walk in realbench's work folders: :class:`AnalyzeMetrics`).
-
-TypedDicts, so a document read is the JSON object itself; non-finite numbers are ``null`` in the
-files (:func:`~stridefix_analyzer.io.jsonio.json_ready`), hence ``float | None``; blobs shaped by
-other modules (fold constants, site content, ISO/IEC 18305 terms, HEALTH, CONFIG) stay dicts.
-Writers stamp the kind (``write_*``); readers (``read_*``, :func:`read_any_results` for any of the
-three) refuse another kind with a :class:`ResultsFileError` naming the file, its kind and the one
-expected, and read a file without ``kind`` (written before the kinds) as v1 of the kind its shape says.
+Every result file says what it is in its first key, ``kind``: :data:`REALBENCH_RESULTS_KIND`
+(``realbench [fusion]``, :class:`RealbenchResults`), :data:`CROWD_MAP_RESULTS_KIND` (``realbench
+crowd-map``, :class:`CrowdMapResults`: groups pair a truth-built and a crowd-built map) and
+:data:`ANALYZE_METRICS_KIND` (``analyze``'s metrics.json, :class:`AnalyzeMetrics`; its ``walk``:
+:mod:`.results_walk`). TypedDicts: a document read is the JSON object itself; non-finite numbers are
+``null``, hence ``float | None``; blobs shaped by other modules stay dicts. Writers stamp the kind
+(``write_*``); readers (``read_*``, :func:`read_any_results`) refuse another kind with a
+:class:`ResultsFileError` naming the file, its kind and the one expected, and read a file without
+``kind`` as v1 of the kind its shape says.
 """
 
 from __future__ import annotations
@@ -24,6 +20,7 @@ from collections.abc import Mapping
 from typing import Any, NotRequired, TypedDict, cast
 
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.io.results_walk import WALK_REQUIRED, WalkMetrics
 
 #: the ``kind`` of realbench fusion's results.json, of realbench crowd-map's, of analyze's metrics.json
 REALBENCH_RESULTS_KIND = "stridefix.realbench.results/v1"
@@ -326,12 +323,16 @@ class SchemeMetrics(TypedDict):  # one POSE scheme scored against TRUTH (``per_s
 
 class AnalyzeMetrics(TypedDict):
     """``stridefix analyze``'s metrics.json (:mod:`stridefix_analyzer.scoring.analyze`): the primary
-    scheme's numbers at the top level, every scheme's under ``per_scheme``, and what the logs held."""
+    scheme's numbers at the top level, every scheme's under ``per_scheme``, and what the logs held;
+    ``walk`` its truth-less figures (:mod:`.results_walk`)."""
 
     kind: NotRequired[str]  # ANALYZE_METRICS_KIND; absent in files written before it
     label: str | None
     inputs: list[dict[str, Any]]
     primary_scheme: str
+    primary_from: NotRequired[str]  # pose_channel, requested, fallback (scoring.primary)
+    truth: NotRequired[bool]  # false: no TRUTH; then the keys up to per_scheme are absent
+    walk: NotRequired[WalkMetrics]
     position_error_m: PositionErrorStats
     unscored: int
     n_truth: int
@@ -435,7 +436,8 @@ def _checked(path: str | os.PathLike[str], doc: dict[str, Any], expected: str) -
         got = "no 'kind' and not the shape of a result file" if kind is None else got
         what = f" ({_WHAT[kind]})" if kind in _WHAT else ""
         raise ResultsFileError(f"{name}: {got}{what}; expected {expected!r} ({_WHAT[expected]})")
-    missing = [k for k in _REQUIRED[expected] if k not in doc]
+    required = WALK_REQUIRED if doc.get("truth") is False else _REQUIRED[expected]  # truth-less analyze
+    missing = [k for k in required if k not in doc]
     if missing:
         raise ResultsFileError(f"{name}: {_WHAT[expected]} without {', '.join(missing)}")
     return doc
@@ -485,16 +487,13 @@ def read_any_results(path: str | os.PathLike[str]) -> AnyResults:
     return AnyResults(name, kind, metrics=cast(AnalyzeMetrics, doc))
 
 
-#: the start modes of a realbench walk row and group: every scheme from its first fix, and (with
-#: ``--true-start``) truth-initialised
+#: the start modes of a walk row and group: every scheme from its first fix, truth-initialised
 START_MODES = ("fixes", "true_start")
 
 
 def walk_scores(row: WalkRow, start: str) -> dict[str, WalkScore]:
     """A walk row's scores per scheme in start mode ``start`` (:data:`START_MODES`); {} when that
     mode did not run (or the walk failed)."""
-    if start == "fixes":
-        return row.get("fixes", {})
-    if start == "true_start":
-        return row.get("true_start", {})
+    if start in START_MODES:
+        return cast(dict[str, WalkScore], row.get(start, {}))
     raise ValueError(f"start mode {start!r} not one of {START_MODES}")

@@ -8,10 +8,12 @@ HEALTH counters and CONTEXT, and the truth track when the log carries TRUTH. :me
 JSON-ready document the page draws; ``version`` grows with every message so a client asks only
 for what changed. POSE of any scheme goes to that scheme's track, whether it came on ``POSE`` or on
 a per-scheme ``POSE_<SCHEME>`` channel; once a per-scheme channel is seen, ``POSE`` feeds no fusion
-scheme's track (it carries copies then, which the analyzer leaves out too). The primary pose: the ``POSE`` channel's latest once
-per-scheme channels are seen (POSE then carries the primary only), else the latest of the scheme
-first in the analyzer's preference (:func:`~stridefix_analyzer.scoring.metrics.preference_rank`:
-the tie-break of its primary choice; a live view cannot count messages still to come).
+scheme's track (it carries copies then, which the analyzer leaves out too). The primary pose is the
+one the firmware chose, as in ``analyze`` (:mod:`stridefix_analyzer.scoring.primary`): the ``POSE``
+channel's latest once per-scheme channels are seen (POSE then carries the primary only); in a log
+that carries every scheme on POSE, the latest of the scheme first in the analyzer's fallback order
+(:func:`~stridefix_analyzer.scoring.primary.fallback_rank`; a live view cannot count messages still
+to come).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from stridefix import pose_t
 from stridefix_analyzer.io.channels import POSE, POSE_CHANNELS
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_colour, scheme_name
 from stridefix_analyzer.scoring.fixsources import method_name, reason_name
-from stridefix_analyzer.scoring.metrics import preference_rank
+from stridefix_analyzer.scoring.primary import fallback_rank
 
 TRACK_EVERY_S = 0.5
 TRACK_MAX = 4000
@@ -140,7 +142,7 @@ class LiveState:
         if channel != POSE:
             return
         name = self._scheme_name(code)
-        if self.per_scheme_channels or preference_rank(name) <= preference_rank(
+        if self.per_scheme_channels or fallback_rank(name) <= fallback_rank(
             self.primary["scheme"] if self.primary else ""
         ):
             self.primary = {**p, "scheme": name}

@@ -1,5 +1,12 @@
 """``stridefix analyze``: read LCM logs, score POSE against TRUTH, write metrics.json + analysis.npz.
 
+Without TRUTH (a field recording) the walk is described instead of scored: metrics.json then has
+``"truth": false``, the primary scheme and ``walk`` (:mod:`stridefix_analyzer.scoring.walk`: steps,
+floors, barometric height, claimed σ, the fixes' innovation consistency, HEALTH growth) and none
+of the error keys below; with TRUTH it has ``"truth": true`` and ``walk`` besides them. The primary
+scheme is the one the firmware published on POSE (:mod:`stridefix_analyzer.scoring.primary`,
+``primary_from`` says how it was chosen), ``--scheme`` overrides it.
+
 Outputs in ``--out DIR`` (default ``out/analyze``):
 
 - ``metrics.json``: the summary (see :meth:`stridefix_analyzer.metrics.Metrics.summary`; per scheme
@@ -17,8 +24,9 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
 Exit status (:mod:`stridefix_common.exits`): 0 success; 1 nothing could be scored (every truth
-sample precedes the first POSE); 2 missing or unreadable input, or no TRUTH / no POSE in the logs;
-3 nothing valid in them (not an LCM log, or neither TRUTH nor POSE in any).
+sample precedes the first POSE); 2 missing or unreadable input, or no POSE in the logs;
+3 nothing valid in them (not an LCM log, or neither TRUTH nor POSE in any). The tables on stdout
+follow the console verbosity (``stridefix -q analyze``: errors only).
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from typing import Any
 import numpy as np
 from stridefix_common.exits import input_error_status
 
+from stridefix_analyzer import console
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,
@@ -41,8 +50,8 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.io.results import write_analyze_metrics
-from stridefix_analyzer.schemes import NAMES
-from stridefix_analyzer.scoring import floor_height, iso18305
+from stridefix_analyzer.schemes import NAMES, scheme_name
+from stridefix_analyzer.scoring import floor_height, iso18305, walk_report
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
 from stridefix_analyzer.scoring.floor_height import FloorHeightError, FloorHeights
@@ -50,26 +59,32 @@ from stridefix_analyzer.scoring.metrics import (
     IPIN_FLOOR_PENALTY_M,
     Metrics,
     MetricsInputError,
+    NothingToScoreError,
+    choose_primary,
     run_metrics,
     scheme_code,
 )
+from stridefix_analyzer.scoring.walk import Walk, run_walk
 
 DEFAULT_OUT = os.path.join("out", "analyze")
 METRICS_FILE = "metrics.json"
 SERIES_FILE = "analysis.npz"
 
 # channels the analysis needs decoded; the rest (IMU, MAG, ...) are only counted, which is faster
-_DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG", "CONTEXT")
+_DECODE = ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG", "CONTEXT", "BARO")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Declare the ``analyze`` sub-command and its options."""
     p = subparsers.add_parser(
         "analyze",
-        help="score POSE against TRUTH in LCM logs; write metrics.json and analysis.npz",
+        help="score POSE against TRUTH in LCM logs (or, without TRUTH, describe the walk); write "
+        "metrics.json and analysis.npz",
         description="Read one or more LCM event logs (e.g. the firmware's log and the simulator's "
         "truth log), score every POSE scheme against TRUTH with the causal protocol of "
-        "DESIGN.md, and write DIR/metrics.json and DIR/analysis.npz.",
+        "DESIGN.md, and write DIR/metrics.json and DIR/analysis.npz. Without TRUTH (a field "
+        "recording) the walk is described instead: steps, floors, barometric height, the sigma the "
+        "estimator claims, every fix's verdict and the consistency of its innovation, HEALTH.",
     )
     p.add_argument("logs", nargs="+", metavar="LOG", help="LCM event log(s); events of all logs are merged")
     p.add_argument(
@@ -83,7 +98,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         default=None,
         metavar="NAME",
         help="pose scheme reported at the top level when POSE holds several "
-        f"({', '.join(NAMES)} or a number; default: the one with most POSE messages)",
+        f"({', '.join(NAMES)} or a number; default: the one the firmware published on the POSE "
+        "channel)",
     )
     p.add_argument(
         "--truth-source",
@@ -117,8 +133,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "--site",
         default=None,
         metavar="FILE",
-        help="site file whose floor-height table gives each floor its height: the vertical "
-        "ISO/IEC 18305 terms and the TUM z (default: the log's CONFIG floor.height_m, uniform)",
+        help="site file whose floor-height table gives each floor its height (the vertical "
+        "ISO/IEC 18305 terms and the TUM z; default: the log's CONFIG floor.height_m, uniform) and "
+        "whose walls the report draws under the tracks",
     )
     p.add_argument(
         "--all-channels",
@@ -129,10 +146,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> dict:
-    """The metrics.json document for ``data`` scored as ``metrics`` (JSON-ready)."""
+def build_summary(data: LogData, metrics: Metrics | None, walk: Walk, label: str | None = None) -> dict:
+    """The metrics.json document for ``data`` scored as ``metrics`` (None: no TRUTH) and described as
+    ``walk`` (JSON-ready)."""
     doc: dict[str, Any] = {"label": label, "inputs": data.inputs}
-    doc.update(metrics.summary())
+    if metrics is not None:
+        doc.update(metrics.summary())
+    else:
+        doc.update(primary_scheme=scheme_name(walk.primary), primary_from=walk.primary_from)
+    doc.update(truth=metrics is not None, walk=walk.summary)
     doc.update(
         messages=dict(sorted(data.messages.items())),
         unknown_channels=data.unknown_channels,
@@ -152,14 +174,19 @@ def _end_us(data: LogData) -> int | None:
     return int(pose["t_us"][-1]) if pose is not None and len(pose) else None
 
 
-def write_outputs(out_dir: str, summary: dict, metrics: Metrics, site: Any = None) -> tuple[str, str]:
-    """Write metrics.json and analysis.npz into ``out_dir``; return their paths. With a ``site``
-    (site_t) the npz also holds its walls (``site_wall_*``: the report's floor plans)."""
+def write_outputs(
+    out_dir: str, summary: dict, metrics: Metrics | None, walk: Walk, site: Any = None
+) -> tuple[str, str]:
+    """Write metrics.json and analysis.npz into ``out_dir``; return their paths. The npz holds the
+    walk's series and, with TRUTH, the scored ones (:meth:`Metrics.series`); with a ``site``
+    (site_t) also its walls (``site_wall_*``: the report's floor plans)."""
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, METRICS_FILE)
     npz_path = os.path.join(out_dir, SERIES_FILE)
     write_analyze_metrics(json_path, summary)
-    series: dict[str, Any] = metrics.series()
+    series: dict[str, Any] = walk.series()
+    if metrics is not None:
+        series.update(metrics.series())
     if site is not None:
         for col in ("x0_m", "y0_m", "x1_m", "y1_m"):
             series[f"site_wall_{col}"] = np.asarray(getattr(site, f"wall_{col}"), np.float64)
@@ -219,7 +246,7 @@ def run_analyze(
     site: str | None = None,
     heights: FloorHeights | None = None,
 ) -> tuple[dict, Metrics]:
-    """Read ``logs``, score them and write the outputs; return (summary, metrics).
+    """Read ``logs``, score them against their TRUTH and write the outputs; return (summary, metrics).
 
     Floor heights (vertical ISO/IEC 18305 terms, TUM z): ``heights`` when given, else those of
     :func:`stridefix_analyzer.scoring.floor_height.resolve` (``site``'s table, else the CONFIG's).
@@ -233,35 +260,74 @@ def run_analyze(
     FloorHeightError
         The site or the CONFIG's floor.height_m is unusable.
     """
+    summary, metrics = analyze_logs(
+        logs, out_dir, scheme, all_channels, label, truth_source, site, heights, True
+    )
+    assert metrics is not None  # need_truth: raised otherwise
+    return summary, metrics
+
+
+def analyze_logs(
+    logs: list[str],
+    out_dir: str = DEFAULT_OUT,
+    scheme: str | None = None,
+    all_channels: bool = False,
+    label: str | None = None,
+    truth_source: str | None = None,
+    site: str | None = None,
+    heights: FloorHeights | None = None,
+    need_truth: bool = False,
+) -> tuple[dict, Metrics | None]:
+    """:func:`run_analyze`, and without TRUTH (unless ``need_truth``) the truth-less description
+    alone: (summary, None)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)  # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
     code = scheme_code(scheme) if scheme is not None else None
     site_obj = floor_height.read_site_for_scoring(site) if site is not None else None
-    if heights is None:
-        heights = floor_height.resolve(data.config, site_obj, str(site))
-    metrics = run_metrics(data, scheme=code, truth_source=truth_source, heights=heights)
-    summary = build_summary(data, metrics, label)
-    write_outputs(out_dir, summary, metrics, site_obj)
+    truth = data.table("TRUTH")
+    metrics = None
+    if need_truth or truth_source is not None or (truth is not None and len(truth)):
+        if heights is None:
+            heights = floor_height.resolve(data.config, site_obj, str(site))
+        metrics = run_metrics(data, scheme=code, truth_source=truth_source, heights=heights)
+        walk = run_walk(data, metrics.primary, metrics.primary_from)
+    else:
+        pose = data.table("POSE")
+        if pose is None or not len(pose):
+            inputs = ", ".join(i["path"] for i in data.inputs) or "the input"
+            raise NothingToScoreError(f"no TRUTH and no POSE messages in {inputs}")
+        walk = run_walk(data, *choose_primary(data, code))
+    summary = build_summary(data, metrics, walk, label)
+    write_outputs(out_dir, summary, metrics, walk, site_obj)
     return summary, metrics
 
 
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
-        summary, metrics = run_analyze(
+        summary, metrics = analyze_logs(
             args.logs, args.out, args.scheme, args.all_channels, args.label, args.truth_source, args.site
         )
     except (LogReadError, MetricsInputError, FloorHeightError) as exc:
         print(f"stridefix analyze: error: {exc}", file=sys.stderr)
         return input_error_status(exc)
+    show = console.show
     for note in summary["warnings"]:
-        print(f"stridefix analyze: warning: {note}", file=sys.stderr)
-    print(format_summary(summary))
-    print(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
-    print(format_fix_sources(summary["fix_sources"]))
-    print(format_context_line(summary.get("context")))
-    print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
+        console.say(f"stridefix analyze: warning: {note}")
+    if metrics is None:
+        show(walk_report.format_walk(summary))
+    else:
+        show(format_summary(summary))
+        show(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
+    show(format_fix_sources(summary["fix_sources"]))
+    show(format_context_line(summary.get("context")))
+    show(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
+    if metrics is None:
+        if getattr(args, "tum", None) or getattr(args, "csv", None):
+            print("stridefix analyze: error: --tum and --csv need TRUTH in the logs", file=sys.stderr)
+            return 2
+        return 0
     if getattr(args, "tum", None):
         from stridefix_analyzer.io.tum import TumError, write_tum
 
@@ -271,12 +337,12 @@ def run(args: argparse.Namespace) -> int:
             print(f"stridefix analyze: error: {exc}", file=sys.stderr)
             return 2
         z_source = metrics.heights.source if metrics.heights is not None else "0"
-        print(f"wrote {len(paths)} TUM trajectories into {args.tum} (z: {z_source})")
+        show(f"wrote {len(paths)} TUM trajectories into {args.tum} (z: {z_source})")
     if getattr(args, "csv", None):
         from stridefix_analyzer.io.pose_csv import write_csv
 
         paths = write_csv(metrics, args.csv)
-        print(f"wrote {len(paths)} CSV files into {args.csv}")
+        show(f"wrote {len(paths)} CSV files into {args.csv}")
     if summary["position_error_m"]["n"] == 0:
         print(
             "stridefix analyze: error: no truth sample could be scored (all precede the first "

@@ -58,6 +58,11 @@ def load_run(path: str) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
                 }
     elif run.metrics is not None:
         m = run.metrics
+        if m.get("truth") is False:
+            raise CompareInputError(
+                f"{path}: an analyze metrics.json of a walk without truth has no position errors to "
+                "compare; analyze the walk with its TRUTH log"
+            )
         walks[("walk", str(m.get("label") or os.path.basename(os.path.dirname(os.path.abspath(path)))))] = {
             name: {
                 **{k: _num(e.get(k)) for k in METRICS if k in e},

@@ -11,7 +11,7 @@ distance walked along the truth, and the final error.
 
 When a log holds POSE messages of several schemes (``pose_t.scheme``), each is scored on its own
 and reported under its name; one of them is the *primary* scheme whose numbers are repeated at the
-top level of the summary (see :func:`choose_primary`).
+top level of the summary: the scheme the firmware published on ``POSE`` (:mod:`.primary`).
 
 No plotting here: :mod:`stridefix_analyzer.plots` draws what this module computes.
 """
@@ -29,12 +29,7 @@ from stridefix_analyzer.io.logread import LogData, Table
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_name
 from stridefix_analyzer.scoring import iso18305
 from stridefix_analyzer.scoring.floor_height import FloorHeights
-
-#: preference when several schemes have equally many POSE messages (first wins); ``controller`` (the
-#: multi-scheme controller's pose, pose_t.SCHEME_CONTROLLER) is the product's primary pose and wins
-#: whenever it is present, whatever its count (it has none before the controller's first context)
-PRIMARY_PREFERENCE = ["controller", "adaptive", "kalman", "static", "overwrite", "wifi_only", "pdr_only"]
-_ALWAYS_PRIMARY = "controller"
+from stridefix_analyzer.scoring.primary import FALLBACK, PrimaryError, choose_scheme
 
 #: percentiles reported, in percent
 PERCENTILES = (50, 75, 90, 95)
@@ -328,36 +323,16 @@ def score_scheme(
     return SchemeScore(code=int(code), name=scheme_name(code), summary=summary, match=m, pose=pose)
 
 
-def preference_rank(name: str) -> int:
-    """A scheme's place in :data:`PRIMARY_PREFERENCE` (lower is preferred; a scheme not listed comes
-    after every listed one)."""
-    return PRIMARY_PREFERENCE.index(name) if name in PRIMARY_PREFERENCE else len(PRIMARY_PREFERENCE)
-
-
-def choose_primary(pose: Table, requested: int | None = None) -> int:
-    """The scheme whose numbers go at the top level.
-
-    ``requested`` if given (it must occur in the log); else ``controller`` when the log has its
-    POSE (the controller's pose is the product's primary pose); else the scheme with most POSE
-    messages, ties broken in the order adaptive, kalman, static, overwrite, wifi_only, pdr_only, then
-    any other scheme in id order (a scheme new to ``pose_t.lcm`` needs no row here).
-    """
-    codes, counts = np.unique(pose["scheme"], return_counts=True)
-    if requested is not None:
-        if requested not in codes:
-            raise MetricsInputError(
-                f"scheme {scheme_name(requested)} not in the POSE stream; present: "
-                f"{[scheme_name(c) for c in codes]}"
-            )
-        return int(requested)
-    names = [scheme_name(c) for c in codes]
-    if _ALWAYS_PRIMARY in names:
-        return int(codes[names.index(_ALWAYS_PRIMARY)])
-
-    def rank(i: int):
-        return (-counts[i], preference_rank(scheme_name(codes[i])), int(codes[i]))
-
-    return int(codes[min(range(len(codes)), key=rank)])
+def choose_primary(data: LogData, requested: int | None = None) -> tuple[int, str]:
+    """(the primary scheme, how it was chosen): :func:`stridefix_analyzer.scoring.primary.choose_scheme`
+    on the log's POSE table and the scheme its POSE channel carried. Raises :class:`MetricsInputError`."""
+    pose = data.table("POSE")
+    if pose is None or not len(pose):
+        raise MetricsInputError("no POSE messages: no primary scheme")
+    try:
+        return choose_scheme(pose["scheme"], requested, data.pose_channel_scheme)
+    except PrimaryError as exc:
+        raise MetricsInputError(str(exc)) from None
 
 
 @dataclasses.dataclass
@@ -383,12 +358,14 @@ class Metrics:
     truth: Table
     distance_walked_m: float
     heights: FloorHeights | None = None
+    primary_from: str = FALLBACK
 
     def summary(self) -> dict:
         """JSON-ready dict: the primary scheme's numbers at the top level plus ``per_scheme``."""
         top = self.schemes[self.primary].summary
         return {
             "primary_scheme": scheme_name(self.primary),
+            "primary_from": self.primary_from,
             "position_error_m": top["position_error_m"],
             "unscored": top["unscored"],
             "n_truth": len(self.truth),
@@ -484,9 +461,9 @@ def run_metrics(
     steps = data.table("STEP")
     n_steps = len(steps) if steps is not None else 0
     distance = distance_walked_m(truth)
-    primary = choose_primary(pose, scheme)
+    chosen, chosen_from = choose_primary(data, scheme)
     schemes = {}
     for code in np.unique(pose["scheme"]):
         rows = pose.rows(pose["scheme"] == code)  # stays sorted by time
         schemes[int(code)] = score_scheme(rows, truth, n_steps, distance, int(code), heights)
-    return Metrics(primary=primary, schemes=schemes, truth=truth, distance_walked_m=distance, heights=heights)
+    return Metrics(chosen, schemes, truth, distance, heights, chosen_from)

@@ -3,8 +3,10 @@
 Reads ``DIR/metrics.json`` and ``DIR/analysis.npz`` (written by ``stridefix analyze``) and writes
 ``report.html`` (default ``DIR/report.html``) with inline CSS and the figures of
 :mod:`stridefix_analyzer.plots` embedded as base64 PNG data URIs, so the file can be mailed or
-archived alone. Exit status: 0 written; 2 the directory or one of its two files is missing or
-unreadable.
+archived alone. An analysis without TRUTH (metrics.json ``"truth": false``) gets the walk's
+sections instead of the error ones (:mod:`stridefix_analyzer.scoring.walk_report`); with TRUTH the
+walk's sections follow the error ones. Exit status: 0 written; 2 the directory or one of its two
+files is missing or unreadable.
 """
 
 from __future__ import annotations
@@ -18,13 +20,14 @@ import sys
 import numpy as np
 
 from stridefix_analyzer.io.results import AnalyzeMetrics, ResultsFileError, read_analyze_metrics
-from stridefix_analyzer.scoring import plots
+from stridefix_analyzer.scoring import plots, walk_plots
 from stridefix_analyzer.scoring.analyze import METRICS_FILE, SERIES_FILE
 from stridefix_analyzer.scoring.config_table import config_html
 from stridefix_analyzer.scoring.context import context_html
 from stridefix_analyzer.scoring.fixsources import fix_sources_html
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
 from stridefix_analyzer.scoring.style import CSS
+from stridefix_analyzer.scoring.walk_report import walk_sections
 
 
 class ReportInputError(Exception):
@@ -58,12 +61,13 @@ def load_analysis(directory: str) -> tuple[AnalyzeMetrics, dict]:
             series = {k: z[k] for k in z.files}
     except (OSError, ValueError) as exc:
         raise ReportInputError(f"{npz_path}: cannot read as .npz ({exc})") from exc
+    truth = summary.get("truth", True)
     need = [
         k
         for k in ("truth_t_us", "truth_x_m", "truth_y_m", "scheme_codes", "primary_scheme")
-        if k not in series
+        if k not in series and (truth or not k.startswith("truth_"))
     ]
-    for key in ("per_scheme", "primary_scheme", "position_error_m"):
+    for key in ("per_scheme", "primary_scheme", "position_error_m") if truth else ("primary_scheme", "walk"):
         if key not in summary:
             need.append(f"{METRICS_FILE}:{key}")
     if need:
@@ -185,15 +189,18 @@ def _iso_overview(t: dict | None) -> str | None:
 
 def render_html(summary: AnalyzeMetrics, series: dict, title: str = "StrideFix walk report") -> str:
     """The complete report page for one analysis, as an HTML string."""
+    truth = summary.get("truth", True)
+    body = _truth_sections(summary, series) if truth else []
+    if "walk" in summary:
+        names = tuple(walk_plots.FIGURES)[1:] if truth else tuple(walk_plots.FIGURES)
+        body += walk_sections(summary, series, walk_plots.render_walk(series, names), truth)
+    return _page(summary, title, body, truth)
+
+
+def _truth_sections(summary: AnalyzeMetrics, series: dict) -> list[str]:
+    """The scored sections: overview, errors by scheme, ISO/IEC 18305, their figures, steps."""
     figs = plots.render_all(series)
     e = summary["position_error_m"]
-    inputs = summary.get("inputs", [])
-    input_rows = "".join(
-        f"<tr><td class='k'>{html.escape(str(i.get('path')))}</td><td>{_cell(i.get('bytes'))}</td>"
-        f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td>"
-        f"<td>{_cell(i.get('skipped_bytes'))}</td></tr>"
-        for i in inputs
-    )
     overview = [
         ("primary scheme", summary["primary_scheme"]),
         ("truth samples scored / unscored", f"{e.get('n')} / {summary.get('unscored')}"),
@@ -211,25 +218,13 @@ def render_html(summary: AnalyzeMetrics, series: dict, title: str = "StrideFix w
         ),
         ("floors in truth", ", ".join(str(f) for f in summary.get("floors_in_truth", []))),
     ]
-    health = summary.get("health") or {}
-    config = summary.get("config") or {}
-    params = config.get("params") or {}
-    version_rows = [(k, v) for k, v in config.items() if k != "params"]
-    warnings_html = "".join(f"<li class='warn'>{html.escape(w)}</li>" for w in summary.get("warnings", []))
-    messages = summary.get("messages", {})
-    extra_counts = [("unknown channel " + k, v) for k, v in summary.get("unknown_channels", {}).items()] + [
-        ("decode errors on " + k, v) for k, v in summary.get("decode_errors", {}).items()
-    ]
-    parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
-        f"<h1>{html.escape(title)}</h1>",
+    return [
         "<p class='note'>Error at each truth time = horizontal distance to the latest POSE at or "
         "before it (causal; nothing looks ahead). Percentiles: numpy linear interpolation. "
         f"IPIN score (the IPIN competition's metric): p75 of 2-D error + {IPIN_FLOOR_PENALTY_M:g} m "
         "× |floor error|, by Matlab's quantile as the organisers compute it.</p>",
         _kv_table(overview, ("summary", "")),
-        f"<ul>{warnings_html}</ul>" if warnings_html else "",
+        _warnings_html(summary),
         "<h2>Position error by scheme</h2>",
         _scheme_table(summary),
         "<h2>ISO/IEC 18305 terms by scheme</h2>",
@@ -245,6 +240,44 @@ def render_html(summary: AnalyzeMetrics, series: dict, title: str = "StrideFix w
         _img(figs["error_cdf"], "error CDF"),
         "<h2>Steps</h2>",
         _steps_table(summary),
+    ]
+
+
+def _warnings_html(summary: AnalyzeMetrics) -> str:
+    items = "".join(f"<li class='warn'>{html.escape(w)}</li>" for w in summary.get("warnings", []))
+    return f"<ul>{items}</ul>" if items else ""
+
+
+def _page(summary: AnalyzeMetrics, title: str, body: list[str], truth: bool) -> str:
+    """The page around ``body``: title, (without truth: a note and the warnings), then fix sources,
+    context, HEALTH, messages, inputs and configuration."""
+    inputs = summary.get("inputs", [])
+    input_rows = "".join(
+        f"<tr><td class='k'>{html.escape(str(i.get('path')))}</td><td>{_cell(i.get('bytes'))}</td>"
+        f"<td>{_cell(i.get('events'))}</td><td>{_cell(i.get('truncated_bytes'))}</td>"
+        f"<td>{_cell(i.get('skipped_bytes'))}</td></tr>"
+        for i in inputs
+    )
+    health = summary.get("health") or {}
+    config = summary.get("config") or {}
+    params = config.get("params") or {}
+    version_rows = [(k, v) for k, v in config.items() if k != "params"]
+    messages = summary.get("messages", {})
+    extra_counts = [("unknown channel " + k, v) for k, v in summary.get("unknown_channels", {}).items()] + [
+        ("decode errors on " + k, v) for k, v in summary.get("decode_errors", {}).items()
+    ]
+    no_truth = [
+        "<p class='note'>No TRUTH in the logs: nothing here is an error against ground truth. The "
+        "figures are what the firmware's own log says: its tracks, floors, steps, the σ it claims and "
+        "how its fixes' innovations agree with that claim.</p>",
+        _warnings_html(summary),
+    ]
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{html.escape(title)}</title><style>{CSS}</style></head><body>",
+        f"<h1>{html.escape(title)}</h1>",
+        *([] if truth else no_truth),
+        *body,
         "<h2>Fix sources</h2>",
         "<p class='note'>FIX records per scheme and source (every scheme judges every fix): offered, "
         "accepted, rejected and why.</p>",

@@ -79,12 +79,20 @@ def test_new_log_reads_as_the_old_one(write_log, msg, controller, indexed):
     assert new.messages["POSE_EKF"] == new.messages["POSE_PDR_ONLY"] == 10
     assert new.messages["POSE"] == 10 and old.messages["POSE"] == len(want)
     assert new.unknown_channels == {} and new.warnings == []
-    # and scoring sees the same: the same schemes, primary and numbers
+    # the primary: the new log says which scheme its POSE channel carried (the controller's pose,
+    # else ekf's copy); the old one does not, and falls back to the controller, else equal counts
+    # and pdr_only before ekf in the fallback order
+    primary = CONTROLLER if controller else EKF
+    assert new.pose_channel_scheme == primary and old.pose_channel_scheme is None
     m_old, m_new = run_metrics(old), run_metrics(new)
-    # (without the controller: equal counts, and pdr_only before ekf in the preference order)
-    assert m_new.primary == m_old.primary == (CONTROLLER if controller else PDR)
+    assert (m_new.primary, m_new.primary_from) == (primary, "pose_channel")
+    assert (m_old.primary, m_old.primary_from) == (CONTROLLER if controller else PDR, "fallback")
+    # and scoring sees the same: the same schemes and, with the same primary, the same numbers
+    m_old = run_metrics(old, scheme=primary)
+    s_old, s_new = m_old.summary(), m_new.summary()
+    assert s_old.pop("primary_from") == "requested" and s_new.pop("primary_from") == "pose_channel"
     # (as text: NaN, the heading error without truth headings, is not equal to itself)
-    assert json.dumps(m_new.summary(), sort_keys=True) == json.dumps(m_old.summary(), sort_keys=True)
+    assert json.dumps(s_new, sort_keys=True) == json.dumps(s_old, sort_keys=True)
     series_old, series_new = m_old.series(), m_new.series()
     assert sorted(series_new) == sorted(series_old)
     for key, values in series_old.items():

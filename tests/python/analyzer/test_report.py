@@ -11,7 +11,17 @@ def test_report_embeds_png_images(walk_logs, tmp_path, cli_main):
     assert cli_main(["report", str(out)]) == 0
     page = (out / "report.html").read_text()
     images = re.findall(r"data:image/png;base64,([A-Za-z0-9+/=]+)", page)
-    assert len(images) == 4  # trajectory per floor, floor over time, error over time, error CDF
+    # the error figures: trajectory per floor, floor over time, error over time, error CDF; then the
+    # walk's that the log has data for: floor and barometric height, claimed σ, HEALTH (no STEP, no FIX)
+    alts = re.findall(r"<img alt='([^']*)'", page)
+    assert alts[:4] == [
+        "trajectory, one panel per floor",
+        "estimated vs true floor over time",
+        "error over time, one panel per scheme",
+        "error CDF",
+    ]
+    assert alts[4:] == ["floor and barometric height over time", "claimed sigma over time"]
+    assert len(images) == len(alts) == 6
     for img in images:
         assert base64.b64decode(img).startswith(b"\x89PNG\r\n\x1a\n")
     for text in ("adaptive", "pdr_only", "frames_total", "fusion.mode", "<style>"):
