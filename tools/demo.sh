@@ -3,10 +3,11 @@
 #   1. survey: the simulator surveys the office (both floors) -> candump -> stridefixd -> LCM log
 #      -> `stridefix radiomap build` -> out/demo/site.sfsite (floors, map rotation, radio map)
 #   2. walk: the default two-floor tour -> candump -> stridefixd --site -> LCM log with every fusion
-#      scheme side by side (POSE per scheme, FIX audit records) -> analyzer -> metrics.json + report.html
+#      scheme side by side (POSE per scheme, FIX audit records) -> analyzer -> metrics.json + report.html,
+#      headlining the scheme stridefixd published on POSE (its primary pose)
 #   3. true start: the same walk replayed once more with every scheme truth-initialised (the simulator's
 #      init_truth.ini, init.use_config_pose=1) -> out/demo/true_start/ (metrics.json, report.html): the
-#      row to read there is pdr_only, PDR alone from the true start
+#      row to read there is pdr_only, PDR alone from the true start (--scheme pdr_only headlines it)
 # The survey is its own recording (seed 1000); the walk never trains its own map. In step 2 every scheme
 # starts at its first Wi-Fi fix (pdr_only too): nothing there is truth-initialised.
 set -euo pipefail
@@ -25,7 +26,7 @@ step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcm
 step sim        "$venv/bin/stridefix" sim --out "$out"
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
 step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" --site "$out/site.sfsite" \
-                --scheme kalman --label "default SIL walk, office radio map, every scheme from its first fix"
+                --label "default SIL walk, office radio map, every scheme from its first fix"
 step report     "$venv/bin/stridefix" report "$out"
 echo "demo: the same walk, every scheme TRUTH-INITIALISED (read pdr_only: PDR alone from the true start)"
 mkdir -p "$out/true_start"

@@ -165,6 +165,10 @@ def plot_fixes(series: dict):
     return fig
 
 
+#: HEALTH panels at most (the table lists every counter that grew)
+MAX_HEALTH_PANELS = 18
+
+
 def plot_health(series: dict):
     """Each HEALTH counter that grew, against time since the first pose (small multiples)."""
     names = [
@@ -172,21 +176,22 @@ def plot_health(series: dict):
     ]
     if not names:
         return None
-    names = names[:12]
+    shown = names[:MAX_HEALTH_PANELS]
     cols = 3
     rows = -(-len(names) // cols)
     fig, axes = plt.subplots(
         rows, cols, figsize=(10, 1.8 * rows + 0.6), squeeze=False, sharex=True, layout="constrained"
     )
     t = _s(series, "walk_health_t_us")
-    for k, name in enumerate(names):
+    for k, name in enumerate(shown):
         ax = axes[k // cols][k % cols]
         ax.step(t, series[f"walk_health_{name}"], where="post", color="#246")
         ax.set_title(name, fontsize="small")
         ax.grid(True, **style.GRID)
-    for k in range(len(names), rows * cols):
+    for k in range(len(shown), rows * cols):
         axes[k // cols][k % cols].set_visible(False)
-    fig.suptitle("HEALTH counters that grew (time since the first pose [s])")
+    more = f", the first {len(shown)} of {len(names)} (all in the table)" if len(shown) < len(names) else ""
+    fig.suptitle(f"HEALTH counters that grew (time since the first pose [s]){more}")
     return fig
 
 

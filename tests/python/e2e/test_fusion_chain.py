@@ -276,3 +276,32 @@ def test_fast_reader_reads_the_log_as_lcm_eventlog_does(walk, assert_reads_alike
     assert len(data.tables["FIX"]) > 10 * len(SCHEMES) and len(set(data.tables["FIX"]["reason_text"])) > 1
     assert_reads_alike(logs, ("POSE", "TRUTH", "STEP", "FIX", "HEALTH", "CONFIG", "CONTEXT"))
     assert_reads_alike([walk["log"]], ("FIX",))
+
+
+def test_the_walk_without_truth_headlines_the_pose_channels_scheme(walk, cli, tmp_path):
+    """stridefixd's log alone (no TRUTH, as in the field): analyze describes the walk with finite
+    numbers and headlines the scheme the POSE channel carried (controller.init_scheme's, kalman);
+    with the truth log beside it the same scheme is primary; the report draws the walk."""
+    carried = [pose_t.decode(e.data).scheme for e in walk["events"] if e.channel == "POSE"]
+    pose_scheme = pose_t.SCHEME_KALMAN
+    assert carried[-1] == pose_scheme
+    proc = cli("analyze", str(walk["log"]), "--out", str(tmp_path / "walk"))
+    assert proc.returncode == 0, proc.stderr
+    m = read_analyze_metrics(tmp_path / "walk" / "metrics.json")
+    assert m["truth"] is False and (m["primary_scheme"], m["primary_from"]) == ("kalman", "pose_channel")
+    w = m["walk"]
+    assert w["steps"]["count"] > 50 and 80 < w["steps"]["cadence_spm"] < 140
+    assert w["duration_s"] > 30 and w["floors_visited"]
+    kalman = w["per_scheme"]["kalman"]
+    assert kalman["fixes"]["judged"] > 5 and 0.0 < kalman["fixes"]["nis_mean"] < 100.0
+    assert 0.0 <= kalman["fixes"]["within_chi2_95_rate"] <= 1.0
+    assert 0.0 < kalman["sigma_m"]["median"] < 50.0 and np.isfinite(kalman["track_length_m"])
+    assert set(w["per_scheme"]) == set(m["fix_sources"])  # every scheme judged the fixes
+    assert cli("report", str(tmp_path / "walk")).returncode == 0
+    page = (tmp_path / "walk" / "report.html").read_text()
+    for heading in ("The walk (no ground truth)", "Claimed σ and innovation consistency by scheme"):
+        assert heading in page
+    assert "Every fix: verdict and innovation (kalman)" in page
+    proc = cli("analyze", str(walk["log"]), str(walk["dir"] / "truth.lcmlog"), "--out", str(tmp_path / "t"))
+    assert proc.returncode == 0, proc.stderr
+    assert read_analyze_metrics(tmp_path / "t" / "metrics.json")["primary_scheme"] == "kalman"
