@@ -322,6 +322,7 @@ class SchemeMetrics(TypedDict):  # one POSE scheme scored against TRUTH (``per_s
     steps: StepCounts
     final_error_m: float | None
     final_error_pct_of_distance: float | None
+    wall_crossings: NotRequired[int]  # the site's walls its POSE track passes through (--site with walls)
 
 
 class AnalyzeMetrics(TypedDict):
@@ -347,6 +348,7 @@ class AnalyzeMetrics(TypedDict):
     final_error_m: float | None
     final_error_pct_of_distance: float | None
     per_scheme: dict[str, SchemeMetrics]
+    truth_wall_crossings: NotRequired[int]  # the same count for the truth (--site with walls)
     messages: dict[str, int]
     unknown_channels: Any
     decode_errors: Any

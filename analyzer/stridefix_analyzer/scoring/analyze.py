@@ -12,7 +12,8 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
   accepted, rejected and rejected by reason; :mod:`stridefix_analyzer.scoring.fixsources`),
   ``context`` when the logs hold CONTEXT (the multi-scheme controller's events, switches by rule,
   time per context, radios-on seconds from the last HEALTH; :mod:`stridefix_analyzer.scoring.context`;
-  null without CONTEXT), and
+  null without CONTEXT), and with a ``--site`` that has walls ``wall_crossings`` per scheme and
+  ``truth_wall_crossings`` (:mod:`stridefix_analyzer.scoring.walls`), and
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
@@ -42,7 +43,7 @@ from stridefix_analyzer.io.logread import (
 )
 from stridefix_analyzer.io.results import write_analyze_metrics
 from stridefix_analyzer.schemes import NAMES
-from stridefix_analyzer.scoring import floor_height, iso18305
+from stridefix_analyzer.scoring import floor_height, iso18305, walls
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
 from stridefix_analyzer.scoring.floor_height import FloorHeightError, FloorHeights
@@ -146,6 +147,18 @@ def build_summary(data: LogData, metrics: Metrics, label: str | None = None) -> 
     return json_ready(doc)
 
 
+def add_wall_crossings(summary: dict, metrics: Metrics, plan: np.ndarray) -> None:
+    """``wall_crossings`` per scheme (its POSE track) and ``truth_wall_crossings`` into ``summary``:
+    the walls of the site each track passes through (:func:`.walls.crossings`; the truth's is 0 on
+    a plan that fits the walk)."""
+    for s in metrics.schemes.values():
+        summary["per_scheme"][s.name]["wall_crossings"] = walls.crossings(
+            s.pose["x_m"], s.pose["y_m"], s.pose["floor"], plan
+        )
+    t = metrics.truth
+    summary["truth_wall_crossings"] = walls.crossings(t["x_m"], t["y_m"], t["floor"], plan)
+
+
 def _end_us(data: LogData) -> int | None:
     """The walk's end for the time per context [µs]: the last POSE (None without one)."""
     pose = data.table("POSE")
@@ -154,16 +167,15 @@ def _end_us(data: LogData) -> int | None:
 
 def write_outputs(out_dir: str, summary: dict, metrics: Metrics, site: Any = None) -> tuple[str, str]:
     """Write metrics.json and analysis.npz into ``out_dir``; return their paths. With a ``site``
-    (site_t) the npz also holds its walls (``site_wall_*``: the report's floor plans)."""
+    (site_t) the npz also holds its walls and ports (``site_wall_*``, ``site_port_*``: the report's
+    floor plans)."""
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, METRICS_FILE)
     npz_path = os.path.join(out_dir, SERIES_FILE)
     write_analyze_metrics(json_path, summary)
     series: dict[str, Any] = metrics.series()
     if site is not None:
-        for col in ("x0_m", "y0_m", "x1_m", "y1_m"):
-            series[f"site_wall_{col}"] = np.asarray(getattr(site, f"wall_{col}"), np.float64)
-        series["site_wall_floor"] = np.asarray(site.wall_floor, np.int64)
+        series.update(walls.plan_series(site))
     np.savez_compressed(npz_path, **series)
     return json_path, npz_path
 
@@ -242,6 +254,8 @@ def run_analyze(
         heights = floor_height.resolve(data.config, site_obj, str(site))
     metrics = run_metrics(data, scheme=code, truth_source=truth_source, heights=heights)
     summary = build_summary(data, metrics, label)
+    if site_obj is not None and site_obj.n_walls:
+        add_wall_crossings(summary, metrics, walls.wall_array(site_obj))
     write_outputs(out_dir, summary, metrics, site_obj)
     return summary, metrics
 
@@ -261,6 +275,11 @@ def run(args: argparse.Namespace) -> int:
     print(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
     print(format_fix_sources(summary["fix_sources"]))
     print(format_context_line(summary.get("context")))
+    if "truth_wall_crossings" in summary:
+        counts = ", ".join(f"{n} {s['wall_crossings']}" for n, s in summary["per_scheme"].items())
+        print(
+            f"wall crossings (the site's walls a track passes through): {counts}; truth {summary['truth_wall_crossings']}"
+        )
     print(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")
     if getattr(args, "tum", None):
         from stridefix_analyzer.io.tum import TumError, write_tum
