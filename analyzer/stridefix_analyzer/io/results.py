@@ -290,8 +290,7 @@ class CrowdMapResults(TypedDict):
 # --- analyze: metrics.json ------------------------------------------------------------------------
 
 
-class PositionErrorStats(ErrorStats):
-    # A scheme's position error statistics [m], and the non-finite errors left out.
+class PositionErrorStats(ErrorStats):  # a scheme's position error [m], and the non-finite errors left out.
     nonfinite: int
 
 
@@ -301,8 +300,7 @@ class HeadingError(TypedDict):  # heading error [deg] at the scored samples.
     mean_abs_deg: float | None
 
 
-class StepCounts(TypedDict):
-    # Steps detected against the truth's (``truth``, ``error`` null without truth steps).
+class StepCounts(TypedDict):  # steps detected against the truth's (``truth``, ``error`` null without them).
     detected: int
     step_messages: int
     truth: int | None
