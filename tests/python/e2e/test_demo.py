@@ -4,7 +4,9 @@ keeps to its walls, and the report draws them.
 Measured on the demo walk (seed 1, 340 m, two floors) when these bounds were set: with the walls the
 particle filter's mean error is 0.71 m (p95 1.69 m) and its track crosses 1 wall; on the same site
 without the building description 0.92 m (p95 2.07 m) and 18 walls. The schemes that do not use walls
-cross 8 (wifi_only) to 31 (pdr_only) and do not change; the truth crosses none.
+cross 8 (wifi_only) to 31 (pdr_only) and do not change; the truth crosses none. The one cost: the
+particle filter's floor hit rate goes 99.4 -> 99.0 % (1.2 s later on floor 1 at the top of the stairs,
+as its particles change floor only inside the site's stairs port, which the bare site lacks).
 """
 
 from __future__ import annotations
