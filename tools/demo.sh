@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The default SIL walk, end to end, timing each step:
 #   1. survey: the simulator surveys the office (both floors) -> candump -> stridefixd -> LCM log
-#      -> `stridefix radiomap build` -> out/demo/site.sfsite (floors, map rotation, radio map)
+#      -> `stridefix radiomap build --building` -> out/demo/site.sfsite (floors, map rotation, radio map, and
+#      the survey's building.toml: walls, stairs and elevator, geo-reference; the survey's world is the walk's)
 #   2. walk: the default two-floor tour -> candump -> stridefixd --site -> LCM log with every fusion
 #      scheme side by side (POSE per scheme, FIX audit records) -> analyzer -> metrics.json + report.html,
 #      headlining the scheme stridefixd published on POSE (its primary pose)
@@ -22,7 +23,8 @@ step survey-fw  "$stridefixd" --input "$out/survey/board.candump" --log "$out/su
 rotation=$("$venv/bin/python" -c 'import json,sys; print(json.load(open(sys.argv[1]))["map_rotation_deg"])' \
            "$out/survey/sim_summary.json")
 step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcmlog" "$out/survey/truth.lcmlog" \
-                --mode survey --name office --map-rotation-deg "$rotation" --out "$out/site.sfsite"
+                --mode survey --name office --map-rotation-deg "$rotation" --building "$out/survey/building.toml" \
+                --out "$out/site.sfsite"
 step sim        "$venv/bin/stridefix" sim --out "$out"
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
 step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" --site "$out/site.sfsite" \

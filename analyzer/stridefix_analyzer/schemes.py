@@ -19,8 +19,13 @@ _COLOURS = {
     "static": "#d62728",
     "adaptive": "#9467bd",
     "kalman": "#8c564b",
+    "ekf": "#e377c2",
+    # not tab10's grey (#7f7f7f): the particle filter's track runs along the floor plan's grey walls
+    "particle": "#17becf",
+    "controller": "#bcbd22",
 }
-_FALLBACK_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
+# a scheme without a row, until it gets one: colours no row above has
+_FALLBACK_COLOURS = ("#7f7f7f", "#393b79", "#637939", "#843c39")
 
 
 class UnknownSchemeError(ValueError):

@@ -287,8 +287,7 @@ class CrowdMapResults(TypedDict):
 # --- analyze: metrics.json ------------------------------------------------------------------------
 
 
-class PositionErrorStats(ErrorStats):
-    # A scheme's position error statistics [m], and the non-finite errors left out.
+class PositionErrorStats(ErrorStats):  # a scheme's position error [m], and the non-finite errors left out.
     nonfinite: int
 
 
@@ -298,8 +297,7 @@ class HeadingError(TypedDict):  # heading error [deg] at the scored samples.
     mean_abs_deg: float | None
 
 
-class StepCounts(TypedDict):
-    # Steps detected against the truth's (``truth``, ``error`` null without truth steps).
+class StepCounts(TypedDict):  # steps detected against the truth's (``truth``, ``error`` null without them).
     detected: int
     step_messages: int
     truth: int | None
@@ -319,6 +317,7 @@ class SchemeMetrics(TypedDict):  # one POSE scheme scored against TRUTH (``per_s
     steps: StepCounts
     final_error_m: float | None
     final_error_pct_of_distance: float | None
+    wall_crossings: NotRequired[int]  # the site's walls its POSE track passes through (--site with walls)
 
 
 class AnalyzeMetrics(TypedDict):
@@ -348,6 +347,7 @@ class AnalyzeMetrics(TypedDict):
     final_error_m: float | None
     final_error_pct_of_distance: float | None
     per_scheme: dict[str, SchemeMetrics]
+    truth_wall_crossings: NotRequired[int]  # the same count for the truth (--site with walls)
     messages: dict[str, int]
     unknown_channels: Any
     decode_errors: Any

@@ -137,27 +137,51 @@ def make_app(state: LiveState, lock: threading.Lock) -> Any:
     return app
 
 
-def walls_of(site_path: str | None) -> list[tuple[float, float, float, float, int]]:
-    """The site's walls [(x0, y0, x1, y1, floor)], none without a site."""
+def plan_of(
+    site_path: str | None,
+) -> tuple[list[tuple[float, float, float, float, int]], list[dict[str, Any]]]:
+    """The site's floor plan: its walls [(x0, y0, x1, y1, floor)] and ports [{kind (building.toml's
+    name), x_m, y_m, radius_m, floor_lo, floor_hi}]; none without a site."""
     if not site_path:
-        return []
+        return [], []
     from stridefix_analyzer.io.sitefile import SiteFileError, read_site
+    from stridefix_analyzer.scoring.walls import PORT_KINDS
 
     try:
         s = read_site(site_path)
     except SiteFileError as exc:
         raise LiveInputError(str(exc)) from exc
-    return [
+    walls = [
         (float(a), float(b), float(c), float(d), int(f))
         for a, b, c, d, f in zip(s.wall_x0_m, s.wall_y0_m, s.wall_x1_m, s.wall_y1_m, s.wall_floor)
     ]
+    ports = [
+        {
+            "kind": PORT_KINDS.get(int(k), f"kind_{int(k)}"),
+            "x_m": float(x),
+            "y_m": float(y),
+            "radius_m": float(r),
+            "floor_lo": int(lo),
+            "floor_hi": int(hi),
+        }
+        for k, x, y, r, lo, hi in zip(
+            s.port_kind, s.port_x_m, s.port_y_m, s.port_radius_m, s.port_floor_lo, s.port_floor_hi
+        )
+    ]
+    return walls, ports
+
+
+def walls_of(site_path: str | None) -> list[tuple[float, float, float, float, int]]:
+    """The site's walls [(x0, y0, x1, y1, floor)], none without a site."""
+    return plan_of(site_path)[0]
 
 
 async def serve(lcm_url: str, site: str | None, host: str, port: int, ready: Any = None) -> None:
     """Run the view until cancelled; ``ready(url)`` is called once it listens."""
     from aiohttp import web
 
-    state, lock = LiveState(walls_of(site), source=lcm_url), threading.Lock()
+    walls, ports = plan_of(site)
+    state, lock = LiveState(walls, source=lcm_url, ports=ports), threading.Lock()
     feed = LcmFeed(lcm_url, state, lock)
     runner = web.AppRunner(make_app(state, lock), access_log=None)
     await runner.setup()
@@ -192,7 +216,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument(
         "--lcm-url", required=True, metavar="URL", help="LCM URL to listen on (udpm://…, file://…)"
     )
-    p.add_argument("--site", metavar="FILE", help="site file whose walls are the floor plan")
+    p.add_argument(
+        "--site",
+        metavar="FILE",
+        help="site file whose walls and ports (doors, stairs, elevators) are the floor plan",
+    )
     p.add_argument(
         "--host", default="127.0.0.1", help="address to serve on (default: 127.0.0.1, this machine only)"
     )

@@ -74,12 +74,17 @@ def _pose_fields(m: Any) -> dict[str, Any]:
 
 
 class LiveState:
-    """The folded view (module docstring); ``walls`` are the site's [(x0, y0, x1, y1, floor)]."""
+    """The folded view (module docstring); ``walls`` are the site's [(x0, y0, x1, y1, floor)],
+    ``ports`` its doors, stairs and elevators [{kind, x_m, y_m, radius_m, floor_lo, floor_hi}]."""
 
     def __init__(
-        self, walls: list[tuple[float, float, float, float, int]] | None = None, source: str = ""
+        self,
+        walls: list[tuple[float, float, float, float, int]] | None = None,
+        source: str = "",
+        ports: list[dict[str, Any]] | None = None,
     ) -> None:
         self.walls = walls or []
+        self.ports = ports or []
         self.source = source
         self.version = 0
         self.messages: collections.Counter[str] = collections.Counter()
@@ -215,6 +220,7 @@ class LiveState:
             "context": self.context,
             "truth": {"track_start": tracks[TRUTH_KEY][0], "track": tracks[TRUTH_KEY][1]},
             "walls": self.walls,
+            "ports": self.ports,
         }
 
 

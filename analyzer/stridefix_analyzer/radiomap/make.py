@@ -23,7 +23,7 @@ from stridefix_common.geodesy import project
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.io.sitefile import SiteFileError, set_counts, write_site
 from stridefix_analyzer.parallel import SchedulerError, WorkerFiles, is_remote, task_runner
-from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT
+from stridefix_analyzer.radiomap.assemble import DEFAULT_FLOOR_HEIGHT_M, DEFAULT_MIN_COUNT, site_summary
 from stridefix_analyzer.radiomap.build import build_site
 from stridefix_analyzer.radiomap.building import BuildingError, merge_building, read_building
 from stridefix_analyzer.radiomap.contexts import ContextMapError, build_context_map
@@ -165,6 +165,9 @@ def make_site(
             from stridefix_analyzer.radiomap.beacons import place_readings
 
             summary["context_map"] = build_context_map(site, building, place_readings(recordings))
+    # the plan line counts what the site file holds: the floor plan's and the description's too
+    plan = site_summary(site)
+    summary.update({k: plan[k] for k in ("n_walls", "n_ports", "n_beacons", "ble_model")})
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     summary["bytes"] = write_site(out, site)
     return site, summary

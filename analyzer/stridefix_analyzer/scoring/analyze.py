@@ -19,7 +19,8 @@ Outputs in ``--out DIR`` (default ``out/analyze``):
   accepted, rejected and rejected by reason; :mod:`stridefix_analyzer.scoring.fixsources`),
   ``context`` when the logs hold CONTEXT (the multi-scheme controller's events, switches by rule,
   time per context, radios-on seconds from the last HEALTH; :mod:`stridefix_analyzer.scoring.context`;
-  null without CONTEXT), and
+  null without CONTEXT), and with a ``--site`` that has walls ``wall_crossings`` per scheme and
+  ``truth_wall_crossings`` (:mod:`stridefix_analyzer.scoring.walls`), and
 - ``analysis.npz``: the per-truth-sample series the report plots
   (see :meth:`stridefix_analyzer.metrics.Metrics.series`).
 
@@ -51,7 +52,7 @@ from stridefix_analyzer.io.logread import (
 )
 from stridefix_analyzer.io.results import write_analyze_metrics
 from stridefix_analyzer.schemes import NAMES, scheme_name
-from stridefix_analyzer.scoring import floor_height, iso18305, walk_report
+from stridefix_analyzer.scoring import floor_height, iso18305, walk_report, walls
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
 from stridefix_analyzer.scoring.floor_height import FloorHeightError, FloorHeights
@@ -168,6 +169,18 @@ def build_summary(data: LogData, metrics: Metrics | None, walk: Walk, label: str
     return json_ready(doc)
 
 
+def add_wall_crossings(summary: dict, metrics: Metrics, plan: np.ndarray) -> None:
+    """``wall_crossings`` per scheme (its POSE track) and ``truth_wall_crossings`` into ``summary``:
+    the walls of the site each track passes through (:func:`.walls.crossings`; the truth's is 0 on
+    a plan that fits the walk)."""
+    for s in metrics.schemes.values():
+        summary["per_scheme"][s.name]["wall_crossings"] = walls.crossings(
+            s.pose["x_m"], s.pose["y_m"], s.pose["floor"], plan
+        )
+    t = metrics.truth
+    summary["truth_wall_crossings"] = walls.crossings(t["x_m"], t["y_m"], t["floor"], plan)
+
+
 def _end_us(data: LogData) -> int | None:
     """The walk's end for the time per context [µs]: the last POSE (None without one)."""
     pose = data.table("POSE")
@@ -179,7 +192,8 @@ def write_outputs(
 ) -> tuple[str, str]:
     """Write metrics.json and analysis.npz into ``out_dir``; return their paths. The npz holds the
     walk's series and, with TRUTH, the scored ones (:meth:`Metrics.series`); with a ``site``
-    (site_t) also its walls (``site_wall_*``: the report's floor plans)."""
+    (site_t) also its walls and ports (``site_wall_*``,
+    ``site_port_*``: the report's floor plans)."""
     os.makedirs(out_dir, exist_ok=True)
     json_path = os.path.join(out_dir, METRICS_FILE)
     npz_path = os.path.join(out_dir, SERIES_FILE)
@@ -188,9 +202,7 @@ def write_outputs(
     if metrics is not None:
         series.update(metrics.series())
     if site is not None:
-        for col in ("x0_m", "y0_m", "x1_m", "y1_m"):
-            series[f"site_wall_{col}"] = np.asarray(getattr(site, f"wall_{col}"), np.float64)
-        series["site_wall_floor"] = np.asarray(site.wall_floor, np.int64)
+        series.update(walls.plan_series(site))
     np.savez_compressed(npz_path, **series)
     return json_path, npz_path
 
@@ -299,6 +311,8 @@ def analyze_logs(
             raise NothingToScoreError(f"no TRUTH and no POSE messages in {inputs}")
         walk = run_walk(data, *choose_primary(data, code))
     summary = build_summary(data, metrics, walk, label)
+    if metrics is not None and site_obj is not None and site_obj.n_walls:
+        add_wall_crossings(summary, metrics, walls.wall_array(site_obj))
     write_outputs(out_dir, summary, metrics, walk, site_obj)
     return summary, metrics
 
@@ -320,6 +334,12 @@ def run(args: argparse.Namespace) -> int:
     else:
         show(format_summary(summary))
         show(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
+        if "truth_wall_crossings" in summary:
+            counts = ", ".join(f"{n} {s['wall_crossings']}" for n, s in summary["per_scheme"].items())
+            show(
+                f"wall crossings (the site's walls a track passes through): {counts}; "
+                f"truth {summary['truth_wall_crossings']}"
+            )
     show(format_fix_sources(summary["fix_sources"]))
     show(format_context_line(summary.get("context")))
     show(f"wrote {os.path.join(args.out, METRICS_FILE)} and {os.path.join(args.out, SERIES_FILE)}")

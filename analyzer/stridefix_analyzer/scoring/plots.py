@@ -14,9 +14,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
+from matplotlib.patches import Circle  # noqa: E402
 
 from stridefix_analyzer.schemes import scheme_colour, scheme_name  # noqa: E402
 from stridefix_analyzer.scoring import style  # noqa: E402
+from stridefix_analyzer.scoring.walls import PORT_KINDS  # noqa: E402
 
 _PERCENTILE_LINES = ((50, "p50", ":"), (75, "p75", "--"), (95, "p95", "-."))
 
@@ -69,15 +71,37 @@ def _walls(ax, series: dict, f: int) -> bool:
     return True
 
 
+def _port_kinds(series: dict) -> list[str]:
+    """The kinds of port the site has (building.toml's names), in :data:`PORT_KINDS` order."""
+    kinds = {int(k) for k in series.get("site_port_kind", [])}
+    return [name for k, name in PORT_KINDS.items() if k in kinds]
+
+
+def _ports(ax, series: dict, f: int) -> None:
+    """Draw the site's ports that join floor ``f``: a marker per kind and the disc a walker passes."""
+    if "site_port_kind" not in series:
+        return
+    lo, hi = np.asarray(series["site_port_floor_lo"]), np.asarray(series["site_port_floor_hi"])
+    for k in np.flatnonzero((lo <= f) & (f <= hi)):
+        name = PORT_KINDS.get(int(series["site_port_kind"][k]))
+        if name is None:
+            continue
+        x, y, r = (float(series[f"site_port_{c}"][k]) for c in ("x_m", "y_m", "radius_m"))
+        ax.plot(x, y, **style.PORT[name])
+        ax.add_patch(Circle((x, y), r, edgecolor=style.PORT[name]["color"], **style.PORT_DISC))
+
+
 def plot_trajectory(series: dict):
     """Truth path and every scheme's POSE track in the map frame, one panel per floor (the samples
-    on that floor; the site's walls under them when the analysis had a site), equal aspect.
+    on that floor; the site's walls and ports (doors, stairs, elevators: a marker each and the disc
+    a walker passes) under them when the analysis had a site), equal aspect.
 
     Parameters
     ----------
     series : dict
         ``truth_x_m``, ``truth_y_m``, ``truth_floor`` (n_truth,); ``scheme_codes``; ``s<c>_pose_x_m``,
-        ``s<c>_pose_y_m``, ``s<c>_pose_floor`` (n_pose,) per scheme code c; optionally ``site_wall_*``.
+        ``s<c>_pose_y_m``, ``s<c>_pose_floor`` (n_pose,) per scheme code c; optionally ``site_wall_*``
+        and ``site_port_*`` (:func:`stridefix_analyzer.scoring.walls.plan_series`).
     """
     floors = _floors(series)
     cols = min(len(floors), 2)
@@ -91,6 +115,7 @@ def plot_trajectory(series: dict):
     for k, f in enumerate(floors):
         ax = axes[k // cols][k % cols]
         walls = _walls(ax, series, f)
+        _ports(ax, series, f)
         ax.plot(*_on_floor(tx, ty, tf, f), **style.TRUTH)
         for code, color in colors.items():
             px, py, pf = (
@@ -114,6 +139,8 @@ def plot_trajectory(series: dict):
         ax.grid(True, **style.GRID)
         if k == 0:
             ax.plot([], [], color="grey", **style.POSE_END, label="end (pose)")
+            for name in _port_kinds(series):  # every kind of the site, whichever floor has it
+                ax.plot([], [], **style.PORT[name], label=name)
             # under the panels, not over the tracks
             fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=6, fontsize="small")
     for k in range(len(floors), rows * cols):

@@ -39,3 +39,10 @@ PRIMARY_LINEWIDTH = 1.8
 PLAN_IMAGE: dict[str, Any] = dict(alpha=0.6, zorder=0)
 WALL: dict[str, Any] = dict(color="#888", linewidth=1.0, zorder=1)
 GRID: dict[str, Any] = dict(alpha=0.3)
+#: a site's ports: a marker at the centre per kind (building.toml's names) and the disc it joins over
+PORT: dict[str, dict[str, Any]] = {
+    "door": dict(marker="D", color="#8c564b", markersize=7, linestyle="none", zorder=4),
+    "stairs": dict(marker="^", color="#7a3db8", markersize=9, linestyle="none", zorder=4),
+    "elevator": dict(marker="h", color="#1f6f8b", markersize=9, linestyle="none", zorder=4),
+}
+PORT_DISC: dict[str, Any] = dict(fill=False, linestyle="--", linewidth=0.8, alpha=0.7, zorder=1)

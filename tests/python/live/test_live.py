@@ -18,7 +18,7 @@ import pytest
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.channels import CHANNELS
 from stridefix_analyzer.io.logread import read_logs
-from stridefix_analyzer.live.server import SUBSCRIBE, walls_of
+from stridefix_analyzer.live.server import SUBSCRIBE, plan_of, walls_of
 from stridefix_analyzer.live.state import LiveState
 from stridefix_analyzer.scoring.fixsources import fix_source_counts
 
@@ -34,6 +34,29 @@ def campus_walk(tmp_path_factory, stridefixd):
     site, _ = sources.build_site(fw, out / "survey")
     fusion.simulate_and_log("campus", 1, fw, out / "walk", site)
     log = out / "walk" / "stridefixd.lcmlog"
+    data = read_logs([log], decode=("POSE", "STEP", "FIX", "HEALTH"))
+    return {"site": site, "log": log, "data": data}
+
+
+@pytest.fixture(scope="module")
+def office_walk(tmp_path_factory, stridefixd, cli):
+    """The demo's office: surveyed (seed 1000) into a site with its building.toml (two floors, 114
+    walls, the stairs and the elevator), then the default walk replayed with it."""
+    out = tmp_path_factory.mktemp("office")
+    sv = out / "survey"
+    assert cli("sim", "--scenario", "office_survey", "--seed", "1000", "--out", str(sv)).returncode == 0
+    fw = Firmware(stridefixd)
+    fw.run(input=sv / "board.candump", log=sv / "fw.lcmlog")
+    rot = json.loads((sv / "sim_summary.json").read_text())["map_rotation_deg"]
+    site = out / "site.sfsite"
+    p = cli(
+        "radiomap", "build", str(sv / "fw.lcmlog"), str(sv / "truth.lcmlog"), "--mode", "survey",
+        "--map-rotation-deg", str(rot), "--building", str(sv / "building.toml"), "--out", str(site),
+    )  # fmt: skip
+    assert p.returncode == 0, p.stderr
+    assert cli("sim", "--out", str(out / "walk")).returncode == 0
+    log = out / "walk" / "stridefixd.lcmlog"
+    fw.run(input=out / "walk" / "board.candump", log=log, site=site)
     data = read_logs([log], decode=("POSE", "STEP", "FIX", "HEALTH"))
     return {"site": site, "log": log, "data": data}
 
@@ -171,6 +194,95 @@ def test_page_in_headless_chromium(campus_walk, tmp_path):
             shot = tmp_path / "live.png"
             page.screenshot(path=str(shot), full_page=True)
             assert shot.read_bytes().startswith(b"\x89PNG") and shot.stat().st_size > 20_000
+            assert errors == []
+            browser.close()
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="Debian's chromium is not installed (tools/deps.sh installs it)")
+@pytest.mark.parametrize(
+    ("walk", "port_kinds", "n_floors"),
+    [("campus_walk", {"door"}, 1), ("office_walk", {"stairs", "elevator"}, 2)],
+)
+def test_page_floor_plan_toggles_zoom_and_axes(request, walk, port_kinds, n_floors):
+    """GIVEN the campus log replayed through `stridefix live --site`, WHEN headless Chromium shows
+    each floor, unchecks a scheme, zooms and pans, THEN the map draws exactly the site's walls and
+    ports of the floor shown, hides that scheme's track alone (the primary pose's stays on), and the
+    scale bar and the axes' ticks follow the zoom (a nice 1-2-5 length, evenly spaced ticks)."""
+    from playwright.sync_api import sync_playwright
+
+    w = request.getfixturevalue(walk)
+    walls, ports = plan_of(str(w["site"]))
+    assert {p["kind"] for p in ports} == port_kinds
+    proc, base = _start_live(f"file://{w['log']}?speed=0", w["site"])
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"], headless=True)
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            errors: list[str] = []
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(base)
+            page.wait_for_function(
+                "document.getElementById('status').textContent === 'log ended'", timeout=60000
+            )
+            page.wait_for_timeout(500)
+            drawn = lambda: page.evaluate("Object.assign({}, document.getElementById('map').dataset)")  # noqa: E731
+            # the floor plan of every floor, one floor button at a time
+            floors = sorted({wall[4] for wall in walls})
+            assert len(floors) == n_floors
+            for f in floors:
+                page.click(f"#floors button[data-floor='{f}']")
+                d = drawn()
+                assert int(d["floor"]) == f
+                assert int(d["walls"]) == sum(1 for wall in walls if wall[4] == f) > 0
+                assert int(d["ports"]) == sum(1 for q in ports if q["floor_lo"] <= f <= q["floor_hi"])
+            # a checkbox hides one scheme's track; the primary pose's cannot be hidden
+            primary = page.inner_text("#primary")
+            tracks = drawn()["tracks"].split(",")
+            assert primary in tracks and len(tracks) == len(_expected(w["data"])["last"])
+            other = next(t for t in tracks if t != primary)
+            page.uncheck(f"#toggles input[data-scheme='{other}']")
+            assert drawn()["tracks"].split(",") == [t for t in tracks if t != other]
+            box = page.locator(f"#toggles input[data-scheme='{primary}']")
+            assert box.is_checked() and box.is_disabled()
+            page.check(f"#toggles input[data-scheme='{other}']")
+            assert drawn()["tracks"].split(",") == tracks
+
+            # zoom: the scale bar's label and the tick spacing follow; fit returns to the start
+            def scale_and_step():
+                d = drawn()
+                xs = [float(v) for v in d["xticks"].split(",")]
+                steps = np.diff(xs)
+                assert len(xs) >= 3 and np.allclose(steps, steps[0])  # evenly spaced, in metres
+                ys = np.diff([float(v) for v in d["yticks"].split(",")])
+                assert np.allclose(ys, steps[0])  # the same step on y: equal scale
+                m = float(d["scaleM"])
+                assert page.inner_text("#scale-label") == f"{m:g} m"
+                assert m / 10 ** np.floor(np.log10(m)) in (1, 2, 5)
+                return m, steps[0]
+
+            m0, step0 = scale_and_step()
+            page.click("#zoom-in")
+            page.click("#zoom-in")
+            m1, step1 = scale_and_step()
+            assert m1 < m0 and step1 < step0
+            page.click("#zoom-fit")
+            assert scale_and_step() == (m0, step0)
+            box = page.locator("#map").bounding_box()
+            page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+            page.mouse.wheel(0, 600)  # wheel down: zoom out
+            page.wait_for_timeout(100)
+            assert scale_and_step()[0] > m0
+            # a drag pans: the ticks move, the scale does not
+            page.click("#zoom-fit")
+            x_before = drawn()["xticks"]
+            page.mouse.move(box["x"] + 300, box["y"] + 300)
+            page.mouse.down()
+            page.mouse.move(box["x"] + 100, box["y"] + 300, steps=5)
+            page.mouse.up()
+            assert drawn()["xticks"] != x_before and scale_and_step()[0] == m0
             assert errors == []
             browser.close()
     finally:
