@@ -329,11 +329,14 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
                 return SF_EXIT_USAGE;
             }
             break;
-        case opt_speed:
-            if (parse_double("--speed", optarg, SF_OPTIONS_SPEED_MIN, SF_OPTIONS_SPEED_MAX, &o->speed) != 0) {
+        case opt_speed: {
+            double speed = 0.0;
+            if (parse_double("--speed", optarg, SF_OPTIONS_SPEED_MIN, SF_OPTIONS_SPEED_MAX, &speed) != 0) {
                 return SF_EXIT_USAGE;
             }
+            sf_pace_init(&o->pace, speed);
             break;
+        }
         case 'q': o->quiet = true; break;
         case opt_max_messages:
             if (parse_long("--max-messages", optarg, 0, LONG_MAX, &o->max_messages) != 0) {
@@ -368,7 +371,7 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         fprintf(stderr, "stridefixd: --input is required (see --help)\n");
         return SF_EXIT_USAGE;
     }
-    if (o->speed > 0.0 && sf_input_spec_is_live(o->input)) {
+    if (sf_pace_on(&o->pace) && sf_input_spec_is_live(o->input)) {
         fprintf(stderr, "stridefixd: --speed: %s is live, already at its own pace (--speed paces a file or stdin)\n",
                 o->input);
         return SF_EXIT_USAGE;

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "sf_channels.h"
+#include "sf_pace.h"
 #include "sf_params.h"
 
 #define SF_OPTIONS_MAX_SETS 64
@@ -53,7 +54,8 @@ typedef struct {
     bool force;      /* --force: an existing log file may be replaced */
     bool allow_root; /* --allow-root: a live input as root */
     uint32_t channels; /* --channels: bit sf_options_channel_<NAME> set = that channel is written */
-    double speed;      /* --speed X: publish at X times the input's pace (sf_pace.h); 0: as fast as possible */
+    sf_pace_t pace;    /* --speed X: the replay published at X times its recorded pace (sf_pace.h); off
+                        * without it (as fast as possible) */
 } sf_options_t;
 
 /* 0 to run, or the exit status (SF_EXIT_USAGE, with a message on stderr). */

@@ -25,7 +25,6 @@
 #include "sf_lcm_out.h"
 #include "sf_log_file.h"
 #include "sf_options.h"
-#include "sf_pace.h"
 #include "sf_params.h"
 #include "sf_privilege.h"
 #include "sf_publish.h"
@@ -65,7 +64,6 @@ typedef struct {
     bool config_written;
     sf_publish_loop_t loop;
     sf_publish_sources_t sources; /* fixes offered and made, by source */
-    sf_pace_t pace; /* --speed */
 } daemon_t;
 
 #define WRITES(d, NAME) SF_OPTIONS_WRITES(&(d)->opt, NAME)
@@ -281,33 +279,6 @@ static double monotonic_us(void)
     return (double)ts.tv_sec * 1e6 + (double)ts.tv_nsec * 1e-3;
 }
 
-static int64_t monotonic_int_us(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000 + ts.tv_nsec / 1000;
-}
-
-/* --speed: sleeps until the item recorded at log_t_us is due (sf_pace.h). False when a stop signal
- * came while waiting (the run then ends as at the end of the input); another signal (SIGHUP's
- * rotation) only wakes the wait, which goes on. */
-static bool wait_until_due(daemon_t *const d, const int64_t log_t_us)
-{
-    const int64_t now_us = monotonic_int_us();
-    const int64_t wait_us = sf_pace_wait_us(&d->pace, log_t_us, now_us);
-    if (wait_us <= 0) {
-        return true;
-    }
-    const int64_t due_us = now_us + wait_us;
-    const struct timespec due = {.tv_sec = (time_t)(due_us / 1000000), .tv_nsec = (long)(due_us % 1000000) * 1000};
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, NULL) == EINTR) {
-        if (sf_signals_stop_requested() != 0) {
-            return false;
-        }
-    }
-    return true;
-}
-
 /* One input item: CONFIG before the first, the sample fed, HEALTH every output.health_period_ms of
  * board time, and the loop timing (of one item in loop.stride: sf_publish.h). */
 static void handle(daemon_t *const d, const sf_input_item_t *const item)
@@ -357,10 +328,9 @@ static int run(daemon_t *const d)
             complain(d, rc);
             continue;
         }
-        if (!wait_until_due(d, d->item.log_t_us)) {
-            break;
+        if (sf_pace_sleep(&d->opt.pace, d->item.log_t_us, sf_signals_stop_requested) == SF_OK) {
+            handle(d, &d->item); /* when due (--speed); not after a stop signal: the loop ends at its top */
         }
-        handle(d, &d->item);
     }
     sf_signals_input_done();
     write_config(d);
@@ -378,9 +348,7 @@ static int open_output(daemon_t *const d, char *const err, const size_t err_size
                                /* Replaying a file: wait for the disk rather than drop. Live SocketCAN: never wait. */
                                .block_when_full = !sf_input_is_live(d->in),
                                /* DEVIATION: STYLE's "queue -> writer thread": a regular file's reads never
-                                * wait, and the hand-off cost a replay more than it saved (sf_lcm_out.h).
-                                * A paced replay (--speed) too: its HEALTH log counters then count the
-                                * same batches as an unpaced one's, so the two logs are the same. */
+                                * wait, and the hand-off cost a replay more than it saved (sf_lcm_out.h). */
                                .caller_writes = sf_input_is_regular_file(d->in),
                                .force = d->opt.force,
                                .fsync_interval_ms = d->params.output_fsync_interval_ms,
@@ -445,7 +413,6 @@ static int serve(daemon_t *const d)
         return SF_EXIT_USAGE;
     }
     sf_input_configure(d->in, &d->params);
-    sf_pace_init(&d->pace, d->opt.speed);
     if (open_output(d, err, sizeof err) != SF_OK) {
         fprintf(stderr, "stridefixd: %s\n", err);
         return 1;

@@ -11,8 +11,10 @@
  *
  * Only *when* an item is handled depends on this, never what is computed: the estimator sees the same
  * items in the same order, and the log's event timestamps are the input's, so a log written with and
- * without --speed is the same. The arithmetic here is pure (no clock, no sleep): the caller reads its
- * clock and sleeps (firmware/app/stridefixd.c). Cost: O(1) per item, no heap. */
+ * without --speed is the same (a file replay writes its log from the reading thread either way:
+ * sf_lcm_out.h caller_writes, so even HEALTH's log counters agree). sf_pace_wait_us is the arithmetic,
+ * pure (no clock: the test drives it with its own); sf_pace_sleep reads CLOCK_MONOTONIC and sleeps.
+ * Cost: O(1) per item, no heap. */
 #ifndef SF_PACE_H
 #define SF_PACE_H
 
@@ -43,5 +45,11 @@ bool sf_pace_on(const sf_pace_t *pace);
  * item whose input time went backwards (a new origin) and for one that is already due; at most
  * SF_PACE_WAIT_MAX_US. Cannot fail. */
 int64_t sf_pace_wait_us(sf_pace_t *pace, int64_t input_t_us, int64_t now_wall_us);
+
+/* Sleeps (CLOCK_MONOTONIC) until the item recorded at input_t_us is due: SF_OK once it is (at once
+ * when pacing is off), or SF_EINTR when a signal woke the sleep and stop_requested() (non-zero: the
+ * run ends) says so; any other signal (SIGHUP's rotation) only wakes it, and it sleeps on to the same
+ * instant. */
+int sf_pace_sleep(sf_pace_t *pace, int64_t input_t_us, int (*stop_requested)(void));
 
 #endif

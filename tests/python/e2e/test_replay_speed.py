@@ -10,6 +10,7 @@ the main loop's measured time per item, which differ between any two runs.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import time
 from pathlib import Path
@@ -79,6 +80,47 @@ def test_speed_paces_the_replay_and_keeps_the_log(stridefixd, walk, tmp_path, so
     assert span / SPEED <= t_paced < span / SPEED + t_fast + 1.0
     assert t_fast < 0.5 * span / SPEED
     assert _assert_same_log(fast, paced) > 10000
+
+
+def test_signals_while_paced(stridefixd, walk, tmp_path):
+    """SIGHUP while a paced replay waits rotates the log and loses no item: the files, CONFIG copies
+    aside, hold the unpaced log's events; SIGTERM ends the wait at once, as at the end of the input."""
+    fast = tmp_path / "fast.lcmlog"
+    _replay(stridefixd, fast, "--input", str(walk / "board.candump"))
+    paced = tmp_path / "paced.lcmlog"
+    cmd = [
+        str(stridefixd),
+        "--input",
+        str(walk / "board.candump"),
+        "--log",
+        str(paced),
+        "-q",
+        "--speed",
+        "30",
+    ]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    for _ in range(2):
+        time.sleep(0.6)
+        proc.send_signal(signal.SIGHUP)
+    assert proc.wait(timeout=30) == 0, proc.stderr.read() if proc.stderr else ""
+    files = [paced, tmp_path / "paced.001.lcmlog", tmp_path / "paced.002.lcmlog"]
+    assert sorted(tmp_path.glob("paced*")) == sorted(files)
+    got: list[tuple[str, int, bytes]] = []
+    for i, f in enumerate(files):
+        events = [(e.channel, e.timestamp, e.data) for e in lcm.EventLog(str(f), "r")]
+        got += [e for e in events[1 if i else 0 :] if e[0] != "HEALTH"]  # a rotated file opens with CONFIG
+    want = [(e.channel, e.timestamp, e.data) for e in lcm.EventLog(str(fast), "r") if e.channel != "HEALTH"]
+    assert got == want and len(want) > 10000
+
+    slow = tmp_path / "slow.lcmlog"
+    cmd = [str(stridefixd), "--input", str(walk / "board.candump"), "--log", str(slow), "-q", "--speed", "1"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=10) == 0
+    assert time.monotonic() - t0 < 1.0
+    assert slow.is_file() and _span_s(slow) < 5.0  # about the one second it ran, not the walk
 
 
 @pytest.mark.parametrize(
