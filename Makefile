@@ -11,7 +11,7 @@ LAB := $(PY) -m stridefix_lab.cli
 DEMO_OUT ?= out/demo
 STRIDEFIXD := $(BUILD)/firmware/stridefixd
 
-.PHONY: all deps build install test test-c test-python lint demo bench clean help change-indication \
+.PHONY: all deps build install wheel test test-c test-python lint demo bench clean help change-indication \
 	gates check-static check-clang check-asan reliability soak check-fuzz fuzz check-arm spy
 
 all: build
@@ -28,6 +28,7 @@ help:
 	@echo "make deps   - install Debian packages and the Python venv ($(VENV)) if missing"
 	@echo "make build  - CMake build into $(BUILD)/"
 	@echo "make install PREFIX=P - cmake --install $(BUILD) into P (default $(PREFIX)): stridefixd, unit, man page, configs, core library"
+	@echo "make wheel  - dist/stridefix-<version>-*.whl: the Python product with the LCM types, board.dbc and the native solver (no lab)"
 	@echo "make gates  - the C/C++ quality gates below, one after the other"
 	@echo "make check-static - cppcheck on firmware/ (suppressions: tools/cppcheck.supp); fails on a finding"
 	@echo "make check-clang  - the whole tree with clang/clang++ (warnings are errors) into build-clang/, ctest"
@@ -52,6 +53,10 @@ build: deps
 PREFIX ?= /usr/local
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)
+
+# The product wheel, with what $(BUILD) generated for Python (setup.py; docs/deployment.md "The Python product").
+wheel: build
+	@PY=$(PY) tools/wheel.sh $(BUILD) dist
 
 # Everything CI checks: the C and Python tests, the Python lint/type gates and the C/C++ gates.
 test: build

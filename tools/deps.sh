@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs what StrideFix needs and is missing; safe to run again (make deps).
 #  1. Debian packages (apt-get update first, only when something is missing).
-#  2. A project virtualenv in .venv with the pinned requirements.txt and StrideFix itself (editable),
-#     re-installed only when requirements.txt or pyproject.toml changed.
-#  3. A .pth file so the venv imports what the build generates (development; an installed logger gets the
-#     LCM types from `cmake --install`, docs/deployment.md "Install on a logger"): the LCM Python bindings and the native
-#     solver module (stridefix_native, with its scipy reference beside it).
+#  2. A project virtualenv in .venv with the pinned requirements.txt, StrideFix itself and the lab
+#     (lab/pyproject.toml: `stridefix-lab`, not in the product wheel), both editable, re-installed only
+#     when requirements.txt or a pyproject.toml changed.
+#  3. A .pth file so the venv imports what the build generates (development; the product wheel of
+#     `make wheel` carries them, and so does `cmake --install`, docs/deployment.md "Install on a logger"): the LCM
+#     Python bindings and the native solver module (stridefix_native, with its scipy reference beside it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${VENV:-.venv}
@@ -61,11 +62,13 @@ if [ ! -x "$VENV/bin/python" ]; then
   python3 -m venv "$VENV"
 fi
 stamp="$VENV/.stridefix-deps"
-want=$(cat requirements.txt pyproject.toml VERSION | sha256sum | cut -d' ' -f1)
+want=$(cat requirements.txt pyproject.toml lab/pyproject.toml VERSION | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "deps: installing Python packages into $VENV"
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt
   "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+  # after the product: a venv whose product install still held stridefix-lab gives the script up first
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e lab
   echo "$want" > "$stamp"
 fi
 site=$("$VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,7 +39,11 @@ static void usage(FILE *const f)
             "  -i, --input SPEC       board frames: a candump -L file, '-' for stdin, or socketcan:IFACE\n"
             "                         (SocketCAN needs a kernel with AF_CAN), or lcmlog:FILE, a raw-sensor\n"
             "                         LCM log (IMU MAG BARO WIFI GNSS channels) as `stridefix import` writes\n"
-            "      --replay FILE      same as --input lcmlog:FILE: replay a raw-sensor log as fast as possible\n"
+            "      --replay FILE      same as --input lcmlog:FILE: replay a raw-sensor log\n"
+            "      --speed X          publish a file or stdin input at X times the pace it was recorded at, by\n"
+            "                         its timestamps from the first one (1 = real time, 20 = a 5-minute walk\n"
+            "                         in 15 s), e.g. for a live view; X in [%g, %g]. The log is the same\n"
+            "                         as without it (default: as fast as possible)\n"
             "Outputs\n"
             "  -l, --log FILE         LCM event log to write (default:\n"
             "                         DIR/stridefixd-YYYYmmdd-HHMMSS-MICROS-PID.lcmlog, UTC); written as\n"
@@ -61,7 +66,8 @@ static void usage(FILE *const f)
             "                         the config pose (init.*)\n"
             "      --fusion MODE      publish one scheme's POSE and FIX, or all (default: every scheme side by\n"
             "                         side, one log compares them all). Same as --set output.scheme=N.\n"
-            "                         Schemes (pose_t.SCHEME_*): ");
+            "                         Schemes (pose_t.SCHEME_*): ",
+            SF_OPTIONS_SPEED_MIN, SF_OPTIONS_SPEED_MAX);
     scheme_list(f, ", ");
     fprintf(f,
             "\n"
@@ -113,6 +119,22 @@ static int parse_long(const char *const option, const char *const text, const lo
     const long v = strtol(text, &end, 10);
     if (end == text || *end != '\0' || errno != 0 || v < min || v > max) {
         fprintf(stderr, "stridefixd: %s '%s': expected an integer in [%ld, %ld]\n", option, text, min, max);
+        return SF_EXIT_USAGE;
+    }
+    *value = v;
+    return 0;
+}
+
+/* A whole-string finite number in [min, max] (strtod with the end checked): 0, or SF_EXIT_USAGE with
+ * a message naming the option. */
+static int parse_double(const char *const option, const char *const text, const double min, const double max,
+                        double *const value)
+{
+    char *end = NULL;
+    errno = 0;
+    const double v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno != 0 || !isfinite(v) || v < min || v > max) {
+        fprintf(stderr, "stridefixd: %s '%s': expected a number in [%g, %g]\n", option, text, min, max);
         return SF_EXIT_USAGE;
     }
     *value = v;
@@ -244,7 +266,8 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         opt_json,
         opt_force,
         opt_allow_root,
-        opt_channels
+        opt_channels,
+        opt_speed
     };
     static const struct option longs[] = {
         {"input", required_argument, NULL, 'i'},   {"log", required_argument, NULL, 'l'},
@@ -260,6 +283,7 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         {"force", no_argument, NULL, opt_force},
         {"allow-root", no_argument, NULL, opt_allow_root},
         {"channels", required_argument, NULL, opt_channels},
+        {"speed", required_argument, NULL, opt_speed},
         {NULL, 0, NULL, 0}};
     *o = (sf_options_t){.log_dir = ".", .max_messages = 20, .channels = UINT32_MAX};
     optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state): parse is re-entrant */
@@ -305,6 +329,14 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
                 return SF_EXIT_USAGE;
             }
             break;
+        case opt_speed: {
+            double speed = 0.0;
+            if (parse_double("--speed", optarg, SF_OPTIONS_SPEED_MIN, SF_OPTIONS_SPEED_MAX, &speed) != 0) {
+                return SF_EXIT_USAGE;
+            }
+            sf_pace_init(&o->pace, speed);
+            break;
+        }
         case 'q': o->quiet = true; break;
         case opt_max_messages:
             if (parse_long("--max-messages", optarg, 0, LONG_MAX, &o->max_messages) != 0) {
@@ -337,6 +369,11 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
     }
     if (o->input == NULL) {
         fprintf(stderr, "stridefixd: --input is required (see --help)\n");
+        return SF_EXIT_USAGE;
+    }
+    if (sf_pace_on(&o->pace) && sf_input_spec_is_live(o->input)) {
+        fprintf(stderr, "stridefixd: --speed: %s is live, already at its own pace (--speed paces a file or stdin)\n",
+                o->input);
         return SF_EXIT_USAGE;
     }
     return 0;

@@ -8,9 +8,14 @@
 #include <stdint.h>
 
 #include "sf_channels.h"
+#include "sf_pace.h"
 #include "sf_params.h"
 
 #define SF_OPTIONS_MAX_SETS 64
+/* --speed's range: slower than a thousandth of real time or faster than a million times it is a typo
+ * (a 5-minute walk would take 3.5 days, or 0.3 ms). */
+#define SF_OPTIONS_SPEED_MIN 0.001
+#define SF_OPTIONS_SPEED_MAX 1e6
 #define SF_OPTIONS_PATH_MAX 4096 /* a path option's length limit (PATH_MAX): refused, never cut short */
 
 /* One bit per LCM channel of SF_CHANNELS (sf_channels.h, from lcmtypes/channels.csv): --channels. */
@@ -49,6 +54,8 @@ typedef struct {
     bool force;      /* --force: an existing log file may be replaced */
     bool allow_root; /* --allow-root: a live input as root */
     uint32_t channels; /* --channels: bit sf_options_channel_<NAME> set = that channel is written */
+    sf_pace_t pace;    /* --speed X: the replay published at X times its recorded pace (sf_pace.h); off
+                        * without it (as fast as possible) */
 } sf_options_t;
 
 /* 0 to run, or the exit status (SF_EXIT_USAGE, with a message on stderr). */

@@ -328,7 +328,9 @@ static int run(daemon_t *const d)
             complain(d, rc);
             continue;
         }
-        handle(d, &d->item);
+        if (sf_pace_sleep(&d->opt.pace, d->item.log_t_us, sf_signals_stop_requested) == SF_OK) {
+            handle(d, &d->item); /* when due (--speed); not after a stop signal: the loop ends at its top */
+        }
     }
     sf_signals_input_done();
     write_config(d);

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 
 import cantools
 import numpy as np
+from stridefix_common import dbc
 
 from . import faults as flt
 from .radio import Scan
@@ -44,7 +45,7 @@ if TYPE_CHECKING:
     from .pipeline import Sources
 
 EPOCH_US = 1_700_000_000 * 1_000_000
-DBC_PATH = Path(__file__).resolve().parents[2] / "firmware" / "board.dbc"
+DBC_PATH = dbc.DBC_PATH
 IMU_PERIOD_MS = 10
 FW_MAJOR, FW_MINOR = 1, 0
 

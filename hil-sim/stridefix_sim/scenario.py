@@ -29,11 +29,10 @@ person walks from calibration point to calibration point, and at each stands sti
 from __future__ import annotations
 
 import copy
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import tomllib
 
 from .scenario_sources import SOURCE_DEFAULTS, validate_sources
 

@@ -40,6 +40,20 @@ def _decoder(channel: str) -> Any:
     return CHANNELS[channel].msg_type if channel in CHANNELS else None
 
 
+#: the kernel receive buffer asked for on a udpm:// URL that names none [bytes] (capped by the kernel's
+#: net.core.rmem_max): a replay at ``stridefixd --speed 20`` sends ~4,000 datagrams a second, which the
+#: default buffer (~200 of them) holds for 50 ms of a stalled Python thread; this holds about a second
+RECV_BUF_BYTES = 4 * 1024 * 1024
+
+
+def receive_url(lcm_url: str) -> str:
+    """``lcm_url`` with ``recv_buf_size`` = :data:`RECV_BUF_BYTES` added when it is a udpm:// URL
+    without one (any other URL, or one that names its own, as it is)."""
+    if not lcm_url.startswith("udpm://") or "recv_buf_size=" in lcm_url:
+        return lcm_url
+    return f"{lcm_url}{'&' if '?' in lcm_url else '?'}recv_buf_size={RECV_BUF_BYTES}"
+
+
 class LcmFeed:
     """The LCM thread: ``lcm_url`` folded into ``state`` until :meth:`stop` or the log's end."""
 
@@ -47,7 +61,7 @@ class LcmFeed:
         import lcm
 
         try:
-            self.lc = lcm.LCM(lcm_url)
+            self.lc = lcm.LCM(receive_url(lcm_url))
         except (OSError, RuntimeError, ValueError) as exc:
             raise LiveInputError(f"--lcm-url {lcm_url}: cannot open LCM: {exc}") from exc
         self.state, self.lock = state, lock

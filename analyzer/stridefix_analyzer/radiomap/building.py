@@ -16,10 +16,10 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import tomllib
 from typing import Any
 
 import numpy as np
-import tomllib
 from stridefix_common.building import (
     FORMAT,
     PORT_EXTRA_KEYS,

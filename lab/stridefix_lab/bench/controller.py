@@ -28,12 +28,12 @@ from __future__ import annotations
 import argparse
 import json
 import time
+import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 from stridefix import pose_t
 from stridefix_analyzer import console, schemes
 from stridefix_analyzer.firmware import Firmware

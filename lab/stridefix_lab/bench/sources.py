@@ -30,12 +30,12 @@ import argparse
 import json
 import math
 import time
+import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import tomllib
 from stridefix import fix_t
 from stridefix_analyzer import console, schemes
 from stridefix_analyzer.firmware import Firmware

@@ -184,3 +184,9 @@ def test_man_page_renders(prefix):
         and "--print-config" in text
         and "/etc/stridefix/stridefixd.ini" in text
     )
+    # every long option of --help is in the page (it is made from --help)
+    options = set(
+        re.findall(r"^\s+(?:-\w, )?(--[a-z-]+)", _run(prefix / "bin" / "stridefixd", "--help").stdout, re.M)
+    )
+    assert {"--speed", "--replay", "--channels"} <= options
+    assert sorted(o for o in options if o not in text.replace("\u2010", "-")) == []

@@ -1,19 +1,20 @@
 """pyproject.toml declares what `stridefix` needs; requirements.txt is its lock (make deps installs it).
 
 GIVEN both files, THEN every pin of requirements.txt satisfies pyproject's range for that package (in the
-dependencies or an extra), every declared package is pinned, and the version comes from VERSION.
+dependencies or an extra), every declared package is pinned, and the version comes from VERSION. The
+product and the lab (lab/pyproject.toml) are two distributions that share the package folders out
+between them, and one Python floor holds for both, ruff and mypy.
 """
 
 from __future__ import annotations
 
 import re
+import tomllib
 from pathlib import Path
 
-import pytest
 from packaging.requirements import Requirement
+from packaging.specifiers import SpecifierSet
 from packaging.utils import canonicalize_name
-
-tomllib = pytest.importorskip("tomllib")  # Python >= 3.11 (the venv's)
 
 REPO = Path(__file__).resolve().parents[3]
 
@@ -73,3 +74,34 @@ def test_every_package_is_in_the_wheel():
             ".".join([name, *init.parent.relative_to(root).parts]) for init in root.rglob("__init__.py")
         }
     assert sorted(found ^ set(setuptools["packages"])) == []
+
+
+def test_product_and_lab_share_the_packages_out():
+    """The product wheel holds every package but the lab's; the lab's distribution holds the lab."""
+    product = tomllib.loads((REPO / "pyproject.toml").read_text())
+    lab = tomllib.loads((REPO / "lab" / "pyproject.toml").read_text())
+    assert set(product["tool"]["setuptools"]["package-dir"]) == {
+        "stridefix_common",
+        "stridefix_sim",
+        "stridefix_analyzer",
+    }
+    assert not any(p.startswith("stridefix_lab") for p in product["tool"]["setuptools"]["packages"])
+    assert lab["tool"]["setuptools"]["packages"]["find"]["include"] == ["stridefix_lab*"]
+    assert set(product["project"]["scripts"]) == {"stridefix"}
+    assert lab["project"]["scripts"] == {"stridefix-lab": "stridefix_lab.cli:main"}
+    assert [Requirement(r).name for r in lab["project"]["dependencies"]] == ["stridefix"]
+    assert (REPO / "lab" / "VERSION").read_text() == (REPO / "VERSION").read_text()
+    assert product["tool"]["setuptools"]["package-data"] == {"stridefix_common": ["board.dbc"]}
+    dbc = REPO / "common" / "stridefix_common" / "board.dbc"
+    assert dbc.resolve() == (REPO / "firmware" / "board.dbc").resolve()
+
+
+def test_one_python_floor():
+    """The modules use 3.11 (tomllib): both distributions require it, ruff and mypy check for it."""
+    product = tomllib.loads((REPO / "pyproject.toml").read_text())
+    lab = tomllib.loads((REPO / "lab" / "pyproject.toml").read_text())
+    floor = SpecifierSet(product["project"]["requires-python"])
+    assert str(floor) == ">=3.11" == lab["project"]["requires-python"]
+    assert "3.10" not in floor and "3.11" in floor
+    assert product["tool"]["ruff"]["target-version"] == "py311"
+    assert product["tool"]["mypy"]["python_version"] == "3.11"

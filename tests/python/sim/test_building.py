@@ -4,10 +4,10 @@ tomllib it gives back the world's walls, ports, beacons and geo-reference."""
 from __future__ import annotations
 
 import math
+import tomllib
 
 import numpy as np
 import pytest
-import tomllib
 from stridefix_sim.building import FORMAT, building_text
 from stridefix_sim.scenario import builtin_scenario
 from stridefix_sim.worlds import WORLDS, load_world

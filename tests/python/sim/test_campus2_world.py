@@ -6,10 +6,10 @@ description carries the context map (outlines, per-building wall floors, port ex
 from __future__ import annotations
 
 import math
+import tomllib
 
 import numpy as np
 import pytest
-import tomllib
 from stridefix_sim.building import building_text
 from stridefix_sim.radio import walls_crossed
 from stridefix_sim.route import Polyline
