@@ -14,11 +14,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
 import pytest
-import tomllib
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.schemes import FUSION_SCHEMES
 
