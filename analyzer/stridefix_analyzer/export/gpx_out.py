@@ -46,6 +46,7 @@ def write_gpx(
     path: str | os.PathLike[str], tracks: Sequence[Track], geo: GeoRef, start: datetime.datetime = EPOCH
 ) -> int:
     """Write the tracks' GPX to ``path``; returns the number of track points."""
+    text = gpx_text(tracks, geo, start)  # before the file is opened: a failure leaves no empty file
     with open(path, "w", encoding="utf-8") as f:
-        f.write(gpx_text(tracks, geo, start))
+        f.write(text)
     return sum(len(t) for t in tracks)

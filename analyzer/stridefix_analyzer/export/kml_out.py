@@ -53,6 +53,7 @@ def write_kml(
     path: str | os.PathLike[str], tracks: Sequence[Track], geo: GeoRef, start: datetime.datetime = EPOCH
 ) -> int:
     """Write the tracks' KML to ``path``; returns the number of poses written."""
+    text = kml_text(tracks, geo, start)  # before the file is opened: a failure leaves no empty file
     with open(path, "w", encoding="utf-8") as f:
-        f.write(kml_text(tracks, geo, start))
+        f.write(text)
     return sum(len(t) for t in tracks)

@@ -3,6 +3,9 @@ stridefix_common.exits, no traceback."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import pytest
 from stridefix_analyzer.io.sitefile import read_site, write_site
 from stridefix_common.exits import EXIT_FAILURE, EXIT_NOTHING_VALID, EXIT_OK, EXIT_USAGE
@@ -70,3 +73,33 @@ def test_format_option_beats_the_suffix(cli, geo_walk, tmp_path):
     )
     assert proc.returncode == EXIT_OK, proc.stderr
     assert out.read_text().lstrip().startswith("<?xml") and "<gpx" in out.read_text()
+
+
+@pytest.mark.parametrize(("suffix", "module"), [("gpx", "gpxpy"), ("kml", "simplekml"), ("mcap", "mcap")])
+def test_a_missing_library_of_the_extra_says_what_to_install(geo_walk, tmp_path, suffix, module):
+    # GIVEN the format's library hidden from the import system (as on an install without the extra)
+    code = (
+        "import sys\n"
+        f"for name in ({module!r}, {module + '.gpx'!r}, {module + '.writer'!r}): sys.modules[name] = None\n"
+        "from stridefix_analyzer.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n"
+    )
+    out = tmp_path / f"walk.{suffix}"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            code,
+            "export",
+            str(geo_walk["log"]),
+            "--site",
+            str(geo_walk["site"]),
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    # THEN one line names the package and the extra, exit 1 (a failure, not the user's input)
+    _one_error(proc, EXIT_FAILURE, module, "pip install 'stridefix[export]'")
+    assert not out.exists()
