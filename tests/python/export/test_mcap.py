@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 from mcap.reader import make_reader
 from numpy.testing import assert_allclose
@@ -85,3 +86,20 @@ def test_a_site_without_geo_reference_gives_map_frame_topics_only(cli, geo_walk,
     topics, _ = _read(out)
     assert not any(t.endswith("/location") for t in topics)
     assert topics["POSE"][0] == "foxglove.PoseInFrame"
+
+
+def test_location_covariance_is_the_map_covariance_turned_into_east_north(mcap_file, logged_poses):
+    # the ekf's covariance is not isotropic, so the 20° rotation shows: C_en = R C_map Rᵀ
+    _, messages = _read(mcap_file)
+    theta = np.radians(20.0)
+    rot = np.array([[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]])  # map -> east-north
+    poses, fixes = logged_poses["POSE_EKF"], [b for _, b in messages["POSE_EKF/location"]]
+    assert len(fixes) == len(poses)
+    checked = 0
+    for m, fix in zip(poses[::200], fixes[::200]):
+        c_map = np.array([[m.cov_xx_m2, m.cov_xy_m2], [m.cov_xy_m2, m.cov_yy_m2]], dtype=np.float64)
+        c_en = rot @ c_map @ rot.T
+        cov = np.array(fix["position_covariance"]).reshape(3, 3)
+        assert_allclose(cov[:2, :2], c_en, rtol=1e-9, atol=1e-12)
+        checked += abs(m.cov_xy_m2) > 1e-6 or abs(m.cov_xx_m2 - m.cov_yy_m2) > 1e-6
+    assert checked > 0  # at least one anisotropic covariance was compared
