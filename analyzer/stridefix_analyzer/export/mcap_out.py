@@ -33,7 +33,7 @@ import numpy as np
 from stridefix_analyzer.export import foxglove
 from stridefix_analyzer.export.extra import need
 from stridefix_analyzer.export.georef import GeoRef
-from stridefix_analyzer.export.tracks import EPOCH, read_channels
+from stridefix_analyzer.export.tracks import EPOCH, NoPoseError, read_channels
 from stridefix_analyzer.io.channels import CHANNELS, POSE_CHANNELS, table_of
 from stridefix_analyzer.io.logread import Table
 from stridefix_analyzer.scoring.floor_height import FloorHeights
@@ -115,11 +115,16 @@ def write_mcap(
     ------
     LogReadError
         A log cannot be read.
+    NoPoseError
+        The logs hold none of the channels written (nothing is written then).
     MissingExtraError
         The ``mcap`` package is not installed.
     """
     writer_mod = need("mcap.writer", "--format mcap")
     read = read_channels(logs, [*POSE_CHANNELS, *LCM_TOPICS, GNSS])
+    if not read.tables:
+        names = ", ".join(os.fspath(p) for p in logs)
+        raise NoPoseError(f"{names}: no pose, step, fix or GNSS message in the log: nothing to export")
     out = _Out()
     t_first: int | None = None
     for channel, table in read.tables.items():

@@ -60,6 +60,13 @@ def test_bad_inputs(cli, geo_walk, tmp_path):
     _one_error(
         cli("export", str(geo_walk["truth"]), "--site", site, "--out", out), EXIT_NOTHING_VALID, "no POSE"
     )
+    empty_mcap = tmp_path / "truth.mcap"
+    _one_error(
+        cli("export", str(geo_walk["truth"]), "--site", site, "--out", str(empty_mcap)),
+        EXIT_NOTHING_VALID,
+        "nothing to export",
+    )
+    assert not empty_mcap.exists()
     unwritable = str(tmp_path / "no" / "such" / "dir" / "walk.gpx")
     _one_error(cli("export", log, "--site", site, "--out", unwritable), EXIT_FAILURE, "cannot write")
     bad_time = cli("export", log, "--site", site, "--out", out, "--start-utc", "yesterday")
