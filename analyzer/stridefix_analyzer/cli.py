@@ -26,6 +26,7 @@ SUBCOMMANDS = {
     "crowd": "stridefix_analyzer.crowd.cli",
     "live": "stridefix_analyzer.live.server",
     "spy": "stridefix_analyzer.spy",
+    "export": "stridefix_analyzer.export.cli",
 }
 
 # sub-command name -> "module:function" rewriting argv before parsing
