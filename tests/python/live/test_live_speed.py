@@ -1,6 +1,6 @@
 """The live page receives every step of a walk replayed at ``stridefixd --speed 20``.
 
-GIVEN a 2-minute SIL walk and ``stridefix live`` listening on a multicast LCM URL that stays on this
+GIVEN the demo's SIL walk (5.5 minutes, 545 steps) and ``stridefix live`` listening on a multicast LCM URL that stays on this
 host (ttl=0, a random port so that no other run on the machine shares it), WHEN a websocket client
 holds the page's ``/ws`` open and stridefixd replays the walk at 20x real time publishing to that URL,
 THEN the last document the websocket pushed counts as many STEP messages as the log holds (every
@@ -27,8 +27,9 @@ SPEED = 20
 
 @pytest.fixture(scope="module")
 def walk(tmp_path_factory, cli) -> Path:
+    """The demo's walk (tools/demo.sh: `stridefix sim --out DIR`, the default scenario and seed)."""
     out = tmp_path_factory.mktemp("livespeed")
-    proc = cli("sim", "--out", str(out), "--duration-s", "120")
+    proc = cli("sim", "--out", str(out))
     assert proc.returncode == 0, proc.stderr
     return out
 
@@ -86,10 +87,11 @@ def test_live_page_receives_every_step_at_speed_20(stridefixd, walk, tmp_path):
         live.wait(timeout=10)
     assert proc.returncode == 0, proc.stderr
     steps = [e for e in lcm.EventLog(str(log), "r") if e.channel == "STEP"]
-    assert len(steps) > 150  # a 2-minute walk
+    walked_s = json.loads((walk / "sim_summary.json").read_text())["duration_s"]
+    assert len(steps) > 400  # the demo's 5.5-minute walk
     assert doc["messages"].get("STEP", 0) == len(steps)
     assert doc["steps"] == len(steps)  # step_t.index of the last step: the first is 1
-    assert elapsed >= 120 / SPEED
+    assert elapsed >= walked_s / SPEED
 
 
 @pytest.mark.parametrize(
