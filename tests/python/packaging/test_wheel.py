@@ -7,7 +7,7 @@ lab. WHEN it is installed into a fresh venv (no pip, no system site-packages; it
 dependencies reached through a .pth to this venv's site directory, which holds no StrideFix file),
 THEN every StrideFix module imports from that venv, `stridefix --help` has every sub-command available,
 and a simulated walk (the DBC from the wheel), replayed by stridefixd, analyzes and reports with the
-same metrics as the checkout's analyzer. Beside `cmake --install`'s prefix, the wheel's analyzer finds
+same metrics as the checkout's analyzer, and exports in latitude/longitude from a site it builds. Beside `cmake --install`'s prefix, the wheel's analyzer finds
 the installed stridefixd.
 """
 
@@ -146,6 +146,19 @@ def test_fresh_venv_runs_the_product_from_the_wheel(fresh_venv, stridefixd, tmp_
         ]
     )
     assert json.loads((ref / "metrics.json").read_text()) == metrics
+    # and it builds a geo-referenced site from the walk and exports the walk in latitude/longitude
+    site = tmp_path / "walk.sfsite"
+    _run(
+        [exe, "radiomap", "build", walk / "run.lcmlog", walk / "truth.lcmlog", "--mode", "walk"]
+        + ["--min-count", "1", "--origin-deg", "47.3769,8.5417", "--out", site],
+        env=env,
+        cwd=tmp_path,
+    )
+    track = tmp_path / "walk.geojson"
+    _run([exe, "export", walk / "run.lcmlog", "--site", site, "--out", track], env=env, cwd=tmp_path)
+    (feature, *_) = json.loads(track.read_text())["features"]
+    lon, lat = feature["geometry"]["coordinates"][0][:2]
+    assert abs(lat - 47.3769) < 0.01 and abs(lon - 8.5417) < 0.01  # near the origin: a 60 s walk
 
 
 def test_wheel_runs_with_the_installed_stridefixd(fresh_venv, prefix, tmp_path):
