@@ -22,6 +22,7 @@ from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, seconds
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.parallel import SchedulerError, add_jobs_argument, add_scheduler_argument
+from stridefix_analyzer.radiomap.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_common.exits import input_error_status
 
 from stridefix_lab.realbench import tuning
@@ -36,7 +37,6 @@ from stridefix_lab.realbench.pdr_distance import (
     run_pdr_distance,
 )
 from stridefix_lab.realbench.sitecontent import ContentOptions
-from stridefix_lab.realbench.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_lab.realbench.summary import format_tables
 from stridefix_lab.realbench.walks import RealbenchError
 
