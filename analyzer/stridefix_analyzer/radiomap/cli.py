@@ -45,7 +45,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     b.add_argument("logs", nargs="+", metavar="LOG")
     b.add_argument("--out", required=True, metavar="SITE.sfsite", help="site file to write")
     add_site_options(b, min_count=DEFAULT_MIN_COUNT)
-    b.set_defaults(learn_beacons=True)
+    b.set_defaults(learn_beacons=True, context_map=False)
     add_scheduler_argument(b, "serial")
     add_jobs_argument(b, "processes of --scheduler processes or local", dest="workers")
     s = sub.add_parser(

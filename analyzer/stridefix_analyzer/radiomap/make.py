@@ -67,6 +67,8 @@ class SiteOptions:
     min_room_area_m2: float = 0.0
     #: beacons placed from the walks' BLE readings when no --beacon-table gives their positions
     learn_beacons: bool = True
+    #: without a described building, a one-building context map so the multi-scheme controller runs
+    context_map: bool = False
 
 
 def read_beacon_table(path: str, origin: tuple[float, float]) -> dict[str, tuple[float, float, int]]:
@@ -179,6 +181,20 @@ def make_site(
             from stridefix_analyzer.radiomap.beacons import place_readings
 
             summary["context_map"] = build_context_map(site, building, place_readings(recordings))
+    if opts.context_map and not site.n_contexts:
+        from stridefix_analyzer.radiomap.beacons import place_readings
+        from stridefix_analyzer.radiomap.contexts import (
+            DEFAULT_SCHEME,
+            MAPPED_SCHEME,
+            context_map_summary,
+            single_building_context_map,
+        )
+
+        # the rule of a described building's floor contexts: the map-aware scheme where there are walls
+        scheme = MAPPED_SCHEME if site.n_walls else DEFAULT_SCHEME
+        placed = place_readings(recordings) if site.n_beacons else None
+        site = single_building_context_map(site, scheme=scheme, ble_placed=placed)
+        summary["context_map"] = context_map_summary(site)
     os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
     summary["bytes"] = write_site(out, site)
     return site, summary

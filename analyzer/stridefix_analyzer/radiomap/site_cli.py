@@ -76,6 +76,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="without --beacon-table, also place BLE beacons from the walks alone (off: a beacon placed "
         "from readings between sparse known points is metres off, and its fixes cost more than they give)",
     )
+    p.add_argument(
+        "--no-context-map",
+        dest="context_map",
+        action="store_false",
+        help="no one-building context map (written unless --building has [[building]] entries): the "
+        "multi-scheme controller then does not run and POSE copies controller.init_scheme's pose",
+    )
     add_site_options(p, min_count=SITE_MIN_COUNT)
     add_stridefixd_argument(p)
     add_scheduler_argument(p, "processes")
