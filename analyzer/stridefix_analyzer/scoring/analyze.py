@@ -41,7 +41,7 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.io.results import write_analyze_metrics
-from stridefix_analyzer.schemes import NAMES
+from stridefix_analyzer.schemes import NAMES, is_fused
 from stridefix_analyzer.scoring import floor_height, iso18305
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
@@ -246,6 +246,13 @@ def run_analyze(
     return summary, metrics
 
 
+#: a log without any fused scheme's pose came from a replay without a site (stridefixd then runs PDR only)
+NO_SITE_NOTE = (
+    "stridefix analyze: note: no fused scheme in the log: they need a site (stridefixd --site SITE.sfsite; "
+    "build one from walks with known points: stridefix site, docs/datasets.md)"
+)
+
+
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
@@ -257,6 +264,8 @@ def run(args: argparse.Namespace) -> int:
         return input_error_status(exc)
     for note in summary["warnings"]:
         print(f"stridefix analyze: warning: {note}", file=sys.stderr)
+    if not any(is_fused(name) for name in summary["per_scheme"]):
+        print(NO_SITE_NOTE, file=sys.stderr)
     print(format_summary(summary))
     print(iso18305.format_line(summary.get("iso18305"), summary["primary_scheme"]))
     print(format_fix_sources(summary["fix_sources"]))
