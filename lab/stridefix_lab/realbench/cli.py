@@ -298,7 +298,21 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
         f"{doc['run_s']['prepare']:.1f} s, folds {doc['run_s']['folds']:.1f} s)"
     )
     scored = sum(s["n"] for g in doc["groups"] for s in g["summary"]["schemes"].values())
-    return 0 if scored else 1
+    failed = failed_walks(doc)
+    if failed:
+        # the results.json is written all the same; a failed walk is a failed run, never a quiet gap
+        names = ", ".join(f"{w} ({why})" for w, why in failed[:5]) + (" ..." if len(failed) > 5 else "")
+        print(f"stridefix-lab realbench: error: {len(failed)} walk(s) failed: {names}", file=sys.stderr)
+    return 0 if scored and not failed else 1
+
+
+def failed_walks(doc: dict) -> list[tuple[str, str]]:
+    """(walk, why) of every walk that could not be prepared or scored, in the groups' order."""
+    return [
+        (e["walk"], e["error"])
+        for g in doc["groups"]
+        for e in [*g.get("failed", []), *g.get("fold_errors", [])]
+    ]
 
 
 def add_crowd_map_parser(sub: Any) -> None:
