@@ -23,6 +23,7 @@ rotation=$("$venv/bin/python" -c 'import json,sys; print(json.load(open(sys.argv
 step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcmlog" "$out/survey/truth.lcmlog" \
                 --mode survey --name office --map-rotation-deg "$rotation" --out "$out/site.sfsite"
 step sim        "$venv/bin/stridefix" sim --out "$out"
+ln -f "$out/board.candump" "$out/board.log"  # the same file: python-can's LogReader picks candump text by .log
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
 step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" --site "$out/site.sfsite" \
                 --scheme kalman --label "default SIL walk, office radio map, every scheme from its first fix"
