@@ -88,11 +88,12 @@ class Progress:
                 end_progress()
                 from tqdm import tqdm  # only when a bar is drawn: a plain import costs ~50 ms
 
-                _live = tqdm(total=n, file=stream, leave=False, dynamic_ncols=True)
+                _live = tqdm(total=n, desc=f"{prefix}: {what}", file=stream, leave=False, dynamic_ncols=True)
                 _live_stream = stream
-            _live.reset(total=n)
-            _live.set_description(f"{prefix}: {what}", refresh=False)
-            _live.set_postfix_str("", refresh=True)
+            else:
+                _live.reset(total=n)
+                _live.set_description(f"{prefix}: {what}", refresh=False)
+                _live.set_postfix_str("", refresh=True)
             self._bar = _live
         if stream is not None and n > 0:
             _open.append(self)
@@ -124,6 +125,7 @@ class Progress:
         if self in _open:
             _open.remove(self)
         if self._bar is not None:
+            self._bar.refresh()  # the phase's final count, drawn however fast its last steps came
             self._bar = None  # the live line stays for the next phase; end_progress clears it
         elif _level == NORMAL and self.i and self.stream is not None:
             el = time.perf_counter() - self.t0
