@@ -418,11 +418,8 @@ static int serve(daemon_t *const d)
     if (d->opt.site_path != NULL && load_site(d) != 0) {
         return SF_EXIT_USAGE;
     }
-    if (d->opt.site_path == NULL && !d->opt.quiet) {
-        /* without a site only PDR runs; say so once, since a site-less replay of real walks looks like a
-         * broken estimator (hundreds of metres off) rather than a missing input */
-        fprintf(stderr, "stridefixd: no --site: PDR only, the fused schemes need a site "
-                        "(build one from walks with known points: stridefix site)\n");
+    if (d->opt.site_path == NULL && !d->opt.quiet) { /* else a site-less replay looks like a broken estimator */
+        fprintf(stderr, "stridefixd: no --site: PDR only, the fused schemes need a site (build one: stridefix site)\n");
     }
     sf_estimator_init(&d->est, &d->params);
     if (d->opt.site_path != NULL) {
