@@ -26,6 +26,7 @@ step radiomap   "$venv/bin/stridefix" radiomap build "$out/survey/stridefixd.lcm
                 --mode survey --name office --map-rotation-deg "$rotation" --building "$out/survey/building.toml" \
                 --out "$out/site.sfsite"
 step sim        "$venv/bin/stridefix" sim --out "$out"
+ln -f "$out/board.candump" "$out/board.log"  # the same file: python-can's LogReader picks candump text by .log
 step stridefixd "$stridefixd" --input "$out/board.candump" --log "$out/stridefixd.lcmlog" --site "$out/site.sfsite"
 step analyze    "$venv/bin/stridefix" analyze "$out/stridefixd.lcmlog" "$out/truth.lcmlog" --out "$out" --site "$out/site.sfsite" \
                 --label "default SIL walk, office radio map, every scheme from its first fix"

@@ -23,6 +23,7 @@ SUBCOMMANDS = {
     "compare": "stridefix_analyzer.scoring.compare",
     "score": "stridefix_analyzer.scoring.ipin_cli",
     "radiomap": "stridefix_analyzer.radiomap.cli",
+    "site": "stridefix_analyzer.radiomap.site_cli",
     "crowd": "stridefix_analyzer.crowd.cli",
     "live": "stridefix_analyzer.live.server",
     "spy": "stridefix_analyzer.spy",

@@ -106,7 +106,10 @@ class CommandLine:
         chosen = rest[0] if rest and rest[0] in self.subcommands else None  # else: help or a usage error
         args = self.build_parser(chosen).parse_args([*front, *rest])
         console.set_level(args.verbosity)
-        return int(args._run(args) or 0)
+        try:
+            return int(args._run(args) or 0)
+        finally:
+            console.end_progress()  # the command's live progress line, cleared whatever happened
 
 
 def split_global(argv: list[str]) -> tuple[list[str], list[str]]:

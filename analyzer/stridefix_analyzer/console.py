@@ -1,7 +1,8 @@
 """What the long-running commands tell the user on stderr, at the verbosity ``stridefix -q``/``-v`` chose.
 
-Three levels: :data:`QUIET` (``-q``: nothing but errors), :data:`NORMAL` (a line per phase, and one
-updating progress bar per phase on a terminal) and :data:`VERBOSE` (``-v``: also a line per step of a
+Three levels: :data:`QUIET` (``-q``: nothing but errors), :data:`NORMAL` (a line per phase, and on a
+terminal one live progress line per command that every phase reuses, cleared by :func:`end_progress`
+when the command ends) and :data:`VERBOSE` (``-v``: also a line per step of a
 phase, with its note, elapsed time and ETA). The level is process-wide: :func:`stridefix_analyzer.cli.main`
 sets it once from the global options, before the sub-command runs; worker processes never print.
 Files never depend on it; a command's tables on stdout go through :func:`show`, which ``-q`` silences.
@@ -15,6 +16,11 @@ from typing import Any, TextIO
 
 QUIET, NORMAL, VERBOSE = 0, 1, 2
 _level = NORMAL
+#: the command's one live progress line on a terminal (a tqdm bar), shared by its phases
+_live: Any = None
+_live_stream: Any = None
+#: phases not yet closed (their count may never be reached): :func:`end_progress` closes them
+_open: list[Progress] = []
 
 
 def set_level(level: int) -> None:
@@ -36,7 +42,22 @@ def quiet() -> bool:
 def say(msg: str, stream: TextIO | None = None) -> None:
     """A phase's line on stderr (or ``stream``), unless quiet."""
     if _level >= NORMAL:
+        if _live is not None:
+            _live.clear()  # the phase's line above the live progress line, not through it
         print(msg, file=stream or sys.stderr, flush=True)
+        if _live is not None:
+            _live.refresh()
+
+
+def end_progress() -> None:
+    """End the command's progress: close every phase still open and clear the live line (the
+    command's console script calls it when the command returns)."""
+    global _live
+    for p in list(_open):
+        p.close()
+    if _live is not None:
+        _live.close()
+        _live = None
 
 
 def show(text: str) -> None:
@@ -55,19 +76,33 @@ def _is_tty(stream: TextIO) -> bool:
 class Progress:
     """The steps of one phase of ``n`` steps on ``stream``: ``PREFIX: WHAT [i/n] note  elapsed, ETA``.
 
-    ``-v``: that line for every step. Otherwise, on a terminal, one tqdm bar that updates in place
-    (about 1,000 lines per floor of ``realbench`` before); off a terminal (a log file, a pipe, CI), one
-    line when the phase is done. ``-q`` or ``stream`` None: nothing."""
+    ``-v``: that line for every step. Otherwise, on a terminal, the command's one live line (a tqdm bar
+    that each phase resets to its own count, so phases never stack up bars, finished or not); off a
+    terminal (a log file, a pipe, CI), one line when the phase is done. ``-q`` or ``stream`` None:
+    nothing."""
 
     def __init__(self, what: str, n: int, stream: TextIO | None = sys.stderr, prefix: str = "realbench"):
         self.what, self.n, self.stream, self.prefix = what, n, stream, prefix
         self.t0, self.i = time.perf_counter(), 0
         self._bar: Any = None
         self._closed = False
+        global _live, _live_stream
         if _level == NORMAL and n > 0 and stream is not None and _is_tty(stream):
-            from tqdm import tqdm  # only when a bar is drawn: a plain import costs ~50 ms
+            for p in list(_open):
+                p.close()  # a phase that never reached its count gives the line to this one
+            if _live is None or _live_stream is not stream:
+                end_progress()
+                from tqdm import tqdm  # only when a bar is drawn: a plain import costs ~50 ms
 
-            self._bar = tqdm(total=n, desc=f"{prefix}: {what}", file=stream, leave=True, dynamic_ncols=True)
+                _live = tqdm(total=n, desc=f"{prefix}: {what}", file=stream, leave=False, dynamic_ncols=True)
+                _live_stream = stream
+            else:
+                _live.reset(total=n)
+                _live.set_description(f"{prefix}: {what}", refresh=False)
+                _live.set_postfix_str("", refresh=True)
+            self._bar = _live
+        if stream is not None and n > 0:
+            _open.append(self)
 
     def step(self, note: str = "") -> None:
         self.i += 1
@@ -93,13 +128,15 @@ class Progress:
         if self._closed:
             return
         self._closed = True
+        if self in _open:
+            _open.remove(self)
         if self._bar is not None:
-            self._bar.close()
-            self._bar = None
+            self._bar.refresh()  # the phase's final count, drawn however fast its last steps came
+            self._bar = None  # the live line stays for the next phase; end_progress clears it
         elif _level == NORMAL and self.i and self.stream is not None:
             el = time.perf_counter() - self.t0
             print(
-                f"{self.prefix}: {self.what} {self.i}/{self.n} done ({el:.0f} s)",
+                f"{self.prefix}: {self.what} {self.i}/{self.n} {'done' if self.i >= self.n else 'ended'} ({el:.0f} s)",
                 file=self.stream,
                 flush=True,
             )

@@ -26,7 +26,7 @@ DEFAULT_STRIDEFIXD = REPO / "build" / "firmware" / "stridefixd"
 
 
 #: Heading variants a hand-held walk is replayed with. realbench uses, per fold, the one whose STEP
-#: headings agree best with the training walks' truth directions (realbench/heading.py); the crowd solves
+#: headings agree best with the training walks' truth directions (radiomap/heading.py); the crowd solves
 #: the one whose walks agree best on their heading bias at the anchors (crowd/graph.py). The question
 #: the firmware default answers for a body-worn board, not for every device: is the gait-learned
 #: mounting offset better than a fixed one (a hand-held phone: so far yes for the fixed one). The

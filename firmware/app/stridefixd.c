@@ -420,6 +420,9 @@ static int serve(daemon_t *const d)
     if (d->opt.site_path != NULL && load_site(d) != 0) {
         return SF_EXIT_USAGE;
     }
+    if (d->opt.site_path == NULL && !d->opt.quiet) { /* else a site-less replay looks like a broken estimator */
+        fprintf(stderr, "stridefixd: no --site: PDR only, the fused schemes need a site (build one: stridefix site)\n");
+    }
     sf_estimator_init(&d->est, &d->params);
     if (d->opt.site_path != NULL) {
         const int rc = sf_estimator_attach_site(&d->est, &d->params, &d->site, &d->ws);

@@ -65,6 +65,10 @@ class SiteOptions:
     floor_info: str | None = None
     plan_floor: int | None = None
     min_room_area_m2: float = 0.0
+    #: beacons placed from the walks' BLE readings when no --beacon-table gives their positions
+    learn_beacons: bool = True
+    #: without a described building, a one-building context map so the multi-scheme controller runs
+    context_map: bool = False
 
 
 def read_beacon_table(path: str, origin: tuple[float, float]) -> dict[str, tuple[float, float, int]]:
@@ -84,6 +88,15 @@ def read_beacon_table(path: str, origin: tuple[float, float]) -> dict[str, tuple
             f"{path}: row {i + 2}: bad field {exc} (needs bleID,Lat,Lon,floor)"
         ) from None
     return out
+
+
+def drop_beacons(site: site_t) -> int:
+    """Remove every beacon of ``site`` (its path-loss model stays); returns how many there were."""
+    n = int(site.n_beacons)
+    for k in ("beacon_id", "beacon_x_m", "beacon_y_m", "beacon_floor", "beacon_rssi_1m_dbm"):
+        setattr(site, k, [])
+    set_counts(site)
+    return n
 
 
 def add_floor_plan(site: site_t, recordings: list[Any], opts: SiteOptions) -> dict[str, Any]:
@@ -156,6 +169,9 @@ def make_site(
         static_tol_m=opts.static_tol_m,
         beacon_table=table,
     )
+    if table is None and not opts.learn_beacons and site.n_beacons:
+        summary["ble"]["left_out"] = f"{drop_beacons(site)} beacons placed from the walks alone"
+        summary["n_beacons"] = 0
     if opts.floor_plan:
         summary["floor_plan"] = add_floor_plan(site, recordings, opts)
     if opts.building:
@@ -165,6 +181,20 @@ def make_site(
             from stridefix_analyzer.radiomap.beacons import place_readings
 
             summary["context_map"] = build_context_map(site, building, place_readings(recordings))
+    if opts.context_map and not site.n_contexts:
+        from stridefix_analyzer.radiomap.beacons import place_readings
+        from stridefix_analyzer.radiomap.contexts import (
+            DEFAULT_SCHEME,
+            MAPPED_SCHEME,
+            context_map_summary,
+            single_building_context_map,
+        )
+
+        # the rule of a described building's floor contexts: the map-aware scheme where there are walls
+        scheme = MAPPED_SCHEME if site.n_walls else DEFAULT_SCHEME
+        placed = place_readings(recordings) if site.n_beacons else None
+        site = single_building_context_map(site, scheme=scheme, ble_placed=placed)
+        summary["context_map"] = context_map_summary(site)
     # the plan line counts what the site file holds: the floor plan's and the description's too
     plan = site_summary(site)
     summary.update({k: plan[k] for k in ("n_walls", "n_ports", "n_beacons", "ble_model")})

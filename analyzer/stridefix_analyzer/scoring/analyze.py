@@ -51,7 +51,7 @@ from stridefix_analyzer.io.logread import (
     read_logs,
 )
 from stridefix_analyzer.io.results import write_analyze_metrics
-from stridefix_analyzer.schemes import NAMES, scheme_name
+from stridefix_analyzer.schemes import NAMES, is_fused, scheme_name
 from stridefix_analyzer.scoring import floor_height, iso18305, walk_report, walls
 from stridefix_analyzer.scoring.context import context_summary, format_context_line
 from stridefix_analyzer.scoring.fixsources import fix_source_counts, format_fix_sources
@@ -317,6 +317,13 @@ def analyze_logs(
     return summary, metrics
 
 
+#: a log without any fused scheme's pose came from a replay without a site (stridefixd then runs PDR only)
+NO_SITE_NOTE = (
+    "stridefix analyze: note: no fused scheme in the log: they need a site (stridefixd --site SITE.sfsite; "
+    "build one from walks with known points: stridefix site, docs/datasets.md)"
+)
+
+
 def run(args: argparse.Namespace) -> int:
     """Entry point of ``stridefix analyze``; returns the exit status."""
     try:
@@ -329,6 +336,9 @@ def run(args: argparse.Namespace) -> int:
     show = console.show
     for note in summary["warnings"]:
         console.say(f"stridefix analyze: warning: {note}")
+    schemes = summary.get("per_scheme") or summary.get("walk", {}).get("per_scheme", {})
+    if not any(is_fused(name) for name in schemes):
+        print(NO_SITE_NOTE, file=sys.stderr)
     if metrics is None:
         show(walk_report.format_walk(summary))
     else:

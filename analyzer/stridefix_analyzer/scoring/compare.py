@@ -1,8 +1,10 @@
 """``stridefix compare A.json B.json``: two runs side by side, per walk, with a significance figure.
 
 A and B are each a realbench ``results.json`` (every walk of every group, per scheme) or an
-``analyze`` ``metrics.json`` (one walk). The walks are paired by (group, walk) and the schemes by
-name, so a ``--set`` what-if run compares against its baseline walk by walk: for each scheme the
+``analyze`` ``metrics.json`` (one walk, named by its ``--label``). The walks are paired by (group,
+walk) and the schemes by name (:func:`pair_runs`; two ``metrics.json`` are one walk each, so they are
+the pair whatever their labels, and the console says so; nothing paired is exit status 3 with the
+groups and walks of each side), so a ``--set`` what-if run compares against its baseline walk by walk: for each scheme the
 per-walk difference B − A of the chosen statistic (``--metric``, default the mean position error),
 its mean and median, the walks where B is better / worse / equal, and the two-sided Wilcoxon
 signed-rank test's p-value over the paired differences (``scipy.stats.wilcoxon``: no normality
@@ -24,6 +26,7 @@ from collections.abc import Mapping
 from typing import Any, cast
 
 import numpy as np
+from stridefix_common.exits import EXIT_NOTHING_VALID, EXIT_USAGE
 
 from stridefix_analyzer.io.results import ResultsFileError, read_any_results
 
@@ -34,11 +37,56 @@ HIGHER_IS_BETTER = frozenset({"floor_hit_rate"})
 MIN_PAIRS = 5
 
 
+#: the group of an analyze metrics.json's one walk (its walk name is the --label)
+SINGLE_WALK_GROUP = "walk"
+
+
 class CompareInputError(ValueError):
     """A run file is missing, unreadable or of an unknown kind (the message names it)."""
 
 
-def load_run(path: str) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
+class NothingPairedError(ValueError):
+    """A and B have no walk in common (the message shows what each side has)."""
+
+
+Run = dict[tuple[str, str], dict[str, dict[str, float]]]
+
+
+def _sides(run: Run) -> str:
+    groups: dict[str, list[str]] = {}
+    for g, w in sorted(run):
+        groups.setdefault(g, []).append(w)
+    return "; ".join(
+        f"group {g!r}: {len(ws)} walk(s) "
+        + ", ".join(repr(w) for w in ws[:3])
+        + (", ..." if len(ws) > 3 else "")
+        for g, ws in groups.items()
+    )
+
+
+def pair_runs(a: Run, b: Run, name_a: str, name_b: str) -> tuple[Run, Run, str]:
+    """A and B ready for :func:`compare`, and the line saying how they were paired: two single-walk
+    metrics.json are paired whatever their labels (B's walk takes A's key); otherwise by (group, walk).
+    Raises :class:`NothingPairedError` when no walk pairs."""
+    single = all(len(r) == 1 and next(iter(r))[0] == SINGLE_WALK_GROUP for r in (a, b))
+    if single:
+        (ka,), (kb,) = a, b
+        if ka != kb:
+            note = (
+                f"paired the one walk of each metrics.json regardless of label: A {ka[1]!r} with B {kb[1]!r}"
+            )
+            return a, {ka: b[kb]}, note
+        return a, b, f"paired the one walk of each metrics.json ({ka[1]!r})"
+    common = set(a) & set(b)
+    if not common:
+        raise NothingPairedError(
+            f"no walk pairs: walks pair by (group, walk), and {name_a} has {_sides(a)}, while {name_b} has "
+            f"{_sides(b)} (an analyze metrics.json is group {SINGLE_WALK_GROUP!r}, walk = its --label)"
+        )
+    return a, b, f"paired {len(common)} walk(s) by (group, walk): {len(a)} in A, {len(b)} in B"
+
+
+def load_run(path: str) -> Run:
     """(group, walk) → scheme → statistic of one run file (module docstring)."""
     try:
         run = read_any_results(path)
@@ -63,7 +111,12 @@ def load_run(path: str) -> dict[tuple[str, str], dict[str, dict[str, float]]]:
                 f"{path}: an analyze metrics.json of a walk without truth has no position errors to "
                 "compare; analyze the walk with its TRUTH log"
             )
-        walks[("walk", str(m.get("label") or os.path.basename(os.path.dirname(os.path.abspath(path)))))] = {
+        walks[
+            (
+                SINGLE_WALK_GROUP,
+                str(m.get("label") or os.path.basename(os.path.dirname(os.path.abspath(path)))),
+            )
+        ] = {
             name: {
                 **{k: _num(e.get(k)) for k in METRICS if k in e},
                 "ipin_score": _num(s.get("ipin_score")),
@@ -237,10 +290,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        doc = compare(load_run(args.a), load_run(args.b), args.metric)
+        a, b, note = pair_runs(load_run(args.a), load_run(args.b), args.a, args.b)
+        doc = compare(a, b, args.metric)
     except CompareInputError as exc:
         print(f"stridefix compare: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
+    except NothingPairedError as exc:
+        print(f"stridefix compare: error: {exc}", file=sys.stderr)
+        return EXIT_NOTHING_VALID
+    print(f"stridefix compare: {note}")
     print(format_table(doc, args.a, args.b))
     if args.json:
         from stridefix_analyzer.io.jsonio import json_ready

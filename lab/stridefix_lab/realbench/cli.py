@@ -22,6 +22,7 @@ from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, seconds
 from stridefix_analyzer.firmware import add_stridefixd_argument
 from stridefix_analyzer.io.logread import LogReadError
 from stridefix_analyzer.parallel import SchedulerError, add_jobs_argument, add_scheduler_argument
+from stridefix_analyzer.radiomap.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_common.exits import input_error_status
 
 from stridefix_lab.realbench import tuning
@@ -36,7 +37,6 @@ from stridefix_lab.realbench.pdr_distance import (
     run_pdr_distance,
 )
 from stridefix_lab.realbench.sitecontent import ContentOptions
-from stridefix_lab.realbench.strides import DEFAULT_MIN_SEGMENT_M
 from stridefix_lab.realbench.summary import format_tables
 from stridefix_lab.realbench.walks import RealbenchError
 
@@ -298,7 +298,21 @@ def _run_fusion_cli(args: argparse.Namespace) -> int:
         f"{doc['run_s']['prepare']:.1f} s, folds {doc['run_s']['folds']:.1f} s)"
     )
     scored = sum(s["n"] for g in doc["groups"] for s in g["summary"]["schemes"].values())
-    return 0 if scored else 1
+    failed = failed_walks(doc)
+    if failed:
+        # the results.json is written all the same; a failed walk is a failed run, never a quiet gap
+        names = ", ".join(f"{w} ({why})" for w, why in failed[:5]) + (" ..." if len(failed) > 5 else "")
+        print(f"stridefix-lab realbench: error: {len(failed)} walk(s) failed: {names}", file=sys.stderr)
+    return 0 if scored and not failed else 1
+
+
+def failed_walks(doc: dict) -> list[tuple[str, str]]:
+    """(walk, why) of every walk that could not be prepared or scored, in the groups' order."""
+    return [
+        (e["walk"], e["error"])
+        for g in doc["groups"]
+        for e in [*g.get("failed", []), *g.get("fold_errors", [])]
+    ]
 
 
 def add_crowd_map_parser(sub: Any) -> None:

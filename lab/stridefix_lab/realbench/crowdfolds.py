@@ -5,7 +5,7 @@ A crowd map has no truth, but every walk carries anchors (every K-th waypoint he
 training walks together says more than one walk alone (the fleet priors of
 :mod:`..crowd.graph`). Per fold (test walk left out), from the training walks' anchors:
 
-* **the heading variant** (:data:`.heading.HEADING_VARIANTS`: learned or fixed mounting offset, mag
+* **the heading variant** (:data:`stridefix_analyzer.radiomap.heading.HEADING_VARIANTS`: learned or fixed mounting offset, mag
   gate) whose STEP headings the walks agree on best: the smallest robust spread of the per-walk heading
   bias that maps each walk's dead reckoning onto its anchors (:func:`~..crowd.graph.walk_similarity`).
   A heading the phone keeps consistent from walk to walk is one the map's rotation can correct;

@@ -9,8 +9,8 @@ of the group only (DESIGN.md, evaluation protocol):
 1. every walk is imported (cached under ``OUT/cache/<group>``) and replayed without a site
    (:mod:`.prepare`): its sufficient statistics;
 2. per group the tuning rows choose per fold (:mod:`.tuning`), and per fold the constants follow: the
-   stride constant K (:func:`.strides.calibrate_lowo`), the map rotation of the chosen heading
-   candidate (:func:`.heading.learn_rotation_deg`) and the floors (:mod:`.floors`);
+   stride constant K (:func:`stridefix_analyzer.radiomap.strides.calibrate_lowo`), the map rotation of the chosen heading
+   candidate (:func:`stridefix_analyzer.radiomap.heading.learn_rotation_deg`) and the floors (:mod:`.floors`);
 3. walk i is replayed on its fold's site (with the walls, geo-reference and beacons of the
    training walks, :mod:`.sitecontent`) with every scheme and scored at its ground-truth times
    (:mod:`.fold`). ``--true-start`` adds a run labelled truth-initialised. Beside the schemes, two
@@ -48,21 +48,21 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.results import write_realbench_results
 from stridefix_analyzer.parallel import TaskRunner, WorkerFiles, is_remote, task_runner
 from stridefix_analyzer.radiomap.build import WalkStats
-from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
-
-from stridefix_lab.realbench import priors, tuning
-from stridefix_lab.realbench.floors import DEFAULT_STOREY_M, fold_floors
-from stridefix_lab.realbench.fold import DEFAULT_MIN_COUNT, FoldJob, run_fold
-from stridefix_lab.realbench.heading import (
+from stridefix_analyzer.radiomap.heading import (
     ROT_MIN_RESULTANT,
     ROT_MIN_SEGMENT_M,
     ROT_MIN_STEPS,
     learn_rotation_deg,
 )
+from stridefix_analyzer.radiomap.strides import build_segments, calibrate_lowo, stride_k
+from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M
+
+from stridefix_lab.realbench import priors, tuning
+from stridefix_lab.realbench.floors import DEFAULT_STOREY_M, fold_floors
+from stridefix_lab.realbench.fold import DEFAULT_MIN_COUNT, FoldJob, run_fold
 from stridefix_lab.realbench.prepare import PrepareJob, prepare
 from stridefix_lab.realbench.select_sites import SelectionSites
 from stridefix_lab.realbench.sitecontent import ContentOptions, group_content
-from stridefix_lab.realbench.strides import build_segments, calibrate_lowo, stride_k
 from stridefix_lab.realbench.summary import ROBUST_MEAN_M, build_doc, strip_samples
 from stridefix_lab.realbench.walks import dataset, find_groups, firmware
 

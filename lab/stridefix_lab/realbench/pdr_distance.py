@@ -5,7 +5,7 @@ For every trace of the floor: import it through the data-set protocol (the ``.lc
 ``OUT/cache``, :func:`.walks.cached_import`), replay it through ``stridefixd --input lcmlog:FILE``,
 read its ``STEP`` messages (``accel_range_mps2`` = vertical acceleration amax − amin over the step) and
 the ``TRUTH`` waypoints. Segments, Weinberg sums and the leave-one-walk-out calibrations are
-:mod:`.strides`: K_i from every *other* walk of the floor, PDR distance = K_i · W, error % =
+:mod:`stridefix_analyzer.radiomap.strides`: K_i from every *other* walk of the floor, PDR distance = K_i · W, error % =
 100 |PDR − true| / true; baseline: a fixed stride (median true / n_steps of the other walks) × n_steps;
 also reported: the firmware's own ``length_m`` sum as configured.
 
@@ -37,9 +37,7 @@ from stridefix_analyzer.firmware import Firmware, FirmwareError
 from stridefix_analyzer.io.jsonio import json_ready
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, Table, read_logs
 from stridefix_analyzer.parallel import WorkerFiles, is_remote, task_runner
-
-from stridefix_lab.realbench.pdr_plot import plot_pdr_distance
-from stridefix_lab.realbench.strides import (
+from stridefix_analyzer.radiomap.strides import (
     DEFAULT_MIN_SEGMENT_M,
     IMU_COVER_TOLERANCE_S,
     SUSPECT_SLOW_MPS,
@@ -50,7 +48,9 @@ from stridefix_lab.realbench.strides import (
     spread,
     stride_lowo,
 )
-from stridefix_lab.realbench.strides import error_stats as error_stats
+from stridefix_analyzer.radiomap.strides import error_stats as error_stats
+
+from stridefix_lab.realbench.pdr_plot import plot_pdr_distance
 from stridefix_lab.realbench.walks import cached_import, dataset, find_groups, firmware, new_walk
 
 #: The data set whose floors this benchmark reads.

@@ -30,9 +30,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+from stridefix_analyzer.radiomap.heading import is_straight
 from stridefix_analyzer.scoring.metrics import wrap_pi
-
-from stridefix_lab.realbench.heading import is_straight
 
 #: a segment shorter than this [m] has no usable direction (waypoint spacing in the IPIN logs: ~5–20 m)
 MIN_SEGMENT_M = 3.0

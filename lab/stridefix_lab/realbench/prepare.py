@@ -3,7 +3,7 @@
 
 From that replay and the walk's own log: the walk-mode radio-map sums
 (:class:`~stridefix_analyzer.radiomap.build.WalkStats`), the Weinberg segment inputs of
-:mod:`.strides`, the heading-offset sums of every heading candidate (:func:`.heading.rotation_stats`;
+:mod:`stridefix_analyzer.radiomap.strides`, the heading-offset sums of every heading candidate (:func:`stridefix_analyzer.radiomap.heading.rotation_stats`;
 the walk is replayed once per candidate) and the barometric height of each truth floor. The walk's
 raw sensors, read once more through the data set, give the textbook references their inputs
 (:func:`.reference.track_of`).
@@ -21,9 +21,9 @@ import numpy as np
 from stridefix_analyzer.datasets.protocol import Dataset
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
+from stridefix_analyzer.radiomap.heading import rotation_stats
 
 from stridefix_lab.realbench.floors import floor_heights_of_walk
-from stridefix_lab.realbench.heading import rotation_stats
 from stridefix_lab.realbench.reference_sensors import track_of
 from stridefix_lab.realbench.walks import cached_import, new_walk
 
@@ -52,10 +52,10 @@ def prepare(job: PrepareJob) -> dict[str, Any]:
     Returns
     -------
     dict
-        The keys :func:`.strides.build_segments` reads (``walk``, ``import``, ``error``,
+        The keys :func:`stridefix_analyzer.radiomap.strides.build_segments` reads (``walk``, ``import``, ``error``,
         ``waypoint_t_us``, ``waypoint_xy_m``, ``step_t_us``, ``step_range_mps2``,
         ``step_length_m``), plus ``stats`` (WalkStats), ``rotation`` (per heading candidate,
-        :func:`.heading.rotation_stats`), ``floor_heights``, ``floors`` (truth floors),
+        :func:`stridefix_analyzer.radiomap.heading.rotation_stats`), ``floor_heights``, ``floors`` (truth floors),
         ``first_waypoint`` (t_us, x, y, floor), ``import_log``, ``fw_log`` (the site-less replay) and
         ``ble_placed`` (the BLE readings placed on the truth,
         :func:`~stridefix_analyzer.radiomap.beacons.place_readings`) and ``reference`` (the textbook

@@ -7,7 +7,7 @@ the training walks is the prior the ``ekf`` should start with (``firmware/core/s
 of the firmware's "unknown" defaults, which fit a unit in the field that has no training walks:
 
 * ``ekf.init_bias_sigma_rad``: the circular standard deviation √(−2 ln R̄) of the per-walk heading
-  offsets (STEP heading − truth direction over straight segments, :func:`.heading.rotation_stats`),
+  offsets (STEP heading − truth direction over straight segments, :func:`stridefix_analyzer.radiomap.heading.rotation_stats`),
   R̄ the mean resultant length of one unit vector per walk;
 * ``ekf.init_scale_sigma``: the relative standard deviation of the per-walk K (Σ true distance /
   Σ Weinberg term over the walk's scored segments);

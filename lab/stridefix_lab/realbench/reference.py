@@ -32,11 +32,11 @@ from typing import Any
 
 import numpy as np
 from stridefix_analyzer.io.logread import Table
+from stridefix_analyzer.radiomap.strides import WEINBERG_EXPONENT
 from stridefix_analyzer.scoring.metrics import wrap_pi
 
 from stridefix_lab.realbench.floors import DEFAULT_STOREY_M
 from stridefix_lab.realbench.reference_sensors import Fingerprints, Track, weinberg_k
-from stridefix_lab.realbench.strides import WEINBERG_EXPONENT
 
 REFERENCE_PDR, REFERENCE_EKF = "reference_pdr", "reference_ekf"
 NAMES = (REFERENCE_PDR, REFERENCE_EKF)

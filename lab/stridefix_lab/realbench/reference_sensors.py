@@ -14,7 +14,7 @@ Per walk (:func:`track_of`, phase 1 of ``realbench fusion``):
 * height = the barometric formula on the pressure (:func:`.floors.pressure_to_height_m`).
 
 Per fold, from the training walks: the Weinberg K = Σ true / Σ range^¼ over their waypoint segments
-(:func:`weinberg_k`: :func:`.strides.build_segments` and :func:`.strides.stride_k`, the functions the
+(:func:`weinberg_k`: :func:`stridefix_analyzer.radiomap.strides.build_segments` and :func:`stridefix_analyzer.radiomap.strides.stride_k`, the functions the
 firmware's K comes from, on these steps) and a WkNN fingerprint map (Bahl & Padmanabhan 2000, RADAR) of
 their raw scans at their truth positions, linear in time between truth points (:class:`Fingerprints`: k =
 :data:`WKNN_K`, Euclidean distance in dBm with :data:`MISSING_DBM` for an AP one side did not hear,
@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 from stridefix_analyzer.datasets.rawwalk import RawWalk
 from stridefix_analyzer.io.logread import Table
+from stridefix_analyzer.radiomap.strides import build_segments, stride_k
 
 from stridefix_lab.realbench.floors import pressure_to_height_m
-from stridefix_lab.realbench.strides import build_segments, stride_k
 
 G_MPS2 = 9.80665
 #: gravity = accelerometer low-passed over a few gait cycles (a step lasts ~0.5 s) [s]
@@ -67,7 +67,7 @@ class Track:
     truth: Table  # t_us, x_m, y_m, floor
 
     def segments_input(self) -> dict[str, Any]:
-        """This walk as :func:`.strides.build_segments` reads it."""
+        """This walk as :func:`stridefix_analyzer.radiomap.strides.build_segments` reads it."""
         tr, n = self.truth, len(self.step_t_us)
         return {
             "walk": "",
@@ -178,7 +178,7 @@ def track_of(raw: RawWalk) -> Track:
 
 
 def weinberg_k(training: Sequence[Track]) -> float:
-    """K = Σ true distance / Σ range^¼ over the training walks' scored waypoint segments (:mod:`.strides`)."""
+    """K = Σ true distance / Σ range^¼ over the training walks' scored waypoint segments (:mod:`stridefix_analyzer.radiomap.strides`)."""
     seg = build_segments([tr.segments_input() for tr in training])
     return stride_k(seg, seg["excluded"] == "")
 

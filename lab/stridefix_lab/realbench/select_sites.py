@@ -18,12 +18,12 @@ from typing import Any
 import numpy as np
 from stridefix_analyzer.io.logread import Table
 from stridefix_analyzer.radiomap.build import WalkStats
+from stridefix_analyzer.radiomap.heading import RotationSums, learn_heading
+from stridefix_analyzer.radiomap.strides import stride_k
 
 from stridefix_lab.realbench.floors import fold_floors
 from stridefix_lab.realbench.fold import fold_site
-from stridefix_lab.realbench.heading import RotationSums, learn_heading
 from stridefix_lab.realbench.sitecontent import GroupContent, apply_fields
-from stridefix_lab.realbench.strides import stride_k
 
 
 @dataclasses.dataclass
@@ -32,7 +32,7 @@ class SelectionSites:
 
     total: WalkStats
     walks: Sequence[Mapping[str, Any]]  # the group's prepared walks
-    seg: Table  # their segments (:func:`.strides.build_segments`) and which are scored
+    seg: Table  # their segments (:func:`stridefix_analyzer.radiomap.strides.build_segments`) and which are scored
     used: np.ndarray
     rotation: Sequence[Mapping[str, RotationSums]]
     heading_candidates: Mapping[str, Sequence[str]]

@@ -21,12 +21,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 from stridefix_analyzer import schemes
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.radiomap.strides import error_stats, spread
 from stridefix_analyzer.scoring.fixsources import format_fix_sources, merge_fix_source_counts
 from stridefix_analyzer.scoring.metrics import IPIN_FLOOR_PENALTY_M, ipin_score
 
 from stridefix_lab.realbench import reference
 from stridefix_lab.realbench.fold import FoldJob
-from stridefix_lab.realbench.strides import error_stats, spread
 from stridefix_lab.realbench.tuning import Axis
 
 #: a walk whose mean error exceeds this is a failure for the robustness share [m]
@@ -36,7 +36,7 @@ PDR_TRUE_START_LABEL = f"{schemes.PDR_ONLY} (truth-initialised)"
 
 
 def stats_of(errors: ArrayLike) -> dict[str, Any]:
-    """n, mean, median, p75, p90, p95, max (:func:`.strides.error_stats`) and RMSE of the finite
+    """n, mean, median, p75, p90, p95, max (:func:`stridefix_analyzer.radiomap.strides.error_stats`) and RMSE of the finite
     position errors [m] (distances, so never negative)."""
     e = np.asarray(errors, float)
     e = e[np.isfinite(e)]

@@ -8,7 +8,7 @@ sees the prepared walks of one group and returns the candidate of every walk's f
 * ``heading`` (:class:`TruthAgreement`): gait-learned or fixed mounting offset (the wide magnetometer
   gate is no candidate since the attitude acquires its references from quiet samples); the one whose
   STEP headings agree best with the other walks' truth directions
-  (:func:`.heading.choose_heading_variant`). A hand-held phone is not a body-worn board.
+  (:func:`stridefix_analyzer.radiomap.heading.choose_heading_variant`). A hand-held phone is not a body-worn board.
 * ``matcher`` (:class:`InnerCV`, :mod:`.select`): scans averaged (1 or 2) × WkNN representation (dBm
   or "powed"), by cross-validation inside the training walks on the Wi-Fi fix error.
 * ``adaptive`` (:class:`InnerCV`): the adaptive scheme's Wi-Fi accuracy-factor scale, the same way on
@@ -34,15 +34,15 @@ from typing import Any, Protocol, TextIO
 from stridefix_analyzer.console import Progress
 from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.parallel import TaskRunner
-
-from stridefix_lab.realbench import fixmodel, lsd
-from stridefix_lab.realbench import select as rs
-from stridefix_lab.realbench.heading import (
+from stridefix_analyzer.radiomap.heading import (
     HEADING_VARIANTS,
     RotationSums,
     choose_heading_variant,
     learn_heading,
 )
+
+from stridefix_lab.realbench import fixmodel, lsd
+from stridefix_lab.realbench import select as rs
 
 #: the matcher's candidates: scans averaged (1 or 2) × WkNN representation (dBm, or "powed" with beta
 #: 2 or e — Torres-Sospedra 2015's choice)

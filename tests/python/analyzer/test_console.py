@@ -2,7 +2,8 @@
 
 GIVEN a phase of 1,000 steps (realbench's folds of a floor printed a line each), WHEN it runs at a
 verbosity on a stream, THEN -v prints 1,000 lines, the default prints one line off a terminal and one
-updating bar (carriage returns, one final newline) on a terminal, and -q prints nothing.
+updating bar (carriage returns, never a newline: the command's live line, cleared when the command
+ends) on a terminal, and -q prints nothing.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ class Terminal(io.StringIO):
 def level():
     """Sets the verbosity for one test and restores the default after it."""
     yield console.set_level
+    console.end_progress()
     console.set_level(console.NORMAL)
 
 
@@ -51,9 +53,14 @@ def test_default_off_a_terminal_prints_one_line(level):
 
 def test_default_on_a_terminal_draws_one_bar(level):
     level(console.NORMAL)
-    out = _phase(Terminal())
-    assert out.count("\n") == 1 and out.count("\r") >= 2
-    assert "realbench: fold" in out and "1000/1000" in out.rsplit("\r", 1)[-1]
+    stream = Terminal()
+    _phase(stream)
+    drawn = stream.getvalue()
+    console.end_progress()
+    out = stream.getvalue()
+    assert out.count("\n") == 0 and drawn.count("\r") >= 2
+    assert "realbench: fold" in drawn and "1000/1000" in drawn.rsplit("\r", 1)[-1]
+    assert out[len(drawn) :].strip() == ""  # the command's end clears the line
 
 
 @pytest.mark.parametrize("stream", [io.StringIO(), Terminal()], ids=["file", "terminal"])

@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 from stridefix import fix_t, pose_t
 from stridefix_analyzer import schemes
+from stridefix_analyzer.radiomap.strides import spread
 from stridefix_analyzer.scoring.fixsources import (
     METHOD_NAMES,
     REASON_NAMES,
@@ -19,7 +20,6 @@ from stridefix_analyzer.scoring.fixsources import (
 from stridefix_lab.realbench import report as rb_report
 from stridefix_lab.realbench import summary as rb_summary
 from stridefix_lab.realbench import tuning
-from stridefix_lab.realbench.strides import spread
 
 KALMAN, ADAPTIVE = schemes.scheme_code("kalman"), schemes.scheme_code("adaptive")
 

@@ -16,13 +16,13 @@ import pytest
 from numpy.testing import assert_allclose
 from stridefix import pose_t
 from stridefix_analyzer import schemes
+from stridefix_analyzer.radiomap.strides import spread
 from stridefix_analyzer.scoring import report as walk_report
 from stridefix_analyzer.scoring.analyze import format_summary, run_analyze
 from stridefix_lab.bench import fusion as bench_fusion
 from stridefix_lab.realbench import report as rb_report
 from stridefix_lab.realbench import summary as rb_summary
 from stridefix_lab.realbench import tuning
-from stridefix_lab.realbench.strides import spread
 
 FAKE = "fake_ekf"
 

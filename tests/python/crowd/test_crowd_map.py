@@ -21,7 +21,7 @@ from stridefix_analyzer.io.results import (
     read_realbench_results,
 )
 from stridefix_analyzer.io.sitefile import read_site
-from stridefix_lab.realbench.heading import HEADING_VARIANTS
+from stridefix_analyzer.radiomap.heading import HEADING_VARIANTS
 
 MSINDOOR_F2 = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "msindoor" / "site1" / "F2"
 

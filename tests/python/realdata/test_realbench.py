@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from stridefix_analyzer.radiomap import strides
 from stridefix_lab.realbench import pdr_distance as rb
-from stridefix_lab.realbench import strides
 
 # --- calibration and segments on synthetic data ---------------------------------------------------
 

@@ -20,8 +20,9 @@ from stridefix_analyzer import datasets, schemes
 from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 from stridefix_analyzer.io.sitefile import read_site
 from stridefix_analyzer.radiomap import build as rm
+from stridefix_analyzer.radiomap import heading
 from stridefix_lab.realbench import cli as rbcli
-from stridefix_lab.realbench import floors, heading
+from stridefix_lab.realbench import floors
 from stridefix_lab.realbench import fold as rfold
 
 SCHEMES = schemes.NAMES

@@ -1,5 +1,6 @@
 """Stride statistics of real walks: Weinberg sums over the segments between waypoints, and the
-leave-one-walk-out calibrations both realbench benchmarks use.
+calibrations from them: Weinberg K over every walk (:func:`stride_k`, what ``stridefix site`` learns) and
+leave one walk out (:func:`calibrate_lowo`, both realbench benchmarks).
 
 - Segment = two consecutive waypoints k, k+1 of a walk; true distance = the straight line between them
   [m]; Weinberg sum W = Σ range^¼ over the steps with t_k < t_step ≤ t_{k+1}; n_steps = their count.
@@ -17,6 +18,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+
 from stridefix_analyzer.io.logread import Table
 
 DEFAULT_MIN_SEGMENT_M = 3.0

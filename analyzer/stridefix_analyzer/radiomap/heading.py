@@ -1,13 +1,14 @@
 """Heading on real walks: how the STEP headings of a replay agree with the truth directions.
 
-Two things are learned from the training walks of a fold, both from the same sums
+Two things are learned from walks with known points (the training walks of a realbench fold, or the
+walks ``stridefix site`` builds a site from), both from the same sums
 (:func:`rotation_stats`, one set per heading variant the walk was replayed with):
 
 * the map rotation: circular mean of (STEP heading − truth direction) over straight segments
   (:func:`learn_rotation_deg`);
 * the heading variant (gait-learned or fixed mounting offset, :data:`HEADING_VARIANTS`): the
   one whose headings agree best with the truth directions once the rotation is taken out
-  (:func:`choose_heading_variant`; the heading axis of :mod:`.tuning`).
+  (:func:`choose_heading_variant`; the heading axis of the lab's realbench tuning).
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from stridefix_analyzer.firmware import HEADING_VARIANTS  # noqa: F401 - the heading axis's candidates
+
+from stridefix_analyzer.firmware import HEADING_VARIANTS  # noqa: F401 - the heading candidates
 
 #: rotation learning: shortest segment, smallest step-heading resultant length, fewest steps
 ROT_MIN_SEGMENT_M = 4.0
@@ -62,7 +64,7 @@ def rotation_stats(
     dict
         ``sum_cos``, ``sum_sin``, ``n_steps``, ``n_segments`` (add over walks; the rotation is
         atan2(Σsin, Σcos) [rad]), and ``segments``: per segment (distance walked to its middle along
-        the truth [m], its mean heading offset [rad]), for the ekf's bias random walk (:mod:`.priors`).
+        the truth [m], its mean heading offset [rad]), for the ekf's bias random walk (the lab's realbench priors).
     """
     step_t_us, h = np.asarray(step_t_us, np.int64), np.asarray(step_heading_rad, float)
     wp_t_us, wp = np.asarray(wp_t_us, np.int64), np.asarray(wp_xy_m, float).reshape(-1, 2)
