@@ -1,14 +1,12 @@
 /* stridefixd — the StrideFix logger daemon: options, the main loop and the lifecycle.
- *
- * One input (firmware/board/sf_input.h: candump file, stdin, SocketCAN or a raw-sensor LCM log) gives
- * timed samples; each is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch
- * (feed()): every absolute source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes, then the
- * multi-scheme controller's CONTEXT events (drain_contexts); the core's steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
- * optionally, live LCM. Bad input is counted and skipped, never fatal; counts go into HEALTH and the
- * exit summary. The scheme names come from pose_t.SCHEME_* through the core's registry.
- * Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h) and the run closes as at the end of
- * the input; a live input is refused as root (sf_privilege.h); the log file's naming, rotation and
- * durability are sf_lcm_out's and sf_log_file's. */
+ * One input (sf_input.h: candump file, stdin, SocketCAN or a raw-sensor LCM log) gives timed samples; each
+ * is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch (feed()): every absolute
+ * source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes, then the controller's CONTEXT events
+ * (drain_contexts); steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
+ * optionally, live LCM (--speed paces a replay: sf_pace.h). Bad input is counted and skipped, never fatal;
+ * counts go into HEALTH and the exit summary. Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h)
+ * and the run closes as at the end of the input; a live input is refused as root (sf_privilege.h); the
+ * log's naming, rotation and durability are sf_lcm_out's and sf_log_file's. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <inttypes.h>
