@@ -22,6 +22,7 @@ import threading
 from typing import Any
 
 from stridefix_analyzer.io.channels import POSE_CHANNELS
+from stridefix_analyzer.live.guard import HEADER_TIMEOUT_S, HostCheck, exposure_warning, middleware, url_host
 from stridefix_analyzer.live.state import LiveState
 
 PUSH_S = 0.2
@@ -99,8 +100,9 @@ class LcmFeed:
         self.thread.join(timeout=2)
 
 
-def make_app(state: LiveState, lock: threading.Lock) -> Any:
-    """The aiohttp application: ``/`` the page, ``/state`` the snapshot, ``/ws`` the pushes."""
+def make_app(state: LiveState, lock: threading.Lock, check: HostCheck) -> Any:
+    """The aiohttp application: ``/`` the page, ``/state`` the snapshot, ``/ws`` the pushes; only
+    for the names and origins ``check`` allows (:mod:`.guard`)."""
     from aiohttp import WSMsgType, web
 
     from stridefix_analyzer.live.page import PAGE
@@ -139,7 +141,7 @@ def make_app(state: LiveState, lock: threading.Lock) -> Any:
     async def no_icon(_request: web.Request) -> web.Response:
         return web.Response(status=204)  # no icon, and no 404 in the browser's console
 
-    app = web.Application()
+    app = web.Application(middlewares=[middleware(check)])
     app.add_routes(
         [
             web.get("/", page),
@@ -197,23 +199,28 @@ async def serve(lcm_url: str, site: str | None, host: str, port: int, ready: Any
     walls, ports = plan_of(site)
     state, lock = LiveState(walls, source=lcm_url, ports=ports), threading.Lock()
     feed = LcmFeed(lcm_url, state, lock)
-    runner = web.AppRunner(make_app(state, lock), access_log=None)
+    # our own socket: with port 0 the kernel picks a free port, and we can say which (and allow it)
+    sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind((host, port))
+    except OSError as exc:
+        sock.close()
+        raise LiveInputError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from exc
+    bound = sock.getsockname()[1]
+    # keepalive_timeout bounds a connection's wait for a whole request from its start (guard.py)
+    runner = web.AppRunner(
+        make_app(state, lock, HostCheck(host, bound)), access_log=None, keepalive_timeout=HEADER_TIMEOUT_S
+    )
     await runner.setup()
     try:
-        # our own socket: with port 0 the kernel picks a free port, and we can say which
-        sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((host, port))
-        except OSError as exc:
-            sock.close()
-            raise LiveInputError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from exc
-        bound = sock.getsockname()[1]
         await web.SockSite(runner, sock).start()
         feed.start()
-        url = f"http://{host}:{bound}/"
+        warning = exposure_warning(host, bound)
+        if warning:
+            print(warning, file=sys.stderr, flush=True)
         if ready is not None:
-            ready(url)
+            ready(f"http://{url_host(host)}:{bound}/")
         await asyncio.Event().wait()  # until cancelled (Ctrl-C)
     finally:
         feed.stop()
@@ -236,7 +243,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="site file whose walls and ports (doors, stairs, elevators) are the floor plan",
     )
     p.add_argument(
-        "--host", default="127.0.0.1", help="address to serve on (default: 127.0.0.1, this machine only)"
+        "--host",
+        default="127.0.0.1",
+        help="address to serve on (default: 127.0.0.1, this machine only; any other "
+        "address lets whoever reaches it read the walk: a warning says so)",
     )
     p.add_argument(
         "--port",
