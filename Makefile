@@ -195,6 +195,7 @@ check-fuzz: deps
 
 fuzz: deps
 	$(call run_fuzzers,$(FUZZ_SECONDS))
+	STRIDEFIX_LIVE_FUZZ_SECONDS=$(FUZZ_SECONDS) $(PY) -m pytest -q -s -p no:cacheprovider tests/python/live/test_live_fuzz.py -k budget
 
 clean:
 	rm -rf $(BUILD) build-clang build-asan build-fuzz $(ARM_BUILD) out

@@ -8,7 +8,9 @@ was pressed), each in its registry colour; x/y axes in metres with ticks and a s
 per scheme shows or hides its track (the primary pose's stays on); the wheel or the +/- buttons zoom
 (about the cursor, or the centre), dragging pans, "fit" shows everything again. Beside the map: the
 primary's floor and scheme, the step count, the FIX verdicts per scheme and source, the latest fix
-records, the HEALTH counters and the context. Element ids (``status``, ``floor``, ``steps``,
+records, the HEALTH counters and the context; the messages skipped as undecodable (``bad``). A value
+the server sends as null (it was NaN or infinite) shows as "–". Element ids (``status``, ``bad``,
+``floor``, ``steps``,
 ``primary``, ``schemes``, ``toggles``, ``zoom-in``, ``zoom-out``, ``zoom-fit``, ``scale-label``,
 ``fix-table``, ``recent-fixes``, ``health-table``, ``context``, ``map``) are what the browser test
 reads; after each drawing the map's ``data-`` attributes say what it drew (``tracks``: the schemes,
@@ -35,7 +37,8 @@ th { background: #f4f4f4; } td.k { text-align: left; }
 </style></head>
 <body>
 <h1>StrideFix live</h1>
-<div class="note">source <span id="source">?</span> · <span id="status">connecting</span> · walk time <span id="time">–</span></div>
+<div class="note">source <span id="source">?</span> · <span id="status">connecting</span> · walk time <span id="time">–</span>
+ · <span id="bad" title="messages that could not be decoded, skipped">0</span> bad messages</div>
 <div id="wrap">
  <div><div id="floors"></div>
   <div id="controls"><button id="zoom-out" title="zoom out">−</button> <button id="zoom-in" title="zoom in">+</button>
@@ -195,7 +198,7 @@ function draw() {
     const primary = s.name === primaryName();
     line(s.track, s.colour, primary ? 2.6 : 1.6, 0.9);
     drawn.push(s.name);
-    if (s.last && s.last.floor === fl) {
+    if (s.last && s.last.floor === fl && Number.isFinite(s.last.x_m) && Number.isFinite(s.last.y_m)) {
       g.fillStyle = s.colour; g.beginPath(); g.arc(X(s.last.x_m), Y(s.last.y_m), primary ? 7 : 5, 0, 2 * Math.PI); g.fill();
     }
   }
@@ -257,6 +260,7 @@ function tables() {
   const d = S.doc;
   $("source").textContent = d.source;
   $("status").textContent = d.ended ? "log ended" : "live";
+  $("bad").textContent = d.bad_messages;
   $("time").textContent = d.t_us === null ? "–" : fmt(d.t_us / 1e6, 1) + " s";
   $("steps").textContent = d.steps;
   $("floor").textContent = d.primary ? d.primary.floor : "–";

@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
-import json
 import socket
 import sys
 import threading
@@ -23,7 +22,7 @@ from typing import Any
 
 from stridefix_analyzer.io.channels import POSE_CHANNELS
 from stridefix_analyzer.live.guard import HEADER_TIMEOUT_S, HostCheck, exposure_warning, middleware, url_host
-from stridefix_analyzer.live.state import LiveState
+from stridefix_analyzer.live.state import LiveState, to_json
 
 PUSH_S = 0.2
 DEFAULT_PORT = 8765
@@ -33,12 +32,6 @@ SUBSCRIBE = "|".join(sorted(POSE_CHANNELS | {"STEP", "FIX", "HEALTH", "CONTEXT",
 
 class LiveInputError(ValueError):
     """The LCM URL or the site cannot be used (the message says which and why)."""
-
-
-def _decoder(channel: str) -> Any:
-    from stridefix_analyzer.io.channels import CHANNELS
-
-    return CHANNELS[channel].msg_type if channel in CHANNELS else None
 
 
 #: the kernel receive buffer asked for on a udpm:// URL that names none [bytes] (capped by the kernel's
@@ -66,22 +59,13 @@ class LcmFeed:
         except (OSError, RuntimeError, ValueError) as exc:
             raise LiveInputError(f"--lcm-url {lcm_url}: cannot open LCM: {exc}") from exc
         self.state, self.lock = state, lock
-        self.decode_errors = 0
         self._stop = threading.Event()
         self.lc.subscribe(SUBSCRIBE, self._on_message)
         self.thread = threading.Thread(target=self._run, name="lcm-feed", daemon=True)
 
     def _on_message(self, channel: str, data: bytes) -> None:
-        msg_type = _decoder(channel)
-        if msg_type is None:
-            return
-        try:
-            msg = msg_type.decode(data)
-        except (ValueError, IndexError, UnicodeDecodeError):
-            self.decode_errors += 1  # a bad message is counted and skipped
-            return
         with self.lock:
-            self.state.add(channel, msg)
+            self.state.fold(channel, data)  # a bad message is counted and skipped
 
     def _run(self) -> None:
         while not self._stop.is_set():
@@ -113,7 +97,7 @@ def make_app(state: LiveState, lock: threading.Lock, check: HostCheck) -> Any:
     async def snapshot(_request: web.Request) -> web.Response:
         with lock:
             doc = state.snapshot()
-        return web.json_response(doc)
+        return web.json_response(doc, dumps=to_json)
 
     async def ws(request: web.Request) -> web.WebSocketResponse:
         sock = web.WebSocketResponse(heartbeat=10)
@@ -127,7 +111,7 @@ def make_app(state: LiveState, lock: threading.Lock, check: HostCheck) -> Any:
                     doc = state.snapshot(sent) if state.version != version or state.ended else None
                     version = state.version
                 if doc is not None:
-                    await sock.send_str(json.dumps(doc, allow_nan=False, default=str))
+                    await sock.send_str(to_json(doc))
                 done, _ = await asyncio.wait({reader}, timeout=PUSH_S)
                 if done:
                     msg = reader.result()

@@ -14,17 +14,25 @@ channel's latest once per-scheme channels are seen (POSE then carries the primar
 that carries every scheme on POSE, the latest of the scheme first in the analyzer's fallback order
 (:func:`~stridefix_analyzer.scoring.primary.fallback_rank`; a live view cannot count messages still
 to come).
+
+Bad data is counted and skipped, never fatal: a message its type cannot decode (cut short, another
+type's fingerprint, bad UTF-8) counts in ``bad_messages`` (:meth:`LiveState.fold`), and a NaN or
+infinite value is held as ``None`` (JSON ``null``: the page shows "–"; a track point without a finite
+position is left out), so the snapshot is always strict JSON (:func:`to_json`).
 """
 
 from __future__ import annotations
 
 import collections
 import dataclasses
+import json
+import math
+import struct
 from typing import Any
 
 from stridefix import pose_t
 
-from stridefix_analyzer.io.channels import POSE, POSE_CHANNELS
+from stridefix_analyzer.io.channels import CHANNELS, POSE, POSE_CHANNELS
 from stridefix_analyzer.schemes import UnknownSchemeError, scheme_colour, scheme_name
 from stridefix_analyzer.scoring.fixsources import method_name, reason_name
 from stridefix_analyzer.scoring.primary import fallback_rank
@@ -35,6 +43,8 @@ RECENT_FIXES = 12
 #: the truth track's key among the schemes' in a client's ``sent`` record
 TRUTH_KEY = -1
 SCHEME_CONTROLLER = pose_t.SCHEME_CONTROLLER
+#: what LCM's generated decode raises on bytes that are not a message of its type
+DECODE_ERRORS = (ValueError, IndexError, UnicodeDecodeError, struct.error)
 
 
 @dataclasses.dataclass
@@ -48,12 +58,14 @@ class _Scheme:
     epoch: int = 0  # grows when the track is thinned: a client holding its points starts again
     poses: int = 0
 
-    def append(self, t_us: int, point: tuple[float, float, int]) -> None:
+    def append(self, t_us: int, x_m: float | None, y_m: float | None, floor: int) -> None:
         """Keep a point every ``every_us`` of walk time; past TRACK_MAX points, every other one
-        and twice the interval (a fixed cost for any walk length)."""
+        and twice the interval (a fixed cost for any walk length). No point without a position."""
+        if x_m is None or y_m is None:
+            return
         if self.last_track_t_us is not None and t_us - self.last_track_t_us < self.every_us:
             return
-        self.track.append(point)
+        self.track.append((round(x_m, 3), round(y_m, 3), floor))
         self.last_track_t_us = t_us
         if len(self.track) >= TRACK_MAX:
             self.track = self.track[::2]
@@ -61,14 +73,20 @@ class _Scheme:
             self.epoch += 1
 
 
+def _num(v: float) -> float | None:
+    """``v`` as a float, ``None`` when it is NaN or infinite (JSON has neither)."""
+    f = float(v)
+    return f if math.isfinite(f) else None
+
+
 def _pose_fields(m: Any) -> dict[str, Any]:
     return {
         "t_us": int(m.t_us),
-        "x_m": float(m.x_m),
-        "y_m": float(m.y_m),
+        "x_m": _num(m.x_m),
+        "y_m": _num(m.y_m),
         "floor": int(m.floor),
-        "heading_rad": float(m.heading_rad),
-        "sigma_m": float(m.sigma_m),
+        "heading_rad": _num(m.heading_rad),
+        "sigma_m": _num(m.sigma_m),
         "step_count": int(m.step_count),
     }
 
@@ -87,6 +105,7 @@ class LiveState:
         self.ports = ports or []
         self.source = source
         self.version = 0
+        self.bad_messages = 0  # undecodable messages, skipped
         self.messages: collections.Counter[str] = collections.Counter()
         self.schemes: dict[int, _Scheme] = {}
         self.primary: dict[str, Any] | None = None
@@ -109,6 +128,21 @@ class LiveState:
             self.schemes[code] = _Scheme(self._scheme_name(code), colour)
         return self.schemes[code]
 
+    def fold(self, channel: str, data: bytes) -> bool:
+        """Decode ``data`` with ``channel``'s type (the channel table) and fold it in; a message that
+        does not decode is counted in ``bad_messages`` and skipped (False). A channel without a type
+        is ignored (False)."""
+        if channel not in CHANNELS:
+            return False
+        try:
+            msg = CHANNELS[channel].msg_type.decode(data)
+        except DECODE_ERRORS:
+            self.bad_messages += 1
+            self.version += 1
+            return False
+        self.add(channel, msg)
+        return True
+
     def add(self, channel: str, msg: Any) -> None:
         """Fold one decoded message of ``channel`` into the view."""
         self.version += 1
@@ -127,9 +161,7 @@ class LiveState:
         elif channel == "CONTEXT":
             self.context = {f: _plain(getattr(msg, f)) for f in msg.__slots__}
         elif channel == "TRUTH":
-            self.truth.append(
-                int(msg.t_us), (round(float(msg.x_m), 3), round(float(msg.y_m), 3), int(msg.floor))
-            )
+            self.truth.append(int(msg.t_us), _num(msg.x_m), _num(msg.y_m), int(msg.floor))
 
     def _pose(self, channel: str, m: Any) -> None:
         code = int(m.scheme)
@@ -143,7 +175,7 @@ class LiveState:
         if channel != POSE or code == SCHEME_CONTROLLER or not self.per_scheme_channels:
             s = self._scheme(code)
             s.last, s.poses = p, s.poses + 1
-            s.append(p["t_us"], (round(p["x_m"], 3), round(p["y_m"], 3), p["floor"]))
+            s.append(p["t_us"], p["x_m"], p["y_m"], p["floor"])
         if channel != POSE:
             return
         name = self._scheme_name(code)
@@ -178,8 +210,8 @@ class LiveState:
                 "method": method,
                 "accepted": bool(m.accepted),
                 "reason": reason_name(int(m.reason)),
-                "test_ratio": float(m.test_ratio),
-                "alpha": float(m.alpha),
+                "test_ratio": _num(m.test_ratio),
+                "alpha": _num(m.alpha),
             }
         )
 
@@ -200,6 +232,7 @@ class LiveState:
             "ended": self.ended,
             "t_us": self.last_t_us,
             "messages": dict(self.messages),
+            "bad_messages": self.bad_messages,
             "steps": self.steps,
             "primary": self.primary,
             "schemes": [
@@ -224,9 +257,23 @@ class LiveState:
         }
 
 
+def to_json(doc: Any) -> str:
+    """``doc`` (a snapshot) as strict JSON: any NaN or infinite float still in it becomes null."""
+    try:
+        return json.dumps(doc, allow_nan=False)
+    except ValueError:  # a value folded without _num: still no NaN on the wire
+        return json.dumps(_plain(doc), allow_nan=False)
+
+
 def _plain(v: Any) -> Any:
-    if isinstance(v, (bool, int, float, str)) or v is None:
+    """``v`` JSON-ready: non-finite floats as None, sequences as lists, mappings with their keys,
+    anything else as its text."""
+    if isinstance(v, float):
+        return _num(v)
+    if isinstance(v, (bool, int, str)) or v is None:
         return v
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
         return [_plain(x) for x in v]
     return str(v)
