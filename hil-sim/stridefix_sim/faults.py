@@ -219,7 +219,9 @@ def board_time_sent(clock: BoardClock, t_ms: np.ndarray, f: dict | None, rec: Fa
     return sent
 
 
-def imu_failed(db, t_ms: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: dict | None, rec: FaultRecord) -> None:
+def imu_failed(
+    db, t_ms: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: dict | None, rec: FaultRecord
+) -> None:
     """Sets the IMU samples (rows of ``acc`` [m/s²] and ``gyr`` [deg/s], taken at simulated ``t_ms``)
     inside an ``imu_failed_at_s`` window to full scale in place: each axis at its signal's maximum,
     which the board encodes as the largest raw value."""
