@@ -1,7 +1,8 @@
 """The firmware survives bus and board faults, end to end: a 90 s SIL walk from the
 simulator's fault injector through the real stridefixd, without a site (PDR alone, so nothing can hide a
 lost step). Each fault costs only the frames it touches: steps and PDR error stay with the clean run's,
-the walk carries on to its end, and the fault's own HEALTH counter moves. (`make reliability` is the
+the walk carries on to its end, and the fault's own HEALTH counter moves. A failed IMU costs the walk's
+steps from then on, and nothing else: the daemon logs on to the end. (`make reliability` is the
 full-length table; this is its regression test.)"""
 
 from __future__ import annotations
