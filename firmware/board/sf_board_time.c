@@ -87,6 +87,21 @@ static bool agrees(const int64_t ref_ms, const int64_t ref_host_us, const uint32
     return t >= ref_ms - AGREE_EARLY_MS && t <= ref_ms + e + (int64_t)(AGREE_DRIFT * (double)e) + AGREE_LATE_MS;
 }
 
+/* Whether a BOARD_TIME received at host_us confirms the held one: it agrees with it and has moved on
+ * with the host time since, less drift and jitter. A board clock counts; a stuck BOARD_TIME repeats
+ * its value second after second while the samples go on, and believing it would restart every
+ * stream at a stale time (and its return as an outage). A frame the bus repeated (no host time
+ * between) confirms as before. */
+static bool confirms_held(const sf_board_time_held_t *const h, const uint32_t time_ms, const int64_t host_us,
+                          int64_t *const t_ms)
+{
+    if (!agrees((int64_t)h->time_ms, h->host_t_us, time_ms, host_us, t_ms)) {
+        return false;
+    }
+    const int64_t e = elapsed_ms(h->host_t_us, host_us);
+    return *t_ms >= (int64_t)h->time_ms + e - (int64_t)(AGREE_DRIFT * (double)e) - AGREE_EARLY_MS;
+}
+
 static void note(sf_board_clock_t *const c, const int64_t t_ms, const int64_t host_us)
 {
     if (t_ms >= c->latest_ms) {
@@ -153,8 +168,7 @@ sf_board_time_verdict_t sf_board_clock_on_time(sf_board_clock_t *const c, const 
         anchor(c, t, host_t_us);
         return sf_board_time_believed;
     }
-    if (c->held.valid && boot_id == c->held.boot_id &&
-        agrees((int64_t)c->held.time_ms, c->held.host_t_us, time_ms, host_t_us, &t)) {
+    if (c->held.valid && boot_id == c->held.boot_id && confirms_held(&c->held, time_ms, host_t_us, &t)) {
         const sf_board_time_verdict_t v = believe_held(c);
         anchor(c, v == sf_board_time_restart ? t : snap(c->latest_ms, time_ms, 32), host_t_us); /* and this frame */
         return v;

@@ -21,9 +21,12 @@
  * The clock believes a BOARD_TIME that agrees with what it knows (the same boot id, and a time
  * between 500 ms before the newest board time seen and the host time elapsed since, +10 %, +1 s).
  * Any other BOARD_TIME is held, not believed on one frame (a bit flip would otherwise move every
- * stream): the next BOARD_TIME that agrees with the held one, or (for a new boot id) a stream sample
- * that restarts its sequence (seq < 16) at the held time and does not fit its old stream, confirms
- * it. A confirmed
+ * stream): the next BOARD_TIME that agrees with the held one and has moved on from it by the host
+ * time since (less 10 % and 500 ms), or (for a new boot id) a stream sample that restarts its
+ * sequence (seq < 16) at the held time and does not fit its old stream, confirms it. A stuck
+ * BOARD_TIME (one value repeated while the samples go on) therefore never confirms itself: each
+ * frame is held, counted as not believed when the next replaces it, and the streams go on by their
+ * seq and t_lo, so output time keeps following the samples through it and after. A confirmed
  * new boot id, or a same-boot time that went backwards, is a board restart: a new epoch begins,
  * every stream restarts, and the output time base is re-anchored so that output time goes on from
  * the last output time plus the host time that passed (output = board time + offset_ms; the offset

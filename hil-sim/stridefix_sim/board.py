@@ -17,8 +17,9 @@ arrives at least one frame time after the previous one (timestamps never decreas
 (``can.loss_rate``, seeded) models frames lost between board and logger: the board sent them (n_ap
 counts every AP frame sent), the log lacks them, the counters report what the log holds. The very first
 BOARD_TIME frame is never dropped so that a log always starts with the time reference. The
-``[faults]`` table adds board resets, implausible samples and bus faults (``faults.py``): resets
-through the board clock that ``_events`` uses for every time and counter, the rest on the ordered
+``[faults]`` table adds board resets, a stuck BOARD_TIME, a failed IMU, implausible samples and bus
+faults (``faults.py``): resets through the board clock that ``_events`` uses for every time and
+counter, the stuck BOARD_TIME and the failed IMU on what ``_events`` sends, the rest on the ordered
 frames; with every fault off none of it runs.
 
 Values are clamped into each signal's DBC range, then encoded per message type at once with numpy
@@ -139,7 +140,9 @@ def _events(
 
     t, seg = clock.periodic(0, 1000, duration_ms)
     boot = np.asarray(clock.boot_ids, dtype=np.int64)[seg] if clock.resets else clock.boot_ids[0]
-    ev.add("BOARD_TIME", t, P_TIME, pack(msgs["BOARD_TIME"], {"time_ms": clock.board_ms(t), "boot_id": boot}))
+    fc = sc.get("faults")
+    time_ms = flt.board_time_sent(clock, t, fc, rec)
+    ev.add("BOARD_TIME", t, P_TIME, pack(msgs["BOARD_TIME"], {"time_ms": time_ms, "boot_id": boot}))
 
     def sent(t: np.ndarray, *cols: np.ndarray, frames: int = 1) -> tuple:
         """(t, seq, t_lo_ms, cols) of the samples a sending boot took (all of them without resets);
@@ -153,6 +156,7 @@ def _events(
         return (t, clock.counter(seg) % 256, clock.board_ms(t, seg) % 256, *(c[ok] for c in cols))
 
     t, seq, lo, acc, gyr = sent(np.arange(n_imu, dtype=np.int64) * IMU_PERIOD_MS, acc, gyr, frames=2)
+    flt.imu_failed(db, t, acc, gyr, fc, rec)
     i = np.arange(len(t), dtype=np.int64)
     base = ev.reserve(2 * len(t))  # ACCEL and GYRO of a sample alternate
     ev.add(

@@ -9,6 +9,11 @@ Two kinds, applied at two places of ``board.py``:
   scan that a reset interrupts is never sent. An implausible sample (``implausible_at_s``,
   ``implausible_rate``) is one IMU frame whose ``implausible_signal`` is wrong: its sign bit flipped
   (``bitflip``: one bit, accel_z 9.8 → −147 m/s², inside the int16 range) or set to full scale.
+  A stuck board clock (``board_time_stuck_at_s``, ``board_time_stuck_s``): for that long every
+  BOARD_TIME carries the board time of the window's start (same boot id) while the samples' seq and
+  t_lo go on. A failed IMU (``imu_failed_at_s``, ``imu_failed_s``): for that long every IMU_ACCEL and
+  IMU_GYRO signal reads full scale, the largest raw value the DBC gives it (the signals are integers:
+  NaN or inf cannot be sent, a saturated or disconnected sensor reads its rail), seq and t_lo go on.
 * bus faults change what the logger receives of what the board sent: loss bursts (``burst_rate``
   per frame, ``burst_frames`` long), silence windows (``silence_at_s``, ``silence_s``: no frame
   arrives), payload corruption (``corrupt_rate``: ``corrupt_bits`` distinct random bits of the
@@ -39,6 +44,7 @@ IMPLAUSIBLE_SIGNALS = {
     "gyro_z": "IMU_GYRO",
 }
 IMPLAUSIBLE_MODES = ("bitflip", "full_scale")
+WINDOW_MAX_S = 86_400  # the longest fault window [s] (a day: "until the walk ends")
 
 
 def faults_on(f: dict) -> bool:
@@ -52,7 +58,51 @@ def faults_on(f: dict) -> bool:
         or f["silence_at_s"]
         or f["reset_at_s"]
         or f["implausible_at_s"]
+        or f["board_time_stuck_at_s"]
+        or f["imu_failed_at_s"]
     )
+
+
+def validate(f: dict, check) -> None:
+    """Checks the ``[faults]`` table; ``check(ok, key, message)`` reports a bad value by its key."""
+    for key in ("burst_rate", "duplicate_rate", "reorder_rate", "corrupt_rate", "implausible_rate"):
+        check(0 <= f[key] < 1, f"faults.{key}", "must be in 0..1")
+    check(1 <= f["burst_frames"] <= 10_000, "faults.burst_frames", "must be in 1..10000")
+    check(1 <= f["reorder_frames"] <= 100, "faults.reorder_frames", "must be in 1..100")
+    check(1 <= f["corrupt_bits"] <= 64, "faults.corrupt_bits", "must be in 1..64")
+    check(0 < f["silence_s"] <= 3600, "faults.silence_s", "must be in 0..3600 (> 0)")
+    for key in ("board_time_stuck_s", "imu_failed_s"):
+        check(0 < f[key] <= WINDOW_MAX_S, f"faults.{key}", f"must be in 0..{WINDOW_MAX_S} (> 0)")
+    check(0 <= f["reset_down_ms"] <= 60_000, "faults.reset_down_ms", "must be in 0..60000")
+    check(0 <= f["reset_time_start_ms"] < 2**32, "faults.reset_time_start_ms", "must be in 0..2**32-1")
+    for key in ("silence_at_s", "reset_at_s", "implausible_at_s", "board_time_stuck_at_s", "imu_failed_at_s"):
+        check(all(v >= 0 for v in f[key]), f"faults.{key}", "must hold times >= 0")
+    resets = sorted(f["reset_at_s"])
+    check(
+        all(b - a > f["reset_down_ms"] / 1000 for a, b in zip(resets, resets[1:])),
+        "faults.reset_at_s",
+        "must be further apart than faults.reset_down_ms",
+    )
+    check(
+        f["implausible_signal"] in IMPLAUSIBLE_SIGNALS,
+        "faults.implausible_signal",
+        f"must be one of {', '.join(IMPLAUSIBLE_SIGNALS)}",
+    )
+    check(
+        f["implausible_mode"] in IMPLAUSIBLE_MODES,
+        "faults.implausible_mode",
+        f"must be one of {', '.join(IMPLAUSIBLE_MODES)}",
+    )
+
+
+def windows(t_ms: np.ndarray, starts_s: Sequence[float], length_s: float) -> np.ndarray:
+    """Whether each simulated time [ms] lies in one of the windows [start, start + length)."""
+    t = np.asarray(t_ms, dtype=np.int64)
+    inside = np.zeros(len(t), dtype=bool)
+    for at_s in starts_s:
+        t0 = round(float(at_s) * 1000)
+        inside |= (t >= t0) & (t < t0 + round(float(length_s) * 1000))
+    return inside
 
 
 @dataclasses.dataclass
@@ -64,6 +114,8 @@ class FaultRecord:
     unsent_reset: int = 0  # frames the board did not send while it rebooted
     scans_lost_reset: int = 0  # Wi-Fi scans a reset interrupted (none of their frames is sent)
     implausible: int = 0
+    board_time_stuck: int = 0  # BOARD_TIME frames sent with a stale time
+    imu_failed: int = 0  # IMU_ACCEL and IMU_GYRO frames sent at full scale
     lost_random: int = 0
     lost_burst: int = 0
     lost_silence: int = 0
@@ -82,6 +134,8 @@ class FaultRecord:
             self.frames_lost
             + self.unsent_reset
             + self.implausible
+            + self.board_time_stuck
+            + self.imu_failed
             + self.corrupted
             + self.duplicated
             + self.reordered
@@ -146,6 +200,41 @@ class BoardClock:
         return np.concatenate(ts), np.concatenate(segs)
 
 
+def board_time_sent(clock: BoardClock, t_ms: np.ndarray, f: dict | None, rec: FaultRecord) -> np.ndarray:
+    """The uint32 time_ms of each BOARD_TIME sent at simulated ``t_ms``: the board time, but inside a
+    ``board_time_stuck_at_s`` window the board time of the window's start (the stale value repeats
+    while the boot that was running at the start goes on)."""
+    t = np.asarray(t_ms, dtype=np.int64)
+    seg = clock.segment(t)
+    sent = clock.board_ms(t, seg)
+    if not f or not f["board_time_stuck_at_s"]:
+        return sent
+    true = sent.copy()
+    for at_s in f["board_time_stuck_at_s"]:
+        t0 = np.array([round(float(at_s) * 1000)], dtype=np.int64)
+        seg0 = clock.segment(t0)
+        inside = windows(t, [at_s], f["board_time_stuck_s"]) & (seg == seg0[0])
+        sent = np.where(inside, clock.board_ms(t0, seg0)[0], sent)
+    rec.board_time_stuck += int(np.sum(sent != true))
+    return sent
+
+
+def imu_failed(
+    db, t_ms: np.ndarray, acc: np.ndarray, gyr: np.ndarray, f: dict | None, rec: FaultRecord
+) -> None:
+    """Sets the IMU samples (rows of ``acc`` [m/s²] and ``gyr`` [deg/s], taken at simulated ``t_ms``)
+    inside an ``imu_failed_at_s`` window to full scale in place: each axis at its signal's maximum,
+    which the board encodes as the largest raw value."""
+    if not f or not f["imu_failed_at_s"]:
+        return
+    bad = windows(t_ms, f["imu_failed_at_s"], f["imu_failed_s"])
+    for values, msg_name, prefix in ((acc, "IMU_ACCEL", "accel"), (gyr, "IMU_GYRO", "gyro")):
+        msg = db.get_message_by_name(msg_name)
+        for axis, name in enumerate("xyz"):
+            values[bad, axis] = msg.get_signal_by_name(f"{prefix}_{name}").maximum
+    rec.imu_failed += 2 * int(bad.sum())  # an ACCEL and a GYRO frame per sample
+
+
 def implausible(
     db, t_ms: np.ndarray, code: np.ndarray, word: np.ndarray, f: dict, rng, rec: FaultRecord
 ) -> None:
@@ -191,10 +280,7 @@ def lost_on_bus(t_ms: np.ndarray, lost: np.ndarray, f: dict, rng, rec: FaultReco
         rec.lost_burst = int(np.sum(burst & ~out))
         out |= burst
     if f["silence_at_s"]:
-        quiet = np.zeros(n, dtype=bool)
-        for at_s in f["silence_at_s"]:
-            t0 = round(float(at_s) * 1000)
-            quiet |= (t_ms >= t0) & (t_ms < t0 + round(float(f["silence_s"]) * 1000))
+        quiet = windows(t_ms, f["silence_at_s"], f["silence_s"])
         quiet[0] = False
         rec.lost_silence = int(np.sum(quiet & ~out))
         out |= quiet

@@ -4,8 +4,8 @@ A scenario names the world, the walk (route, pace, pauses), the person, stairs a
 imperfections (noise, biases and their drift, scale errors, board mounting rotation, magnetic
 disturbances, weather), the radio model, the CAN link (frame loss, board time start; a board time start
 near 2**32 makes the 32-bit time wrap during the walk), bus and board faults (``[faults]``, faults.py:
-loss bursts, silence, duplicates, reordering, corruption, board resets, implausible samples), the seed
-and the duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: the two-floor tour —
+loss bursts, silence, duplicates, reordering, corruption, board resets, a stuck BOARD_TIME, a failed
+IMU, implausible samples), the seed and the duration. Every key has a default (``DEFAULTS`` below, the built-in demo scenario: the two-floor tour —
 a lap of floor 0, the stairs up, a lap of floor 1, the elevator down, a partial lap — at normal pace
 with 3 pauses, about 5 minutes). A file only needs the keys it changes. An unknown key, a wrong type or
 an out-of-range value raises :class:`ScenarioError` naming the file and the key.
@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .faults import validate as validate_faults
 from .scenario_sources import SOURCE_DEFAULTS, validate_sources
 
 # Built-in default scenario. Units are in the key names; comments give ranges.
@@ -155,6 +156,10 @@ DEFAULTS: dict[str, Any] = {
         "implausible_rate": 0.0,  # probability per frame of implausible_signal's message
         "implausible_signal": "accel_z",  # accel_x..z, gyro_x..z
         "implausible_mode": "bitflip",  # "bitflip": sign bit flipped (9.8 -> -147 m/s2); "full_scale"
+        "board_time_stuck_at_s": [],  # from each: BOARD_TIME repeats the board time it had then
+        "board_time_stuck_s": 60.0,  # for this long, 0..86400 (> 0)
+        "imu_failed_at_s": [],  # from each: every IMU signal reads full scale (largest raw value)
+        "imu_failed_s": 60.0,  # for this long, 0..86400 (> 0; past the walk's end: for good)
     },
     **SOURCE_DEFAULTS,  # [ble], [gnss], [landmark] (scenario_sources.py)
 }
@@ -353,7 +358,7 @@ def _validate_values(d: dict, source: str) -> None:
     check(0 <= c["loss_rate"] < 1, "can.loss_rate", "must be in 0..1")
     check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
     check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
-    _validate_faults(d["faults"], check)
+    validate_faults(d["faults"], check)
     validate_sources(d, check)
     check(
         0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
@@ -364,37 +369,6 @@ def _validate_values(d: dict, source: str) -> None:
         0 <= r["scan_duration_ms"] < 1000 * r["scan_interval_min_s"],
         "radio.scan_duration_ms",
         "must be >= 0 and shorter than the scan interval",
-    )
-
-
-def _validate_faults(f: dict, check) -> None:
-    from .faults import IMPLAUSIBLE_MODES, IMPLAUSIBLE_SIGNALS
-
-    for key in ("burst_rate", "duplicate_rate", "reorder_rate", "corrupt_rate", "implausible_rate"):
-        check(0 <= f[key] < 1, f"faults.{key}", "must be in 0..1")
-    check(1 <= f["burst_frames"] <= 10_000, "faults.burst_frames", "must be in 1..10000")
-    check(1 <= f["reorder_frames"] <= 100, "faults.reorder_frames", "must be in 1..100")
-    check(1 <= f["corrupt_bits"] <= 64, "faults.corrupt_bits", "must be in 1..64")
-    check(0 < f["silence_s"] <= 3600, "faults.silence_s", "must be in 0..3600 (> 0)")
-    check(0 <= f["reset_down_ms"] <= 60_000, "faults.reset_down_ms", "must be in 0..60000")
-    check(0 <= f["reset_time_start_ms"] < 2**32, "faults.reset_time_start_ms", "must be in 0..2**32-1")
-    for key in ("silence_at_s", "reset_at_s", "implausible_at_s"):
-        check(all(v >= 0 for v in f[key]), f"faults.{key}", "must hold times >= 0")
-    resets = sorted(f["reset_at_s"])
-    check(
-        all(b - a > f["reset_down_ms"] / 1000 for a, b in zip(resets, resets[1:])),
-        "faults.reset_at_s",
-        "must be further apart than faults.reset_down_ms",
-    )
-    check(
-        f["implausible_signal"] in IMPLAUSIBLE_SIGNALS,
-        "faults.implausible_signal",
-        f"must be one of {', '.join(IMPLAUSIBLE_SIGNALS)}",
-    )
-    check(
-        f["implausible_mode"] in IMPLAUSIBLE_MODES,
-        "faults.implausible_mode",
-        f"must be one of {', '.join(IMPLAUSIBLE_MODES)}",
     )
 
 

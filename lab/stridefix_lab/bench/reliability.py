@@ -16,7 +16,11 @@ from the clean row only by its fault. Per case the table shows:
   counters added to ``health_t`` appear by themselves) that is 0 in the clean run and not here
   (every field that differs is in the JSON);
 * recovered (:func:`recovered`): steps within 2 % of clean when fewer than 2 % of the frames were
-  lost, both mean errors within 1.5 × clean + 1 m, and PDR producing steps in the last 30 s.
+  lost, both mean errors within 1.5 × clean + 1 m, and PDR producing steps in the last 30 s; a
+  stuck BOARD_TIME and a failed IMU have checks of their own (reliability_cases.py: output times and
+  error after the stuck clock like the clean run's; with a failed IMU logging to the end, POSE volume,
+  no steps, Wi-Fi fixes going on), measured on the case's outputs next to the clean run's and
+  described under the table.
 
 Writes ``OUT/reliability.json``; a case that is not recovered is a missed target (``TARGET MISSED``,
 exit 1), as with the other benches.
@@ -37,6 +41,7 @@ from stridefix_analyzer.firmware import Firmware
 from stridefix_analyzer.io.logread import read_logs
 from stridefix_analyzer.scoring.analyze import run_analyze
 
+from stridefix_lab.bench import reliability_cases
 from stridefix_lab.bench.fusion import build_site
 from stridefix_lab.bench.registry import Bench, BenchUsageError
 from stridefix_lab.bench.sil_pdr import BenchError
@@ -63,6 +68,18 @@ CASES: list[tuple[str, str, dict[str, dict[str, Any]]]] = [
         "implausible",
         "0.1 % full scale",
         {"faults": {"implausible_rate": 0.001, "implausible_mode": "full_scale"}},
+    ),
+    # BOARD_TIME repeats its 100 s value for 60 s while the samples go on
+    (
+        "board_time_stuck",
+        "60 s at 100 s",
+        {"faults": {"board_time_stuck_at_s": [100.0], "board_time_stuck_s": 60.0}},
+    ),
+    # every IMU signal at full scale from 150 s to the end of the walk
+    (
+        "imu_failed",
+        "full scale from 150 s",
+        {"faults": {"imu_failed_at_s": [150.0], "imu_failed_s": 3600.0}},
     ),
 ]
 SEED = 1
@@ -148,6 +165,9 @@ def run_case(
         "fault": name,
         "rate": rate,
         "overrides": overrides,
+        "dir": str(out),
+        "start_us": summary["board_time_start_ms"] * 1000,
+        "end_us": end_us,
         "frames_sent": sent,
         "frames_received": summary["frames_total"],
         "frames_ok": health.get("frames_ok"),
@@ -182,6 +202,9 @@ def recovered(row: dict[str, Any], clean: dict[str, Any]) -> dict[str, bool | No
         "error": all(err_ok.values()),
         "steps_in_tail": row["steps_last_30s"] > 0,
     }
+    if reliability_cases.KINDS.get(row.get("fault", "")):
+        checks = dict.fromkeys(checks)  # replaced by the fault's own
+    checks.update(reliability_cases.checks(row, ERR_FACTOR, ERR_MARGIN_M))
     checks["recovered"] = all(v is not False for v in checks.values())
     return checks
 
@@ -217,6 +240,7 @@ def run_reliability(
         rows.append(run_case(name, rate, overrides, firmware, where, site_path, duration_s, sets))
     clean = rows[0]
     for row in rows:
+        row["measures"] = reliability_cases.measure(row, clean)
         row["checks"] = recovered(row, clean)
         row["counters_moved"], row["health_diff"] = moved_counters(row, clean)
     doc = {
@@ -273,6 +297,10 @@ def format_table(doc: dict[str, Any]) -> str:
         f"{ERR_FACTOR:g} x clean + {ERR_MARGIN_M:g} m, steps in the tail; counters moved = HEALTH "
         f"counters 0 in the clean run)"
     )
+    for r in rows:
+        line = reliability_cases.describe(r)
+        if line is not None:
+            lines.append(f"{case_label(r['fault'], r['rate'])}: {line}")
     return "\n".join(lines)
 
 

@@ -86,6 +86,57 @@ def test_recovered_rule(row, recovered):
     assert reliability.recovered(row, _row())["recovered"] is recovered
 
 
+def _stuck(offset_ms=0.0, matched=1000, err=1.2):
+    return {
+        **_row(),
+        "fault": "board_time_stuck",
+        "measures": {
+            "imu_after_clean": 1000,
+            "imu_after_matched": matched,
+            "time_offset_after_max_ms": offset_ms,
+            "mean_error_after_m": {"adaptive": {"case": err, "clean": 1.0}},
+        },
+    }
+
+
+def _failed(pose=33_000, steps=0, wifi=62, clean_wifi=62, last=0.5):
+    side = {"pose_messages": 30_000, "steps_after_grace": 0, "wifi_fixes_in_failure": clean_wifi}
+    case = {
+        "pose_messages": pose,
+        "steps_after_grace": steps,
+        "wifi_fixes_in_failure": wifi,
+        "last_output_before_end_s": last,
+    }
+    # the common checks would fail (no steps, a large error): the fault's own replace them
+    return {
+        **_row(steps=250, pdr=40.0, tail=0),
+        "fault": "imu_failed",
+        "measures": {"case": case, "clean": side},
+    }
+
+
+@pytest.mark.parametrize(
+    "row, recovered",
+    [
+        (_stuck(), True),
+        (_stuck(offset_ms=9.9), True),
+        (_stuck(offset_ms=57_451.0), False),  # output times shifted for the rest of the walk
+        (_stuck(matched=800), False),  # samples after the fault missing
+        (_stuck(err=2.6), False),  # > 1.5 x 1.0 + 1 m after the fault
+        (_failed(), True),
+        (_failed(pose=36_001), False),  # > 1.2 x the clean run's POSE messages
+        (_failed(pose=179_910), False),  # a POSE for every refused sample
+        (_failed(steps=3), False),  # steps from a failed IMU
+        (_failed(wifi=20), False),  # the Wi-Fi fixes stopped too
+        (_failed(wifi=0, clean_wifi=0), True),  # no site: no Wi-Fi fix to check
+        (_failed(last=30.0), False),  # the log stopped before the walk's end
+        (_failed(last=None), False),
+    ],
+)
+def test_fault_specific_recovery_rules(row, recovered):
+    assert reliability.recovered(row, _row())["recovered"] is recovered
+
+
 def test_unknown_fault_kind_is_bad_usage(tmp_path, stridefixd, capsys):
     parser = argparse.ArgumentParser()
     bench_cli.add_parser(parser.add_subparsers())

@@ -168,6 +168,43 @@ def test_implausible_full_scale():
     assert n > 0 and sum(abs(g - full) < 0.1 for g in gyro) == n
 
 
+def test_board_time_stuck_repeats_the_value_of_its_start():
+    """From 5 s for 10 s BOARD_TIME carries the board time of 5 s; the samples go on as sent."""
+    clean, stuck = frames(run()), run(board_time_stuck_at_s=(5.0,), board_time_stuck_s=10.0)
+    f = frames(stuck)
+    assert [x[:2] for x in f] == [x[:2] for x in clean]
+    diff = [(a, b) for a, b in zip(clean, f) if a != b]
+    assert {a[1] for a, _ in diff} == {ID_TIME}
+    times = [DB.decode_message(ID_TIME, x[2]) for x in f if x[1] == ID_TIME]
+    t0 = times[0]["time_ms"]
+    want = [0, 1000, 2000, 3000, 4000] + [5000] * 10 + [15000, 16000]
+    assert [m["time_ms"] - t0 for m in times[:17]] == want
+    assert {m["boot_id"] for m in times} == {7}
+    rec = record(stuck)
+    assert rec["board_time_stuck"] == len(diff) == 9  # the frame at 5 s carries its true time
+    assert rec["frames_affected"] == 9
+
+
+def test_imu_failed_reads_full_scale_on_every_axis():
+    """From 10 s for 5 s every IMU_ACCEL and IMU_GYRO signal is at the DBC's largest raw value (a
+    failed sensor, as the board encodes it: the signals are integers, NaN has no encoding); seq and
+    t_lo go on."""
+    clean, bad = frames(run()), run(imu_failed_at_s=(10.0,), imu_failed_s=5.0)
+    f = frames(bad)
+    assert [x[:2] for x in f] == [x[:2] for x in clean]
+    diff = [(a, b) for a, b in zip(clean, f) if a != b]
+    assert {a[1] for a, _ in diff} == {ID_ACCEL, ID_GYRO}
+    t_start = clean[0][0] + 10_000_000
+    assert all(t_start <= a[0] < t_start + 5_000_000 + 10_000 for a, _ in diff)
+    for a, b in diff:
+        ma, mb = (DB.decode_message(x[1], x[2], scaling=False) for x in (a, b))
+        assert (ma["seq"], ma["t_lo_ms"]) == (mb["seq"], mb["t_lo_ms"])
+        for sig in DB.get_message_by_frame_id(a[1]).signals:
+            if sig.name not in ("seq", "t_lo_ms"):
+                assert sig.is_signed and mb[sig.name] == 2 ** (sig.length - 1) - 1  # int16: 32767
+    assert record(bad)["imu_failed"] == len(diff) == 2 * 500
+
+
 @pytest.mark.parametrize(
     "text, key",
     [
@@ -183,6 +220,11 @@ def test_implausible_full_scale():
         ('implausible_mode = "nan"', "faults.implausible_mode"),
         ("reset_time_start_ms = 4294967296", "faults.reset_time_start_ms"),
         ("reorder_frames = 101", "faults.reorder_frames"),
+        ("board_time_stuck_at_s = [-1]", "faults.board_time_stuck_at_s"),
+        ("board_time_stuck_s = 0", "faults.board_time_stuck_s"),
+        ("imu_failed_at_s = [-0.5]", "faults.imu_failed_at_s"),
+        ("imu_failed_s = -1", "faults.imu_failed_s"),
+        ("imu_failed_s = 1e9", "faults.imu_failed_s"),
         ("bogus = 1", "faults.bogus"),
     ],
 )
