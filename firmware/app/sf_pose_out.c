@@ -10,11 +10,11 @@ void sf_pose_out_init(sf_pose_out_t *const po)
 }
 
 bool sf_pose_out_due(const sf_pose_out_t *const po, const sf_estimator_t *const est, const sf_params_t *const p,
-                     const int n_steps, const int64_t sample_t_us)
+                     const int n_steps)
 {
     sf_estimator_status_t st;
     sf_estimator_status(est, &st);
-    return n_steps > 0 || sample_t_us - po->last_t_us >= (int64_t)p->output_pose_period_ms * 1000 ||
+    return n_steps > 0 || st.t_us - po->last_t_us >= (int64_t)p->output_pose_period_ms * 1000 ||
            st.floor != po->last_floor;
 }
 

@@ -21,10 +21,11 @@ typedef struct {
 
 void sf_pose_out_init(sf_pose_out_t *po);
 
-/* After an IMU sample at sample_t_us that gave n_steps steps: whether the poses are due (a step,
- * output.pose_period_ms since the last ones, or a new floor). */
-bool sf_pose_out_due(const sf_pose_out_t *po, const sf_estimator_t *est, const sf_params_t *p, int n_steps,
-                     int64_t sample_t_us);
+/* After an IMU sample that gave n_steps steps: whether the poses are due (a step, a pose
+ * output.pose_period_ms newer than the last ones, or a new floor). "Newer" is the estimator's time, not
+ * the sample's: a sample the gate refuses (NaN, full scale) leaves the pose as it was, and a failed IMU
+ * must not repeat that pose once per sample with the same stale t_us. */
+bool sf_pose_out_due(const sf_pose_out_t *po, const sf_estimator_t *est, const sf_params_t *p, int n_steps);
 
 /* The poses, each stamped log_t_us in the log, on the channels opt lets through. */
 void sf_pose_out_write(sf_pose_out_t *po, sf_lcm_out_t *out, int64_t log_t_us, const sf_estimator_t *est,

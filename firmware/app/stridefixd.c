@@ -193,7 +193,7 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     for (int i = 0; i < n_steps && WRITES(d, STEP); i++) {
         sf_publish_step(d->out, d->host_t_us, &steps[i]);
     }
-    if (sf_pose_out_due(&d->poses, &d->est, &d->params, n_steps, s->t_us)) {
+    if (sf_pose_out_due(&d->poses, &d->est, &d->params, n_steps)) {
         write_pose(d);
     }
 }
