@@ -70,8 +70,8 @@ static bool safe_to_reuse(const int fd, const char *const part_path, char *const
         return false;
     }
     if (st.st_nlink != 1) {
-        snprintf(err, err_size, "%s: %ju links (a hard link to another file); refused, not truncated", part_path,
-                 (uintmax_t)st.st_nlink);
+        snprintf(err, err_size, "%s: %ju links (a hard link to another file); refused, not truncated",
+                 part_path, (uintmax_t)st.st_nlink);
         return false;
     }
     return true;
