@@ -50,8 +50,9 @@ def pose_counts_and_repeats(log: Path) -> tuple[Counter, Counter]:
     return counts, repeats
 
 
-def imu_stuck_at_full_scale(candump: Path, out: Path) -> None:
-    """The walk's candump with accel_z at full scale in every IMU_ACCEL frame from FAIL_AT_S on."""
+def imu_stuck_at_full_scale(candump: Path, out: Path, until_s: float = math.inf) -> None:
+    """The walk's candump with accel_z at full scale in every IMU_ACCEL frame from FAIL_AT_S on
+    (until until_s)."""
     db = cantools.database.load_file(str(DBC_PATH))
     accel = db.get_message_by_name("IMU_ACCEL")
     full_scale = accel.get_signal_by_name("accel_z").maximum
@@ -61,7 +62,7 @@ def imu_stuck_at_full_scale(candump: Path, out: Path) -> None:
     for line in lines:
         stamp, _iface, frame = line.split()
         can_id, data = frame.split("#")
-        if int(can_id, 16) == accel.frame_id and float(stamp[1:-1]) - t0 >= FAIL_AT_S:
+        if int(can_id, 16) == accel.frame_id and FAIL_AT_S <= float(stamp[1:-1]) - t0 < until_s:
             signals = accel.decode(bytes.fromhex(data), decode_choices=False)
             signals["accel_z"] = full_scale
             line = f"{stamp} {_iface} {can_id}#{accel.encode(signals).hex().upper()}\n"
@@ -121,3 +122,24 @@ def test_imu_nan_in_a_replay_writes_no_more_poses(stridefixd, clean, tmp_path):
     run(stridefixd, ["--replay", str(raw)], replay_clean)
     stderr = run(stridefixd, ["--replay", str(nan)], replay_nan)
     assert_no_more_poses_than_clean(replay_clean, replay_nan, stderr)
+
+
+def test_imu_that_fails_for_5_s_and_recovers_resumes_the_walk(stridefixd, default_walk, clean, tmp_path):
+    """The daemon's side of a failed IMU in the reliability bench: refused samples counted, no pose
+    while the IMU is out, the walk the gap hid bridged, poses and steps again once it is back."""
+    candump = tmp_path / "out5s.candump"
+    imu_stuck_at_full_scale(default_walk["dir"] / "board.candump", candump, until_s=FAIL_AT_S + 5.0)
+    log = tmp_path / "out5s.lcmlog"
+    stderr = run(stridefixd, ["-i", str(candump)], log)
+    assert "samples refused: 500 out of range" in stderr and "1 walk gaps bridged" in stderr, stderr
+
+    def pdr_poses(path: Path) -> list:
+        return [pose_t.decode(e.data) for e in lcm.EventLog(str(path), "r") if e.channel == "POSE_PDR_ONLY"]
+
+    want, got = pdr_poses(clean["log"]), pdr_poses(log)
+    out_from, out_until = clean["fail_us"], clean["fail_us"] + 5_000_000
+    assert not [p for p in got if out_from + 1_000_000 <= p.t_us < out_until]  # nothing new to say
+    assert got[-1].t_us == want[-1].t_us  # poses again to the end
+    # the bridge credits distance, not STEP records: about 9 steps of 5 s are not counted (as a silence)
+    assert abs(got[-1].step_count - want[-1].step_count) <= 12
+    assert math.hypot(got[-1].x_m - want[-1].x_m, got[-1].y_m - want[-1].y_m) < 3.0
