@@ -47,8 +47,8 @@ void sf_summary_print(FILE *const f, const sf_input_counters_t *const in, const 
     if (log_path != NULL) {
         fprintf(f,
                 "stridefixd: log detail: %" PRIu64 " files, %" PRIu64 " events written (%" PRIu64
-                " of them CONFIG copies heading a rotated file), %" PRIu64 " bytes written; %" PRIu64
-                " events dropped, %" PRIu64 " bytes\n",
+                " of them CONFIG copies heading a file: rotated, or after a full disk), %" PRIu64
+                " bytes written; %" PRIu64 " events dropped, %" PRIu64 " bytes\n",
                 oc->files, oc->events, oc->header_copies, oc->bytes, oc->drops, oc->drop_bytes);
     }
 }

@@ -2,11 +2,11 @@
  * One input (sf_input.h: candump file, stdin, SocketCAN or a raw-sensor LCM log) gives timed samples; each
  * is logged as it came (sf_rx_lcm.h) and fed to the estimator core in one switch (feed()): every absolute
  * source (Wi-Fi, GNSS, BLE, landmark) through publish_fixes, then the controller's CONTEXT events
- * (drain_contexts); steps, poses and fix audits go out through sf_publish.h to an LCM event log and,
- * optionally, live LCM (--speed paces a replay: sf_pace.h). Bad input is counted and skipped, never fatal;
- * counts go into HEALTH and the exit summary. Lifecycle: SIGTERM/SIGINT end the input early (sf_signals.h)
- * and the run closes as at the end of the input; a live input is refused as root (sf_privilege.h); the
- * log's naming, rotation and durability are sf_lcm_out's and sf_log_file's. */
+ * (drain_contexts); steps, poses (which and when: sf_pose_out.h) and fix audits go out through sf_publish.h
+ * to an LCM event log and, optionally, live LCM (--speed paces a replay: sf_pace.h). Bad input is counted
+ * and skipped, never fatal; counts go into HEALTH and the exit summary. Lifecycle: SIGTERM/SIGINT end the
+ * input early (sf_signals.h) and the run closes as at the end of the input; a live input is refused as root
+ * (sf_privilege.h); the log's naming, rotation and durability are sf_lcm_out's and sf_log_file's. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <inttypes.h>
@@ -31,6 +31,7 @@
 #include "sf_summary.h"
 #include "sf_site.h"
 #include "sf_particle_mem.h"
+#include "sf_pose_out.h"
 
 #ifndef SF_VERSION
 #define SF_VERSION "0.0.0"
@@ -57,8 +58,7 @@ typedef struct {
     int64_t host_t_us;  /* log timestamp of the item being handled: every message's */
     int64_t board_t_us; /* latest board time seen */
     int64_t last_health_t_us;
-    int64_t last_pose_t_us;
-    int16_t last_pose_floor;
+    sf_pose_out_t poses; /* when the poses are due (sf_pose_out.h) */
     bool config_written;
     sf_publish_loop_t loop;
     sf_publish_sources_t sources; /* fixes offered and made, by source */
@@ -113,28 +113,9 @@ static void write_health(daemon_t *const d)
     d->last_health_t_us = d->board_t_us;
 }
 
-/* One POSE_<SCHEME> per fusion scheme that has a position (a scheme waiting for its first fix has
- * none), then the primary pose on POSE (sf_publish_primary_of). Without a site there are no fixes,
- * so only pdr_only is published (the others would repeat it). */
 static void write_pose(daemon_t *const d)
 {
-    sf_estimator_status_t st;
-    sf_estimator_status(&d->est, &st);
-    const int n_schemes = st.has_site ? sf_scheme_count : sf_scheme_pdr_only + 1;
-    const int only = d->params.output_scheme;
-    for (int scheme = 0; scheme < n_schemes; scheme++) {
-        sf_pose_t p;
-        if ((only < 0 || scheme == only) && sf_options_channel_on(&d->opt, sf_publish_pose_channel(scheme)) &&
-            sf_estimator_scheme_pose(&d->est, &d->params, scheme, &p)) {
-            sf_publish_pose(d->out, d->host_t_us, &p);
-        }
-    }
-    sf_pose_t p;
-    if (WRITES(d, POSE) && sf_publish_primary_of(&d->est, &d->params, st.has_site, &p)) {
-        sf_publish_primary_pose(d->out, d->host_t_us, &p);
-    }
-    d->last_pose_t_us = st.t_us;
-    d->last_pose_floor = st.floor;
+    sf_pose_out_write(&d->poses, d->out, d->host_t_us, &d->est, &d->params, &d->opt);
 }
 
 /* What one absolute source gave the estimator (sf_estimator_wifi / _gnss / _ble / _landmark): its n
@@ -212,10 +193,7 @@ static void on_imu(daemon_t *const d, const sf_rx_imu_t *const s)
     for (int i = 0; i < n_steps && WRITES(d, STEP); i++) {
         sf_publish_step(d->out, d->host_t_us, &steps[i]);
     }
-    sf_estimator_status_t st;
-    sf_estimator_status(&d->est, &st);
-    if (n_steps > 0 || s->t_us - d->last_pose_t_us >= (int64_t)d->params.output_pose_period_ms * 1000 ||
-        st.floor != d->last_pose_floor) {
+    if (sf_pose_out_due(&d->poses, &d->est, &d->params, n_steps)) {
         write_pose(d);
     }
 }
@@ -440,7 +418,7 @@ static int serve(daemon_t *const d)
                 d->opt.site_path, (int)d->site.plan.n_walls, (int)d->particle_mem.walls.n_floors,
                 d->particle_mem.grid_bytes, (int)d->site.ports.n_ports);
     }
-    d->last_pose_t_us = INT64_MIN / 2;
+    sf_pose_out_init(&d->poses);
     d->loop.stride = sf_input_is_regular_file(d->in) ? SF_PUBLISH_LOOP_STRIDE_FILE : 1u;
     const double t0 = monotonic_us();
     int status = run(d);

@@ -33,8 +33,9 @@
  *
  * Disk full, or any failed write: the event is dropped and counted (events and bytes) and the file
  * keeps exactly the events counted as written; the first failure of an episode is reported with
- * its reason on `report` (once, not per event), and so is the first success after it (logging
- * resumes by itself). Invariant: events queued = events - header_copies + drops. */
+ * its reason on `report` (once, not per event), and so is the first event written after it (logging
+ * resumes by itself; sf_log_writer.h: the header copied when the file's own was dropped, no empty
+ * file left when nothing could be written). Invariant: events queued = events - header_copies + drops. */
 #ifndef SF_LCM_OUT_H
 #define SF_LCM_OUT_H
 
@@ -51,7 +52,7 @@ typedef struct {
     uint64_t bytes;         /* log bytes written (payload + channel + 28-byte event header) */
     uint64_t drops;         /* events dropped: queue full, out of memory, or a write failed */
     uint64_t drop_bytes;    /* the log bytes those events would have taken */
-    uint64_t header_copies; /* header events repeated at the start of a rotated file */
+    uint64_t header_copies; /* header events repeated to head a file: rotated, or its own dropped (disk full) */
     uint64_t files;         /* log files opened */
     uint64_t publish_errors;
 } sf_lcm_out_counters_t;

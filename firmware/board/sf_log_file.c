@@ -5,6 +5,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -55,11 +56,25 @@ size_t sf_log_file_event_bytes(const unsigned char *const head)
 }
 
 /* A file we may truncate under --force: a regular file with no other name (a hard link planted at
- * the .part name would otherwise let us truncate someone else's file). */
-static bool safe_to_reuse(const int fd)
+ * the .part name would otherwise let us truncate someone else's file). Looked at through the open fd,
+ * before any byte of it changes; err says why not. */
+static bool safe_to_reuse(const int fd, const char *const part_path, char *const err, const size_t err_size)
 {
     struct stat st;
-    return fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_nlink == 1;
+    if (fstat(fd, &st) != 0) {
+        snprintf(err, err_size, "%s: cannot stat: %s; refused, not truncated", part_path, strerror(errno));
+        return false;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, err_size, "%s: not a regular file; refused, not truncated", part_path);
+        return false;
+    }
+    if (st.st_nlink != 1) {
+        snprintf(err, err_size, "%s: %ju links (a hard link to another file); refused, not truncated",
+                 part_path, (uintmax_t)st.st_nlink);
+        return false;
+    }
+    return true;
 }
 
 int sf_log_file_open(sf_log_file_t *const f, const char *const path, const bool force, char *const err,
@@ -84,7 +99,8 @@ int sf_log_file_open(sf_log_file_t *const f, const char *const path, const bool 
         return SF_EIO;
     }
     /* O_NONBLOCK: a FIFO planted at the name must not hang the open (it is refused below). */
-    const int flags = O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK | (force ? O_TRUNC : O_EXCL);
+    /* --force: no O_TRUNC here, the file is emptied only once safe_to_reuse has looked at it. */
+    const int flags = O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK | (force ? 0 : O_EXCL);
     const int fd = open(f->part_path, flags, 0666);
     if (fd < 0) {
         const int e = errno;
@@ -95,10 +111,16 @@ int sf_log_file_open(sf_log_file_t *const f, const char *const path, const bool 
         errno = e;
         return SF_EIO;
     }
-    if (force && !safe_to_reuse(fd)) {
+    if (force && !safe_to_reuse(fd, f->part_path, err, err_size)) {
         close(fd);
-        snprintf(err, err_size, "%s: not a regular file with one link; refused", f->part_path);
         errno = EEXIST;
+        return SF_EIO;
+    }
+    if (force && ftruncate(fd, 0) != 0) {
+        const int e = errno;
+        close(fd);
+        snprintf(err, err_size, "%s: cannot truncate: %s", f->part_path, strerror(e));
+        errno = e;
         return SF_EIO;
     }
     (void)fcntl(fd, F_SETFL, 0);

@@ -5,8 +5,10 @@
  * (it still reads: every event is whole, see below). The `.part` is created with
  * O_CREAT|O_EXCL|O_NOFOLLOW: an existing file is never overwritten and a symlink never followed (a
  * link planted at a predictable name cannot redirect the log). With `force`, an existing `.part` is
- * truncated (still never through a symlink) and the rename may replace an existing NAME; without
- * it, an existing NAME is refused at open and the rename never replaces one (RENAME_NOREPLACE).
+ * reused (a killed run's) and the rename may replace an existing NAME; without it, an existing NAME
+ * is refused at open and the rename never replaces one (RENAME_NOREPLACE). A reused `.part` is
+ * opened without O_TRUNC, never through a symlink, and emptied only when fstat shows a regular file
+ * with one link: a hard link planted there is refused (EEXIST) with its target untouched.
  *
  * Events are written in the LCM log format (28-byte header: sync word 0xEDA1DA01, event number,
  * timestamp [µs], channel length, data length, all big-endian; then the channel and the data),

@@ -70,6 +70,13 @@ static void episode(sf_log_writer_t *const w, const bool ok, const int err_no)
 static void close_file(sf_log_writer_t *const w)
 {
     char err[2 * SF_LOG_FILE_PATH_MAX + 128];
+    w->file_has_header = false;
+    if (w->file.fd >= 0 && w->file.offset == 0 && w->write_failed) { /* every write failed: no empty log */
+        report(w, "%s: nothing could be written; no log file left", w->file.path);
+        sf_log_file_discard(&w->file);
+        w->unsynced = false;
+        return;
+    }
     if (sf_log_file_close(&w->file, err, sizeof err) != SF_OK) {
         report(w, "%s", err);
         pthread_mutex_lock(&w->lock);
@@ -77,6 +84,14 @@ static void close_file(sf_log_writer_t *const w)
         pthread_mutex_unlock(&w->lock);
     }
     w->unsynced = false;
+}
+
+/* A copy of the header written (w->lock held): an event and its bytes, counted as a copy. */
+static void count_header_copy(sf_log_writer_t *const w)
+{
+    w->counters.events++;
+    w->counters.header_copies++;
+    w->counters.bytes += SF_LOG_FILE_EVENT_OVERHEAD + strlen(w->header_channel) + w->header_size;
 }
 
 /* Opens the next rotated file (skipping names that exist) and writes the header copy into it,
@@ -114,15 +129,32 @@ static int open_next(sf_log_writer_t *const w, const int64_t timestamp_us)
     w->file_index = index;
     w->file_opened_us = monotonic_us();
     w->unsynced = true;
+    w->file_has_header = w->header_channel != NULL;
     pthread_mutex_lock(&w->lock);
     w->counters.files++;
     if (w->header_channel != NULL) {
-        w->counters.events++;
-        w->counters.header_copies++;
-        w->counters.bytes += SF_LOG_FILE_EVENT_OVERHEAD + strlen(w->header_channel) + w->header_size;
+        count_header_copy(w);
     }
     pthread_mutex_unlock(&w->lock);
     return SF_OK;
+}
+
+/* The open file's missing header (dropped when it was due: a disk full from the start), stamped
+ * timestamp_us, before the event that follows it: SF_OK (written, or no header to copy), else the
+ * write's failure with errno. */
+static int copy_missing_header(sf_log_writer_t *const w, const int64_t timestamp_us)
+{
+    if (w->file_has_header || w->header_channel == NULL) {
+        return SF_OK;
+    }
+    const int rc = sf_log_file_write(&w->file, w->header_channel, timestamp_us, w->header_data, w->header_size);
+    if (rc == SF_OK) {
+        w->file_has_header = true;
+        pthread_mutex_lock(&w->lock);
+        count_header_copy(w);
+        pthread_mutex_unlock(&w->lock);
+    }
+    return rc;
 }
 
 static uint32_t be32(const uint8_t *const p)
@@ -192,8 +224,12 @@ static size_t write_one(sf_log_writer_t *const w, uint8_t *const e, const bool i
         return bytes;
     }
     int rc = w->file.fd >= 0 ? SF_OK : open_next(w, event_timestamp_us(e));
+    if (rc == SF_OK && !is_header) {
+        rc = copy_missing_header(w, event_timestamp_us(e));
+    }
     if (rc == SF_OK) {
         rc = sf_log_file_append(&w->file, e, bytes, 1);
+        w->file_has_header |= rc == SF_OK && is_header;
     }
     const int err_no = errno;
     count(w, rc == SF_OK, 1, bytes);
@@ -229,7 +265,8 @@ void sf_log_writer_events(sf_log_writer_t *const w, uint8_t *const p, const size
         uint8_t *const e = p + at;
         const size_t bytes = sf_log_file_event_bytes(e);
         const bool is_header = (sf_log_ring_flags(e) & SF_LOG_RING_HEADER) != 0;
-        if (is_header || w->failing || w->file.fd < 0 || rotation_due(w, run_len, bytes)) {
+        if (is_header || w->failing || w->file.fd < 0 || (!w->file_has_header && w->header_channel != NULL) ||
+            rotation_due(w, run_len, bytes)) {
             write_run(w, p + run, run_len, run_n);
             write_one(w, e, is_header);
             run = at + bytes;
@@ -261,8 +298,9 @@ void sf_log_writer_housekeeping(sf_log_writer_t *const w, bool rotate)
         return;
     }
     if (w->unsynced && now - w->last_sync_us >= (int64_t)w->cfg->fsync_interval_ms * 1000) {
-        const bool ok = sf_log_file_sync(&w->file) == SF_OK;
-        episode(w, ok, errno);
+        if (sf_log_file_sync(&w->file) != SF_OK) { /* a failure starts an episode; only a write ends one */
+            episode(w, false, errno);
+        }
         w->last_sync_us = now;
         w->unsynced = false;
     }

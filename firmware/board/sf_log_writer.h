@@ -6,7 +6,11 @@
  * write-failure episode in progress — is handled on its own, as is every event of a run whose one
  * write failed, so that on a full disk exactly the events that fit are written and each other one is
  * dropped and counted (events and bytes) as if written one by one. The first failure of an episode is
- * reported on cfg->report, and so is the first success after it. Between runs, housekeeping closes a
+ * reported on cfg->report, and so is the first event written after it (a sync that succeeds on a full
+ * disk ends nothing: it only flushes what was written before). Every file starts with the header: a
+ * rotated one with a copy, and a file whose header was dropped (a disk full from the start) gets a
+ * copy before its first event once writes succeed. A file that nothing could be written to is removed
+ * at close, not renamed to its final name as an empty log. Between runs, housekeeping closes a
  * file asked to rotate (rotate_requests, or the caller) or too old (rotate_s), else fdatasyncs when
  * fsync_interval_ms has passed since the last sync.
  *
@@ -37,6 +41,7 @@ typedef struct {
     char *header_channel; /* copy of the latest header event; NULL if none */
     uint8_t *header_data;
     size_t header_size;
+    bool file_has_header; /* the open file holds the header (or a copy of it) */
     bool failing;   /* inside a write-failure episode */
     int fail_errno; /* why the episode began */
     pthread_mutex_t lock; /* the counters and write_failed */

@@ -1,6 +1,7 @@
 /* sf_rx_lcm.c — sf_rx_event_t ↔ the raw-sensor LCM types, one row per kind (see sf_rx_lcm.h). */
 #include "sf_rx_lcm.h"
 
+#include <inttypes.h>
 #include <string.h>
 
 #include "sf_error.h"
@@ -20,12 +21,13 @@ typedef struct {
     size_t err_size;
 } where_t;
 
-/* The generated decode's result: SF_OK when it used all size bytes, else SF_ESYNTAX with a message. */
+/* The generated decode's result: SF_OK when it used all size bytes, else SF_ESYNTAX with a message.
+ * The type fingerprint was checked before (check_type): a failed decode is a payload cut short. */
 static int decoded(const int used, const int size, const char *const type, const where_t *const e)
 {
     if (used < 0) {
-        return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX,
-                            "payload of %d bytes is not a %s (wrong type hash, or too short)", size, type);
+        return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX, "payload of %d bytes is too short for a %s",
+                            size, type);
     }
     if (used != size) {
         return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX, "payload has %d trailing bytes after the %s",
@@ -226,6 +228,22 @@ static void encode_landmark(sf_lcm_out_t *const out, const char *const channel, 
     SF_LCM_WRITE(out, channel, ts_us, stridefix_landmark_t, &msg);
 }
 
+/* ---- per kind: the LCM type (name and fingerprint, the first 8 bytes of every encoding) ------------ */
+
+/* DEVIATION: __<type>_get_hash is the generated C API's only way to the fingerprint (reserved-looking
+ * name, lcm-gen's). */
+#define SF_RX_TYPE(kind, lcm_type) \
+    static const char *type_name_##kind(void) { return "stridefix." #lcm_type; } \
+    static int64_t type_hash_##kind(void) { return __stridefix_##lcm_type##_get_hash(); }
+SF_RX_TYPE(imu, imu_t)
+SF_RX_TYPE(mag, mag_t)
+SF_RX_TYPE(baro, baro_t)
+SF_RX_TYPE(wifi, wifi_scan_t)
+SF_RX_TYPE(gnss, gnss_t)
+SF_RX_TYPE(ble, ble_scan_t)
+SF_RX_TYPE(landmark, landmark_t)
+#undef SF_RX_TYPE
+
 /* ---- the table, generated from SF_RX_KINDS ------------------------------------------------------- */
 
 typedef struct {
@@ -233,10 +251,13 @@ typedef struct {
     const char *channel;
     int (*decode)(const void *data, int size, sf_rx_event_t *ev, const where_t *e);
     void (*encode)(sf_lcm_out_t *out, const char *channel, int64_t ts_us, const sf_rx_event_t *ev);
+    const char *(*type_name)(void);
+    int64_t (*type_hash)(void);
 } kind_row_t;
 
 static const kind_row_t kind_rows[] = {
-#define SF_RX_KIND_ROW(kind, channel) {sf_rx_##kind, channel, decode_##kind, encode_##kind},
+#define SF_RX_KIND_ROW(kind, channel) \
+    {sf_rx_##kind, channel, decode_##kind, encode_##kind, type_name_##kind, type_hash_##kind},
     SF_RX_KINDS(SF_RX_KIND_ROW)
 #undef SF_RX_KIND_ROW
 };
@@ -254,6 +275,32 @@ const char *sf_rx_lcm_channel(const sf_rx_kind_t kind)
     return row != NULL ? row->channel : NULL;
 }
 
+/* The payload's type fingerprint against the channel's type, before any field is read as that type
+ * would have it (another type's bytes would otherwise be reported as a bad count or a short payload):
+ * SF_OK, or SF_ESYNTAX naming the type the payload is when it is one of the raw-sensor types. */
+static int check_type(const kind_row_t *const row, const uint8_t *const p, const size_t size,
+                      const where_t *const e)
+{
+    if (size < 8) {
+        return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX,
+                            "payload of %zu bytes is too short for a %s (no type fingerprint)", size,
+                            row->type_name());
+    }
+    const uint64_t got = (uint64_t)(uint32_t)sf_lcm_be32(p) << 32 | (uint32_t)sf_lcm_be32(p + 4);
+    if (got == (uint64_t)row->type_hash()) {
+        return SF_OK;
+    }
+    for (size_t i = 0; i < sizeof kind_rows / sizeof kind_rows[0]; i++) {
+        if (got == (uint64_t)kind_rows[i].type_hash()) {
+            return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX, "payload is a %s, not a %s",
+                                kind_rows[i].type_name(), row->type_name());
+        }
+    }
+    return sf_lcm_failf(e->err, e->err_size, e->name, SF_ESYNTAX,
+                        "payload is not a %s (type fingerprint 0x%016" PRIx64 ", expected 0x%016" PRIx64 ")",
+                        row->type_name(), got, (uint64_t)row->type_hash());
+}
+
 int sf_rx_lcm_decode(const char *const channel, const void *const data, const size_t size,
                      sf_rx_event_t *const ev, const char *const name, char *const err, const size_t err_size)
 {
@@ -263,7 +310,8 @@ int sf_rx_lcm_decode(const char *const channel, const void *const data, const si
             if (size > (size_t)INT32_MAX) {
                 return sf_lcm_failf(err, err_size, e.name, SF_ESYNTAX, "payload of %zu bytes is too large", size);
             }
-            if (kind_rows[i].decode(data, (int)size, ev, &e) != 1) {
+            if (check_type(&kind_rows[i], data, size, &e) != SF_OK ||
+                kind_rows[i].decode(data, (int)size, ev, &e) != 1) {
                 return SF_ESYNTAX;
             }
             ev->kind = kind_rows[i].kind;

@@ -10,7 +10,8 @@ from collections.abc import Callable
 import pytest
 
 _LOG_DETAIL = re.compile(
-    r"log detail: (\d+) files, (\d+) events written \((\d+) of them CONFIG copies heading a rotated file\), "
+    r"log detail: (\d+) files, (\d+) events written "
+    r"\((\d+) of them CONFIG copies heading a file: rotated, or after a full disk\), "
     r"(\d+) bytes written; (\d+) events dropped, (\d+) bytes"
 )
 
@@ -28,7 +29,7 @@ def default_walk(tmp_path_factory, cli) -> dict:
 @pytest.fixture(scope="session")
 def log_detail() -> Callable[[str], dict[str, int]]:
     """stridefixd's summary line on its log, from its stderr, as numbers: files, events (written),
-    copies (CONFIG heading rotated files), bytes, drops, drop_bytes."""
+    copies (CONFIG heading rotated files, or a file after a full disk), bytes, drops, drop_bytes."""
 
     def parse(stderr: str) -> dict[str, int]:
         m = _LOG_DETAIL.search(stderr)

@@ -54,8 +54,25 @@ def _replay(stridefixd: Path, log: Path) -> subprocess.CompletedProcess:
         (_event(3, "WIFI", _wifi_claiming(-7)), 0, "n_ap = -7 is negative"),
         (_event(3, "IMU", b"\0" * 16, data_len=1_900_000_000), 0, "log ends inside the data (truncated"),
         (_event(3, "IMU", _imu(3), magic=0xDEADBEEF), 1, "bad magic 0xDEADBEEF"),
+        # a message of another type on a channel: said so (its type fingerprint), before any of its
+        # fields is read as the channel's type would have them (an IMU sample on WIFI was a "bad n_ap")
+        (_event(3, "WIFI", _imu(3)), 0, "(WIFI): payload is a stridefix.imu_t, not a stridefix.wifi_scan_t"),
+        (
+            _event(3, "IMU", _wifi_claiming(1)),
+            0,
+            "(IMU): payload is a stridefix.wifi_scan_t, not a stridefix.imu_t",
+        ),
+        (_event(3, "BLE", b"\x01" * 40), 0, "(BLE): payload is not a stridefix.ble_scan_t (type fingerprint"),
     ],
-    ids=["wifi-2^29", "wifi-negative", "header-1.9GB", "bad-magic"],
+    ids=[
+        "wifi-2^29",
+        "wifi-negative",
+        "header-1.9GB",
+        "bad-magic",
+        "imu-on-wifi",
+        "wifi-on-imu",
+        "junk-on-ble",
+    ],
 )
 def test_bad_event_is_named_and_counted(stridefixd, tmp_path, bad, status, words):
     log = tmp_path / "hostile.lcmlog"

@@ -75,6 +75,29 @@ def test_symlink_at_the_part_name_is_never_followed(stridefixd, candump, tmp_pat
     assert not (tmp_path / "walk.lcmlog").exists()
 
 
+def test_force_never_truncates_a_hard_link_at_the_part_name(stridefixd, candump, tmp_path):
+    # Regression: with --force the .part name was opened with O_TRUNC before its link count was
+    # checked, so a hard link planted there had its target emptied, and only then was refused.
+    victim = tmp_path / "victim"
+    victim.write_text("precious")
+    part = tmp_path / "walk.lcmlog.part"
+    os.link(victim, part)
+    proc = run(stridefixd, "-i", str(candump), "-l", str(tmp_path / "walk.lcmlog"), "-q", "--force")
+    assert proc.returncode == 1, proc.stderr
+    assert victim.read_text() == "precious"
+    assert f"{part}: 2 links" in proc.stderr and "not truncated" in proc.stderr, proc.stderr
+    assert not (tmp_path / "walk.lcmlog").exists()
+
+
+def test_force_reuses_a_part_file_left_by_a_killed_run(stridefixd, candump, tmp_path):
+    """A .part of its own (one link, a killed run's) is what --force may start over."""
+    part = tmp_path / "walk.lcmlog.part"
+    part.write_bytes(b"\0" * 100_000)
+    proc = run(stridefixd, "-i", str(candump), "-l", str(tmp_path / "walk.lcmlog"), "-q", "--force")
+    assert proc.returncode == 0, proc.stderr
+    assert not part.exists() and channels(tmp_path / "walk.lcmlog")[0] == "CONFIG"
+
+
 def test_two_daemons_started_together_get_different_default_names(stridefixd, candump, tmp_path):
     # Regression: two daemons started in one second shared a file.
     cmd = [str(stridefixd), "-i", str(candump), "-d", str(tmp_path), "-q"]
