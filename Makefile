@@ -138,7 +138,7 @@ gates: check-static check-clang check-asan check-fuzz check-arm
 check-static: build
 	cppcheck --std=c11 --enable=warning,style,performance,portability --error-exitcode=1 --quiet \
 		--inline-suppr --suppressions-list=tools/cppcheck.supp \
-		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/gen/schemes -I$(BUILD)/lcmtypes/c \
+		-Ifirmware/core -Ifirmware/board -I$(BUILD)/gen/can -I$(BUILD)/gen/schemes -I$(BUILD)/gen/site_ranges -I$(BUILD)/lcmtypes/c \
 		firmware/core firmware/board firmware/app
 
 check-clang: deps

@@ -15,7 +15,8 @@ Schedulers (``--scheduler``, :data:`SCHEDULER_HELP`):
 * ``processes``: a ``concurrent.futures.ProcessPoolExecutor`` of ``workers`` forked processes (no
   start-up cost; realbench's default on one machine);
 * ``local``: a ``dask.distributed.LocalCluster`` of ``workers`` single-threaded worker processes (BLAS
-  in each worker single-threaded too, so 2 workers use 2 cores);
+  in each worker single-threaded too, so 2 workers use 2 cores); its scheduler, workers and dashboard
+  listen on loopback only (:data:`LOOPBACK`), since a Dask client can run any function on a worker;
 * ``tcp://host:port`` (or any address ``Client`` takes): that scheduler's workers, however many.
 
 A Dask worker runs the task functions of this package by name and reads and writes files by path, so
@@ -54,6 +55,8 @@ _WORKER_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THR
 #: Dask submissions in flight per worker: enough to keep each busy, few enough that the scheduler
 #: never holds every task of a long run (a fold task carries its group's radio-map statistics)
 _IN_FLIGHT_PER_WORKER = 4
+#: where ``--scheduler local`` listens (scheduler, workers, dashboard): this machine only
+LOOPBACK = "127.0.0.1"
 _UNSET: Any = object()
 
 
@@ -175,11 +178,14 @@ def dask_client(scheduler: str, workers: int = 2) -> Iterator[Any]:
         old = {k: os.environ.get(k) for k in _WORKER_ENV}
         os.environ.update(_WORKER_ENV)  # inherited by the spawned worker processes
         try:
+            # Loopback only, dashboard included: whoever reaches a Dask scheduler can run any function
+            # on its workers, as this user. No fixed port: two clusters at once must not collide.
             cluster = LocalCluster(
                 n_workers=workers,
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=":0",  # no fixed port: two clusters at once must not collide
+                host=LOOPBACK,
+                dashboard_address=f"{LOOPBACK}:0",
                 silence_logs=logging.ERROR,
             )
         finally:

@@ -7,9 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sf_cls.h"
 #include "sf_error.h"
 #include "sf_file_kind.h"
 #include "sf_lcm_walk.h"
+#include "sf_site_ranges.h"
 #include "sf_site_v2.h"
 #include "sf_site_v3.h"
 
@@ -189,8 +191,9 @@ static int check_fields(const stridefix_site_t *const s, const char *const name,
                        (int)s->rp_scans[r], (int)r);
         }
     }
-    const int plan_rc = sf_site_v2_check_plan(s, (int)lowest, (int)top, name, err, err_size);
-    return plan_rc != SF_OK ? plan_rc : sf_site_v3_check(s, (int)lowest, (int)top, name, err, err_size);
+    int rc = sf_site_v2_check_plan(s, (int)lowest, (int)top, name, err, err_size);
+    rc = rc != SF_OK ? rc : sf_site_v3_check(s, (int)lowest, (int)top, name, err, err_size);
+    return rc != SF_OK ? rc : sf_site_check_ranges(s, name, err, err_size);
 #undef BAD
 }
 
@@ -306,6 +309,11 @@ static int build_view(sf_site_store_t *const store, sf_site_t *const site, const
     const char *what = NULL;
     if (sf_radiomap_check(m, &what) != SF_OK) {
         return sf_lcm_failf(err, err_size, name, SF_ERANGE, "radio map check failed: %s", what != NULL ? what : "?");
+    }
+    /* the controller's own check, so a map it would refuse when attached is refused here, named */
+    if (sf_cls_check_map(site, &what) != SF_OK) {
+        return sf_lcm_failf(err, err_size, name, SF_ERANGE, "context map check failed: %s",
+                            what != NULL ? what : "?");
     }
     return SF_OK;
 }

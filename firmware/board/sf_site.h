@@ -26,8 +26,10 @@
  *      indices in range (e.g. "entry 17: rp index 300 outside 0..99"), strictly sorted by (ap, rp),
  *      finite mean, finite std ≥ 0, 1 ≤ count ≤ rp_scans of the RP; then the version-2 rules
  *      (sf_site_v2.h: geo altitude and rotation when has_geo, walls, ports, beacons, BLE model),
- *      then the version-3 rules (sf_site_v3.h: outlines, port extras, links, contexts, constellations);
- *      finally sf_radiomap_check on the core view.
+ *      then the version-3 rules (sf_site_v3.h: outlines, port extras, links, contexts, constellations),
+ *      then every numeric field within its physical range (sf_site_ranges.h: firmware/site_ranges.tsv,
+ *      the table the Python reader checks too); finally sf_radiomap_check and the controller's
+ *      sf_cls_check_map on the core view (so a site that loads is one the estimator attaches).
  * SF_ENOENT: no such file; SF_EIO: cannot read it (or out of memory); SF_EINVAL: NULL argument.
  *
  * Memory: this is the board layer, the one place that allocates. The store owns everything the view

@@ -102,6 +102,10 @@ static int check_port_extras(const stridefix_site_t *const s, const char *const 
                        "contexts)",
                        (int)i);
         }
+        if (steps != 0 && s->port_kind[i] != sf_port_stairs) {
+            return BAD("port %d: a %s with port_steps %d (steps are a staircase's: 0 for doors and elevators)",
+                       (int)i, s->port_kind[i] == sf_port_door ? "door" : "elevator", steps);
+        }
         const float lx = s->port_lo_x_m[i], ly = s->port_lo_y_m[i], hx = s->port_hi_x_m[i], hy = s->port_hi_y_m[i];
         if (!(isfinite(lx) && isfinite(ly) && isfinite(hx) && isfinite(hy))) {
             return BAD("port %d: endpoints (%g, %g) - (%g, %g) not finite", (int)i, (double)lx, (double)ly,

@@ -6,7 +6,7 @@
  * The rules, their order and their words are analyzer/stridefix_analyzer/io/site_v3.py's: outline
  * vertices with a building in range, a finite position, each building's vertices consecutive, then
  * ≥ 3 per building; port extras with port_building −1 … n_buildings−1, port_outdoor 0/1, port_steps
- * ≥ 0 (> 0 for stairs when the site has contexts), finite endpoints; links with both ports in range,
+ * ≥ 0 (> 0 for stairs when the site has contexts, 0 for doors and elevators), finite endpoints; links with both ports in range,
  * not a port with itself; contexts of a known kind, building −1 for the outdoor one and in range for
  * the others, a floor within the site's, a fusion scheme (< sf_scheme_count), method and cdd_method
  * one of sf_fix_wifi/gnss/ble, cdd_min_hits ≥ 1, one outdoor context at most, one context per

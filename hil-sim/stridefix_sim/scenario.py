@@ -34,8 +34,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .faults import validate as validate_faults
-from .scenario_sources import SOURCE_DEFAULTS, validate_sources
+from .scenario_sources import SOURCE_DEFAULTS
+from .scenario_values import ScenarioError, validate_values
 
 # Built-in default scenario. Units are in the key names; comments give ranges.
 DEFAULTS: dict[str, Any] = {
@@ -165,14 +165,6 @@ DEFAULTS: dict[str, Any] = {
 }
 
 
-class ScenarioError(ValueError):
-    """A scenario file could not be read or holds an unknown key or a bad value."""
-
-    def __init__(self, source: str, message: str):
-        super().__init__(f"{source}: {message}")
-        self.source = source
-
-
 @dataclass(frozen=True)
 class Scenario:
     """A validated scenario: ``data`` has every key of DEFAULTS; ``source`` names where it came from."""
@@ -198,7 +190,7 @@ class Scenario:
             for p in parts[:-1]:
                 node = node[p]
             node[parts[-1]] = value
-        _validate_values(data, "<command line>")
+        validate_values(data, "<command line>")
         return Scenario(data=data, source=self.source)
 
 
@@ -263,115 +255,6 @@ def _merge(defaults: dict, user: dict, source: str, prefix: str = "") -> dict:
     return out
 
 
-def _validate_values(d: dict, source: str) -> None:
-    def check(ok: bool, key: str, what: str) -> None:
-        if not ok:
-            raise ScenarioError(source, f"key '{key}' {what}")
-
-    from .worlds import WORLDS
-
-    w, c, r, p, st, el = d["walk"], d["can"], d["radio"], d["person"], d["stairs"], d["elevator"]
-    sv = d["survey"]
-    check(d["world"]["name"] in WORLDS, "world.name", f"must be one of {', '.join(repr(k) for k in WORLDS)}")
-    world = WORLDS[d["world"]["name"]]()
-    check(d["duration_s"] >= 0, "duration_s", "must be >= 0")
-    routes = ("tour", "loop", "track", "legs")
-    check(w["route"] in routes, "walk.route", "must be 'tour', 'loop', 'track' or 'legs'")
-    if not sv["enabled"]:
-        check(
-            w["route"] != "tour" or (world.stairs is not None and world.elevator is not None),
-            "walk.route",
-            f"'tour' needs stairs and an elevator (world {world.name!r} has none)",
-        )
-        check(
-            w["route"] != "track" or world.track_m is not None,
-            "walk.route",
-            f"'track' needs a world with a track (world {world.name!r} has none)",
-        )
-        check(
-            w["route"] != "legs" or bool(world.walk_legs),
-            "walk.route",
-            f"'legs': world {world.name!r} has none",
-        )
-    check(sv["layout"] in ("grid", "world"), "survey.layout", "must be 'grid' or 'world'")
-    check(
-        sv["layout"] != "world" or world.survey_points_m is not None,
-        "survey.layout",
-        f"'world' needs a world with its own calibration points (world {world.name!r} has none)",
-    )
-    check(0.5 <= sv["spacing_m"] <= 20.0, "survey.spacing_m", "must be in 0.5..20")
-    check(0 <= sv["margin_m"] <= 2.0, "survey.margin_m", "must be in 0..2")
-    check(-1 <= sv["floor"] < world.n_floors, "survey.floor", f"must be -1 (all) or 0..{world.n_floors - 1}")
-    check(1 <= sv["orientations"] <= 8, "survey.orientations", "must be in 1..8")
-    check(1 <= sv["scans_per_orientation"] <= 20, "survey.scans_per_orientation", "must be in 1..20")
-    check(sv["settle_s"] >= 0, "survey.settle_s", "must be >= 0")
-    check(
-        sv["scan_interval_s"] * 1000 > r["scan_duration_ms"],
-        "survey.scan_interval_s",
-        "must be longer than radio.scan_duration_ms",
-    )
-    check(0 <= r["body_loss_db"] <= 30, "radio.body_loss_db", "must be in 0..30")
-    check(w["pace"] in ("slow", "normal", "fast"), "walk.pace", "must be 'slow', 'normal' or 'fast'")
-    check(w["laps"] > 0, "walk.laps", "must be > 0")
-    check(
-        w["cadence_hz"] == 0 or 0.5 <= w["cadence_hz"] <= 3.0, "walk.cadence_hz", "must be 0 or in 0.5..3.0"
-    )
-    check(w["stride_m"] == 0 or 0.2 <= w["stride_m"] <= 1.5, "walk.stride_m", "must be 0 or in 0.2..1.5")
-    check(w["speed_mps"] == 0 or 0.2 <= w["speed_mps"] <= 3.0, "walk.speed_mps", "must be 0 or in 0.2..3.0")
-    check(0 <= w["cadence_jitter"] <= 0.2, "walk.cadence_jitter", "must be in 0..0.2")
-    check(0 <= w["stride_jitter"] <= 0.2, "walk.stride_jitter", "must be in 0..0.2")
-    check(0.1 <= w["turn_radius_m"] <= 1.0, "walk.turn_radius_m", "must be in 0.1..1.0 (corridor half width)")
-    check(w["max_yaw_rate_dps"] > 10, "walk.max_yaw_rate_dps", "must be > 10")
-    check(0 <= w["pendulum_recovery"] <= 1.0, "walk.pendulum_recovery", "must be in 0..1")
-    check(0 <= w["bounce_jitter"] < 0.5, "walk.bounce_jitter", "must be in 0..0.5")
-    check(0 <= w["sway_mps2"] <= 3.0, "walk.sway_mps2", "must be in 0..3")
-    check(
-        p["weinberg_k"] == 0 or 0.2 <= p["weinberg_k"] <= 1.0, "person.weinberg_k", "must be 0 or in 0.2..1.0"
-    )
-    check(
-        p["stride_scale"] == 0 or 0.5 <= p["stride_scale"] <= 1.5,
-        "person.stride_scale",
-        "must be 0 or in 0.5..1.5",
-    )
-    check(
-        p["cadence_scale"] == 0 or 0.5 <= p["cadence_scale"] <= 1.5,
-        "person.cadence_scale",
-        "must be 0 or in 0.5..1.5",
-    )
-    check(0.5 <= st["cadence_hz"] <= 3.0, "stairs.cadence_hz", "must be in 0.5..3.0")
-    check(0 <= st["bounce_p2p_mps2"] <= 20.0, "stairs.bounce_p2p_mps2", "must be in 0..20")
-    check(0.2 <= el["speed_mps"] <= 5.0, "elevator.speed_mps", "must be in 0.2..5")
-    check(0.1 <= el["accel_mps2"] <= 3.0, "elevator.accel_mps2", "must be in 0.1..3")
-    check(el["door_s"] >= 0 and el["exit_s"] >= 0, "elevator.door_s", "must be >= 0 (and exit_s too)")
-    check(d["imu"]["gyro_bias_rw_dps_per_sqrt_s"] >= 0, "imu.gyro_bias_rw_dps_per_sqrt_s", "must be >= 0")
-    check(
-        all(abs(v) < 0.2 for v in d["imu"]["gyro_scale_error"]), "imu.gyro_scale_error", "must be within ±0.2"
-    )
-    check(d["mag"]["disturbance_scale"] >= 0, "mag.disturbance_scale", "must be >= 0")
-    check(d["baro"]["drift_pa_per_sqrt_h"] >= 0, "baro.drift_pa_per_sqrt_h", "must be >= 0")
-    check(r["floor_loss_db"] >= 0, "radio.floor_loss_db", "must be >= 0")
-    check(w["start_still_s"] >= 0 and w["trailing_still_s"] >= 0, "walk.start_still_s", "must be >= 0")
-    for i, p in enumerate(w["pause"]):
-        check(
-            p["at_m"] > 0 and p["duration_s"] >= 0, f"walk.pause[{i}]", "needs at_m > 0 and duration_s >= 0"
-        )
-    check(0 <= c["loss_rate"] < 1, "can.loss_rate", "must be in 0..1")
-    check(0 <= c["board_time_start_ms"] < 2**32, "can.board_time_start_ms", "must be in 0..2**32-1")
-    check(0 <= c["boot_id"] <= 255, "can.boot_id", "must be in 0..255")
-    validate_faults(d["faults"], check)
-    validate_sources(d, check)
-    check(
-        0 < r["scan_interval_min_s"] <= r["scan_interval_max_s"],
-        "radio.scan_interval_min_s",
-        "must be > 0 and <= radio.scan_interval_max_s",
-    )
-    check(
-        0 <= r["scan_duration_ms"] < 1000 * r["scan_interval_min_s"],
-        "radio.scan_duration_ms",
-        "must be >= 0 and shorter than the scan interval",
-    )
-
-
 def _pace_scenario(pace: str) -> dict:
     return {
         "walk": {
@@ -428,7 +311,7 @@ def builtin_scenario(name: str) -> Scenario:
         raise ScenarioError(name, f"unknown built-in scenario (known: {', '.join(BUILTIN)})")
     source = "<built-in default>" if name == "default" else f"<built-in {name}>"
     data = _merge(DEFAULTS, BUILTIN[name], source)
-    _validate_values(data, source)
+    validate_values(data, source)
     return Scenario(data=data, source=source)
 
 
@@ -450,7 +333,7 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError(source, f"bad TOML: {e}") from None
     data = _merge(DEFAULTS, user, source)
-    _validate_values(data, source)
+    validate_values(data, source)
     return Scenario(data=data, source=source)
 
 

@@ -253,8 +253,48 @@ def variants() -> list[tuple[str, bytes, str, str | None]]:
         ("fix_white_share", _edited(fix_white_share=1.5), "field", None),
         *v2_variants(),
         *v3_variants(),
+        *range_variants(),
     ]
     return out
+
+
+def range_variants() -> list[tuple[str, bytes, str, str | None]]:
+    """Finite but absurd values, one per row kind of firmware/site_ranges.tsv (scalars, per-element
+    arrays with and without a label, the conditional ones), and a door with steps."""
+    far, rp_x = 3e38, [0.5, 2.25, -1.75, 10.125, 3.3, 7.0]
+    return [
+        ("range_rotation", _edited(map_rotation_deg=far), "field", None),
+        ("range_geo_rotation", _edited(geo_rotation_deg=-1e6), "field", None),
+        ("range_altitude", _edited(origin_alt_m=-5e6), "field", None),
+        ("range_fix_floor_cov", _edited(fix_floor_cov_m2=[1e12, 0.0, 1.0]), "field", None),
+        ("range_fix_bias_sigma", _edited(fix_bias_sigma_m=1e9), "field", None),
+        ("range_floor_height", _edited(floor_height_m=[-3.5, 0.0, 1e9]), "field", None),
+        ("range_cell", _edited(cell_size_m=1e30), "field", None),
+        ("range_rp_x", _edited(rp_x_m=rp_x[:2] + [far] + rp_x[3:]), "field", None),
+        ("range_rp_y", _edited(rp_y_m=[1.0, -4.5, 0.0, 6.75, 2.2, -far]), "field", None),
+        ("range_rp_scans", _edited(rp_scans=[3, 4, 1, 2, 5, 2_000_000_000]), "field", None),
+        (
+            "range_entry_mean",
+            _edited(entry_mean_dbm=[-45.5, -60.25, -70.1, 500.0, -55.5, -90, -33.3]),
+            "field",
+            None,
+        ),
+        ("range_entry_std", _edited(entry_std_db=[1.25, 0.0, 2.5, 3.0, 1e9, 0.0, 1.1]), "field", None),
+        ("range_wall", _edited(wall_x1_m=[10.0, 1e7, -2.5]), "field", None),
+        ("range_port", _edited(port_y_m=[0.0, -1e6]), "field", None),
+        ("range_port_radius", _edited(port_radius_m=[0.75, 1e5]), "field", None),
+        ("range_beacon", _edited(beacon_x_m=[1.0, 2.5, far]), "field", None),
+        ("range_beacon_rssi", _edited(beacon_rssi_1m_dbm=[float("nan"), -61.5, 200.0]), "field", None),
+        ("range_ble_rssi", _edited(ble_rssi_1m_dbm=-1000.0), "field", None),
+        ("range_ble_exponent", _edited(ble_path_loss_exponent=50.0), "field", None),
+        ("range_ble_sigma", _edited(ble_range_sigma_db=1e4), "field", None),
+        ("range_outline", _edited(outline_y_m=[-5.0, -5.0, 8.0, 8.0, 0.0, -far, 7.5]), "field", None),
+        ("range_port_steps", _edited(port_steps=[0, 30000]), "field", None),
+        ("range_port_end", _edited(port_lo_x_m=[5.0, 2e5]), "field", None),
+        ("range_min_hits", _edited(context_cdd_min_hits=[1, 2, 5000]), "field", None),
+        ("range_cdd_dbm", _edited(cdd_min_dbm=[-62.5, 99.0, -75.25]), "field", None),
+        ("door_steps", _edited(port_steps=[5, 24]), "field", None),
+    ]
 
 
 def v2_variants() -> list[tuple[str, bytes, str, str | None]]:

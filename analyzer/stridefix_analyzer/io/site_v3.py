@@ -10,7 +10,8 @@ same words. Rules, in order (every array's length equal to its count first, :dat
   consecutive; then each building has at least 3 vertices;
 * port extras: ``port_building`` in −1 … n_buildings−1, ``port_outdoor`` 0 or 1, ``port_steps`` ≥ 0
   (and > 0 for stairs when the site has contexts: the controller's stairs rule counts them; a site
-  without contexts keeps :func:`fill_port_defaults`' neutral 0), finite endpoints;
+  without contexts keeps :func:`fill_port_defaults`' neutral 0; 0 for doors and elevators, which the
+  controller refuses otherwise), finite endpoints;
 * links: both ports in range, not one port linked with itself;
 * contexts: kind one of ``CONTEXT_*``; building −1 for the outdoor context, in range for the others;
   floor within the site's floors; scheme a fusion scheme (0 … ``pose_t.SCHEME_CONTROLLER`` − 1);
@@ -29,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 from stridefix import fix_t, pose_t, site_t
 
-from stridefix_analyzer.io.site_v2 import SiteV2ValidationError, check_len, finite
+from stridefix_analyzer.io.site_v2 import PORT_KINDS, SiteV2ValidationError, check_len, finite
 
 #: The version-3 fields of ``site_t``: each count with its arrays (the per-port extras under
 #: ``n_ports``, which the version-2 table counts from ``port_kind``). The one list the checks, the
@@ -111,6 +112,11 @@ def _validate_port_extras(site: site_t, n_buildings: int) -> None:
         if steps == 0 and site.port_kind[i] == site_t.PORT_STAIRS and site.n_contexts > 0:
             raise _bad(
                 f"port {i}: stairs with port_steps 0 (a staircase needs its step count when the site has contexts)"
+            )
+        if steps != 0 and site.port_kind[i] != site_t.PORT_STAIRS:
+            raise _bad(
+                f"port {i}: a {PORT_KINDS.get(site.port_kind[i], 'port')} with port_steps {steps} "
+                f"(steps are a staircase's: 0 for doors and elevators)"
             )
         lx, ly, hx, hy = site.port_lo_x_m[i], site.port_lo_y_m[i], site.port_hi_x_m[i], site.port_hi_y_m[i]
         if not finite(lx, ly, hx, hy):

@@ -24,8 +24,9 @@ order and word their messages alike, so a file rejected by one is rejected by th
    indices in range, strictly sorted by (ap, rp), finite mean, finite std ≥ 0, and
    1 ≤ count ≤ ``rp_scans`` of their RP; then the version-2 content (:mod:`.site_v2`: geo altitude
    and rotation, walls, ports, beacons and the BLE path-loss model), then the version-3 content
-   (:mod:`.site_v3`: outlines, port extras, links, contexts, constellations). Every array's length
-   must equal its count.
+   (:mod:`.site_v3`: outlines, port extras, links, contexts, constellations), then every numeric
+   field within its physical range (:mod:`.site_ranges`: the table ``firmware/site_ranges.tsv`` both
+   readers check). Every array's length must equal its count.
 
 Errors: :class:`SiteFileError` (``path: what``), with ``kind`` one of :data:`ERROR_KINDS`.
 Cost: one read of the file, O(n_ap + n_rp + n_entries) checks.
@@ -44,6 +45,7 @@ from typing import Any
 import numpy as np
 from stridefix import site_t
 
+from stridefix_analyzer.io.site_ranges import validate_ranges
 from stridefix_analyzer.io.site_v2 import (
     SiteV2ValidationError,
     check_len,
@@ -247,6 +249,7 @@ def validate_site(site: site_t) -> None:
     try:
         validate_plan(site, site.lowest_floor, top_floor)
         validate_contexts(site, site.lowest_floor, top_floor)
+        validate_ranges(site)
     except SiteV2ValidationError as exc:
         raise SiteValidationError(str(exc)) from None
 

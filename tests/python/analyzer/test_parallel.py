@@ -3,8 +3,11 @@ check that Dask workers see the files the tasks need, on every scheduler."""
 
 from __future__ import annotations
 
+import ipaddress
 import os
+import urllib.parse
 
+import psutil
 import pytest
 from stridefix_analyzer.parallel import (
     NEEDS,
@@ -138,3 +141,22 @@ def test_a_scheduler_address_runs_on_its_workers(client):
     with task_runner(address, files=WorkerFiles(read=[os.getcwd()])) as r:
         assert r.describe() == address
         assert r.map(square_plus, range(4), shared=1) == [1, 2, 5, 10]
+
+
+def _listening(pid: int) -> set[str]:
+    """The addresses process ``pid`` listens on (TCP)."""
+    return {c.laddr.ip for c in psutil.Process(pid).net_connections("tcp") if c.status == psutil.CONN_LISTEN}
+
+
+def test_the_local_cluster_listens_on_loopback_only(client):
+    # a Dask client can run any function on a worker: nothing of a local run may be reachable from
+    # another machine, the dashboard included
+    scheduler = urllib.parse.urlparse(client.scheduler.address).hostname
+    dashboard = urllib.parse.urlparse(client.dashboard_link).hostname
+    workers = [urllib.parse.urlparse(w).hostname for w in client.scheduler_info()["workers"]]
+    assert ipaddress.ip_address(scheduler).is_loopback and dashboard in ("127.0.0.1", "localhost")
+    assert workers and all(ipaddress.ip_address(w).is_loopback for w in workers)
+    pids = [os.getpid(), *client.run(os.getpid).values()]
+    listening = {pid: _listening(pid) for pid in pids}
+    assert listening[os.getpid()], "the scheduler and dashboard listen in this process"
+    assert all(ipaddress.ip_address(ip).is_loopback for ips in listening.values() for ip in ips), listening

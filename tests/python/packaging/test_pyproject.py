@@ -91,7 +91,11 @@ def test_product_and_lab_share_the_packages_out():
     assert lab["project"]["scripts"] == {"stridefix-lab": "stridefix_lab.cli:main"}
     assert [Requirement(r).name for r in lab["project"]["dependencies"]] == ["stridefix"]
     assert (REPO / "lab" / "VERSION").read_text() == (REPO / "VERSION").read_text()
-    assert product["tool"]["setuptools"]["package-data"] == {"stridefix_common": ["board.dbc"]}
+    assert product["tool"]["setuptools"]["package-data"] == {
+        "stridefix_common": ["board.dbc", "site_ranges.tsv"]
+    }
+    ranges = REPO / "common" / "stridefix_common" / "site_ranges.tsv"
+    assert ranges.resolve() == (REPO / "firmware" / "site_ranges.tsv").resolve()
     dbc = REPO / "common" / "stridefix_common" / "board.dbc"
     assert dbc.resolve() == (REPO / "firmware" / "board.dbc").resolve()
 

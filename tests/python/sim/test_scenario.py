@@ -125,3 +125,103 @@ def test_cli_named_scenario_and_unknown_name(tmp_path, sim_cli, capsys):
     assert sim_cli(["--scenario", "pace_jog", "--out", str(tmp_path / "p")]) == 2
     err = capsys.readouterr().err
     assert "pace_jog" in err and "pace_slow" in err
+
+
+def _numeric_keys(table: dict, prefix: str = "") -> list[tuple[str, object]]:
+    """(dotted key, default) of every numeric key of ``table``: numbers, lists of numbers (an empty
+    default list is a list of times), and the pauses' at_m and duration_s."""
+    out: list[tuple[str, object]] = []
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out += _numeric_keys(value, f"{name}.")
+        elif key == "pause":
+            out += [(f"{name}[0].at_m", 10.0), (f"{name}[0].duration_s", 2.0)]
+        elif isinstance(value, list) or (isinstance(value, (int, float)) and not isinstance(value, bool)):
+            out.append((name, value))
+    return out
+
+
+def _toml_with(key: str, bad: str) -> str:
+    """A scenario file that sets ``key`` (dotted) to the TOML float ``bad`` (nan, inf, -inf); in a list,
+    its first element."""
+    if key.startswith("walk.pause[0]."):
+        leaf = key.rsplit(".", 1)[1]
+        other = {"at_m": "duration_s = 2.0", "duration_s": "at_m = 10.0"}[leaf]
+        return f"[[walk.pause]]\n{leaf} = {bad}\n{other}\n"
+    *tables, leaf = key.split(".")
+    default = DEFAULTS
+    for t in tables:
+        default = default[t]
+    value = default[leaf]
+    if isinstance(value, list):
+        rest = [repr(float(v)) for v in value[1:]]
+        text = f"{leaf} = [{', '.join([bad, *rest])}]"
+    else:
+        text = f"{leaf} = {bad}"
+    return (f"[{'.'.join(tables)}]\n" if tables else "") + text + "\n"
+
+
+_NUMERIC_KEYS = _numeric_keys(DEFAULTS)
+
+
+def test_every_numeric_key_is_listed():
+    keys = {k for k, _ in _NUMERIC_KEYS}
+    assert {"seed", "duration_s", "mounting.roll_deg", "imu.accel_bias_mps2", "walk.pause[0].at_m"} <= keys
+    assert "faults.silence_at_s" in keys and "gnss.tau_s" in keys and len(keys) > 90
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "-inf"])
+@pytest.mark.parametrize("key", [k for k, _ in _NUMERIC_KEYS])
+def test_non_finite_values_are_errors_naming_the_key(key, bad):
+    text = _toml_with(key, bad)
+    with pytest.raises(ScenarioError) as e:
+        parse_scenario(text, source="x.toml")
+    assert str(e.value).startswith("x.toml: ") and f"'{key}'" in str(e.value), (text, str(e.value))
+
+
+@pytest.mark.parametrize(
+    "overrides, key",
+    [
+        ({"seed": -1}, "seed"),
+        ({"duration_s": float("inf")}, "duration_s"),
+        ({"duration_s": float("nan")}, "duration_s"),
+        ({"duration_s": 1e12}, "duration_s"),
+        ({"mounting.roll_deg": float("nan")}, "mounting.roll_deg"),
+        ({"world.map_rotation_deg": 3e38}, "world.map_rotation_deg"),
+        ({"imu.accel_noise_mps2": -0.1}, "imu.accel_noise_mps2"),
+        ({"baro.sea_level_pa": 0.0}, "baro.sea_level_pa"),
+        ({"radio.path_loss_exponent": 0.0}, "radio.path_loss_exponent"),
+        ({"mag.dip_deg": 95.0}, "mag.dip_deg"),
+        ({"walk.laps": 1e9}, "walk.laps"),
+    ],
+)
+def test_out_of_range_overrides_are_errors_naming_the_key(overrides, key):
+    with pytest.raises(ScenarioError) as e:
+        resolve_scenario("default").with_overrides(**overrides)
+    assert f"'{key}'" in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ("duration_s = inf\n", "duration_s"),
+        ("seed = -1\n", "seed"),
+        ("[[walk.pause]]\nat_m = 10.0\nduration_s = inf\n", "walk.pause[0].duration_s"),
+        ("[mounting]\nroll_deg = nan\n", "mounting.roll_deg"),
+    ],
+)
+def test_cli_non_finite_or_negative_seed_exits_2_with_one_line(tmp_path, sim_cli, capsys, text, key):
+    f = tmp_path / "bad.toml"
+    f.write_text(text)
+    assert sim_cli(["--scenario", str(f), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(f) in err and f"'{key}'" in err, err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("args", [["--seed", "-1"], ["--duration-s", "inf"], ["--duration-s", "nan"]])
+def test_cli_bad_seed_or_duration_option_exits_2(tmp_path, sim_cli, capsys, args):
+    assert sim_cli([*args, "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "error" in err, err

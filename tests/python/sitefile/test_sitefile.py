@@ -177,6 +177,53 @@ def test_missing_file(tmp_path):
             {"entry_std_db": [1.25, float("nan"), 2.5, 3.0, 0.5, 0.0, 1.1]},
             "entry 1: entry_std_db = nan, must be finite and >= 0",
         ),
+        # finite but absurd: each outside its physical range (firmware/site_ranges.tsv)
+        ({"map_rotation_deg": 3e38}, "map_rotation_deg = 3e+38 outside -360..360 deg"),
+        ({"geo_rotation_deg": 720.5}, "geo_rotation_deg = 720.5 outside -360..360 deg"),
+        ({"origin_alt_m": -5e6}, "origin_alt_m = -5e+06 outside -1000..10000 m"),
+        ({"rp_x_m": [0.5, 2.25, 3e38, 10.125, 3.3, 7.0]}, "rp 2: rp_x_m = 3e+38 outside -100000..100000 m"),
+        ({"rp_y_m": [1.0, -4.5, 0.0, 6.75, 2.2, -3e38]}, "rp 5: rp_y_m = -3e+38 outside -100000..100000 m"),
+        ({"floor_height_m": [-3.5, 0.0, 1e9]}, "floor_height_m[2] = 1e+09 outside -1000..10000 m"),
+        ({"fix_floor_cov_m2": [1e12, 0.0, 1.0]}, "fix_floor_cov_m2[0] = 1e+12 outside -1e+06..1e+06 m2"),
+        ({"fix_bias_length_m": 1e9}, "fix_bias_length_m = 1e+09 outside 0..100000 m"),
+        ({"cell_size_m": 1e30}, "cell_size_m = 1e+30 outside 0..1000 m"),
+        ({"rp_scans": [3, 4, 1, 2, 5, 2_000_000_000]}, "rp 5: rp_scans = 2e+09 outside 1..1e+06"),
+        (
+            {"entry_mean_dbm": [-45.5, -60.25, -70.1, 500.0, -55.5, -90.0, -33.3]},
+            "entry 3: entry_mean_dbm = 500 outside -150..30 dBm",
+        ),
+        ({"wall_x1_m": [10.0, 1e7, -2.5]}, "wall 1: wall_x1_m = 1e+07 outside -100000..100000 m"),
+        ({"port_radius_m": [0.75, 1e5]}, "port 1: port_radius_m = 100000 outside 0..1000 m"),
+        (
+            {"beacon_rssi_1m_dbm": [float("nan"), -61.5, 200.0]},
+            "beacon 2: beacon_rssi_1m_dbm = 200 outside -150..30 dBm",
+        ),
+        ({"ble_path_loss_exponent": 50.0}, "ble_path_loss_exponent = 50 outside 0..10"),
+        (
+            {"outline_y_m": [-5.0, -5.0, 8.0, 8.0, 0.0, -3e38, 7.5]},
+            "outline vertex 5: outline_y_m = -3e+38 outside -100000..100000 m",
+        ),
+        ({"port_steps": [0, 30000]}, "port 1: port_steps = 30000 outside 0..1000 steps"),
+        ({"port_hi_y_m": [0.0, 2e5]}, "port 1: port_hi_y_m = 200000 outside -100000..100000 m"),
+        ({"context_cdd_min_hits": [1, 2, 5000]}, "context 2: context_cdd_min_hits = 5000 outside 1..1000"),
+        ({"cdd_min_dbm": [-62.5, 99.0, -75.25]}, "cdd 1: cdd_min_dbm = 99 outside -150..30 dBm"),
+        (
+            {
+                "lowest_floor": -100,
+                "rp_floor": [-100] * 6,
+                "wall_floor": [-100] * 3,
+                "port_floor_lo": [-100, -100],
+                "port_floor_hi": [-100, -98],
+                "beacon_floor": [-100] * 3,
+                "context_floor": [-100, -100, -99],
+            },
+            "lowest_floor = -100 outside -50..200",
+        ),
+        # a door's steps: the controller refuses them, so the writer and both readers do
+        (
+            {"port_steps": [5, 24]},
+            "port 0: a door with port_steps 5 (steps are a staircase's: 0 for doors and elevators)",
+        ),
     ],
 )
 def test_validate_names_the_field(vector_site, change, text):
@@ -191,3 +238,18 @@ def test_array_length_must_match_count(vector_site):
     vector_site.rp_y_m = vector_site.rp_y_m[:-1]
     with pytest.raises(sitefile.SiteValidationError, match="rp_y_m has 5 values but n_rp = 6"):
         sitefile.validate_site(vector_site)
+
+
+def test_too_many_floors_is_refused_naming_the_count():
+    # more floors than the firmware's floor model holds (SF_FLOOR_CAPACITY): refused when written
+    site = sitefile.new_site(floor_height_m=[3.0 * f for f in range(65)])
+    with pytest.raises(sitefile.SiteValidationError, match=r"^n_floors = 65 outside 1\.\.64$"):
+        sitefile.validate_site(site)
+
+
+def test_a_door_with_steps_is_not_written(tmp_path, vector_site):
+    vector_site.port_steps = [5, 24]
+    with pytest.raises(sitefile.SiteFileError) as info:
+        sitefile.write_site(tmp_path / "s.sfsite", vector_site)
+    assert info.value.kind == "field" and "port 0: a door with port_steps 5" in str(info.value)
+    assert not (tmp_path / "s.sfsite").exists()
