@@ -104,6 +104,15 @@ def file_counts(
     }
 
 
+def check_has_records(info: dict[str, Any]) -> None:
+    """Raise :class:`NotALogError` when a file's counts (:func:`file_counts`) hold no whole record: an
+    empty file, or one cut short inside its first record. Read, but nothing valid in it."""
+    if info["events"] == 0:
+        raise NotALogError(
+            info["path"], f"nothing valid in the input: no whole LCM record ({info['bytes']} bytes)"
+        )
+
+
 def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[str, Any], list[str]]:
     """Pass every whole record of one log to ``on_event(channel, payload)``.
 

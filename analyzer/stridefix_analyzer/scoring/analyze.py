@@ -338,7 +338,7 @@ def run(args: argparse.Namespace) -> int:
         console.say(f"stridefix analyze: warning: {note}")
     schemes = summary.get("per_scheme") or summary.get("walk", {}).get("per_scheme", {})
     if not any(is_fused(name) for name in schemes):
-        print(NO_SITE_NOTE, file=sys.stderr)
+        console.say(NO_SITE_NOTE)  # -q: errors only
     if metrics is None:
         show(walk_report.format_walk(summary))
     else:

@@ -1,9 +1,12 @@
 """logread: decoding, merging, counting bad data, truncated and missing files."""
 
+import warnings
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import wifi_scan_t
+from stridefix_analyzer.io.lcmfile import NotALogError
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 
 
@@ -103,13 +106,19 @@ def test_truncated_log_reads_whole_records(msg, write_log, tmp_path):
     assert any("truncated" in w for w in d.warnings)
 
 
-def test_log_cut_inside_first_record_is_empty_not_an_error(msg, write_log, tmp_path):
+@pytest.mark.parametrize("keep", [0, 10, 40])
+def test_log_without_one_whole_record_is_nothing_valid(msg, write_log, tmp_path, keep):
+    """An empty log, or one cut inside its first record, read as an empty log and `analyze` or
+    `radiomap build` of it exited 2 (a channel missing); it holds nothing valid: NotALogError (exit 3),
+    naming the file, from both readers."""
     path = write_log("one.lcmlog", [("POSE", msg.pose(0, 0, 0))])
     cut = tmp_path / "stub.lcmlog"
-    cut.write_bytes(path.read_bytes()[:10])
-    with pytest.warns(LogTruncatedWarning):
-        d = read_logs([cut])
-    assert d.tables == {} and d.inputs[0]["events"] == 0
+    cut.write_bytes(path.read_bytes()[:keep])
+    for indexed in (True, False):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", LogTruncatedWarning)
+            with pytest.raises(NotALogError, match=f"stub.lcmlog: nothing valid in the input.*{keep} bytes"):
+                read_logs([cut], indexed=indexed)
 
 
 def test_missing_file_names_it(tmp_path):
