@@ -121,12 +121,14 @@ def run_imports(
         file: TextIO | None = None,
         line: str | None = None,
     ) -> None:
-        if not console.quiet():  # -q: errors only; the skipped lines are counted in the summary
-            print(f"{prog}: warning: {message}", file=sys.stderr)
+        held.append(f"{prog}: warning: {message}")
 
     statuses, summaries = [EXIT_OK], []
     for i, (item, out) in enumerate(zip(inputs, outs), 1):
         t0 = time.perf_counter()
+        # an input's malformed-line warnings are printed once it imported: an input that did not is
+        # one error line, which names the first malformed line itself
+        held: list[str] = []
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("always", MalformedLineWarning)
@@ -140,6 +142,8 @@ def run_imports(
             print(f"{prog}: error: cannot write {out}: {exc}", file=sys.stderr)
             statuses.append(EXIT_FAILURE)
             continue
+        for line in held:
+            print(line, file=sys.stderr)
         summaries.append(s)
         console.say(f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)")
         print(json.dumps({k: s[k] for k in json_keys}))

@@ -8,7 +8,7 @@ Decoding the payloads is :mod:`.logread`'s job.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, BinaryIO
 
 import lcm
@@ -104,13 +104,16 @@ def file_counts(
     }
 
 
-def check_has_records(info: dict[str, Any]) -> None:
-    """Raise :class:`NotALogError` when a file's counts (:func:`file_counts`) hold no whole record: an
-    empty file, or one cut short inside its first record. Read, but nothing valid in it."""
-    if info["events"] == 0:
-        raise NotALogError(
-            info["path"], f"nothing valid in the input: no whole LCM record ({info['bytes']} bytes)"
-        )
+def require_records(inputs: Iterable[Mapping[str, Any]]) -> None:
+    """Raise :class:`NotALogError` for the first file of a read (``LogData.inputs``, :func:`file_counts`)
+    without one whole record: empty, or cut short inside its first record. A command's input so is
+    read, but nothing valid; the readers themselves take it as an empty log (a replay that wrote
+    nothing, e.g. with ``--channels`` none of its messages went to)."""
+    for info in inputs:
+        if info["events"] == 0:
+            raise NotALogError(
+                info["path"], f"nothing valid in the input: no whole LCM record ({info['bytes']} bytes)"
+            )
 
 
 def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[str, Any], list[str]]:

@@ -42,10 +42,9 @@ only the channels asked for are decoded, and the fixed-layout ones all at once (
 any other file is read record by record, with salvage, by :mod:`.lcmfile`. Both give the same
 ``LogData`` (``read_logs(..., indexed=False)`` forces the second; the tests compare them).
 
-Errors: a missing or unreadable file raises :class:`LogReadError` naming it, one without a whole
-record (empty, not a log, cut inside its first record) :class:`NotALogError`. Bad data is not an
-error: unknown channels and undecodable messages are counted (by channel), and a log cut short
-reads up to its last whole record, with a warning in ``LogData.warnings``.
+Errors: a missing or unreadable file raises :class:`LogReadError` naming it. Bad data is not an
+error: unknown channels and messages that fail to decode are counted (by channel), and a log cut
+short reads up to its last whole record, with a warning in ``LogData.warnings``.
 """
 
 from __future__ import annotations
@@ -66,7 +65,6 @@ from stridefix_analyzer.io.lcmdecode import decode_columns
 from stridefix_analyzer.io.lcmfile import (
     LogReadError,
     LogTruncatedWarning,
-    check_has_records,
     check_readable,
     file_counts,
     read_file,
@@ -419,7 +417,7 @@ def read_logs(
     Raises
     ------
     LogReadError
-        A file is missing, not readable, or holds no whole LCM record (NotALogError); names it.
+        A file is missing, not readable, or holds no LCM record at all; the message names it.
     """
     files = [os.fspath(p) for p in paths]
     if not files:
@@ -443,7 +441,6 @@ def read_logs(
             info, notes = file_counts(path, len(index.data), len(index)), list[str]()
         else:
             info, notes = read_file(path, functools.partial(collector.add_event, path))
-        check_has_records(info)
         collector.data.inputs.append(info)
         for text in notes:
             collector.data.warnings.append(text)
@@ -452,7 +449,8 @@ def read_logs(
 
 
 def _index(path: str) -> LogIndex | None:
-    """The file's :class:`LogIndex`, or None to read it record by record (naming the file in any error)."""
+    """The file's :class:`LogIndex`, or None to read it record by record (which also names the file
+    in any error)."""
     check_readable(path)
     try:
         return index_file(path)
@@ -461,7 +459,8 @@ def _index(path: str) -> LogIndex | None:
 
 
 def _tables_of(channels: Iterable[str], decode: set[str]) -> dict[str, list[str]]:
-    """The known channels of a file to decode, grouped by their table (in first-record order)."""
+    """The known channels of a file to decode, grouped by the table they go into (first-record
+    order)."""
     out: dict[str, list[str]] = {}
     for channel in channels:
         if channel in _KNOWN and channel in decode:

@@ -397,7 +397,7 @@ def _load(path: str | os.PathLike[str]) -> dict[str, Any]:
     except ValueError as exc:  # UnicodeDecodeError, JSONDecodeError, a 5000-digit number
         raise NotAResultsFileError(f"{os.fspath(path)}: nothing valid in the input: not JSON: {exc}") from exc
     if not isinstance(doc, dict):
-        raise NotAResultsFileError(
+        raise ResultsFileError(
             f"{os.fspath(path)}: not a result file (a JSON {type(doc).__name__}, not an object)"
         )
     return doc

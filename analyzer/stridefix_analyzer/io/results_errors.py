@@ -1,5 +1,5 @@
 """The errors of reading a result file (:mod:`.results`): every one names the file, and a file that is
-not a JSON object at all is "nothing valid in the input" for the exit status."""
+not JSON at all is "nothing valid in the input" for the exit status."""
 
 from __future__ import annotations
 
@@ -11,5 +11,6 @@ class ResultsFileError(ValueError):
 
 
 class NotAResultsFileError(ResultsFileError, NothingValid):
-    """A result file was read but is not a JSON object (empty, binary, UTF-16, not JSON): nothing
-    valid in it (exit :data:`~stridefix_common.exits.EXIT_NOTHING_VALID`)."""
+    """A result file was read but is not JSON (empty, binary, UTF-16, a 5000-digit number): nothing
+    valid in it (exit :data:`~stridefix_common.exits.EXIT_NOTHING_VALID`). JSON of another shape or
+    kind is a :class:`ResultsFileError` (2), as a config of unknown keys is."""

@@ -194,7 +194,7 @@ def _hostile_bytes(kind: str, fmt: str, good: dict[str, Path]) -> bytes:
     if kind == "truncated_lcm":
         return good["lcm"].read_bytes()[:40]  # inside the first event's channel name
     assert kind == "huge_numbers", kind
-    return HUGE["trace" if fmt == "floor_dir" else "lcm" if fmt == "analysis_dir" else fmt].encode()
+    return HUGE["trace" if fmt == "floor_dir" else "json" if fmt == "analysis_dir" else fmt].encode()
 
 
 def _hostile(kind: str, fmt: str, where: Path, good: dict[str, Path]) -> Path:
