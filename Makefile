@@ -190,12 +190,23 @@ define run_fuzzers
 	done
 endef
 
+# The Python importers' property tests (hypothesis, tests/python/realdata/test_importer_properties.py):
+# about 50 examples a second, so FUZZ_SECONDS per property; prints the examples each one ran.
+define fuzz_importers
+	@STRIDEFIX_HYPOTHESIS_EXAMPLES=$$(( $(1) * 50 )) $(PY) -m pytest -q -p no:cacheprovider \
+		--hypothesis-show-statistics tests/python/realdata/test_importer_properties.py > build-fuzz/fuzz_importers.log 2>&1 \
+		|| { tail -60 build-fuzz/fuzz_importers.log; echo "fuzz: importers FAILED"; exit 1; }
+	@awk '/::test_/ { sub(/:$$/, ""); sub(/.*::/, ""); t = $$0 } /passing,/ { print "fuzz: " t ": " $$2 " examples passed" }' \
+		build-fuzz/fuzz_importers.log
+endef
+
 check-fuzz: deps
 	$(call run_fuzzers,$(FUZZ_CHECK_SECONDS))
 
 fuzz: deps
 	$(call run_fuzzers,$(FUZZ_SECONDS))
 	STRIDEFIX_LIVE_FUZZ_SECONDS=$(FUZZ_SECONDS) $(PY) -m pytest -q -s -p no:cacheprovider tests/python/live/test_live_fuzz.py -k budget
+	$(call fuzz_importers,$(FUZZ_SECONDS))
 
 clean:
 	rm -rf $(BUILD) build-clang build-asan build-fuzz $(ARM_BUILD) out

@@ -7,6 +7,9 @@ sub-sub-command): a :class:`CommandLine`'s ``argv_rewrites`` names that hook as 
 ``function(argv) -> argv``, applied only when that sub-command is the one given.
 Exit status: the one contract of :mod:`stridefix_common.exits` (0 ok, 1 failed while running, 2 bad
 usage or unreadable input, 3 nothing valid in the input), stated in every sub-command's ``--help``.
+A sub-command checks its inputs itself (2 or 3, naming the file); an ``OSError`` that still escapes it
+happened while it ran (an output that cannot be written, a read that failed midway): :meth:`main`
+reports it in one line naming the file and exits 1, never with a traceback.
 Global options, before the sub-command: ``-q``/``-v`` (:mod:`stridefix_analyzer.console`: what the
 long-running commands print on stderr) and ``--version`` (the package's and the stridefixd's it runs).
 Every ``--help`` goes through :mod:`stridefix_analyzer.helptext` (no docstring markup).
@@ -108,8 +111,18 @@ class CommandLine:
         console.set_level(args.verbosity)
         try:
             return int(args._run(args) or 0)
+        except OSError as exc:
+            print(f"{self.prog} {args.command}: error: {os_error_text(exc)}", file=sys.stderr)
+            return EXIT_FAILURE
         finally:
             console.end_progress()  # the command's live progress line, cleared whatever happened
+
+
+def os_error_text(exc: OSError) -> str:
+    """``exc`` as "FILE: what happened" (both files of a rename), without Python's ``[Errno N]``."""
+    what = exc.strerror or str(exc)
+    files = [os.fsdecode(f) for f in (exc.filename, exc.filename2) if f is not None]
+    return f"{' -> '.join(files)}: {what}" if files else what
 
 
 def split_global(argv: list[str]) -> tuple[list[str], list[str]]:

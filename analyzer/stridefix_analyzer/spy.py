@@ -22,10 +22,11 @@ import shlex
 import shutil
 import subprocess
 import sys
+import zipfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from stridefix_common.exits import EXIT_FAILURE, EXIT_OK
+from stridefix_common.exits import EXIT_FAILURE, EXIT_OK, EXIT_USAGE
 
 REPO = Path(__file__).resolve().parents[2]
 #: the build's Java types (lcmtypes/CMakeLists.txt); ``$STRIDEFIX_LCMTYPES_JAR`` overrides it
@@ -39,7 +40,13 @@ SPY_CLASS = "lcm.spy.Spy"
 
 
 class SpyError(RuntimeError):
-    """What lcm-spy needs is missing (java, lcm.jar, the types jar); the message says how to get it."""
+    """What lcm-spy needs is missing (java, lcm.jar, the types jar); the message says how to get it.
+    ``status``: the exit status (1: the machine lacks a tool; 2: the types jar cannot be read or is
+    not a jar, as stridefixd treats a --site or --config that is not one)."""
+
+    def __init__(self, message: str, status: int = EXIT_FAILURE) -> None:
+        super().__init__(message)
+        self.status = status
 
 
 def types_jar() -> Path:
@@ -76,8 +83,11 @@ def classpath(types: Path | None = None, lcm: Path | None = None) -> list[Path]:
     if not types.is_file():
         raise SpyError(
             f"{types}: no StrideFix Java types (make build with a JDK and lcm.jar found; "
-            "or set $STRIDEFIX_LCMTYPES_JAR)"
+            "or set $STRIDEFIX_LCMTYPES_JAR)",
+            EXIT_USAGE,
         )
+    if not zipfile.is_zipfile(types):  # java would start and decode nothing: say so before it does
+        raise SpyError(f"{types}: not a jar (zip) file of StrideFix Java types", EXIT_USAGE)
     extra = [DEFAULT_JCHART2D_JAR] if DEFAULT_JCHART2D_JAR.is_file() else []
     return [lcm, types, *extra]
 
@@ -130,8 +140,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         cmd = spy_command(args.lcm_url, args.types_jar)
     except SpyError as exc:
-        print(f"stridefix spy: {exc}", file=sys.stderr)
-        return EXIT_FAILURE
+        print(f"stridefix spy: error: {exc}", file=sys.stderr)
+        return exc.status
     if args.print:
         print(shlex.join(cmd))
         return EXIT_OK

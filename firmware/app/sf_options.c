@@ -52,7 +52,7 @@ static void usage(FILE *const f)
             "  -d, --log-dir DIR      directory for the default log name (default: .)\n"
             "      --force            replace an existing log file (never through a symlink); without it an\n"
             "                         existing FILE or FILE.part is refused (exit 1)\n"
-            "      --no-log           write no log (live publishing only)\n"
+            "      --no-log           write no log (live publishing only; not with --log, --log-dir)\n"
             "      --channels LIST    write only these channels (log and live LCM), comma-separated, e.g.\n"
             "                         FIX,POSE_ADAPTIVE (a replay scored on them alone: less to write and to\n"
             "                         read back); the estimator runs the same (default: every channel)\n"
@@ -289,12 +289,16 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
     optind = 0; /* getopt_long starts over (GNU: 0 also resets its internal state): parse is re-entrant */
     bool want_print_config = false;
     bool want_json = false;
+    bool log_dir_given = false;
     int c;
     while ((c = getopt_long(argc, argv, "i:l:d:u:c:s:qhV", longs, NULL)) != -1) {
         switch (c) {
         case 'i': o->input = optarg; break;
         case 'l': o->log_path = optarg; break;
-        case 'd': o->log_dir = optarg; break;
+        case 'd':
+            o->log_dir = optarg;
+            log_dir_given = true;
+            break;
         case opt_no_log: o->no_log = true; break;
         case 'u': o->lcm_url = optarg; break;
         case opt_site: o->site_path = optarg; break;
@@ -353,6 +357,11 @@ int sf_options_parse(const int argc, char **const argv, const char *const versio
         return SF_EXIT_USAGE;
     }
     if (check_paths(o) != 0) {
+        return SF_EXIT_USAGE;
+    }
+    if (o->no_log && (o->log_path != NULL || log_dir_given)) { /* which one was meant cannot be guessed */
+        fprintf(stderr, "stridefixd: --no-log contradicts %s (see --help)\n",
+                o->log_path != NULL ? "--log" : "--log-dir");
         return SF_EXIT_USAGE;
     }
     if (want_json && !want_print_config) {

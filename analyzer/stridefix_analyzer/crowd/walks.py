@@ -28,6 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from stridefix_analyzer.crowd.model import fingerprint_matrix
+from stridefix_analyzer.io.lcmfile import require_records
 from stridefix_analyzer.io.logread import LogTruncatedWarning, read_logs
 
 SOURCE_SIMULATION, SOURCE_WAYPOINT = 1, 2
@@ -124,7 +125,9 @@ def _keep_band(freq_mhz: np.ndarray, band: str) -> np.ndarray:
 def _read(path: str):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)
-        return read_logs([path], decode=("WIFI", "TRUTH", "STEP"))
+        data = read_logs([path], decode=("WIFI", "TRUTH", "STEP"))
+    require_records(data.inputs)  # an empty log, or one cut in its first record: nothing valid
+    return data
 
 
 def _make_walk(files: list[str], datas: list) -> Walk:

@@ -46,7 +46,11 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
         fp.add_argument("inputs", nargs="+", metavar=ds.input_metavar, help=ds.input_help)
         add_output_arguments(fp)
         ds.add_arguments(fp)
-        fp.add_argument("--json", metavar="FILE", help="also write the summaries as JSON to FILE")
+        fp.add_argument(
+            "--json",
+            metavar="FILE",
+            help="also write the summaries as JSON to FILE (when one input imported)",
+        )
         fp.set_defaults(_dataset=ds)
     return p
 
@@ -117,11 +121,14 @@ def run_imports(
         file: TextIO | None = None,
         line: str | None = None,
     ) -> None:
-        print(f"{prog}: warning: {message}", file=sys.stderr)
+        held.append(f"{prog}: warning: {message}")
 
     statuses, summaries = [EXIT_OK], []
     for i, (item, out) in enumerate(zip(inputs, outs), 1):
         t0 = time.perf_counter()
+        # an input's malformed-line warnings are printed once it imported: an input that did not is
+        # one error line, which names the first malformed line itself
+        held: list[str] = []
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("always", MalformedLineWarning)
@@ -135,10 +142,13 @@ def run_imports(
             print(f"{prog}: error: cannot write {out}: {exc}", file=sys.stderr)
             statuses.append(EXIT_FAILURE)
             continue
+        for line in held:
+            print(line, file=sys.stderr)
         summaries.append(s)
         console.say(f"[{i}/{len(inputs)}] {format_summary(s)} -> {out} ({time.perf_counter() - t0:.2f} s)")
         print(json.dumps({k: s[k] for k in json_keys}))
-    if args.json:
+    if args.json and summaries:  # none: every input failed, and each said so already
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)  # as --out DIR and -o FILE's are
         Path(args.json).write_text(json.dumps(summaries, indent=2) + "\n", encoding="utf-8")
     where = args.output if args.output else args.out
     console.say(f"{prog}: {len(summaries)}/{len(inputs)} {noun}(s) imported into {where}")

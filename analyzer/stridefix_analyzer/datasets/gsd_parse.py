@@ -5,8 +5,8 @@ the data set's README and in each file's header). :func:`parse_log` keeps, per r
 the numbers the conversion (:mod:`.gsd_convert`) needs, in file order and on the file's own clocks;
 nothing is aligned, grouped or projected here.
 
-Bad data is not an error: a malformed line (wrong field count, a field that is not a number, an
-unknown record tag) is counted, skipped and reported with a :class:`~.lines.MalformedLineWarning`
+Bad data is not an error: a malformed line (wrong field count, a field that is not a number, a time
+beyond ±10¹² s or an integer beyond its column's type, an unknown record tag) is counted, skipped and reported with a :class:`~.lines.MalformedLineWarning`
 naming file and line. BLE4 records (iBeacon and Eddystone: app time, MAC, RSSI) are kept. Record types not
 imported (AHRS, LIGH, SOUN, ...) are counted per type. A
 missing or unreadable file raises :class:`LogReadError` naming it; a pressure unit the importer does
@@ -23,7 +23,14 @@ import re
 
 from stridefix_analyzer.datasets.lines import LineReader
 from stridefix_analyzer.datasets.protocol import DatasetReadError
-from stridefix_analyzer.datasets.rawwalk import bssid_to_int, finite
+from stridefix_analyzer.datasets.rawwalk import (
+    INT16_RANGE,
+    INT32_RANGE,
+    bounded_int,
+    bssid_to_int,
+    finite,
+    times_s,
+)
 
 #: Malformed lines reported one by one per file; the rest are summed up in one warning.
 MAX_LINE_WARNINGS = 20
@@ -139,28 +146,37 @@ def parse_log(path: str | os.PathLike[str], max_line_warnings: int = MAX_LINE_WA
             bad(line_no, f"{kind} with {len(parts)} fields, expected {n}")
             continue
         try:
+            # every time through times_s (bounded), every integer through bounded_int (its column's
+            # type): an absurd number is a malformed line here, not an overflow in the conversion
             if kind in inertial:
-                inertial[kind].append(finite(parts[1:6]))
+                values = finite(parts[1:6])
+                times_s(values[:2])
+                inertial[kind].append(values)
             elif kind == "PRES":
-                pres.append(finite(parts[1:4]))
+                values = finite(parts[1:4])
+                times_s(values[:2])
+                pres.append(values)
             elif kind == "GNSS":
                 app, sensor, lat, lon, alt = finite(parts[1:6])
+                times_s([app, sensor])
                 acc = finite(parts[7:8])[0]
                 _latlon_ok(lat, lon)
                 gnss.append((app, sensor, lat, lon, alt, acc))
             elif kind == "WIFI":
-                app, sensor = finite(parts[1:3])
-                wifi.append(
-                    (app, sensor, bssid_to_int(parts[-3].strip()), finite(parts[-1:])[0], int(parts[-2]))
-                )
+                app, sensor = times_s(finite(parts[1:3]))
+                freq = bounded_int(parts[-2], INT32_RANGE, "frequency [MHz]")
+                wifi.append((app, sensor, bssid_to_int(parts[-3].strip()), finite(parts[-1:])[0], freq))
             elif kind == "BLE4":
                 if parts[2] not in BLE4_KINDS:
                     raise ValueError(f"frame kind {parts[2][:20]!r} not one of {BLE4_KINDS}")
-                ble.append((finite(parts[1:2])[0], bssid_to_int(parts[3].strip()), finite(parts[4:5])[0]))
+                app = times_s(finite(parts[1:2]))[0]
+                ble.append((app, bssid_to_int(parts[3].strip()), finite(parts[4:5])[0]))
             else:  # POSI
                 app, lat, lon = finite([parts[1], parts[3], parts[4]])
+                times_s([app])
                 _latlon_ok(lat, lon)
-                posi.append((app, lat, lon, int(parts[5]), parts[6].strip()))
+                floor = bounded_int(parts[5], INT16_RANGE, "floor")  # truth_t.floor
+                posi.append((app, lat, lon, floor, parts[6].strip()))
         except ValueError as exc:
             bad(line_no, f"{kind}: {exc}")
     reader.finish()

@@ -14,8 +14,9 @@ lines after ``#`` header lines. What becomes of each record (:mod:`.msindoor` ha
   of :data:`~.rawwalk.BLE_WINDOW_S` (:func:`~.rawwalk.ble_scans`; the format has no scan grouping).
 * TYPE_WAYPOINT → ``truth`` on the floor of the FloorName header (F1 → 0, F2 → 1, B1 → −1, ...).
 
-Times: ``t_us`` = the file's unix time [ms] × 1000. Bad data is not an error: a malformed line is
-counted, skipped and warned about (:class:`~.lines.MalformedLineWarning`, naming file and line).
+Times: ``t_us`` = the file's unix time [ms] × 1000. Bad data is not an error: a malformed line (a
+time beyond 10¹² s, a frequency beyond an int32 among them: :mod:`.rawwalk`'s bounds) is counted,
+skipped and warned about (:class:`~.lines.MalformedLineWarning`, naming file and line).
 Cost: one pass over the text (~1 s per 10⁵ lines), memory ∝ the samples of one trace.
 """
 
@@ -27,14 +28,18 @@ import re
 import numpy as np
 
 from stridefix_analyzer.datasets.lines import LineReader
-from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, DatasetReadError
+from stridefix_analyzer.datasets.protocol import DEFAULT_MAX_WIFI_AGE_S, DatasetReadError, check_has_records
 from stridefix_analyzer.datasets.rawwalk import (
+    INT16_RANGE,
+    INT32_RANGE,
     RawWalk,
     ble_scans,
+    bounded_int,
     bssid_to_int,
     dedupe_sorted,
     finite,
     gyro_at,
+    unix_ms,
     wifi_scans,
 )
 from stridefix_analyzer.io.logread import Table
@@ -68,18 +73,23 @@ def floor_index(name: str) -> int:
     Raises
     ------
     ValueError
-        The name follows none of these patterns.
+        The name follows none of these patterns, or its index is beyond an int16 (``truth_t.floor``).
     """
     s = name.strip().upper()
     if s in ("G", "GF"):
         return 0
-    m = re.fullmatch(r"(?:F|L)(\d+)|(\d+)F", s)
-    if m and int(m.group(1) or m.group(2)) >= 1:
-        return int(m.group(1) or m.group(2)) - 1
-    m = re.fullmatch(r"B(\d+)|(\d+)B", s)
-    if m and int(m.group(1) or m.group(2)) >= 1:
-        return -int(m.group(1) or m.group(2))
-    raise ValueError(f"floor name {name!r} is not F<n>, <n>F, L<n>, G, B<n> or <n>B")
+    above = re.fullmatch(r"(?:F|L)([0-9]+)|([0-9]+)F", s)
+    below = re.fullmatch(r"B([0-9]+)|([0-9]+)B", s)
+    m = above or below
+    digits = ((m.group(1) or m.group(2)) if m else "").lstrip("0")
+    if not digits:  # no match, or floor 0
+        raise ValueError(f"floor name {name[:40]!r} is not F<n>, <n>F, L<n>, G, B<n> or <n>B")
+    # truth_t.floor is an int16: a longer number is refused before int() reads all its digits
+    lo, hi = INT16_RANGE
+    index = (int(digits) - 1 if above else -int(digits)) if len(digits) <= 6 else hi + 1
+    if not lo <= index <= hi:
+        raise ValueError(f"floor name {name[:40]!r}: floor index outside {lo}..{hi}")
+    return index
 
 
 def _columns(rows: list[tuple[float, ...]], width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -115,7 +125,8 @@ def read_trace(
     TraceReadError
         The file is missing, not a file, or unreadable.
     TraceHeaderError
-        No usable FloorName header and ``floor`` not given.
+        No usable FloorName header and ``floor`` not given (a file without one sensor record raises
+        :class:`~.protocol.NothingValidError` instead: that is the first thing wrong with it).
     """
     reader = LineReader(path, TraceReadError, max_line_warnings)
     name = reader.path
@@ -136,7 +147,7 @@ def read_trace(
         if line.count("\tTYPE_") > 1:
             bad(line_no, f"{line.count(chr(9) + 'TYPE_')} records run together")
             continue
-        if len(parts) < 2 or not parts[0].isdigit():
+        if len(parts) < 2 or not (parts[0].isascii() and parts[0].isdigit()):
             bad(line_no, "no unix-ms time in the first field")
             continue
         kind = parts[1]
@@ -149,14 +160,14 @@ def read_trace(
         if len(parts) != _FIELDS[kind]:
             bad(line_no, f"{kind} with {len(parts)} fields, expected {_FIELDS[kind]}")
             continue
-        t_ms = int(parts[0])
         try:
+            t_ms = unix_ms(parts[0])
             if kind == "TYPE_WIFI":
                 bssid, rssi, freq, seen = (
                     bssid_to_int(parts[3]),
                     finite(parts[4:5])[0],
-                    int(parts[5]),
-                    int(parts[6]),
+                    bounded_int(parts[5], INT32_RANGE, "frequency [MHz]"),
+                    unix_ms(parts[6].strip()),
                 )
                 wifi.setdefault(t_ms, []).append((bssid, rssi, freq, float(t_ms - seen)))
             elif kind == "TYPE_BEACON":
@@ -176,11 +187,12 @@ def read_trace(
     reader.finish()
 
     floor_name = header.get("FloorName", "")
+    floor_error = None
     if floor is None:
         try:
             floor = floor_index(floor_name)
         except ValueError as exc:
-            raise TraceHeaderError(name, f"no floor index: {exc} (pass the floor explicitly)") from None
+            floor_error, floor = f"no floor index: {exc} (pass the floor explicitly)", 0
     notes: list[str] = []
     stats: dict[str, object] = {
         "lines": reader.n_lines,
@@ -201,7 +213,7 @@ def read_trace(
     waypoints.sort(key=lambda w: w[0])
     wp_t = np.array([w[0] for w in waypoints], dtype=np.int64)
     wp_xy = np.array([w[1:] for w in waypoints], dtype=np.float64).reshape(-1, 2)
-    return RawWalk(
+    raw = RawWalk(
         path=name,
         imu=Table({"t_us": acc_t * 1000, "accel_mps2": acc, "gyro_radps": gyro}),
         mag=Table({"t_us": mag_t * 1000, "field_ut": mag}),
@@ -220,3 +232,7 @@ def read_trace(
         skipped=reader.skipped,
         notes=notes,
     )
+    if floor_error is not None:
+        check_has_records(raw)  # a file without one sensor record is that first (empty, PNG, UTF-16)
+        raise TraceHeaderError(name, floor_error)
+    return raw

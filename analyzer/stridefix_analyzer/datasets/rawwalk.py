@@ -155,6 +155,45 @@ class RawWalk:
 # --- conversions the importers share ---------------------------------------------------------------
 
 
+#: Times beyond ±this [s] are refused by the importers (10¹² s, some 31,700 years): the sum or
+#: difference of any two accepted times, and so every clock offset, still fits LCM's int64 µs
+#: (±9.2·10¹² s); a larger one would overflow where it is converted, not be skipped as bad data.
+MAX_ABS_TIME_S = 1e12
+#: what an int16 (``truth_t.floor``) and an int32 (``wifi_scan_t.freq_mhz``) hold
+INT16_RANGE = (-(2**15), 2**15 - 1)
+INT32_RANGE = (-(2**31), 2**31 - 1)
+
+
+def times_s(values: list[float]) -> list[float]:
+    """``values`` (times [s]) unchanged. Raises ValueError on one beyond :data:`MAX_ABS_TIME_S`."""
+    for t in values:
+        if not -MAX_ABS_TIME_S <= t <= MAX_ABS_TIME_S:
+            raise ValueError(f"time {t:.6g} s beyond ±{MAX_ABS_TIME_S:g} s")
+    return values
+
+
+def unix_ms(text: str) -> int:
+    """A time field of unsigned ASCII digits [ms]. Raises ValueError on another form or a time beyond
+    :data:`MAX_ABS_TIME_S` (``int()`` alone takes ``²``, ``+1``, ``1_000`` and any length)."""
+    if not (text.isascii() and text.isdigit()):
+        raise ValueError(f"time {text[:40]!r} is not unsigned digits")
+    if len(text) > 16 or int(text) > MAX_ABS_TIME_S * 1000:
+        raise ValueError(f"time {text[:20]}{'...' if len(text) > 20 else ''} ms beyond {MAX_ABS_TIME_S:g} s")
+    return int(text)
+
+
+def bounded_int(text: str, bounds: tuple[int, int], what: str) -> int:
+    """An integer field within ``bounds`` (inclusive), e.g. :data:`INT32_RANGE` for what an int32
+    column holds. Raises ValueError naming ``what`` otherwise."""
+    text = text.strip()
+    if len(text) > 20:  # also keeps int() off a 5000-digit field
+        raise ValueError(f"{what} {text[:20]}... outside {bounds[0]}..{bounds[1]}")
+    value = int(text)
+    if not bounds[0] <= value <= bounds[1]:
+        raise ValueError(f"{what} {value} outside {bounds[0]}..{bounds[1]}")
+    return value
+
+
 def finite(values: list[str]) -> list[float]:
     """The fields as floats. Raises ValueError on a field that is not a finite number."""
     out = list(map(float, values))

@@ -8,7 +8,7 @@ Decoding the payloads is :mod:`.logread`'s job.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any, BinaryIO
 
 import lcm
@@ -102,6 +102,18 @@ def file_counts(
         "skipped_bytes": skipped,
         "salvaged_events": salvaged,
     }
+
+
+def require_records(inputs: Iterable[Mapping[str, Any]]) -> None:
+    """Raise :class:`NotALogError` for the first file of a read (``LogData.inputs``, :func:`file_counts`)
+    without one whole record: empty, or cut short inside its first record. A command's input so is
+    read, but nothing valid; the readers themselves take it as an empty log (a replay that wrote
+    nothing, e.g. with ``--channels`` none of its messages went to)."""
+    for info in inputs:
+        if info["events"] == 0:
+            raise NotALogError(
+                info["path"], f"nothing valid in the input: no whole LCM record ({info['bytes']} bytes)"
+            )
 
 
 def read_file(path: str, on_event: Callable[[str, bytes], None]) -> tuple[dict[str, Any], list[str]]:

@@ -20,6 +20,8 @@ from collections.abc import Mapping
 from typing import Any, NotRequired, TypedDict, cast
 
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.io.results_errors import NotAResultsFileError
+from stridefix_analyzer.io.results_errors import ResultsFileError as ResultsFileError
 from stridefix_analyzer.io.results_walk import WALK_REQUIRED, WalkMetrics
 
 #: the ``kind`` of realbench fusion's results.json, of realbench crowd-map's, of analyze's metrics.json
@@ -34,10 +36,6 @@ _WHAT = {
     CROWD_MAP_RESULTS_KIND: "a realbench crowd-map results.json",
     ANALYZE_METRICS_KIND: "an analyze metrics.json",
 }
-
-
-class ResultsFileError(ValueError):
-    """A result file is missing, not JSON, of another kind or lacks a key; the message names it."""
 
 
 # --- shared pieces --------------------------------------------------------------------------------
@@ -396,8 +394,8 @@ def _load(path: str | os.PathLike[str]) -> dict[str, Any]:
             doc = json.load(f)
     except OSError as exc:
         raise ResultsFileError(f"{os.fspath(path)}: cannot read: {exc.strerror or exc}") from exc
-    except ValueError as exc:
-        raise ResultsFileError(f"{os.fspath(path)}: not JSON: {exc}") from exc
+    except ValueError as exc:  # UnicodeDecodeError, JSONDecodeError, a 5000-digit number
+        raise NotAResultsFileError(f"{os.fspath(path)}: nothing valid in the input: not JSON: {exc}") from exc
     if not isinstance(doc, dict):
         raise ResultsFileError(
             f"{os.fspath(path)}: not a result file (a JSON {type(doc).__name__}, not an object)"

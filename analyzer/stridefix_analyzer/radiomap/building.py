@@ -247,6 +247,8 @@ def read_building(path: str | os.PathLike[str]) -> Building:
         raise BuildingError(f"{path}: cannot read: {exc.strerror or exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise BuildingError(f"{path}: not TOML: {exc}") from None
+    except UnicodeDecodeError as exc:  # tomllib decodes the bytes itself: a PNG, UTF-16, junk
+        raise BuildingError(f"{path}: not TOML: not UTF-8 text (byte {exc.start}: {exc.reason})") from None
     if doc.get("format") != FORMAT:
         raise BuildingError(f"{path}: format: {doc.get('format')!r}, expected {FORMAT!r}")
     _unknown(

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from stridefix_analyzer.io.lcmfile import require_records
 from stridefix_analyzer.io.logread import LogData, LogTruncatedWarning, Table, read_logs
 from stridefix_analyzer.parallel import TaskRunner
 
@@ -80,7 +81,9 @@ def read_ble(paths: list[str]) -> Table:
 def _read_one(path: str) -> LogData:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)
-        return read_logs([path], decode=("WIFI", "TRUTH"))
+        data = read_logs([path], decode=("WIFI", "TRUTH"))
+    require_records(data.inputs)  # an empty log, or one cut in its first record: nothing valid
+    return data
 
 
 def _merge(files: list[str], datas: list[LogData]) -> Recording:

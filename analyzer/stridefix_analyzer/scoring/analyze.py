@@ -43,6 +43,7 @@ from stridefix_common.exits import input_error_status
 
 from stridefix_analyzer import console
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_analyzer.io.lcmfile import require_records
 from stridefix_analyzer.io.logread import (
     KNOWN_CHANNELS,
     LogData,
@@ -295,6 +296,7 @@ def analyze_logs(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", LogTruncatedWarning)  # kept in data.warnings instead
         data = read_logs(logs, decode=None if all_channels else _DECODE)
+    require_records(data.inputs)  # an empty log, or one cut in its first record: nothing valid
     code = scheme_code(scheme) if scheme is not None else None
     site_obj = floor_height.read_site_for_scoring(site) if site is not None else None
     truth = data.table("TRUTH")
@@ -338,7 +340,7 @@ def run(args: argparse.Namespace) -> int:
         console.say(f"stridefix analyze: warning: {note}")
     schemes = summary.get("per_scheme") or summary.get("walk", {}).get("per_scheme", {})
     if not any(is_fused(name) for name in schemes):
-        print(NO_SITE_NOTE, file=sys.stderr)
+        console.say(NO_SITE_NOTE)  # -q: errors only
     if metrics is None:
         show(walk_report.format_walk(summary))
     else:

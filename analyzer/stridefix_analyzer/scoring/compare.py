@@ -26,7 +26,7 @@ from collections.abc import Mapping
 from typing import Any, cast
 
 import numpy as np
-from stridefix_common.exits import EXIT_NOTHING_VALID, EXIT_USAGE
+from stridefix_common.exits import EXIT_NOTHING_VALID, EXIT_USAGE, input_error_status
 
 from stridefix_analyzer.io.results import ResultsFileError, read_any_results
 
@@ -42,7 +42,12 @@ SINGLE_WALK_GROUP = "walk"
 
 
 class CompareInputError(ValueError):
-    """A run file is missing, unreadable or of an unknown kind (the message names it)."""
+    """A run file is missing, unreadable or of an unknown kind (the message names it); ``status``:
+    the command's exit status for it (3 for a file that is not JSON, else 2)."""
+
+    def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
+        super().__init__(message)
+        self.status = status
 
 
 class NothingPairedError(ValueError):
@@ -91,7 +96,7 @@ def load_run(path: str) -> Run:
     try:
         run = read_any_results(path)
     except ResultsFileError as exc:
-        raise CompareInputError(str(exc)) from exc
+        raise CompareInputError(str(exc), input_error_status(exc)) from exc
     walks: dict[tuple[str, str], dict[str, dict[str, float]]] = {}
     if run.realbench is not None:
         for g in run.realbench["groups"]:
@@ -294,7 +299,7 @@ def run(args: argparse.Namespace) -> int:
         doc = compare(a, b, args.metric)
     except CompareInputError as exc:
         print(f"stridefix compare: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return exc.status
     except NothingPairedError as exc:
         print(f"stridefix compare: error: {exc}", file=sys.stderr)
         return EXIT_NOTHING_VALID

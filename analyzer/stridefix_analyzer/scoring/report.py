@@ -18,6 +18,7 @@ import os
 import sys
 
 import numpy as np
+from stridefix_common.exits import NothingValid, input_error_status
 
 from stridefix_analyzer.io.results import AnalyzeMetrics, ResultsFileError, read_analyze_metrics
 from stridefix_analyzer.scoring import plots, walk_plots
@@ -32,6 +33,10 @@ from stridefix_analyzer.scoring.walk_report import walk_sections
 
 class ReportInputError(Exception):
     """An analysis directory lacks a file or holds an unreadable one; the message names it."""
+
+
+class ReportNothingValidError(ReportInputError, NothingValid):
+    """A file of the analysis directory was read but is not what analyze writes (not JSON, not .npz)."""
 
 
 _STAT_COLS = ("n", "mean", "median", "p75", "p90", "p95", "max", "rmse")
@@ -55,12 +60,14 @@ def load_analysis(directory: str) -> tuple[AnalyzeMetrics, dict]:
     try:
         summary = read_analyze_metrics(json_path)
     except ResultsFileError as exc:
-        raise ReportInputError(str(exc)) from exc
+        raise (ReportNothingValidError if isinstance(exc, NothingValid) else ReportInputError)(
+            str(exc)
+        ) from exc
     try:
         with np.load(npz_path) as z:
             series = {k: z[k] for k in z.files}
-    except (OSError, ValueError) as exc:
-        raise ReportInputError(f"{npz_path}: cannot read as .npz ({exc})") from exc
+    except (OSError, ValueError, EOFError) as exc:
+        raise ReportNothingValidError(f"{npz_path}: nothing valid in the input: not .npz ({exc})") from exc
     truth = summary.get("truth", True)
     need = [
         k
@@ -345,6 +352,6 @@ def run(args: argparse.Namespace) -> int:
         path = run_report(args.directory, args.out)
     except ReportInputError as exc:
         print(f"stridefix report: error: {exc}", file=sys.stderr)
-        return 2
+        return input_error_status(exc)
     print(f"wrote {path}")
     return 0

@@ -5,7 +5,8 @@ calls the benchmark modules).
 scheme, leave one walk out (:mod:`.fusion`); ``--format`` is any registered data set.
 ``pdr-distance``: step detection + Weinberg length against the distance walked (:mod:`.pdr_distance`).
 ``crowd-map``: fusion's folds replayed on the truth-built and on a crowd-built site (:mod:`.crowdmap`).
-Exit status: 0 done, 1 nothing could be scored, 2 bad usage or unreadable input.
+Exit status: 0 done, 1 nothing could be scored or a walk failed, 2 bad usage or unreadable input, 3 not
+one walk imported (every file empty, binary or not of the format).
 """
 
 from __future__ import annotations

@@ -64,7 +64,7 @@ from stridefix_lab.realbench.prepare import PrepareJob, prepare
 from stridefix_lab.realbench.select_sites import SelectionSites
 from stridefix_lab.realbench.sitecontent import ContentOptions, group_content
 from stridefix_lab.realbench.summary import ROBUST_MEAN_M, build_doc, strip_samples
-from stridefix_lab.realbench.walks import dataset, find_groups, firmware
+from stridefix_lab.realbench.walks import check_some_imported, dataset, find_groups, firmware
 
 DEFAULT_CELL_SIZE_M = 2.0
 
@@ -227,6 +227,7 @@ def prepare_walks(run: Run, groups: list[WalkGroup]) -> tuple[list[dict[str, Any
         prog.step(f"{w['walk']}: {steps}")
 
     walks: list[dict[str, Any]] = run.tasks.map(prepare, jobs, on_result=done)
+    check_some_imported(walks)
     parts = []
     for g in groups:
         ids = [i for i, (o, _) in enumerate(owner) if o is g]

@@ -328,7 +328,9 @@ def format_tables(doc: Mapping[str, Any], axes: Sequence[Axis]) -> str:
             true_pdr = pdr_true_start(g)
             if key == "summary" and true_pdr is not None:
                 rows.append((PDR_TRUE_START_LABEL, true_pdr))
-            w = max(10, *(len(name) + 1 for name, _ in rows), *(len(n) + 1 for n in s.get("references", {})))
+            w = max(
+                [10, *(len(name) + 1 for name, _ in rows), *(len(n) + 1 for n in s.get("references", {}))]
+            )
             lines.append(f"  [{title}]  errors in m at the ground-truth times")
             lines.append(
                 f"  {'scheme':<{w}}{'n':>6}{'mean':>8}{'median':>8}{'p75':>8}{'p90':>8}"

@@ -19,10 +19,29 @@ from stridefix_analyzer.datasets.lines import MalformedLineWarning
 from stridefix_analyzer.datasets.protocol import Dataset, DatasetError, WalkGroup
 from stridefix_analyzer.firmware import Firmware, FirmwareError
 from stridefix_analyzer.io.jsonio import json_ready
+from stridefix_common.exits import NothingValid
 
 
 class RealbenchError(RuntimeError):
     """The benchmark cannot run (no walks, no firmware binary, a bad --set). The message says what."""
+
+
+class NoWalkImportedError(RealbenchError, NothingValid):
+    """Walks were found but not one could be imported (every file empty, binary, not of the format):
+    nothing valid in the input, so nothing to fold or score."""
+
+
+def check_some_imported(walks: Sequence[Mapping[str, Any]]) -> None:
+    """Raise :class:`NoWalkImportedError` naming the first walk's file and error when ``walks`` (records
+    of :func:`new_walk`) are not empty and none was imported."""
+    if not walks or any(w["import"] is not None for w in walks):
+        return
+    first = walks[0]
+    why = str(first["error"]).removeprefix("import failed: ")
+    more = f"; {len(walks) - 1} more walk(s) failed alike" if len(walks) > 1 else ""
+    raise NoWalkImportedError(
+        f"nothing valid in the input: not one walk imported ({first['trace']}: {why}{more})"
+    )
 
 
 def new_walk(trace: Path) -> dict[str, Any]:

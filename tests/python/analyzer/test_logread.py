@@ -1,9 +1,12 @@
 """logread: decoding, merging, counting bad data, truncated and missing files."""
 
+import warnings
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from stridefix import wifi_scan_t
+from stridefix_analyzer.io.lcmfile import NotALogError, require_records
 from stridefix_analyzer.io.logread import LogReadError, LogTruncatedWarning, read_logs, read_table
 
 
@@ -110,6 +113,23 @@ def test_log_cut_inside_first_record_is_empty_not_an_error(msg, write_log, tmp_p
     with pytest.warns(LogTruncatedWarning):
         d = read_logs([cut])
     assert d.tables == {} and d.inputs[0]["events"] == 0
+
+
+@pytest.mark.parametrize("keep", [0, 10, 40])
+def test_a_command_input_without_one_whole_record_is_nothing_valid(msg, write_log, tmp_path, keep):
+    """Regression: `analyze` or `radiomap build` of an empty log, or one cut inside its first record,
+    exited 2 (a channel missing); such an input holds nothing valid: require_records raises
+    NotALogError (exit 3) naming the file. The reader still takes it as empty (a replay that wrote
+    nothing)."""
+    path = write_log("one.lcmlog", [("POSE", msg.pose(0, 0, 0)), ("POSE", msg.pose(1, 0, 0))])
+    cut = tmp_path / "stub.lcmlog"
+    cut.write_bytes(path.read_bytes()[:keep])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LogTruncatedWarning)
+        data = read_logs([path, cut])
+    with pytest.raises(NotALogError, match=f"stub.lcmlog: nothing valid in the input.*\\({keep} bytes"):
+        require_records(data.inputs)
+    require_records(data.inputs[:1])  # the whole log passes
 
 
 def test_missing_file_names_it(tmp_path):

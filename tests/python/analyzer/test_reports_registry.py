@@ -135,6 +135,14 @@ def test_realbench_labels_truth_initialised_pdr_per_data_set():
     assert rb_summary.PDR_TRUE_START_LABEL + " " not in console.split("TRUE START")[0]
 
 
+def test_realbench_console_of_a_group_without_one_scored_walk():
+    """Regression: a group whose walks all failed has no scheme row, and the table's width was
+    max(10, *nothing) = TypeError; the header and the failed count are printed instead."""
+    doc = _doc([{"walk": "walk_a", "group": "F2", "error": "import failed", "fixes": {}}])
+    console = rb_summary.format_tables(doc, tuning.axes([]))
+    assert "[every scheme from its first fix]" in console and "scheme" in console
+
+
 def test_bench_tables_show_every_registered_scheme_with_ipin(one_more_scheme):
     # pdr_only last, then in id order; the IPIN score of (k + 1) m errors with one of four a floor off
     walk = {n: (np.full(4, k + 1.0), np.array([0, 0, 0, 1])) for k, n in enumerate(one_more_scheme)}

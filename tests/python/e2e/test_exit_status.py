@@ -135,3 +135,14 @@ def test_over_long_config_line_names_its_own_line(stridefixd, tmp_path):
     proc = _run(stridefixd, "--config", str(ini), "--print-config")
     assert proc.returncode == exits.EXIT_USAGE
     assert f"{ini}:3: line longer than" in proc.stderr
+
+
+@pytest.mark.parametrize("option", ["--log", "--log-dir"])
+def test_no_log_with_a_log_is_bad_usage(stridefixd, default_walk, tmp_path, option):
+    """Regression: `--no-log --log x` silently wrote no log; the two contradict each other, so it is
+    bad usage (2) naming both, and nothing runs."""
+    walk = str(default_walk["dir"] / "board.candump")
+    proc = _run(stridefixd, "--input", walk, "--no-log", option, str(tmp_path / "x"))
+    assert proc.returncode == exits.EXIT_USAGE, proc.stderr
+    assert proc.stderr.strip() == f"stridefixd: --no-log contradicts {option} (see --help)"
+    assert list(tmp_path.iterdir()) == []

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 from stridefix import imu_t, truth_t, wifi_scan_t
 from stridefix_analyzer.datasets import msindoor, msindoor_parse
 from stridefix_analyzer.datasets.lines import MalformedLineWarning
+from stridefix_analyzer.datasets.protocol import NothingValidError
 from stridefix_analyzer.datasets.rawwalk import bssid_to_int
 from stridefix_analyzer.io.logread import read_logs
 
@@ -132,11 +133,28 @@ def test_missing_file_raises_naming_it(tmp_path):
 
 def test_unknown_floor_name_raises_unless_given(tmp_path):
     path = tmp_path / "roof.txt"
-    path.write_text("#\tFloorName:Roof\n1000\tTYPE_WAYPOINT\t1\t2\n", encoding="utf-8")
+    path.write_text(
+        "#\tFloorName:Roof\n1000\tTYPE_WAYPOINT\t1\t2\n1000\tTYPE_ACCELEROMETER\t0\t0\t9.8\t3\n",
+        encoding="utf-8",
+    )
     with pytest.raises(msindoor_parse.TraceHeaderError, match="roof.txt"):
         msindoor.DATASET.read(path)
     walk = msindoor.DATASET.read(path, floor=7)
     assert walk.meta["floor"] == 7 and walk.truth["floor"].tolist() == [7]
+
+
+@pytest.mark.parametrize("floor_name", ["Roof", "F32769", "F" + "9" * 400, ""])
+def test_without_a_sensor_record_nothing_valid_comes_before_the_floor(tmp_path, floor_name):
+    """Regression: an empty, PNG or UTF-16 trace has no FloorName either, and import said "no floor
+    index" (exit 2); not one sensor record is what is wrong with it (NothingValidError, exit 3). A
+    floor beyond an int16 (truth_t.floor) is refused as a header error, never an OverflowError."""
+    path = tmp_path / "waypoints.txt"
+    path.write_text(f"#\tFloorName:{floor_name}\n1000\tTYPE_WAYPOINT\t1\t2\n", encoding="utf-8")
+    with pytest.raises(NothingValidError, match="waypoints.txt: nothing valid in the input"):
+        msindoor.DATASET.read(path)
+    path.write_text(path.read_text() + "1000\tTYPE_ACCELEROMETER\t0\t0\t9.8\t3\n", encoding="utf-8")
+    with pytest.raises(msindoor_parse.TraceHeaderError, match="no floor index"):
+        msindoor.DATASET.read(path)
 
 
 def test_many_malformed_lines_are_summed_up(tmp_path):
