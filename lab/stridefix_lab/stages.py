@@ -25,14 +25,19 @@ class StageError(RuntimeError):
     """A stage of the chain failed; the message names the stage and its output."""
 
 
+def _console_script(name: str) -> str:
+    """The console script ``name`` of this interpreter's environment."""
+    return str(Path(sys.executable).with_name(name))
+
+
 def stridefix_exe() -> str:
-    """The ``stridefix`` console script of this interpreter's environment."""
-    return str(Path(sys.executable).with_name("stridefix"))
+    """The product's ``stridefix`` console script."""
+    return _console_script("stridefix")
 
 
 def lab_exe() -> str:
-    """The lab's ``stridefix-lab`` console script of this interpreter's environment."""
-    return str(Path(sys.executable).with_name("stridefix-lab"))
+    """The lab's ``stridefix-lab`` console script."""
+    return _console_script("stridefix-lab")
 
 
 def run_stage(

@@ -48,6 +48,14 @@ def _add_common(p: argparse.ArgumentParser, seeds: str) -> None:
     )
 
 
+def _declare(p: argparse.ArgumentParser, bench: Bench) -> argparse.ArgumentParser:
+    """``p`` with the common options (``bench``'s seeds as their default) and the bench's own."""
+    _add_common(p, bench.seeds)
+    if bench.add_arguments is not None:
+        bench.add_arguments(p)
+    return p
+
+
 def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     found = benches()
     p: argparse.ArgumentParser = subparsers.add_parser(
@@ -59,10 +67,7 @@ def add_parser(subparsers: Any) -> argparse.ArgumentParser:
     p.add_argument("--list", action="store_true", help="name every bench with its help, and exit")
     sub = p.add_subparsers(dest="which", metavar="BENCH")
     for bench in found.values():
-        b = sub.add_parser(bench.name, help=bench.help, description=bench.help)
-        _add_common(b, bench.seeds)
-        if bench.add_arguments is not None:
-            bench.add_arguments(b)
+        _declare(sub.add_parser(bench.name, help=bench.help, description=bench.help), bench)
     every = sub.add_parser(ALL, help="every bench make bench runs, with its default options")
     _add_common(every, "each bench's")
     return p
@@ -103,10 +108,7 @@ def _run_all(found: dict[str, Bench], args: argparse.Namespace) -> int:
     """Every ``make bench`` bench with its own defaults and the given common options."""
     status = 0
     for bench in (b for b in found.values() if b.in_make_bench):
-        parser = argparse.ArgumentParser(prog=f"stridefix-lab bench {bench.name}")
-        _add_common(parser, bench.seeds)
-        if bench.add_arguments is not None:
-            bench.add_arguments(parser)
+        parser = _declare(argparse.ArgumentParser(prog=f"stridefix-lab bench {bench.name}"), bench)
         own = parser.parse_args(["--stridefixd", str(args.stridefixd), "--out", args.out])
         own.seeds, own.sets = args.seeds, args.sets
         print(f"== bench {bench.name}", flush=True)

@@ -58,7 +58,7 @@ from stridefix_analyzer.firmware import REPO, Firmware
 
 from stridefix_lab.bench import callgrind, particle_cost, perf_knn_real, perf_peers
 from stridefix_lab.bench.registry import Bench
-from stridefix_lab.bench.scale import DEFAULT_FLOOR
+from stridefix_lab.bench.scale import add_floor_argument
 from stridefix_lab.bench.soak import vm_hwm_kb
 from stridefix_lab.stages import StageError, simulate, stridefix_exe
 
@@ -467,12 +467,7 @@ def missed_targets(doc: dict[str, Any]) -> list[str]:
 
 
 def _add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--floor",
-        default=str(DEFAULT_FLOOR),
-        metavar="DIR",
-        help=f"the msindoor floor folder of the scikit-learn peer on a real map (default {DEFAULT_FLOOR})",
-    )
+    add_floor_argument(p, " of the scikit-learn peer on a real map")
 
 
 def _run(args: argparse.Namespace, firmware: Firmware, seeds: list[int], out: Path) -> list[str]:

@@ -144,12 +144,13 @@ def missed_targets(doc: dict[str, Any]) -> list[str]:
     return [] if doc["identical"] else ["scale: a Dask or process run differs from the serial run"]
 
 
-def _add_arguments(p: argparse.ArgumentParser) -> None:
+def add_floor_argument(p: argparse.ArgumentParser, of: str = "") -> None:
+    """``--floor DIR``: the msindoor floor a bench reads (``of`` says what for, in the help)."""
     p.add_argument(
         "--floor",
         default=str(DEFAULT_FLOOR),
         metavar="DIR",
-        help=f"the msindoor floor folder (default {DEFAULT_FLOOR})",
+        help=f"the msindoor floor folder{of} (default {DEFAULT_FLOOR})",
     )
 
 
@@ -166,5 +167,5 @@ BENCH = Bench(
     "realbench and radiomap build on one msindoor floor serially, on 2 processes and on Dask 1 and 2 "
     "workers: wall times and identical results (~25 min, not in make bench)",
     _run,
-    add_arguments=_add_arguments,
+    add_arguments=add_floor_argument,
 )
